@@ -1,0 +1,55 @@
+#pragma once
+/// @file mesh_io.hpp
+/// Reading and writing meshes: OFF, OBJ, PLY (ascii, binary little and big endian) and STL (ascii
+/// and binary). Readers never trust a header count further than the file size allows and report
+/// every failure as a ParseError naming the file and the line (text) or byte offset (binary).
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string_view>
+
+#include "primseg/mesh.hpp"
+
+namespace primseg {
+
+enum class MeshFormat { Off, Obj, Ply, Stl };
+
+/// Format from the file extension (case-insensitive: .off .obj .ply .stl). Throws
+/// InvalidInputError naming the path for any other extension.
+MeshFormat mesh_format_from_path(const std::filesystem::path& path);
+
+/// Reads a mesh file, choosing the reader by extension. Polygons are triangulated (Mesh invariants
+/// hold); STL triangle soups are welded by exact coordinate match.
+/// Throws IoError (cannot open/read), ParseError (malformed, truncated, counts that do not match,
+/// indices out of range, unparsable tokens, empty file), InvalidInputError (NaN/inf coordinates,
+/// no faces).
+Mesh read_mesh(const std::filesystem::path& path);
+
+/// Reads a mesh from an in-memory file image. `name` is only used in error messages.
+Mesh read_mesh(std::span<const char> bytes, MeshFormat format, std::string_view name = "<memory>");
+
+/// What write_mesh writes besides the geometry.
+struct MeshWriteOptions {
+  /// Optional group (cluster) of each input face, shape (F). Empty: no groups.
+  /// PLY: faces get the group's colour as uchar red/green/blue properties; OBJ: one `g cluster_<id>`
+  /// statement per group, faces grouped by id; OFF: per-face RGB colours; STL: ignored.
+  std::span<const std::uint32_t> face_groups;
+  /// Colour of each group, shape (number of groups). Empty with groups: a built-in palette of
+  /// well-separated colours.
+  std::span<const std::array<std::uint8_t, 3>> group_colors;
+  /// PLY and STL: binary little-endian (true) or ascii (false).
+  bool binary = true;
+};
+
+/// Writes the mesh's input polygons (STL: its triangles) in the format given by the extension.
+/// The file is written to a temporary name beside the target and renamed into place, so an
+/// interrupted run never leaves a partial file. Throws IoError, InvalidInputError.
+void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
+                const MeshWriteOptions& options = {});
+
+/// A palette of `count` distinct, well-separated RGB colours (deterministic).
+std::vector<std::array<std::uint8_t, 3>> distinct_colors(std::size_t count);
+
+}  // namespace primseg

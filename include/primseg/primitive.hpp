@@ -1,0 +1,49 @@
+#pragma once
+/// @file primitive.hpp
+/// Primitive types and their parameters, as reported to users (in input units).
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "primseg/mesh.hpp"
+
+namespace primseg {
+
+/// The kinds of primitive a cluster can be fitted with. The numeric values are stored in tree
+/// files: never renumber them. Their order is also the tie order of model selection: on equal
+/// penalised error the lower value wins.
+enum class PrimitiveType : std::uint8_t { Plane = 0, Cylinder = 1, Sphere = 2, Cone = 3, Torus = 4 };
+
+inline constexpr int kPrimitiveTypeCount = 5;
+
+/// Lower-case name ("plane", "cylinder", "sphere", "cone", "torus").
+std::string_view to_string(PrimitiveType type);
+/// Inverse of to_string; std::nullopt for an unknown name.
+std::optional<PrimitiveType> primitive_type_from_string(std::string_view name);
+
+/// A fitted primitive. Which fields are meaningful depends on `type`; the others are zero.
+/// - Plane: `point` = weighted centroid of the cluster, `axis` = unit normal, oriented along the
+///   cluster's summed area-weighted face normals.
+/// - Sphere: `point` = centre, `radius`.
+/// - Cylinder: `point` = the cluster's centroid projected on the axis, `axis` = unit direction
+///   with its largest-magnitude component positive, `radius`.
+/// - Cone: `point` = apex, `axis` = unit direction from the apex into the cone, `half_angle`
+///   in radians.
+/// - Torus: `point` = centre, `axis` = unit normal of the equatorial plane (largest-magnitude
+///   component positive), `radius` = major radius, `minor_radius`.
+struct Primitive {
+  PrimitiveType type = PrimitiveType::Plane;
+  Vec3 point{0, 0, 0};
+  Vec3 axis{0, 0, 0};
+  double radius = 0;
+  double minor_radius = 0;
+  double half_angle = 0;
+
+  /// Unsigned Euclidean distance from x to the primitive's surface (input units).
+  double distance(const Vec3& x) const;
+  /// The point of the primitive's surface closest to x.
+  Vec3 closest_point(const Vec3& x) const;
+};
+
+}  // namespace primseg
