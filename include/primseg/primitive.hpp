@@ -13,7 +13,13 @@ namespace primseg {
 /// The kinds of primitive a cluster can be fitted with. The numeric values are stored in tree
 /// files: never renumber them. Their order is also the tie order of model selection: on equal
 /// penalised error the lower value wins.
-enum class PrimitiveType : std::uint8_t { Plane = 0, Cylinder = 1, Sphere = 2, Cone = 3, Torus = 4 };
+enum class PrimitiveType : std::uint8_t {
+  Plane = 0,
+  Cylinder = 1,
+  Sphere = 2,
+  Cone = 3,
+  Torus = 4
+};
 
 inline constexpr int kPrimitiveTypeCount = 5;
 

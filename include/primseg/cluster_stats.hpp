@@ -1,0 +1,81 @@
+#pragma once
+/// @file cluster_stats.hpp
+/// Additive summary statistics of a cluster of triangles, from which every primitive fit and its
+/// error are computed in time independent of the cluster's size. Merging two clusters adds their
+/// statistics.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+
+namespace primseg {
+
+/// Weighted moments Σ w (x − o)^α of a point set about an origin o, for every monomial x^α of
+/// degree 0 to 4 in three variables (35 numbers).
+///
+/// Degree-4 moments about a far-away origin lose all precision for a small cluster, so each
+/// cluster keeps its own origin (near its points) and moments are translated exactly (binomial
+/// expansion) before being added.
+class Moments {
+ public:
+  static constexpr int kCount = 35;
+
+  Moments() = default;
+  explicit Moments(const Eigen::Vector3d& origin) : origin_(origin) {}
+
+  /// Index of monomial x^i y^j z^k (i + j + k <= 4) in values().
+  static int index(int i, int j, int k);
+
+  const Eigen::Vector3d& origin() const { return origin_; }
+  const std::array<double, kCount>& values() const { return values_; }
+  double at(int i, int j, int k) const { return values_[index(i, j, k)]; }
+
+  /// Σ w.
+  double weight() const { return values_[0]; }
+  /// Weighted mean of the points (the origin for zero weight).
+  Eigen::Vector3d centroid() const;
+
+  /// Adds the point x with weight w.
+  void add_point(const Eigen::Vector3d& x, double w);
+  /// The same moments about another origin.
+  Moments translated(const Eigen::Vector3d& new_origin) const;
+  /// Adds other's moments (translated to this origin).
+  Moments& operator+=(const Moments& other);
+
+  /// Σ w (x−o)(x−o)ᵀ, the second moment matrix about the origin.
+  Eigen::Matrix3d second_moment() const;
+  /// Σ w (x−o)_a (x−o)_b (x−o)_c contracted with a symmetric 3x3 Q over (b, c): a 3-vector.
+  Eigen::Vector3d third_moment_contracted(const Eigen::Matrix3d& q) const;
+  /// Σ w ((x−o)ᵀ Q (x−o))², the fourth moment contracted twice with a symmetric 3x3 Q.
+  double fourth_moment_contracted(const Eigen::Matrix3d& q) const;
+
+ private:
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+  std::array<double, kCount> values_{};
+};
+
+/// Everything a primitive fit needs to know about a cluster; all sums over its triangles, so the
+/// statistics of a union are the sums of its parts (plus the tensor of the edges between them).
+struct ClusterStats {
+  /// Moments of the weighted triangle corners (working frame).
+  Moments moments;
+  /// Normal-variation tensor Σ |e| β(e) ê êᵀ over the cluster's internal edges, as the upper
+  /// triangle (xx, xy, xz, yy, yz, zz). β is the signed dihedral angle (positive where convex).
+  std::array<double, 6> tensor{};
+  /// Σ over triangles of area × unit normal (consistently oriented), for orienting plane normals.
+  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+  /// Σ triangle area (working frame).
+  double area = 0;
+  /// Number of triangles (the fits' minimum support is counted in triangles).
+  std::uint32_t triangle_count = 0;
+
+  /// Adds other (which must not share triangles with this) and the tensor of the edges between
+  /// the two clusters.
+  void merge(const ClusterStats& other, const std::array<double, 6>& shared_tensor);
+  Eigen::Matrix3d tensor_matrix() const;
+};
+
+/// Adds |e| β ê êᵀ for the edge vector e to an upper-triangle tensor.
+void add_edge_to_tensor(std::array<double, 6>& tensor, const Eigen::Vector3d& edge, double beta);
+
+}  // namespace primseg

@@ -1,0 +1,50 @@
+#pragma once
+/// @file cut.hpp
+/// Levels of a hierarchy: per-face labels and per-cluster primitives, each cut in O(F).
+
+#include <cstdint>
+#include <vector>
+
+#include "primseg/hierarchy.hpp"
+
+namespace primseg {
+
+/// A level of the hierarchy.
+struct Segmentation {
+  /// Cluster of each input face, 0..K-1, shape (F). Clusters are numbered by decreasing area,
+  /// ties by their lowest face index.
+  std::vector<std::uint32_t> labels;
+  /// Tree node of each cluster, shape (K).
+  std::vector<std::uint32_t> nodes;
+  std::uint32_t cluster_count() const { return static_cast<std::uint32_t>(nodes.size()); }
+};
+
+/// The level with `clusters` clusters: the first F − K real merges applied. Trailing merges are
+/// never applied, so K below the number of components C gives C clusters. Throws
+/// InvalidInputError unless 1 <= clusters <= F.
+Segmentation cut_by_count(const Hierarchy& hierarchy, std::uint32_t clusters);
+
+/// Walking top-down from each component's root, a node is kept whole when its RMS estimate
+/// (Hierarchy::rms_estimate, input units) is at most `tolerance`, else its children are visited;
+/// leaves are always kept. Throws InvalidInputError for a negative or non-finite tolerance.
+Segmentation cut_by_tolerance(const Hierarchy& hierarchy, double tolerance);
+
+/// What a user wants to know about one cluster of a cut.
+struct ClusterReport {
+  std::uint32_t id = 0;    ///< its label
+  std::uint32_t node = 0;  ///< its tree node
+  Primitive primitive;     ///< fitted primitive, input units
+  double area = 0;         ///< input units²
+  std::uint32_t face_count = 0;
+  /// Exact weighted RMS Euclidean distance of the cluster's vertices to the primitive
+  /// (the hierarchy's vertex weights), input units.
+  double rms = 0;
+  /// Largest Euclidean distance of a cluster vertex to the primitive, input units.
+  double max = 0;
+};
+
+/// Reports of every cluster of a cut, in label order. O(F) in total.
+std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
+                                             const Segmentation& segmentation);
+
+}  // namespace primseg

@@ -1,0 +1,101 @@
+#pragma once
+/// @file dual_graph.hpp
+/// The mesh as the engine sees it: its input faces as the nodes of a dual graph, its geometry in a
+/// normalised working frame, its triangles consistently oriented, and the statistics of every
+/// face.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "primseg/cluster_stats.hpp"
+#include "primseg/mesh.hpp"
+#include "primseg/primitive.hpp"
+
+namespace primseg {
+
+/// How much each triangle corner counts in a cluster's fitting error E = Σ w d².
+enum class VertexWeights : std::uint8_t {
+  /// w = triangle area / 3, so a vertex weighs a third of its cluster-incident area (the paper).
+  Area = 0,
+  /// w = 1 / (number of triangles incident on the vertex): a vertex inside a cluster weighs 1, a
+  /// boundary vertex the fraction of its triangles in the cluster. (The paper weighs each vertex
+  /// 1 in every cluster containing it; that is not additive over triangles, this is.)
+  Uniform = 1,
+};
+
+/// Input coordinates x map to working coordinates (x − center) · 2^-exponent, with the exponent
+/// chosen so that the mesh fits in [-1, 1]³. A power of two keeps the scaling exact: a mesh
+/// scaled by 2^k has bit-identical working coordinates, and degree-4 moments of inputs near
+/// 1e150 neither overflow nor lose precision.
+struct WorkingFrame {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  int exponent = 0;
+
+  double scale() const;  ///< 2^exponent: one working unit in input units.
+  Eigen::Vector3d to_working(const Vec3& x) const;
+  Vec3 to_input(const Eigen::Vector3d& x) const;
+  /// A primitive's parameters from working to input units.
+  Primitive to_input(const Primitive& working) const;
+};
+
+/// The frame for a mesh: centre and extent of the bounding box of its vertices.
+WorkingFrame working_frame_for(const Mesh& mesh);
+
+/// A dual edge: two input faces sharing at least one mesh edge.
+struct DualEdge {
+  std::uint32_t first, second;  ///< input faces, first < second
+  /// Σ |e| β ê êᵀ over the mesh edges the two faces share (upper triangle, working frame).
+  std::array<double, 6> tensor;
+};
+
+/// Dual graph and working geometry of a mesh.
+///
+/// Non-manifold edges: the k >= 3 triangles on one mesh edge are sorted by index and joined in a
+/// chain (t1–t2, t2–t3, …): k − 1 dual links, never k², and every face on the edge stays
+/// connected to the others. Orientation propagates only across manifold edges.
+class DualGraph {
+ public:
+  DualGraph(const Mesh& mesh, VertexWeights weights);
+
+  const Mesh& mesh() const { return *mesh_; }
+  const WorkingFrame& frame() const { return frame_; }
+  VertexWeights weights() const { return weights_; }
+  std::uint32_t face_count() const { return mesh_->face_count(); }
+  /// Edge-connected components of the dual graph.
+  std::uint32_t component_count() const { return component_count_; }
+  /// Component of each input face, numbered by their lowest face, shape (F).
+  const std::vector<std::uint32_t>& component_of_face() const { return component_of_face_; }
+  /// Dual edges sorted by (first, second), each face pair once.
+  const std::vector<DualEdge>& edges() const { return edges_; }
+
+  /// Triangles of input face f: [first_triangle(f), first_triangle(f + 1)).
+  std::uint32_t first_triangle(std::uint32_t f) const { return first_triangle_[f]; }
+  /// Working-frame position of vertex v.
+  const Eigen::Vector3d& position(std::uint32_t v) const { return positions_[v]; }
+  /// Whether triangle t was flipped to orient its component consistently (outward when closed).
+  bool flipped(std::uint32_t t) const { return flipped_[t] != 0; }
+  /// Area of triangle t (working frame; input area = ldexp(area, 2 · frame().exponent)).
+  double triangle_area(std::uint32_t t) const;
+  /// Weight of each corner of triangle t (working frame).
+  std::array<double, 3> corner_weights(std::uint32_t t) const;
+  /// Statistics of input face f alone (its triangles and the edges between them).
+  ClusterStats face_stats(std::uint32_t f) const;
+
+ private:
+  const Mesh* mesh_;
+  VertexWeights weights_;
+  WorkingFrame frame_;
+  std::vector<Eigen::Vector3d> positions_;
+  std::vector<std::uint32_t> first_triangle_;
+  std::vector<std::uint8_t> flipped_;
+  std::vector<std::uint32_t> valence_;
+  std::vector<std::uint32_t> component_of_face_;
+  std::uint32_t component_count_ = 0;
+  std::vector<DualEdge> edges_;
+  /// Tensors of the edges inside polygon faces, sorted by face (only faces that have some).
+  std::vector<std::pair<std::uint32_t, std::array<double, 6>>> internal_tensors_;
+};
+
+}  // namespace primseg

@@ -1,0 +1,147 @@
+#pragma once
+/// @file hierarchy.hpp
+/// Greedy hierarchical face clustering (Attene, Falcidieno, Spagnuolo 2006, after Garland et al.
+/// 2001): every input face starts as a cluster, the cheapest merge of two adjacent clusters is
+/// applied until one cluster per connected component remains, and a cluster's cost is the
+/// smallest L2 error over the enabled primitive types. The result is a full binary tree that can
+/// be cut at any level without recomputation (cut.hpp).
+///
+/// One-shot use: `Hierarchy h = build_hierarchy(mesh);`. Step-by-step control (progress, early
+/// stop, inspecting the live clusters): HierarchyBuilder.
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "primseg/dual_graph.hpp"
+#include "primseg/mesh.hpp"
+#include "primseg/primitive.hpp"
+
+namespace primseg {
+
+/// Options of the hierarchy. Defaults reproduce the paper's set-up with the robustness rules
+/// documented here.
+struct HierarchyOptions {
+  /// Primitive types a cluster may be fitted with (at least one; each at most once).
+  std::vector<PrimitiveType> primitives{PrimitiveType::Plane, PrimitiveType::Cylinder,
+                                        PrimitiveType::Sphere};
+  /// Corner weights of the fitting error.
+  VertexWeights weights = VertexWeights::Area;
+  /// Model selection: a type's error is multiplied by its penalty before types are compared, so
+  /// a richer primitive wins only when it fits markedly better (noise alone lowers the error of a
+  /// type with more parameters). Indexed by PrimitiveType. Ties go to the lower type value.
+  std::array<double, 5> type_penalty{1.0, 1.5, 1.5, 1.75, 2.0};
+  /// A cost at most this fraction of the merged cluster's spread Σ w |x − c|² counts as zero
+  /// (round-off of an exact fit), so that flat or exactly curved regions tie and the tie rule
+  /// (lowest merged degree) grows them evenly.
+  double zero_cost_tolerance = 1e-12;
+  /// Reference mode: the error of each fit is the exact Σ w d² over the clusters' vertices
+  /// (Euclidean distance to the same fitted primitive), as the paper's prototype computed it.
+  /// Cost O(|A| + |B|) per candidate instead of O(1): for comparison only.
+  bool exact_costs = false;
+};
+
+/// Throws InvalidInputError if options are unusable (no primitive, a type without a fitter, a
+/// duplicate, a negative or non-finite penalty or tolerance).
+void validate(const HierarchyOptions& options);
+
+/// One merge of the tree. Node ids: input faces are leaves 0..F-1, merge i creates node F + i.
+struct Merge {
+  std::uint32_t first = 0, second = 0;  ///< children node ids, first < second
+  /// Merge priority: the penalised error of the chosen type, zero-snapped (working frame:
+  /// weight × length², see DualGraph's WorkingFrame). Trailing merges have a cost above all others.
+  double cost = 0;
+  /// L2 error Σ w d² of the chosen primitive (working frame, not penalised).
+  double error = 0;
+  /// Σ w of the merged cluster (working frame).
+  double weight = 0;
+  std::uint32_t face_count = 0;  ///< input faces in the merged cluster
+  /// True for a merge joining two connected components after all real merges: no fit, never
+  /// applied by cuts.
+  bool trailing = false;
+  /// Fitted primitive of the merged cluster, input units (type Plane and zeros when trailing).
+  Primitive primitive;
+};
+
+/// The full merge tree of a mesh. Immutable; cheap to cut (cut.hpp).
+class Hierarchy {
+ public:
+  /// A tree from its parts (as read from a tree file). Throws InvalidInputError unless `merges`
+  /// form a binary tree over the mesh's F faces (F − 1 merges, children before parents).
+  Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options, std::vector<Merge> merges);
+  /// The same, adopting the dual graph the builder already made (of this mesh and weights).
+  Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options, std::vector<Merge> merges,
+            std::unique_ptr<DualGraph> graph);
+
+  const Mesh& mesh() const { return *mesh_; }
+  std::shared_ptr<const Mesh> shared_mesh() const { return mesh_; }
+  const HierarchyOptions& options() const { return options_; }
+  const DualGraph& graph() const { return *graph_; }
+  std::uint32_t face_count() const { return mesh_->face_count(); }
+  std::uint32_t node_count() const { return 2 * face_count() - 1; }
+  std::uint32_t component_count() const { return graph_->component_count(); }
+  /// F − 1 merges: F − C real ones in the greedy order, then C − 1 trailing ones.
+  std::span<const Merge> merges() const { return merges_; }
+  bool is_leaf(std::uint32_t node) const { return node < face_count(); }
+  /// Parent of each node (UINT32_MAX for the root), shape (2F − 1).
+  const std::vector<std::uint32_t>& parents() const { return parents_; }
+
+  /// Fitted primitive of a node, input units (leaves are fitted on demand).
+  Primitive primitive(std::uint32_t node) const;
+  /// L2 error of a node's primitive (working frame, as Merge::error; 0 for planar leaves).
+  double error(std::uint32_t node) const;
+  /// Σ w of a node (working frame).
+  double weight(std::uint32_t node) const;
+  /// Input faces of a node.
+  std::uint32_t face_count(std::uint32_t node) const;
+  /// sqrt(error / weight) in input units: the node's RMS distance estimate.
+  double rms_estimate(std::uint32_t node) const;
+
+  /// SciPy linkage matrix, shape (F − 1, 4): children ids, cost, face count.
+  std::vector<std::array<double, 4>> linkage() const;
+
+ private:
+  Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options, std::vector<Merge> merges,
+            std::unique_ptr<DualGraph> graph, int);
+
+  std::shared_ptr<const Mesh> mesh_;
+  HierarchyOptions options_;
+  std::unique_ptr<DualGraph> graph_;
+  std::vector<Merge> merges_;
+  std::vector<std::uint32_t> parents_;
+};
+
+/// Step-by-step construction of a Hierarchy.
+class HierarchyBuilder {
+ public:
+  /// Prepares the dual graph and every initial candidate (O(F log F)). Throws InvalidInputError
+  /// for invalid options or a mesh that fails Mesh::validate().
+  explicit HierarchyBuilder(std::shared_ptr<const Mesh> mesh, HierarchyOptions options = {});
+  ~HierarchyBuilder();
+  HierarchyBuilder(const HierarchyBuilder&) = delete;
+  HierarchyBuilder& operator=(const HierarchyBuilder&) = delete;
+
+  /// Applies the next cheapest merge; false when no adjacent clusters remain.
+  bool step();
+  /// Number of merges applied so far (real merges only).
+  std::uint32_t merge_count() const;
+  /// Number of real merges the build will make: F − number of components.
+  std::uint32_t total_merge_count() const;
+  /// Runs the remaining steps, adds the trailing merges and returns the tree. `progress`, if
+  /// given, is called now and then with the fraction done (0..1).
+  Hierarchy finish(const std::function<void(double)>& progress = {});
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Builds the whole hierarchy of a mesh (copies the mesh).
+Hierarchy build_hierarchy(const Mesh& mesh, const HierarchyOptions& options = {});
+/// Builds the whole hierarchy of a shared mesh (no copy).
+Hierarchy build_hierarchy(std::shared_ptr<const Mesh> mesh, const HierarchyOptions& options = {});
+
+}  // namespace primseg

@@ -1,0 +1,16 @@
+#pragma once
+/// @file plane.hpp
+/// The plane fitter (see plane.cpp for the method).
+
+#include "primseg/primitives/primitive_fitter.hpp"
+
+namespace primseg {
+
+class PlaneFitter final : public PrimitiveFitter {
+ public:
+  PrimitiveType type() const override { return PrimitiveType::Plane; }
+  std::uint32_t min_triangles() const override;
+  PrimitiveFit fit(const ClusterStats& centred) const override;
+};
+
+}  // namespace primseg

@@ -1,0 +1,49 @@
+#pragma once
+/// @file primitive_fitter.hpp
+/// The plug-in interface every primitive type implements. The engine knows primitives only
+/// through it: adding a type means adding one fitter and registering it in fitter_for().
+
+#include <cstdint>
+#include <limits>
+
+#include "primseg/cluster_stats.hpp"
+#include "primseg/primitive.hpp"
+
+namespace primseg {
+
+/// One primitive type fitted to a cluster's statistics, in the working frame.
+struct PrimitiveFit {
+  /// False when this type cannot honestly represent the cluster: too little support, a
+  /// degenerate configuration (no axis, flat data for a curved type, a radius beyond the
+  /// plausible range). An invalid fit never wins a merge.
+  bool valid = false;
+  /// L2 error Σ w d², exact for planes and a first-order equivalent for curved types (see each
+  /// fitter), in working-frame units (weight × length²).
+  double error = std::numeric_limits<double>::infinity();
+  /// Fitted parameters in the working frame.
+  Primitive primitive;
+};
+
+/// A primitive type's fitter.
+class PrimitiveFitter {
+ public:
+  virtual ~PrimitiveFitter() = default;
+  virtual PrimitiveType type() const = 0;
+  /// Fewest triangles a cluster needs before this type is fitted at all: below it every cluster
+  /// fits exactly (two triangles always lie on a sphere), which says nothing about the shape.
+  virtual std::uint32_t min_triangles() const = 0;
+  /// Fits the type to statistics whose moments are centred at the cluster's centroid.
+  virtual PrimitiveFit fit(const ClusterStats& centred) const = 0;
+};
+
+/// The fitter of a type. Throws InvalidInputError for a type without one.
+const PrimitiveFitter& fitter_for(PrimitiveType type);
+
+/// Whether a type has a fitter in this build.
+bool has_fitter(PrimitiveType type);
+
+/// Flips a unit direction so that its largest-magnitude component is positive (first such
+/// component on ties): the canonical sign of cylinder, cone and torus axes.
+Eigen::Vector3d canonical_axis(const Eigen::Vector3d& axis);
+
+}  // namespace primseg

@@ -1,0 +1,27 @@
+#pragma once
+/// @file tree_io.hpp
+/// The tree file: a whole hierarchy in one self-contained, versioned, little-endian binary file
+/// (the mesh, the options, every merge with its cost, primitive, weight and face count, and a
+/// checksum), so that any level can be cut and reported later without the mesh file and without
+/// recomputing. docs/tree-format.md gives the layout.
+
+#include <filesystem>
+#include <span>
+#include <string>
+
+#include "primseg/hierarchy.hpp"
+
+namespace primseg {
+
+/// The tree file's bytes.
+std::string serialize_tree(const Hierarchy& hierarchy);
+/// Parses a tree file image. Throws ParseError (with the byte offset) for a foreign, truncated,
+/// corrupt (checksum) or newer-version file, InvalidInputError for an inconsistent tree.
+Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name = "<memory>");
+
+/// Writes the tree file atomically. Throws IoError.
+void write_tree(const std::filesystem::path& path, const Hierarchy& hierarchy);
+/// Reads a tree file. Throws IoError, ParseError, InvalidInputError.
+Hierarchy read_tree(const std::filesystem::path& path);
+
+}  // namespace primseg

@@ -1,0 +1,64 @@
+#include "model_selection.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "primseg/error.hpp"
+
+namespace primseg {
+
+void validate(const HierarchyOptions& options) {
+  if (options.primitives.empty()) throw InvalidInputError("no primitive type enabled");
+  for (std::size_t i = 0; i < options.primitives.size(); ++i) {
+    const PrimitiveType t = options.primitives[i];
+    if (static_cast<int>(t) >= kPrimitiveTypeCount || !has_fitter(t))
+      throw InvalidInputError("primitive type '" + std::string(to_string(t)) +
+                              "' is not available in this version");
+    for (std::size_t j = 0; j < i; ++j)
+      if (options.primitives[j] == t)
+        throw InvalidInputError("primitive type '" + std::string(to_string(t)) +
+                                "' is listed twice");
+  }
+  for (double p : options.type_penalty)
+    if (!(p > 0) || !std::isfinite(p))
+      throw InvalidInputError("type penalties must be positive and finite");
+  if (!(options.zero_cost_tolerance >= 0) || !std::isfinite(options.zero_cost_tolerance))
+    throw InvalidInputError("zero_cost_tolerance must be non-negative and finite");
+}
+
+namespace detail {
+
+ModelSelector::ModelSelector(const HierarchyOptions& options) : options_(options) {
+  validate(options);
+  std::vector<PrimitiveType> types = options.primitives;
+  std::sort(types.begin(), types.end());
+  for (PrimitiveType t : types) fitters_.push_back(&fitter_for(t));
+}
+
+SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactError* exact) const {
+  const double zero_level = options_.zero_cost_tolerance * centred.moments.second_moment().trace();
+  auto finish = [&](PrimitiveFit fit) {
+    if (exact) fit.error = (*exact)(fit.primitive);
+    if (fit.error <= zero_level) fit.error = 0;
+    SelectedModel model{fit,
+                        fit.error * options_.type_penalty[static_cast<int>(fit.primitive.type)]};
+    return model;
+  };
+  SelectedModel best;
+  bool found = false;
+  for (const PrimitiveFitter* fitter : fitters_) {
+    if (centred.triangle_count < fitter->min_triangles()) continue;
+    PrimitiveFit fit = fitter->fit(centred);
+    if (!fit.valid || !std::isfinite(fit.error)) continue;
+    SelectedModel candidate = finish(std::move(fit));
+    if (!found || candidate.cost < best.cost) {
+      best = candidate;
+      found = true;
+    }
+  }
+  if (!found) best = finish(fitter_for(PrimitiveType::Plane).fit(centred));
+  return best;
+}
+
+}  // namespace detail
+}  // namespace primseg

@@ -1,0 +1,35 @@
+#pragma once
+// Choosing a cluster's primitive type: the honest-model rule shared by merges and leaves.
+
+#include <functional>
+
+#include "primseg/hierarchy.hpp"
+#include "primseg/primitives/primitive_fitter.hpp"
+
+namespace primseg::detail {
+
+struct SelectedModel {
+  PrimitiveFit fit;  // working frame; fit.error already zero-snapped
+  double cost = 0;   // penalised error: the merge priority
+};
+
+/// Exact Σ w d² of a working-frame primitive over a cluster's corners.
+using ExactError = std::function<double(const Primitive&)>;
+
+/// The rule: every enabled type with enough triangles is fitted; invalid fits drop out; errors at
+/// most zero_cost_tolerance × Σ w |x − c|² snap to 0; the smallest error × penalty wins, ties to
+/// the lower type. If no enabled type is valid the cluster is reported as a plane (the limit of
+/// every curved type as its radius grows), whether or not planes are enabled.
+class ModelSelector {
+ public:
+  explicit ModelSelector(const HierarchyOptions& options);
+  /// `centred`: statistics with moments about the cluster's centroid. `exact`: if given, replaces
+  /// each fit's error by the exact one.
+  SelectedModel select(const ClusterStats& centred, const ExactError* exact = nullptr) const;
+
+ private:
+  std::vector<const PrimitiveFitter*> fitters_;  // ascending type
+  HierarchyOptions options_;
+};
+
+}  // namespace primseg::detail

@@ -1,0 +1,88 @@
+#include "primseg/primitive.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+
+namespace primseg {
+namespace {
+
+constexpr std::string_view kNames[kPrimitiveTypeCount] = {"plane", "cylinder", "sphere", "cone",
+                                                          "torus"};
+
+Eigen::Vector3d to_eigen(const Vec3& v) {
+  return {v[0], v[1], v[2]};
+}
+Vec3 to_vec3(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+// Any unit vector orthogonal to the unit vector a.
+Eigen::Vector3d orthogonal_to(const Eigen::Vector3d& a) {
+  Eigen::Index least;
+  a.cwiseAbs().minCoeff(&least);
+  return a.cross(Eigen::Vector3d::Unit(least)).normalized();
+}
+
+}  // namespace
+
+std::string_view to_string(PrimitiveType type) {
+  const auto index = static_cast<std::size_t>(type);
+  return index < kPrimitiveTypeCount ? kNames[index] : std::string_view("unknown");
+}
+
+std::optional<PrimitiveType> primitive_type_from_string(std::string_view name) {
+  for (int t = 0; t < kPrimitiveTypeCount; ++t)
+    if (kNames[t] == name) return static_cast<PrimitiveType>(t);
+  return std::nullopt;
+}
+
+double Primitive::distance(const Vec3& x) const {
+  const Eigen::Vector3d p = to_eigen(x);
+  return (p - to_eigen(closest_point(x))).norm();
+}
+
+Vec3 Primitive::closest_point(const Vec3& x) const {
+  const Eigen::Vector3d p = to_eigen(x);
+  const Eigen::Vector3d origin = to_eigen(point);
+  const Eigen::Vector3d a = to_eigen(axis);
+  switch (type) {
+    case PrimitiveType::Plane:
+      return to_vec3(p - a * a.dot(p - origin));
+    case PrimitiveType::Sphere: {
+      Eigen::Vector3d d = p - origin;
+      if (d.squaredNorm() == 0) d = Eigen::Vector3d::UnitX();
+      return to_vec3(origin + d.normalized() * radius);
+    }
+    case PrimitiveType::Cylinder: {
+      const Eigen::Vector3d on_axis = origin + a * a.dot(p - origin);
+      Eigen::Vector3d radial = p - on_axis;
+      if (radial.squaredNorm() == 0) radial = orthogonal_to(a);
+      return to_vec3(on_axis + radial.normalized() * radius);
+    }
+    case PrimitiveType::Cone: {
+      // In the half-plane through the axis and p: the generator leaves the apex at half_angle.
+      const Eigen::Vector3d d = p - origin;
+      const double along = a.dot(d);
+      Eigen::Vector3d radial = d - a * along;
+      const Eigen::Vector3d radial_dir =
+          radial.squaredNorm() > 0 ? Eigen::Vector3d(radial.normalized()) : orthogonal_to(a);
+      const Eigen::Vector3d generator =
+          a * std::cos(half_angle) + radial_dir * std::sin(half_angle);
+      const double t = std::max(0.0, d.dot(generator));
+      return to_vec3(origin + generator * t);
+    }
+    case PrimitiveType::Torus: {
+      const Eigen::Vector3d d = p - origin;
+      Eigen::Vector3d radial = d - a * a.dot(d);
+      if (radial.squaredNorm() == 0) radial = orthogonal_to(a);
+      const Eigen::Vector3d ring = origin + radial.normalized() * radius;
+      Eigen::Vector3d to_p = p - ring;
+      if (to_p.squaredNorm() == 0) to_p = a;
+      return to_vec3(ring + to_p.normalized() * minor_radius);
+    }
+  }
+  return x;
+}
+
+}  // namespace primseg

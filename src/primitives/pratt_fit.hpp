@@ -1,0 +1,39 @@
+#pragma once
+// Pratt's constrained algebraic fit of a circle (D = 2) or sphere (D = 3) from centred moments.
+//
+// Minimises Σ w (A|p|² + B·p + C)² subject to |B|² − 4AC = 1. For a sphere with centre c and
+// radius r the numerator is A²(|p−c|² − r²)² and the constraint 4A²r², so the minimum is exactly
+// min over spheres of Σ w (|p−c|² − r²)² / (4r²): a first-order equivalent of Σ w (|p−c| − r)²,
+// with planes (A = 0) as the limit, so flat data yields a huge radius instead of noise.
+
+#include <Eigen/Core>
+
+namespace primseg::detail {
+
+template <int D>
+struct CentredMomentsND {
+  double weight = 0;                   // Σ w
+  Eigen::Matrix<double, D, D> second;  // Σ w p pᵀ
+  Eigen::Matrix<double, D, 1> third;   // Σ w p |p|²
+  double fourth = 0;                   // Σ w |p|⁴
+};
+
+template <int D>
+struct PrattResult {
+  bool valid = false;
+  double error = 0;                    // the minimum objective (≥ 0)
+  Eigen::Matrix<double, D, 1> centre;  // relative to the centroid
+  double radius = 0;
+};
+
+/// Largest radius, relative to the RMS spread of the points about their centroid, still taken
+/// as curved: beyond it the sagitta is under 1/2000 of the spread, which is a plane.
+inline constexpr double kMaxRelativeRadius = 1e3;
+
+template <int D>
+PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments);
+
+extern template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&);
+extern template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&);
+
+}  // namespace primseg::detail

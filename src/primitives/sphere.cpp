@@ -1,0 +1,34 @@
+// Sphere: Pratt's constrained algebraic fit (pratt_fit.hpp) from the centred moments up to degree
+// 4. Its error, Σ w (|x − c|² − r²)² / (4r²), is the exact minimum of that normalised algebraic
+// distance over all spheres and a first-order equivalent of Σ w (|x − c| − r)².
+#include "primseg/primitives/sphere.hpp"
+
+#include "primitives/pratt_fit.hpp"
+
+namespace primseg {
+
+std::uint32_t SphereFitter::min_triangles() const {
+  return 4;
+}
+
+PrimitiveFit SphereFitter::fit(const ClusterStats& centred) const {
+  PrimitiveFit result;
+  result.primitive.type = PrimitiveType::Sphere;
+  if (centred.triangle_count < min_triangles()) return result;
+  const Moments& m = centred.moments;
+  detail::CentredMomentsND<3> moments;
+  moments.weight = m.weight();
+  moments.second = m.second_moment();
+  moments.third = m.third_moment_contracted(Eigen::Matrix3d::Identity());
+  moments.fourth = m.fourth_moment_contracted(Eigen::Matrix3d::Identity());
+  const detail::PrattResult<3> sphere = detail::pratt_fit(moments);
+  if (!sphere.valid) return result;
+  const Eigen::Vector3d centre = m.origin() + sphere.centre;
+  result.valid = true;
+  result.error = sphere.error;
+  result.primitive.point = {centre.x(), centre.y(), centre.z()};
+  result.primitive.radius = sphere.radius;
+  return result;
+}
+
+}  // namespace primseg

@@ -1,0 +1,224 @@
+#include "primseg/tree_io.hpp"
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+
+#include "atomic_write.hpp"
+#include "primseg/error.hpp"
+
+namespace primseg {
+namespace {
+
+constexpr char kMagic[8] = {'P', 'R', 'I', 'M', 'S', 'E', 'G', 'T'};
+constexpr std::uint32_t kVersion = 1;
+
+std::uint64_t fnv1a(std::string_view bytes) {
+  std::uint64_t hash = 0xcbf29ce484222325ull;
+  for (unsigned char c : bytes) hash = (hash ^ c) * 0x100000001b3ull;
+  return hash;
+}
+
+class Writer {
+ public:
+  template <typename T>
+  void put(T value) {
+    static_assert(std::is_arithmetic_v<T>);
+    char raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    if constexpr (std::endian::native == std::endian::big) std::reverse(raw, raw + sizeof(T));
+    bytes_.append(raw, sizeof(T));
+  }
+  void put_vec3(const Vec3& v) {
+    for (double x : v) put(x);
+  }
+  void put_raw(const char* data, std::size_t n) { bytes_.append(data, n); }
+  std::string& bytes() { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+class Reader {
+ public:
+  Reader(std::span<const char> bytes, const std::string& name) : bytes_(bytes), name_(name) {}
+
+  template <typename T>
+  T get(const char* what) {
+    need(sizeof(T), what);
+    char raw[sizeof(T)];
+    std::memcpy(raw, bytes_.data() + offset_, sizeof(T));
+    if constexpr (std::endian::native == std::endian::big) std::reverse(raw, raw + sizeof(T));
+    offset_ += sizeof(T);
+    T value;
+    std::memcpy(&value, raw, sizeof(T));
+    return value;
+  }
+  Vec3 get_vec3(const char* what) {
+    return {get<double>(what), get<double>(what), get<double>(what)};
+  }
+  // A count of items of `item_size` bytes each, checked against the bytes left.
+  std::size_t get_count(std::size_t item_size, const char* what) {
+    const auto count = get<std::uint64_t>(what);
+    if (count > (bytes_.size() - offset_) / item_size)
+      fail(std::string(what) + " count " + std::to_string(count) + " exceeds the file size");
+    return static_cast<std::size_t>(count);
+  }
+  void need(std::size_t n, const char* what) {
+    if (bytes_.size() - offset_ < n) fail(std::string("truncated file while reading ") + what);
+  }
+  [[noreturn]] void fail(const std::string& reason) const {
+    throw ParseError(name_ + ": byte " + std::to_string(offset_) + ": " + reason);
+  }
+  std::size_t offset() const { return offset_; }
+
+ private:
+  std::span<const char> bytes_;
+  std::string name_;
+  std::size_t offset_ = 0;
+};
+
+}  // namespace
+
+std::string serialize_tree(const Hierarchy& hierarchy) {
+  Writer w;
+  w.put_raw(kMagic, sizeof kMagic);
+  w.put(kVersion);
+  const HierarchyOptions& options = hierarchy.options();
+  w.put(static_cast<std::uint8_t>(options.weights));
+  w.put(static_cast<std::uint8_t>(options.exact_costs));
+  w.put(static_cast<std::uint8_t>(options.primitives.size()));
+  for (PrimitiveType t : options.primitives) w.put(static_cast<std::uint8_t>(t));
+  for (double p : options.type_penalty) w.put(p);
+  w.put(options.zero_cost_tolerance);
+
+  const Mesh& mesh = hierarchy.mesh();
+  w.put(static_cast<std::uint64_t>(mesh.positions.size()));
+  for (const Vec3& p : mesh.positions) w.put_vec3(p);
+  w.put(static_cast<std::uint64_t>(mesh.polygon_offsets.size()));
+  for (std::uint32_t o : mesh.polygon_offsets) w.put(o);
+  w.put(static_cast<std::uint64_t>(mesh.polygon_vertices.size()));
+  for (std::uint32_t v : mesh.polygon_vertices) w.put(v);
+  w.put(static_cast<std::uint64_t>(mesh.triangles.size()));
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (std::uint32_t v : mesh.triangles[t]) w.put(v);
+    w.put(mesh.face_of_triangle[t]);
+  }
+
+  w.put(static_cast<std::uint64_t>(hierarchy.merges().size()));
+  for (const Merge& m : hierarchy.merges()) {
+    w.put(m.first);
+    w.put(m.second);
+    w.put(m.cost);
+    w.put(m.error);
+    w.put(m.weight);
+    w.put(m.face_count);
+    w.put(static_cast<std::uint8_t>(m.trailing));
+    w.put(static_cast<std::uint8_t>(m.primitive.type));
+    w.put_vec3(m.primitive.point);
+    w.put_vec3(m.primitive.axis);
+    w.put(m.primitive.radius);
+    w.put(m.primitive.minor_radius);
+    w.put(m.primitive.half_angle);
+  }
+  w.put(fnv1a(w.bytes()));
+  return std::move(w.bytes());
+}
+
+Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name) {
+  Reader r(bytes, name);
+  r.need(sizeof kMagic, "the header");
+  if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    r.fail("not a primseg tree file (bad magic number)");
+  if (bytes.size() < sizeof kMagic + 4 + 8) r.fail("truncated file while reading the header");
+  {
+    Reader checksum_reader(bytes.subspan(bytes.size() - 8), name);
+    const auto stored = checksum_reader.get<std::uint64_t>("the checksum");
+    if (stored != fnv1a({bytes.data(), bytes.size() - 8}))
+      throw ParseError(name + ": checksum mismatch: the file is corrupt or truncated");
+  }
+  bytes = bytes.first(bytes.size() - 8);
+  r = Reader(bytes, name);
+  for (std::size_t i = 0; i < sizeof kMagic; ++i) r.get<char>("the header");
+  const auto version = r.get<std::uint32_t>("the version");
+  if (version != kVersion)
+    r.fail("tree file version " + std::to_string(version) +
+           " is not supported (this primseg reads "
+           "version " +
+           std::to_string(kVersion) + ")");
+
+  HierarchyOptions options;
+  const auto weights = r.get<std::uint8_t>("the options");
+  if (weights > 1) r.fail("unknown vertex weighting " + std::to_string(weights));
+  options.weights = static_cast<VertexWeights>(weights);
+  options.exact_costs = r.get<std::uint8_t>("the options") != 0;
+  const auto type_count = r.get<std::uint8_t>("the options");
+  options.primitives.clear();
+  for (int i = 0; i < type_count; ++i) {
+    const auto t = r.get<std::uint8_t>("the primitive types");
+    if (t >= kPrimitiveTypeCount) r.fail("unknown primitive type " + std::to_string(t));
+    options.primitives.push_back(static_cast<PrimitiveType>(t));
+  }
+  for (double& p : options.type_penalty) p = r.get<double>("the type penalties");
+  options.zero_cost_tolerance = r.get<double>("the options");
+
+  auto mesh = std::make_shared<Mesh>();
+  mesh->positions.resize(r.get_count(24, "vertex"));
+  for (Vec3& p : mesh->positions) p = r.get_vec3("the vertices");
+  mesh->polygon_offsets.resize(r.get_count(4, "polygon offset"));
+  for (std::uint32_t& o : mesh->polygon_offsets) o = r.get<std::uint32_t>("the polygons");
+  mesh->polygon_vertices.resize(r.get_count(4, "polygon vertex"));
+  for (std::uint32_t& v : mesh->polygon_vertices) v = r.get<std::uint32_t>("the polygons");
+  const std::size_t triangle_count = r.get_count(16, "triangle");
+  mesh->triangles.resize(triangle_count);
+  mesh->face_of_triangle.resize(triangle_count);
+  for (std::size_t t = 0; t < triangle_count; ++t) {
+    for (std::uint32_t& v : mesh->triangles[t]) v = r.get<std::uint32_t>("the triangles");
+    mesh->face_of_triangle[t] = r.get<std::uint32_t>("the triangles");
+  }
+  try {
+    mesh->validate();
+  } catch (const Error& e) {
+    r.fail(std::string("invalid mesh: ") + e.what());
+  }
+
+  std::vector<Merge> merges(r.get_count(12 * 8 + 3 * 4 + 2, "merge"));
+  for (Merge& m : merges) {
+    m.first = r.get<std::uint32_t>("the merges");
+    m.second = r.get<std::uint32_t>("the merges");
+    m.cost = r.get<double>("the merges");
+    m.error = r.get<double>("the merges");
+    m.weight = r.get<double>("the merges");
+    m.face_count = r.get<std::uint32_t>("the merges");
+    m.trailing = r.get<std::uint8_t>("the merges") != 0;
+    const auto type = r.get<std::uint8_t>("the merges");
+    if (type >= kPrimitiveTypeCount) r.fail("unknown primitive type " + std::to_string(type));
+    m.primitive.type = static_cast<PrimitiveType>(type);
+    m.primitive.point = r.get_vec3("the merges");
+    m.primitive.axis = r.get_vec3("the merges");
+    m.primitive.radius = r.get<double>("the merges");
+    m.primitive.minor_radius = r.get<double>("the merges");
+    m.primitive.half_angle = r.get<double>("the merges");
+  }
+  if (r.offset() != bytes.size()) r.fail("unexpected data after the merges");
+  try {
+    return Hierarchy(std::move(mesh), std::move(options), std::move(merges));
+  } catch (const InvalidInputError& e) {
+    throw ParseError(name + ": invalid tree: " + e.what());
+  }
+}
+
+void write_tree(const std::filesystem::path& path, const Hierarchy& hierarchy) {
+  detail::write_file_atomically(path, serialize_tree(hierarchy));
+}
+
+Hierarchy read_tree(const std::filesystem::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw IoError("cannot open " + path.string());
+  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (file.bad()) throw IoError("cannot read " + path.string());
+  if (bytes.empty()) throw ParseError(path.string() + ": empty file");
+  return deserialize_tree(bytes, path.string());
+}
+
+}  // namespace primseg

@@ -1,0 +1,95 @@
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+
+namespace primseg::testing {
+
+std::filesystem::path cgal_mesh(const std::string& name) {
+  static std::mutex mutex;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const std::filesystem::path archive = "/usr/share/doc/libcgal-dev/data.tar.gz";
+  const std::filesystem::path cache = std::filesystem::temp_directory_path() / "primseg-cgal-data";
+  const std::filesystem::path path = cache / "data" / "meshes" / name;
+  if (std::filesystem::exists(path)) return path;
+  if (!std::filesystem::exists(archive)) {
+    ADD_FAILURE() << archive << " is missing: install Debian's libcgal-demo";
+    return path;
+  }
+  std::filesystem::create_directories(cache);
+  const std::string command =
+      "tar xzf " + archive.string() + " -C " + cache.string() + " data/meshes/" + name + " 2>&1";
+  if (run_command(command) != 0)
+    ADD_FAILURE() << "could not extract " << name << " from " << archive;
+  return path;
+}
+
+std::filesystem::path temp_directory(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  const auto dir =
+      std::filesystem::temp_directory_path() /
+      ("primseg-test-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+std::filesystem::path cli_path() {
+  return PRIMSEG_CLI_PATH;
+}
+
+int run_command(const std::string& command, std::string* output) {
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buffer;
+  std::string text;
+  std::size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) text.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  if (output) *output = text;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::array<std::array<double, 3>, 3> random_rotation(std::mt19937_64& rng) {
+  // A unit quaternion with uniform random direction: Shoemake's method.
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double u1 = uniform(rng), u2 = 2 * M_PI * uniform(rng), u3 = 2 * M_PI * uniform(rng);
+  const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
+  const double w = a * std::sin(u2), x = a * std::cos(u2), y = b * std::sin(u3),
+               z = b * std::cos(u3);
+  return {{{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+           {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+           {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}}};
+}
+
+void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation, double scale,
+               const Vec3& translation) {
+  for (Vec3& p : mesh.positions) {
+    Vec3 q{};
+    for (int r = 0; r < 3; ++r)
+      q[r] = scale * (rotation[r][0] * p[0] + rotation[r][1] * p[1] + rotation[r][2] * p[2]) +
+             translation[r];
+    p = q;
+  }
+}
+
+}  // namespace primseg::testing
+
+namespace primseg::testing {
+
+ClusterStats whole_mesh_stats(const DualGraph& graph) {
+  ClusterStats stats = graph.face_stats(0);
+  for (std::uint32_t f = 1; f < graph.face_count(); ++f) stats.merge(graph.face_stats(f), {});
+  for (const DualEdge& e : graph.edges())
+    for (int n = 0; n < 6; ++n) stats.tensor[n] += e.tensor[n];
+  stats.moments = stats.moments.translated(stats.moments.centroid());
+  return stats;
+}
+
+}  // namespace primseg::testing

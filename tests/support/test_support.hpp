@@ -1,0 +1,67 @@
+#pragma once
+// Shared helpers of the test suite.
+
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "primseg/mesh.hpp"
+
+namespace primseg::testing {
+
+/// Path of a mesh shipped by Debian's libcgal-demo (for example "fandisk.off"), extracted from
+/// /usr/share/doc/libcgal-dev/data.tar.gz into a cache directory at first use. Fails the
+/// calling test (not skips) when the package is missing: CI installs it.
+std::filesystem::path cgal_mesh(const std::string& name);
+
+/// A fresh empty directory under the system temp dir, unique per call.
+std::filesystem::path temp_directory(const std::string& tag);
+
+/// Path of the primseg executable built with the tests.
+std::filesystem::path cli_path();
+
+/// Runs a shell command, returns its exit status; stdout+stderr go to *output if given.
+int run_command(const std::string& command, std::string* output = nullptr);
+
+/// A uniformly random rotation (deterministic for a given engine state).
+std::array<std::array<double, 3>, 3> random_rotation(std::mt19937_64& rng);
+
+/// Applies x -> scale * R x + t to every vertex.
+void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation, double scale,
+               const Vec3& translation);
+
+}  // namespace primseg::testing
+
+#include "primseg/cluster_stats.hpp"
+#include "primseg/dual_graph.hpp"
+
+namespace primseg::testing {
+
+/// A grid of (rows + 1) × (cols + 1) vertices p(u, v), u, v in [0, 1], split into 2·rows·cols
+/// triangles (diagonals alternating when `alternate`), outward orientation given by p's
+/// parametrisation (∂p/∂u × ∂p/∂v).
+template <typename Surface>
+Mesh grid_mesh(int rows, int cols, Surface&& p, bool alternate = false) {
+  std::vector<Vec3> positions;
+  for (int i = 0; i <= rows; ++i)
+    for (int j = 0; j <= cols; ++j) positions.push_back(p(double(i) / rows, double(j) / cols));
+  std::vector<Triangle> triangles;
+  auto id = [&](int i, int j) { return static_cast<std::uint32_t>(i * (cols + 1) + j); };
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) {
+      if (alternate && (i + j) % 2) {
+        triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+        triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+      } else {
+        triangles.push_back({id(i, j), id(i + 1, j), id(i, j + 1)});
+        triangles.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+      }
+    }
+  return Mesh::from_triangles(std::move(positions), std::move(triangles));
+}
+
+/// Statistics of the whole mesh as one cluster, accumulated face by face and edge by edge the way
+/// the engine does, with moments centred at the centroid.
+ClusterStats whole_mesh_stats(const DualGraph& graph);
+
+}  // namespace primseg::testing
