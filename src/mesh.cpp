@@ -1,0 +1,302 @@
+#include "primseg/mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "primseg/error.hpp"
+
+namespace primseg {
+namespace {
+
+struct Point2 {
+  double x;
+  double y;
+};
+
+double cross(const Point2& origin, const Point2& a, const Point2& b) {
+  return (a.x - origin.x) * (b.y - origin.y) - (a.y - origin.y) * (b.x - origin.x);
+}
+
+bool same_point(const Point2& a, const Point2& b) {
+  return a.x == b.x && a.y == b.y;
+}
+
+// Closed test: a point on the boundary of the ear also blocks it, since clipping that ear would
+// create a diagonal touching the polygon boundary.
+bool inside_or_on_triangle(const Point2& p, const Point2& a, const Point2& b, const Point2& c) {
+  return cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0;
+}
+
+Vec3 newell_normal(std::span<const std::uint32_t> loop, const std::vector<Vec3>& positions) {
+  Vec3 normal{0.0, 0.0, 0.0};
+  // Relative to the first vertex, so that far-from-origin polygons keep their precision.
+  const Vec3& origin = positions[loop[0]];
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const Vec3& p = positions[loop[i]];
+    const Vec3& q = positions[loop[(i + 1) % loop.size()]];
+    const double px = p[0] - origin[0], py = p[1] - origin[1], pz = p[2] - origin[2];
+    const double qx = q[0] - origin[0], qy = q[1] - origin[1], qz = q[2] - origin[2];
+    normal[0] += (py - qy) * (pz + qz);
+    normal[1] += (pz - qz) * (px + qx);
+    normal[2] += (px - qx) * (py + qy);
+  }
+  return normal;
+}
+
+/// Triangulates polygons by ear clipping; owns scratch buffers so that a mesh of many polygons
+/// triggers no per-polygon allocation.
+class EarClipper {
+ public:
+  /// Appends loop.size() - 2 triangles of `loop` to `triangles`, oriented like the loop.
+  void triangulate(std::span<const std::uint32_t> loop, const std::vector<Vec3>& positions,
+                   std::vector<Triangle>& triangles) {
+    const Vec3 normal = newell_normal(loop, positions);
+    const double length =
+        std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+    remaining_.assign(loop.begin(), loop.end());
+    if (!(length > 0.0) || !std::isfinite(length)) {
+      fan_remaining(triangles);  // Zero-area polygon: no plane to clip in, every split is equal.
+      return;
+    }
+    project(normal, length, positions);
+    clip_ears(triangles);
+  }
+
+ private:
+  // Projects the loop on a basis (u, v) with u x v along the Newell normal, which makes the
+  // projected loop counter-clockwise.
+  void project(const Vec3& normal, double length, const std::vector<Vec3>& positions) {
+    const Vec3 n{normal[0] / length, normal[1] / length, normal[2] / length};
+    // Any vector not parallel to n seeds u: use the axis along n's smallest component.
+    Vec3 seed{0.0, 0.0, 0.0};
+    const int smallest = std::fabs(n[0]) <= std::fabs(n[1])
+                             ? (std::fabs(n[0]) <= std::fabs(n[2]) ? 0 : 2)
+                             : (std::fabs(n[1]) <= std::fabs(n[2]) ? 1 : 2);
+    seed[smallest] = 1.0;
+    Vec3 u{n[1] * seed[2] - n[2] * seed[1], n[2] * seed[0] - n[0] * seed[2],
+           n[0] * seed[1] - n[1] * seed[0]};
+    const double u_length = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (double& c : u) c /= u_length;
+    const Vec3 v{n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+
+    const Vec3& origin = positions[remaining_[0]];
+    projected_.clear();
+    for (std::uint32_t vertex : remaining_) {
+      const Vec3& p = positions[vertex];
+      const double dx = p[0] - origin[0], dy = p[1] - origin[1], dz = p[2] - origin[2];
+      projected_.push_back({dx * u[0] + dy * u[1] + dz * u[2], dx * v[0] + dy * v[1] + dz * v[2]});
+    }
+    // remaining_ from here on holds positions in projected_ (loop order), not vertex ids.
+    corners_.assign(remaining_.begin(), remaining_.end());
+    for (std::uint32_t i = 0; i < remaining_.size(); ++i) remaining_[i] = i;
+  }
+
+  bool is_ear(std::size_t i, bool allow_flat) {
+    const std::size_t n = remaining_.size();
+    const Point2& a = projected_[remaining_[(i + n - 1) % n]];
+    const Point2& b = projected_[remaining_[i]];
+    const Point2& c = projected_[remaining_[(i + 1) % n]];
+    const double turn = cross(a, b, c);
+    if (allow_flat ? turn < 0.0 : turn <= 0.0) return false;
+    work_ += n;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j == i || j == (i + n - 1) % n || j == (i + 1) % n) continue;
+      const Point2& p = projected_[remaining_[j]];
+      // Copies of a corner (e.g. a bridge to a hole) do not block the ear.
+      if (same_point(p, a) || same_point(p, b) || same_point(p, c)) continue;
+      if (inside_or_on_triangle(p, a, b, c)) return false;
+    }
+    return true;
+  }
+
+  void clip_ears(std::vector<Triangle>& triangles) {
+    // Scanning on from the last ear keeps the usual case quadratic; the work budget bounds
+    // pathological polygons (thousands of reflex vertices), which then get the fan fallback.
+    const std::size_t budget = std::max<std::size_t>(1u << 22, 64 * remaining_.size());
+    work_ = 0;
+    std::size_t i = 0;
+    std::size_t misses = 0;
+    // Flat ears (collinear or repeated vertices) are clipped only when no proper ear is left.
+    bool allow_flat = false;
+    while (remaining_.size() > 3 && work_ < budget) {
+      const std::size_t n = remaining_.size();
+      if (is_ear(i, allow_flat)) {
+        triangles.push_back({corners_[remaining_[(i + n - 1) % n]], corners_[remaining_[i]],
+                             corners_[remaining_[(i + 1) % n]]});
+        remaining_.erase(remaining_.begin() + static_cast<std::ptrdiff_t>(i));
+        if (i == remaining_.size()) i = 0;
+        misses = 0;
+        allow_flat = false;
+        continue;
+      }
+      i = (i + 1) % n;
+      if (++misses < n) continue;
+      if (allow_flat) break;  // Self-intersecting or numerically hopeless: fan the rest.
+      allow_flat = true;
+      misses = 0;
+    }
+    for (std::uint32_t& r : remaining_) r = corners_[r];
+    fan_remaining(triangles);
+  }
+
+  void fan_remaining(std::vector<Triangle>& triangles) const {
+    for (std::size_t i = 1; i + 1 < remaining_.size(); ++i) {
+      triangles.push_back({remaining_[0], remaining_[i], remaining_[i + 1]});
+    }
+  }
+
+  std::vector<std::uint32_t> remaining_;
+  std::vector<std::uint32_t> corners_;
+  std::vector<Point2> projected_;
+  std::size_t work_ = 0;
+};
+
+[[noreturn]] void invalid(const std::string& message) {
+  throw InvalidInputError(message);
+}
+
+void check_positions(const std::vector<Vec3>& positions) {
+  if (positions.size() > std::numeric_limits<std::uint32_t>::max()) {
+    invalid("mesh has " + std::to_string(positions.size()) +
+            " vertices, more than 32-bit indices can address");
+  }
+  for (std::size_t v = 0; v < positions.size(); ++v) {
+    const Vec3& p = positions[v];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      invalid("vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+  }
+}
+
+void check_polygons(const std::vector<std::uint32_t>& offsets,
+                    const std::vector<std::uint32_t>& vertices, std::size_t vertex_count) {
+  if (offsets.empty() || offsets.front() != 0) {
+    invalid("polygon offsets must start with 0");
+  }
+  if (offsets.size() == 1) invalid("mesh has no faces");
+  for (std::size_t f = 0; f + 1 < offsets.size(); ++f) {
+    if (offsets[f + 1] < offsets[f] || offsets[f + 1] - offsets[f] < 3) {
+      const long long size = static_cast<long long>(offsets[f + 1]) - offsets[f];
+      invalid("face " + std::to_string(f) + " has " + std::to_string(size) +
+              " vertices, fewer than 3");
+    }
+  }
+  if (offsets.back() != vertices.size()) {
+    invalid("polygon offsets end at " + std::to_string(offsets.back()) + " but there are " +
+            std::to_string(vertices.size()) + " polygon vertices");
+  }
+  std::size_t face = 0;
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    if (vertices[i] >= vertex_count) {
+      while (offsets[face + 1] <= i) ++face;
+      invalid("face " + std::to_string(face) + " references vertex " + std::to_string(vertices[i]) +
+              " but the mesh has " + std::to_string(vertex_count) + " vertices");
+    }
+  }
+}
+
+}  // namespace
+
+Mesh Mesh::from_polygons(std::vector<Vec3> positions, std::vector<std::uint32_t> offsets,
+                         std::vector<std::uint32_t> vertices) {
+  check_positions(positions);
+  check_polygons(offsets, vertices, positions.size());
+
+  Mesh mesh;
+  mesh.positions = std::move(positions);
+  mesh.polygon_offsets = std::move(offsets);
+  mesh.polygon_vertices = std::move(vertices);
+  const std::uint32_t faces = mesh.face_count();
+  const std::size_t triangle_estimate = mesh.polygon_vertices.size() - 2 * std::size_t{faces};
+  mesh.triangles.reserve(triangle_estimate);
+  mesh.face_of_triangle.reserve(triangle_estimate);
+
+  EarClipper clipper;
+  for (std::uint32_t f = 0; f < faces; ++f) {
+    const std::span<const std::uint32_t> loop = mesh.polygon(f);
+    if (loop.size() == 3) {
+      mesh.triangles.push_back({loop[0], loop[1], loop[2]});
+    } else {
+      clipper.triangulate(loop, mesh.positions, mesh.triangles);
+    }
+    mesh.face_of_triangle.resize(mesh.triangles.size(), f);
+  }
+  return mesh;
+}
+
+Mesh Mesh::from_triangles(std::vector<Vec3> positions, std::vector<Triangle> triangles) {
+  check_positions(positions);
+  if (triangles.empty()) invalid("mesh has no faces");
+  if (triangles.size() > std::numeric_limits<std::uint32_t>::max() / 3) {
+    invalid("mesh has " + std::to_string(triangles.size()) +
+            " triangles, more than 32-bit offsets can address");
+  }
+  Mesh mesh;
+  mesh.polygon_offsets.resize(triangles.size() + 1);
+  mesh.polygon_vertices.reserve(3 * triangles.size());
+  mesh.face_of_triangle.resize(triangles.size());
+  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+    for (std::uint32_t corner : triangles[t]) {
+      if (corner >= positions.size()) {
+        invalid("face " + std::to_string(t) + " references vertex " + std::to_string(corner) +
+                " but the mesh has " + std::to_string(positions.size()) + " vertices");
+      }
+      mesh.polygon_vertices.push_back(corner);
+    }
+    mesh.polygon_offsets[t + 1] = 3 * (t + 1);
+    mesh.face_of_triangle[t] = t;
+  }
+  mesh.positions = std::move(positions);
+  mesh.triangles = std::move(triangles);
+  return mesh;
+}
+
+void Mesh::validate() const {
+  check_positions(positions);
+  check_polygons(polygon_offsets, polygon_vertices, positions.size());
+  if (face_of_triangle.size() != triangles.size()) {
+    invalid("mesh has " + std::to_string(triangles.size()) + " triangles but " +
+            std::to_string(face_of_triangle.size()) + " face_of_triangle entries");
+  }
+  const std::uint32_t faces = face_count();
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (std::uint32_t corner : triangles[t]) {
+      if (corner >= positions.size()) {
+        invalid("triangle " + std::to_string(t) + " references vertex " + std::to_string(corner) +
+                " but the mesh has " + std::to_string(positions.size()) + " vertices");
+      }
+    }
+    // Non-decreasing with steps of at most one from face 0 means every face has a triangle.
+    const std::uint32_t expected_low = t == 0 ? 0 : face_of_triangle[t - 1];
+    const std::uint32_t face = face_of_triangle[t];
+    if (face < expected_low || face > expected_low + (t == 0 ? 0 : 1) || face >= faces) {
+      invalid("face_of_triangle[" + std::to_string(t) + "] = " + std::to_string(face) +
+              " breaks the order of faces (each face needs at least one triangle, in order)");
+    }
+  }
+  if (triangles.empty()) invalid("mesh has faces but no triangles");
+  if (face_of_triangle.back() + 1 != faces) {
+    invalid("faces after face " + std::to_string(face_of_triangle.back()) + " have no triangles");
+  }
+}
+
+double bounding_box_diagonal(const Mesh& mesh) {
+  if (mesh.polygon_vertices.empty()) return 0.0;
+  Vec3 low{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+           std::numeric_limits<double>::infinity()};
+  Vec3 high{-low[0], -low[1], -low[2]};
+  for (std::uint32_t vertex : mesh.polygon_vertices) {
+    const Vec3& p = mesh.positions[vertex];
+    for (int axis = 0; axis < 3; ++axis) {
+      low[axis] = std::min(low[axis], p[axis]);
+      high[axis] = std::max(high[axis], p[axis]);
+    }
+  }
+  const double dx = high[0] - low[0], dy = high[1] - low[1], dz = high[2] - low[2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+}  // namespace primseg
