@@ -419,7 +419,10 @@ TEST(ShapeGenerator, NoiseMovesVerticesAlongNormalsByTheRequestedAmount) {
   EXPECT_NEAR(rms, expected, 0.2 * expected);
   // Primitives describe the noise-free surface.
   for (std::size_t r = 0; r < exact.regions.size(); ++r) {
-    EXPECT_EQ(std::memcmp(&exact.regions[r], &noisy.regions[r], sizeof(Primitive)), 0);
+    EXPECT_EQ(exact.regions[r].type, noisy.regions[r].type);
+    EXPECT_EQ(exact.regions[r].point, noisy.regions[r].point);
+    EXPECT_EQ(exact.regions[r].axis, noisy.regions[r].axis);
+    EXPECT_EQ(exact.regions[r].radius, noisy.regions[r].radius);
   }
 }
 
@@ -435,6 +438,53 @@ TEST(ShapeGenerator, FineUniformShapesAreQuick) {
     // Generous: Debug and sanitizer builds are several times slower than Release.
     EXPECT_LT(seconds, 10.0) << name;
     RecordProperty(name + "_faces", static_cast<int>(shape.mesh.face_count()));
+  }
+}
+
+}  // namespace
+}  // namespace primseg
+
+namespace primseg {
+namespace {
+
+/// Closed, manifold, outward and on-primitive across the whole option range, not only at the
+/// defaults (coarse circles, triangular holes, huge or tiny Uniform edges).
+TEST(ShapeGenerator, ValidAcrossOptionRanges) {
+  std::vector<ShapeOptions> variants;
+  for (int segments : {3, 4, 5, 7, 16, 100}) {
+    ShapeOptions o;
+    o.segments = segments;
+    variants.push_back(o);
+  }
+  for (double edge_length : {1.0, 0.5, 0.3, 0.2, 0.12, 0.07, 0.03}) {
+    ShapeOptions o;
+    o.tessellation = Tessellation::Uniform;
+    o.edge_length = edge_length;
+    variants.push_back(o);
+  }
+  for (const ShapeOptions& options : variants) {
+    for (const std::string& name : shape_names()) {
+      SCOPED_TRACE(name + " segments " + std::to_string(options.segments) + " edge_length " +
+                   std::to_string(options.edge_length));
+      const GroundTruthShape shape = make_shape(name, options);
+      std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+      for (const Triangle& t : shape.mesh.triangles) {
+        for (int i = 0; i < 3; ++i) ++directed[{t[i], t[(i + 1) % 3]}];
+      }
+      bool manifold = true;
+      for (const auto& [edge, count] : directed) {
+        manifold = manifold && count == 1 && directed.count({edge.second, edge.first}) == 1;
+      }
+      EXPECT_TRUE(manifold);
+      EXPECT_GT(signed_volume(shape.mesh), 0);
+      EXPECT_EQ(edge_components(shape.mesh, [](std::uint32_t) { return true; }), 1);
+      for (std::uint32_t r = 0; r < shape.regions.size(); ++r) {
+        EXPECT_EQ(edge_components(shape.mesh,
+                                  [&](std::uint32_t f) { return shape.region_of_face[f] == r; }),
+                  1);
+      }
+      expect_vertices_on_primitives(shape);
+    }
   }
 }
 
