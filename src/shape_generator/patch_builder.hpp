@@ -45,6 +45,13 @@ struct CircleFrame {
   Vec3 sphere_point(double radius, double polar, double angle) const;
 };
 
+/// Builds a solid patch by patch. Shared boundaries are created once (straight_edge, circle,
+/// latitude) and handed to both adjacent patches. Every triangle is oriented by its region's
+/// outward normal, so patch code need not care about vertex order.
+///
+/// New curved surfaces need only a point function and a list of rings: a cone is rings of
+/// shrinking radius ending in an apex pole(); a torus is its minor circles joined by
+/// ring_strips(region, rings, /*wrap=*/true); a partial surface uses open rings (Ring::closed).
 class PatchBuilder {
  public:
   /// `diagonal`: bounding-box diagonal of the shape, the unit of ShapeOptions::edge_length.

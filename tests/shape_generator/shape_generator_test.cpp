@@ -219,6 +219,12 @@ TEST_P(EveryShape, IsClosedManifoldAndOutwardOriented) {
   EXPECT_GT(signed_volume(mesh), 0);
 }
 
+TEST_P(EveryShape, SatisfiesTheMeshInvariants) {
+  const GroundTruthShape shape = make_shape(name(), options());
+  EXPECT_NO_THROW(shape.mesh.validate());
+  EXPECT_NEAR(bounding_box_diagonal(shape.mesh), diagonal(shape.mesh), 1e-12);
+}
+
 TEST_P(EveryShape, VolumeMatchesTheSolid) {
   const GroundTruthShape shape = make_shape(name(), options());
   const double expected = expectations().at(name()).volume;
