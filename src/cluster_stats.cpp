@@ -1,5 +1,7 @@
 #include "primseg/cluster_stats.hpp"
 
+#include <cmath>
+
 namespace primseg {
 namespace {
 
@@ -29,11 +31,52 @@ constexpr auto kIndex = make_index();
 constexpr double kBinomial[5][5] = {
     {1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0}, {1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
 
-// Exponents of the monomial of a full tensor entry (a, b, ...) with axis indices 0..2.
-int index_of_axes(std::initializer_list<int> axes) {
-  int e[3] = {0, 0, 0};
-  for (int a : axes) ++e[a];
-  return Moments::index(e[0], e[1], e[2]);
+// One term C(α, β) (−d)^(α−β) M_β of the translation of monomial α.
+struct TranslationTerm {
+  std::uint8_t target, source, shift;
+  double coefficient;
+};
+
+constexpr int count_translation_terms() {
+  int n = 0;
+  for (const Monomial& m : kMonomials) n += (m.i + 1) * (m.j + 1) * (m.k + 1);
+  return n;
+}
+
+constexpr auto make_translation_terms() {
+  std::array<TranslationTerm, count_translation_terms()> terms{};
+  int n = 0;
+  for (int target = 0; target < Moments::kCount; ++target) {
+    const Monomial& m = kMonomials[target];
+    for (int a = 0; a <= m.i; ++a)
+      for (int b = 0; b <= m.j; ++b)
+        for (int c = 0; c <= m.k; ++c)
+          terms[n++] = {
+              static_cast<std::uint8_t>(target),
+              static_cast<std::uint8_t>(kIndex[(a * 5 + b) * 5 + c]),
+              static_cast<std::uint8_t>(kIndex[((m.i - a) * 5 + (m.j - b)) * 5 + (m.k - c)]),
+              kBinomial[m.i][a] * kBinomial[m.j][b] * kBinomial[m.k][c]};
+  }
+  return terms;
+}
+constexpr auto kTranslationTerms = make_translation_terms();
+
+// Monomial index of the full tensor entry with axes (a, b, c, d) (a 4-digit base-3 number;
+// lower degrees pad with the axis value 3, which adds no exponent).
+constexpr std::array<std::uint8_t, 256> make_axes_index() {
+  std::array<std::uint8_t, 256> table{};
+  for (int key = 0; key < 256; ++key) {
+    int e[4] = {0, 0, 0, 0};
+    for (int digit = 0, k = key; digit < 4; ++digit, k /= 4) ++e[k % 4];
+    if (e[0] + e[1] + e[2] + e[3] == 4)
+      table[key] = static_cast<std::uint8_t>(kIndex[(e[0] * 5 + e[1]) * 5 + e[2]]);
+  }
+  return table;
+}
+constexpr auto kAxesIndex = make_axes_index();
+
+constexpr int axes(int a, int b, int c = 3, int d = 3) {
+  return kAxesIndex[a + 4 * (b + 4 * (c + 4 * d))];
 }
 
 }  // namespace
@@ -65,26 +108,22 @@ void Moments::add_point(const Eigen::Vector3d& x, double w) {
 }
 
 Moments Moments::translated(const Eigen::Vector3d& new_origin) const {
-  // Σ w (y − d)^α with y = x − o and d = o' − o, expanded binomially per axis.
+  // Σ w (y − d)^α with y = x − o and d = o' − o: each target monomial α is a fixed combination
+  // Σ_β C(α, β) (−d)^(α−β) M_β over sub-monomials β ≤ α, listed once in kTranslationTerms.
   const Eigen::Vector3d d = new_origin - origin_;
-  double nx[5], ny[5], nz[5];
-  nx[0] = ny[0] = nz[0] = 1;
+  double px[5], py[5], pz[5];
+  px[0] = py[0] = pz[0] = 1;
   for (int p = 1; p <= 4; ++p) {
-    nx[p] = nx[p - 1] * -d.x();
-    ny[p] = ny[p - 1] * -d.y();
-    nz[p] = nz[p - 1] * -d.z();
+    px[p] = px[p - 1] * -d.x();
+    py[p] = py[p - 1] * -d.y();
+    pz[p] = pz[p - 1] * -d.z();
   }
+  double shift[kCount];
+  for (int n = 0; n < kCount; ++n)
+    shift[n] = px[kMonomials[n].i] * py[kMonomials[n].j] * pz[kMonomials[n].k];
   Moments result(new_origin);
-  for (int n = 0; n < kCount; ++n) {
-    const Monomial& m = kMonomials[n];
-    double sum = 0;
-    for (int a = 0; a <= m.i; ++a)
-      for (int b = 0; b <= m.j; ++b)
-        for (int c = 0; c <= m.k; ++c)
-          sum += kBinomial[m.i][a] * kBinomial[m.j][b] * kBinomial[m.k][c] * nx[m.i - a] *
-                 ny[m.j - b] * nz[m.k - c] * values_[kIndex[(a * 5 + b) * 5 + c]];
-    result.values_[n] = sum;
-  }
+  for (const TranslationTerm& term : kTranslationTerms)
+    result.values_[term.target] += term.coefficient * shift[term.shift] * values_[term.source];
   return result;
 }
 
@@ -101,7 +140,7 @@ Moments& Moments::operator+=(const Moments& other) {
 Eigen::Matrix3d Moments::second_moment() const {
   Eigen::Matrix3d s;
   for (int a = 0; a < 3; ++a)
-    for (int b = a; b < 3; ++b) s(a, b) = s(b, a) = values_[index_of_axes({a, b})];
+    for (int b = a; b < 3; ++b) s(a, b) = s(b, a) = values_[axes(a, b)];
   return s;
 }
 
@@ -109,7 +148,7 @@ Eigen::Vector3d Moments::third_moment_contracted(const Eigen::Matrix3d& q) const
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b)
-      for (int c = 0; c < 3; ++c) v[a] += q(b, c) * values_[index_of_axes({a, b, c})];
+      for (int c = 0; c < 3; ++c) v[a] += q(b, c) * values_[axes(a, b, c)];
   return v;
 }
 
@@ -118,30 +157,54 @@ double Moments::fourth_moment_contracted(const Eigen::Matrix3d& q) const {
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b)
       for (int c = 0; c < 3; ++c)
-        for (int d = 0; d < 3; ++d) sum += q(a, b) * q(c, d) * values_[index_of_axes({a, b, c, d})];
+        for (int d = 0; d < 3; ++d) sum += q(a, b) * q(c, d) * values_[axes(a, b, c, d)];
   return sum;
 }
 
-void ClusterStats::merge(const ClusterStats& other, const std::array<double, 6>& shared_tensor) {
+void ClusterStats::merge(const ClusterStats& other, const EdgeStats& shared_edges) {
+  // (c − o) = (c − o_other) + (o_other − o).
+  normal_position += other.normal_position +
+                     (other.moments.origin() - moments.origin()) * other.normal_sum.transpose();
   moments += other.moments;
-  for (int n = 0; n < 6; ++n) tensor[n] += other.tensor[n] + shared_tensor[n];
+  edges += other.edges;
+  edges += shared_edges;
   normal_sum += other.normal_sum;
   area += other.area;
   triangle_count += other.triangle_count;
 }
 
-Eigen::Matrix3d ClusterStats::tensor_matrix() const {
+ClusterStats ClusterStats::translated(const Eigen::Vector3d& new_origin) const {
+  ClusterStats result = *this;
+  result.normal_position -= (new_origin - moments.origin()) * normal_sum.transpose();
+  result.moments = moments.translated(new_origin);
+  return result;
+}
+
+double ClusterStats::normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vector3d& point,
+                                      double radius) const {
+  if (!(area > 0) || !(radius > 0)) return 0;
+  // Σ A n · Q (c − p) = tr(Q Σ (c − o) (A n)ᵀ) − (A n)ᵀ Q (p − o), summed over triangles.
+  const double sum = (q * normal_position).trace() - normal_sum.dot(q * (point - moments.origin()));
+  return std::abs(sum) / (radius * area);
+}
+
+EdgeStats& EdgeStats::operator+=(const EdgeStats& other) {
+  for (int n = 0; n < 6; ++n) tensor[n] += other.tensor[n];
+  return *this;
+}
+
+Eigen::Matrix3d EdgeStats::tensor_matrix() const {
   Eigen::Matrix3d t;
   t << tensor[0], tensor[1], tensor[2], tensor[1], tensor[3], tensor[4], tensor[2], tensor[4],
       tensor[5];
   return t;
 }
 
-void add_edge_to_tensor(std::array<double, 6>& tensor, const Eigen::Vector3d& edge, double beta) {
-  const double length = edge.norm();
-  if (!(length > 0)) return;
+void EdgeStats::add_edge(const Eigen::Vector3d& edge, double beta) {
+  const double edge_length = edge.norm();
+  if (!(edge_length > 0)) return;
   // |e| β ê êᵀ = (β / |e|) e eᵀ.
-  const double s = beta / length;
+  const double s = beta / edge_length;
   tensor[0] += s * edge.x() * edge.x();
   tensor[1] += s * edge.x() * edge.y();
   tensor[2] += s * edge.x() * edge.z();

@@ -218,14 +218,14 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights)
       beta = std::atan2(n1.cross(n2).norm(), n1.dot(n2));
       if ((positions_[opposite] - positions_[link.low]).dot(n1) > 0) beta = -beta;
     }
-    std::array<double, 6> tensor{};
-    add_edge_to_tensor(tensor, edge, beta);
+    EdgeStats stats;
+    stats.add_edge(edge, beta);
     const std::uint32_t fa = mesh.face_of_triangle[link.first];
     const std::uint32_t fb = mesh.face_of_triangle[link.second];
     if (fa == fb)
-      internal_tensors_.push_back({fa, tensor});
+      internal_edges_.push_back({fa, stats});
     else
-      records.push_back({std::min(fa, fb), std::max(fa, fb), tensor});
+      records.push_back({std::min(fa, fb), std::max(fa, fb), stats});
   }
   std::vector<TriangleLink>().swap(links);
 
@@ -236,12 +236,12 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights)
   std::stable_sort(records.begin(), records.end(), by_faces);
   for (const DualEdge& r : records) {
     if (!edges_.empty() && edges_.back().first == r.first && edges_.back().second == r.second) {
-      for (int n = 0; n < 6; ++n) edges_.back().tensor[n] += r.tensor[n];
+      edges_.back().shared += r.shared;
     } else {
       edges_.push_back(r);
     }
   }
-  std::stable_sort(internal_tensors_.begin(), internal_tensors_.end(),
+  std::stable_sort(internal_edges_.begin(), internal_edges_.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
 
   UnionFind components(face_count);
@@ -285,15 +285,17 @@ ClusterStats DualGraph::face_stats(std::uint32_t f) const {
     Eigen::Vector3d n =
         (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
     if (flipped_[t]) n = -n;
+    const Eigen::Vector3d centroid =
+        (positions_[tri[0]] + positions_[tri[1]] + positions_[tri[2]]) / 3;
+    stats.normal_position += (centroid - stats.moments.origin()) * (0.5 * n).transpose();
     stats.normal_sum += 0.5 * n;
     stats.area += 0.5 * n.norm();
     ++stats.triangle_count;
   }
   auto it =
-      std::lower_bound(internal_tensors_.begin(), internal_tensors_.end(), f,
+      std::lower_bound(internal_edges_.begin(), internal_edges_.end(), f,
                        [](const auto& entry, std::uint32_t face) { return entry.first < face; });
-  for (; it != internal_tensors_.end() && it->first == f; ++it)
-    for (int n = 0; n < 6; ++n) stats.tensor[n] += it->second[n];
+  for (; it != internal_edges_.end() && it->first == f; ++it) stats.edges += it->second;
   return stats;
 }
 

@@ -13,10 +13,13 @@ namespace {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
-// Candidate merges ordered by (cost, degree of the merged node, smaller id, larger id). The
-// version only tells stale entries apart; it never decides between live ones.
+// Candidate merges ordered by (cost, primitive type, degree of the merged node, smaller id, larger
+// id). On equal cost (in practice: zero, exact fits) simpler types go first, so flat regions are
+// whole before exact curved fits can reach into them. The version only tells stale entries
+// apart; it never decides between live ones.
 struct HeapEntry {
   double cost;
+  PrimitiveType type;
   std::uint32_t degree;
   std::uint32_t low, high;
   std::uint32_t edge;
@@ -26,6 +29,7 @@ struct HeapEntry {
 // std heaps are max-heaps: "a after b" puts the smallest key on top.
 bool comes_after(const HeapEntry& a, const HeapEntry& b) {
   if (a.cost != b.cost) return a.cost > b.cost;
+  if (a.type != b.type) return a.type > b.type;
   if (a.degree != b.degree) return a.degree > b.degree;
   if (a.low != b.low) return a.low > b.low;
   if (a.high != b.high) return a.high > b.high;
@@ -36,12 +40,11 @@ struct LiveEdge {
   std::uint32_t a, b;  // current node ids of the two clusters
   std::uint32_t version = 0;
   bool alive = true;
-  std::array<double, 6> tensor;  // of the mesh edges between the two clusters
+  EdgeStats shared;  // the mesh edges between the two clusters
 };
 
-ClusterStats centred(ClusterStats stats) {
-  stats.moments = stats.moments.translated(stats.moments.centroid());
-  return stats;
+ClusterStats centred(const ClusterStats& stats) {
+  return stats.centred();
 }
 
 }  // namespace
@@ -147,7 +150,7 @@ class HierarchyBuilder::Impl {
     edges_.reserve(graph_->edges().size());
     for (const DualEdge& e : graph_->edges()) {
       const auto id = static_cast<std::uint32_t>(edges_.size());
-      edges_.push_back({e.first, e.second, 0, true, e.tensor});
+      edges_.push_back({e.first, e.second, 0, true, e.shared});
       adjacency_[e.first].push_back(id);
       adjacency_[e.second].push_back(id);
     }
@@ -224,7 +227,7 @@ class HierarchyBuilder::Impl {
 
   ClusterStats union_stats(const LiveEdge& e) const {
     ClusterStats stats = stats_[slot_of_node_[e.a]];
-    stats.merge(stats_[slot_of_node_[e.b]], e.tensor);
+    stats.merge(stats_[slot_of_node_[e.b]], e.shared);
     return stats;
   }
 
@@ -252,7 +255,8 @@ class HierarchyBuilder::Impl {
   HeapEntry candidate(std::uint32_t id) {
     const LiveEdge& e = edges_[id];
     const detail::SelectedModel model = select(union_stats(e), e);
-    return {model.cost, merged_degree(e.a, e.b), std::min(e.a, e.b), std::max(e.a, e.b), id,
+    return {model.cost,         model.fit.primitive.type, merged_degree(e.a, e.b),
+            std::min(e.a, e.b), std::max(e.a, e.b),       id,
             e.version};
   }
 
@@ -302,7 +306,7 @@ class HierarchyBuilder::Impl {
           kept.push_back(id);
         } else {
           LiveEdge& into = edges_[marker_[other]];
-          for (int n = 0; n < 6; ++n) into.tensor[n] += e.tensor[n];
+          into.shared += e.shared;
           e.alive = false;
         }
       }

@@ -54,28 +54,47 @@ class Moments {
   std::array<double, kCount> values_{};
 };
 
+/// Statistics of a set of mesh edges: those inside a cluster, or those between two clusters.
+struct EdgeStats {
+  /// Normal-variation tensor Σ |e| β(e) ê êᵀ as the upper triangle (xx, xy, xz, yy, yz, zz). β
+  /// is the signed dihedral angle (positive where convex).
+  std::array<double, 6> tensor{};
+
+  /// Adds the edge vector e with dihedral angle beta (radians).
+  void add_edge(const Eigen::Vector3d& e, double beta);
+  EdgeStats& operator+=(const EdgeStats& other);
+  Eigen::Matrix3d tensor_matrix() const;
+};
+
 /// Everything a primitive fit needs to know about a cluster; all sums over its triangles, so the
 /// statistics of a union are the sums of its parts (plus the tensor of the edges between them).
 struct ClusterStats {
   /// Moments of the weighted triangle corners (working frame).
   Moments moments;
-  /// Normal-variation tensor Σ |e| β(e) ê êᵀ over the cluster's internal edges, as the upper
-  /// triangle (xx, xy, xz, yy, yz, zz). β is the signed dihedral angle (positive where convex).
-  std::array<double, 6> tensor{};
+  /// The cluster's internal edges (between two of its triangles).
+  EdgeStats edges;
   /// Σ over triangles of area × unit normal (consistently oriented), for orienting plane normals.
   Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+  /// Σ over triangles of (centroid − moments.origin()) (area × unit normal)ᵀ: with normal_sum,
+  /// it gives how well the face normals agree with a curved primitive's normal field.
+  Eigen::Matrix3d normal_position = Eigen::Matrix3d::Zero();
   /// Σ triangle area (working frame).
   double area = 0;
   /// Number of triangles (the fits' minimum support is counted in triangles).
   std::uint32_t triangle_count = 0;
 
-  /// Adds other (which must not share triangles with this) and the tensor of the edges between
-  /// the two clusters.
-  void merge(const ClusterStats& other, const std::array<double, 6>& shared_tensor);
-  Eigen::Matrix3d tensor_matrix() const;
+  /// Adds other (which must not share triangles with this) and the edges between the two.
+  void merge(const ClusterStats& other, const EdgeStats& shared_edges);
+  /// The same statistics about another origin.
+  ClusterStats translated(const Eigen::Vector3d& new_origin) const;
+  /// The same statistics about the centroid (what the fitters take).
+  ClusterStats centred() const { return translated(moments.centroid()); }
+  /// Area-weighted mean of |n · ν| over the triangles, where ν(x) = Q (x − point) / radius is the
+  /// unit normal field of a sphere (Q = I) or cylinder (Q = I − a aᵀ) at the triangle centroids
+  /// (first order). 1 when every face agrees with the surface, about cos(θ/2) for facets that
+  /// span an angle θ, and near the area fraction of the agreeing faces for a mixed cluster.
+  double normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vector3d& point,
+                          double radius) const;
 };
-
-/// Adds |e| β ê êᵀ for the edge vector e to an upper-triangle tensor.
-void add_edge_to_tensor(std::array<double, 6>& tensor, const Eigen::Vector3d& edge, double beta);
 
 }  // namespace primseg

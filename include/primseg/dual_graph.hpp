@@ -46,8 +46,8 @@ WorkingFrame working_frame_for(const Mesh& mesh);
 /// A dual edge: two input faces sharing at least one mesh edge.
 struct DualEdge {
   std::uint32_t first, second;  ///< input faces, first < second
-  /// Σ |e| β ê êᵀ over the mesh edges the two faces share (upper triangle, working frame).
-  std::array<double, 6> tensor;
+  /// The mesh edges the two faces share (working frame).
+  EdgeStats shared;
 };
 
 /// Dual graph and working geometry of a mesh.
@@ -94,8 +94,8 @@ class DualGraph {
   std::vector<std::uint32_t> component_of_face_;
   std::uint32_t component_count_ = 0;
   std::vector<DualEdge> edges_;
-  /// Tensors of the edges inside polygon faces, sorted by face (only faces that have some).
-  std::vector<std::pair<std::uint32_t, std::array<double, 6>>> internal_tensors_;
+  /// Edges inside polygon faces, sorted by face (only faces that have some).
+  std::vector<std::pair<std::uint32_t, EdgeStats>> internal_edges_;
 };
 
 }  // namespace primseg

@@ -29,7 +29,7 @@ PrimitiveFit CylinderFitter::fit(const ClusterStats& centred) const {
   result.primitive.type = PrimitiveType::Cylinder;
   if (centred.triangle_count < min_triangles() || !(centred.area > 0)) return result;
 
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(centred.tensor_matrix());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(centred.edges.tensor_matrix());
   const Eigen::Vector3d lambda = solver.eigenvalues();
   const int largest = std::abs(lambda(0)) > std::abs(lambda(2)) ? 0 : 2;
   if (!(std::abs(lambda(largest)) > kMinRelativeAxisEigenvalue * std::sqrt(centred.area)))
@@ -56,6 +56,8 @@ PrimitiveFit CylinderFitter::fit(const ClusterStats& centred) const {
   if (!circle.valid) return result;
 
   const Eigen::Vector3d point = m.origin() + basis.transpose() * circle.centre;
+  if (centred.normal_alignment(projector, point, circle.radius) < kMinNormalAlignment)
+    return result;
   result.valid = true;
   result.error = circle.error;
   result.primitive.point = {point.x(), point.y(), point.z()};

@@ -8,63 +8,75 @@ namespace primseg::detail {
 
 template <int D>
 PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments) {
-  constexpr int n = D + 2;
-  using Matrix = Eigen::Matrix<double, n, n>;
+  using Vector = Eigen::Matrix<double, D, 1>;
+  using Matrix = Eigen::Matrix<double, D, D>;
   PrattResult<D> result;
-  const double spread2 = moments.second.trace() / moments.weight;
-  if (!(moments.weight > 0) || !(spread2 > 0) || !std::isfinite(spread2)) return result;
+  const double w = moments.weight;
+  const double spread2 = moments.second.trace() / w;
+  if (!(w > 0) || !(spread2 > 0) || !std::isfinite(spread2)) return result;
 
-  // Scale the points to unit RMS spread so that the matrix entries are of comparable size.
-  const double s = 1 / std::sqrt(spread2);
-  const double s2 = s * s;
-  Matrix m = Matrix::Zero();
-  m(0, 0) = moments.fourth * s2 * s2;
-  m.template block<1, D>(0, 1) = (moments.third * s2 * s).transpose();
-  m(0, n - 1) = moments.second.trace() * s2;
-  m.template block<D, D>(1, 1) = moments.second * s2;
-  m(n - 1, n - 1) = moments.weight;
-  m.template block<D, 1>(1, 0) = m.template block<1, D>(0, 1).transpose();
-  m(n - 1, 0) = m(0, n - 1);
+  // Scale the points to unit RMS spread so that every quantity below is of order w.
+  const double scale = 1 / std::sqrt(spread2);
+  const double scale2 = scale * scale;
+  const double f = moments.fourth * scale2 * scale2;  // Σ w |p|⁴
+  const Vector t = moments.third * (scale2 * scale);  // Σ w p |p|²
+  const Matrix c = moments.second * scale2;           // Σ w p pᵀ
+  const double s = c.trace();                         // Σ w |p|²
 
-  Matrix constraint = Matrix::Zero();
-  constraint(0, n - 1) = constraint(n - 1, 0) = -2;
-  for (int a = 1; a <= D; ++a) constraint(a, a) = 1;
-
-  // M θ = η N θ, i.e. η is an eigenvalue of N⁻¹M; the fit is the smallest η whose eigenvector
-  // is a real sphere (θᵀNθ > 0; the one negative η has θᵀNθ < 0). N⁻¹M swaps and scales the A
-  // and C rows of M. Not the symmetric-definite route: an exact fit makes M singular, and a
-  // Cholesky factor of a singular M is garbage.
-  Matrix reduced = m;
-  reduced.row(0) = -0.5 * m.row(n - 1);
-  reduced.row(n - 1) = -0.5 * m.row(0);
-  Eigen::EigenSolver<Matrix> solver(reduced, true);
-  if (solver.info() != Eigen::Success) return result;
-  int best = -1;
-  double best_eta = 0, norm = 0;
-  Eigen::Matrix<double, n, 1> theta;
-  for (int k = 0; k < n; ++k) {
-    const Eigen::Matrix<double, n, 1> candidate = solver.eigenvectors().col(k).real();
-    const double candidate_norm = candidate.dot(constraint * candidate);
-    if (!(candidate_norm > 0)) continue;
-    const double eta = solver.eigenvalues()(k).real();
-    if (best < 0 || eta < best_eta) {
-      best = k;
-      best_eta = eta;
-      norm = candidate_norm;
-      theta = candidate;
+  // With θ = (A, B, C) and centred points, the rows of (M − ηN) θ = 0 give
+  //   C = −(s + 2η) A / w,   B = −(c − ηI)⁻¹ t A,
+  // and A ≠ 0 solves the secular equation
+  //   g(η) = f − (s + 2η)² / w − Σ_k τ_k² / (λ_k − η) = 0,   τ = Uᵀ t,  c = U Λ Uᵀ.
+  // On [0, λ_min) g is strictly decreasing with g(0) ≥ 0 (a Schur complement of the positive
+  // semi-definite M), so the smallest η ≥ 0 is its only root there. No root before λ_min means
+  // the optimum is the plane limit (A = 0): not a sphere.
+  Eigen::SelfAdjointEigenSolver<Matrix> eigen(c);
+  const Vector lambda = eigen.eigenvalues();
+  const Vector tau = eigen.eigenvectors().transpose() * t;
+  auto g = [&](double eta, double* derivative) {
+    double value = f - (s + 2 * eta) * (s + 2 * eta) / w;
+    double slope = -4 * (s + 2 * eta) / w;
+    for (int k = 0; k < D; ++k) {
+      const double gap = lambda(k) - eta;
+      value -= tau(k) * tau(k) / gap;
+      slope -= tau(k) * tau(k) / (gap * gap);
+    }
+    *derivative = slope;
+    return value;
+  };
+  double lo = 0, hi = lambda(0);
+  if (!(hi > 0)) return result;  // flat data: the plane itself
+  double eta = 0, slope = 0;
+  double value = g(eta, &slope);
+  if (!(value > 0)) {
+    eta = 0;  // an exact fit (round-off can make g(0) a hair negative)
+  } else {
+    for (int iteration = 0; iteration < 200; ++iteration) {
+      if (value > 0)
+        lo = eta;
+      else
+        hi = eta;
+      // Newton while it stays inside the bracket, bisection otherwise.
+      double next = eta - value / slope;
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (!(std::abs(next - eta) > 1e-15 * std::max(hi, 1e-300))) break;
+      eta = next;
+      value = g(eta, &slope);
+      if (value == 0) break;
     }
   }
-  if (best < 0) return result;
-  const double a = theta(0);
-  const Eigen::Matrix<double, D, 1> b = theta.template segment<D>(1);
-  // r² = (|B|² − 4AC) / (4A²) in scaled units.
-  const double relative_radius = std::sqrt(norm) / (2 * std::abs(a));
-  if (!(relative_radius <= kMaxRelativeRadius)) return result;
+  const double gap_to_plane = lambda(0) - eta;
+  if (!(gap_to_plane > 1e-12 * lambda(D - 1))) return result;
 
+  Vector b = Vector::Zero();
+  for (int k = 0; k < D; ++k) b -= eigen.eigenvectors().col(k) * (tau(k) / (lambda(k) - eta));
+  // With A = 1: centre −B/2, r² = (|B|² − 4C) / 4 = |B|²/4 + (s + 2η)/w.
+  const double relative_radius = std::sqrt(b.squaredNorm() / 4 + (s + 2 * eta) / w);
+  if (!(relative_radius <= kMaxRelativeRadius)) return result;
   result.valid = true;
-  result.error = std::max(0.0, theta.dot(m * theta) / norm) / s2;
-  result.centre = -b / (2 * a) / s;
-  result.radius = relative_radius / s;
+  result.error = std::max(0.0, eta) / scale2;
+  result.centre = -b / 2 / scale;
+  result.radius = relative_radius / scale;
   return result;
 }
 

@@ -24,6 +24,9 @@ PrimitiveFit SphereFitter::fit(const ClusterStats& centred) const {
   const detail::PrattResult<3> sphere = detail::pratt_fit(moments);
   if (!sphere.valid) return result;
   const Eigen::Vector3d centre = m.origin() + sphere.centre;
+  if (centred.normal_alignment(Eigen::Matrix3d::Identity(), centre, sphere.radius) <
+      kMinNormalAlignment)
+    return result;
   result.valid = true;
   result.error = sphere.error;
   result.primitive.point = {centre.x(), centre.y(), centre.z()};

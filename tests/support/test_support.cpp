@@ -86,10 +86,8 @@ namespace primseg::testing {
 ClusterStats whole_mesh_stats(const DualGraph& graph) {
   ClusterStats stats = graph.face_stats(0);
   for (std::uint32_t f = 1; f < graph.face_count(); ++f) stats.merge(graph.face_stats(f), {});
-  for (const DualEdge& e : graph.edges())
-    for (int n = 0; n < 6; ++n) stats.tensor[n] += e.tensor[n];
-  stats.moments = stats.moments.translated(stats.moments.centroid());
-  return stats;
+  for (const DualEdge& e : graph.edges()) stats.edges += e.shared;
+  return stats.centred();
 }
 
 }  // namespace primseg::testing

@@ -36,6 +36,13 @@ class PrimitiveFitter {
   virtual PrimitiveFit fit(const ClusterStats& centred) const = 0;
 };
 
+/// Curved fits must agree with the face normals (ClusterStats::normal_alignment at least this):
+/// the vertices of a coarse CAD triangulation lie exactly on many wrong surfaces (the rim of a
+/// flat cap lies on the cylinder it closes; two faces of a box corner on a circle through three
+/// points), but their faces' normals do not follow those surfaces. 0.9 admits facets spanning up
+/// to about 50 degrees of arc.
+inline constexpr double kMinNormalAlignment = 0.9;
+
 /// The fitter of a type. Throws InvalidInputError for a type without one.
 const PrimitiveFitter& fitter_for(PrimitiveType type);
 

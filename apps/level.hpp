@@ -1,0 +1,26 @@
+#pragma once
+// Which level of the hierarchy a command reports, as given on the command line.
+
+#include <optional>
+#include <string>
+
+#include "primseg/cut.hpp"
+
+namespace primseg::cli {
+
+struct LevelChoice {
+  std::optional<std::uint32_t> clusters;  // --clusters K
+  std::optional<std::string> tolerance;   // --tolerance T or T% (of the bounding-box diagonal)
+};
+
+/// Parses "T" or "T%" into input units. Throws InvalidInputError naming the option.
+double parse_tolerance(const std::string& text, double bounding_box_diagonal);
+
+/// The segmentation for a level choice; with neither option, the default tolerance below.
+Segmentation cut(const Hierarchy& hierarchy, const LevelChoice& level);
+
+/// Default level when none is given: clusters whose RMS estimate is within this percentage of
+/// the bounding-box diagonal.
+inline constexpr const char* kDefaultTolerance = "0.1%";
+
+}  // namespace primseg::cli

@@ -1,0 +1,88 @@
+#include "outputs.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "../src/atomic_write.hpp"
+#include "primseg/error.hpp"
+#include "primseg/mesh_io.hpp"
+
+namespace primseg::cli {
+namespace {
+
+nlohmann::json vec(const Vec3& v) {
+  return nlohmann::json::array({v[0], v[1], v[2]});
+}
+
+}  // namespace
+
+nlohmann::json primitive_params(const Primitive& p) {
+  switch (p.type) {
+    case PrimitiveType::Plane:
+      return {{"normal", vec(p.axis)}, {"point", vec(p.point)}};
+    case PrimitiveType::Sphere:
+      return {{"center", vec(p.point)}, {"radius", p.radius}};
+    case PrimitiveType::Cylinder:
+      return {{"axis", vec(p.axis)}, {"point", vec(p.point)}, {"radius", p.radius}};
+    case PrimitiveType::Cone:
+      return {{"apex", vec(p.point)}, {"axis", vec(p.axis)}, {"half_angle", p.half_angle}};
+    case PrimitiveType::Torus:
+      return {{"center", vec(p.point)},
+              {"axis", vec(p.axis)},
+              {"major_radius", p.radius},
+              {"minor_radius", p.minor_radius}};
+  }
+  return {};
+}
+
+void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
+                         const std::vector<ClusterReport>& reports, const OutputFiles& files,
+                         const nlohmann::json& summary) {
+  if (files.labels) {
+    std::string text;
+    text.reserve(segmentation.labels.size() * 4);
+    for (std::uint32_t label : segmentation.labels) {
+      text += std::to_string(label);
+      text += '\n';
+    }
+    detail::write_file_atomically(*files.labels, text);
+  }
+  if (files.json) {
+    nlohmann::json json = summary;
+    nlohmann::json clusters = nlohmann::json::array();
+    for (const ClusterReport& r : reports)
+      clusters.push_back({{"id", r.id},
+                          {"type", std::string(to_string(r.primitive.type))},
+                          {"faces", r.face_count},
+                          {"area", r.area},
+                          {"rms", r.rms},
+                          {"max", r.max},
+                          {"params", primitive_params(r.primitive)}});
+    json["clusters"] = std::move(clusters);
+    detail::write_file_atomically(*files.json, json.dump(2) + "\n");
+  }
+  if (files.colored) {
+    const std::filesystem::path path(*files.colored);
+    const MeshFormat format = mesh_format_from_path(path);
+    if (format != MeshFormat::Ply && format != MeshFormat::Obj)
+      throw InvalidInputError("--colored: " + path.string() + " must end in .ply or .obj");
+    MeshWriteOptions options;
+    options.face_groups = segmentation.labels;
+    write_mesh(path, hierarchy.mesh(), options);
+  }
+}
+
+void print_summary(const std::vector<ClusterReport>& reports, std::size_t max_rows) {
+  std::printf("%zu clusters\n", reports.size());
+  std::printf("%6s  %-8s  %8s  %12s  %12s  %12s\n", "id", "type", "faces", "area", "rms", "max");
+  for (std::size_t i = 0; i < reports.size() && i < max_rows; ++i) {
+    const ClusterReport& r = reports[i];
+    std::printf("%6u  %-8s  %8u  %12.5g  %12.5g  %12.5g\n", r.id,
+                std::string(to_string(r.primitive.type)).c_str(), r.face_count, r.area, r.rms,
+                r.max);
+  }
+  if (reports.size() > max_rows) std::printf("   ... %zu more\n", reports.size() - max_rows);
+}
+
+}  // namespace primseg::cli

@@ -1,0 +1,30 @@
+#pragma once
+// The per-level outputs shared by `segment` and `cut`: labels, JSON, coloured mesh, summary.
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "primseg/cut.hpp"
+
+namespace primseg::cli {
+
+struct OutputFiles {
+  std::optional<std::string> labels;   // one label per line, per input face
+  std::optional<std::string> json;     // clusters with primitives
+  std::optional<std::string> colored;  // .ply (face colours) or .obj (groups)
+  std::optional<std::string> tree;     // whole hierarchy (segment only)
+};
+
+/// JSON parameters of a primitive, input units.
+nlohmann::json primitive_params(const Primitive& primitive);
+
+/// Writes the requested per-level files. `summary` holds mesh and timing entries for the JSON.
+void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
+                         const std::vector<ClusterReport>& reports, const OutputFiles& files,
+                         const nlohmann::json& summary);
+
+/// A short human-readable table of the largest clusters, on stdout.
+void print_summary(const std::vector<ClusterReport>& reports, std::size_t max_rows = 12);
+
+}  // namespace primseg::cli
