@@ -53,22 +53,31 @@ class EarClipper {
   /// Appends loop.size() - 2 triangles of `loop` to `triangles`, oriented like the loop.
   void triangulate(std::span<const std::uint32_t> loop, const std::vector<Vec3>& positions,
                    std::vector<Triangle>& triangles) {
+    const std::size_t n = loop.size();
+    corners_.assign(loop.begin(), loop.end());
+    next_.resize(n);
+    previous_.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      next_[i] = i + 1 == n ? 0 : i + 1;
+      previous_[i] = i == 0 ? static_cast<std::uint32_t>(n - 1) : i - 1;
+    }
     const Vec3 normal = newell_normal(loop, positions);
     const double length =
         std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-    remaining_.assign(loop.begin(), loop.end());
-    if (!(length > 0.0) || !std::isfinite(length)) {
-      fan_remaining(triangles);  // Zero-area polygon: no plane to clip in, every split is equal.
-      return;
+    if (length > 0.0 && std::isfinite(length)) {
+      project(normal, length, loop, positions);
+      clip_ears(n, triangles);
+    } else {
+      // Zero-area polygon: no plane to clip in, and every split is as good as another.
+      fan(0, n, triangles);
     }
-    project(normal, length, positions);
-    clip_ears(triangles);
   }
 
  private:
   // Projects the loop on a basis (u, v) with u x v along the Newell normal, which makes the
   // projected loop counter-clockwise.
-  void project(const Vec3& normal, double length, const std::vector<Vec3>& positions) {
+  void project(const Vec3& normal, double length, std::span<const std::uint32_t> loop,
+               const std::vector<Vec3>& positions) {
     const Vec3 n{normal[0] / length, normal[1] / length, normal[2] / length};
     // Any vector not parallel to n seeds u: use the axis along n's smallest component.
     Vec3 seed{0.0, 0.0, 0.0};
@@ -82,29 +91,32 @@ class EarClipper {
     for (double& c : u) c /= u_length;
     const Vec3 v{n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
 
-    const Vec3& origin = positions[remaining_[0]];
+    // Relative to the first vertex, so that far-from-origin polygons keep their precision.
+    const Vec3& origin = positions[loop[0]];
     projected_.clear();
-    for (std::uint32_t vertex : remaining_) {
+    for (const std::uint32_t vertex : loop) {
       const Vec3& p = positions[vertex];
       const double dx = p[0] - origin[0], dy = p[1] - origin[1], dz = p[2] - origin[2];
       projected_.push_back({dx * u[0] + dy * u[1] + dz * u[2], dx * v[0] + dy * v[1] + dz * v[2]});
     }
-    // remaining_ from here on holds positions in projected_ (loop order), not vertex ids.
-    corners_.assign(remaining_.begin(), remaining_.end());
-    for (std::uint32_t i = 0; i < remaining_.size(); ++i) remaining_[i] = i;
   }
 
-  bool is_ear(std::size_t i, bool allow_flat) {
-    const std::size_t n = remaining_.size();
-    const Point2& a = projected_[remaining_[(i + n - 1) % n]];
-    const Point2& b = projected_[remaining_[i]];
-    const Point2& c = projected_[remaining_[(i + 1) % n]];
-    const double turn = cross(a, b, c);
-    if (allow_flat ? turn < 0.0 : turn <= 0.0) return false;
-    work_ += n;
-    for (std::size_t j = 0; j < n; ++j) {
-      if (j == i || j == (i + n - 1) % n || j == (i + 1) % n) continue;
-      const Point2& p = projected_[remaining_[j]];
+  double turn(std::uint32_t i) const {
+    return cross(projected_[previous_[i]], projected_[i], projected_[next_[i]]);
+  }
+
+  // Only reflex (or flat) vertices can lie in an ear, so convex stretches cost nothing to check.
+  bool is_ear(std::uint32_t i, bool allow_flat, std::size_t remaining) {
+    const double t = turn(i);
+    if (allow_flat ? t < 0.0 : t <= 0.0) return false;
+    if (reflex_count_ == 0) return true;
+    const Point2& a = projected_[previous_[i]];
+    const Point2& b = projected_[i];
+    const Point2& c = projected_[next_[i]];
+    work_ += remaining;
+    for (std::uint32_t j = next_[next_[i]]; j != previous_[i]; j = next_[j]) {
+      if (!reflex_[j]) continue;
+      const Point2& p = projected_[j];
       // Copies of a corner (e.g. a bridge to a hole) do not block the ear.
       if (same_point(p, a) || same_point(p, b) || same_point(p, c)) continue;
       if (inside_or_on_triangle(p, a, b, c)) return false;
@@ -112,45 +124,68 @@ class EarClipper {
     return true;
   }
 
-  void clip_ears(std::vector<Triangle>& triangles) {
-    // Scanning on from the last ear keeps the usual case quadratic; the work budget bounds
-    // pathological polygons (thousands of reflex vertices), which then get the fan fallback.
-    const std::size_t budget = std::max<std::size_t>(1u << 22, 64 * remaining_.size());
+  void update_reflex(std::uint32_t i) {
+    const bool reflex = turn(i) <= 0.0;
+    reflex_count_ += static_cast<std::size_t>(reflex) - static_cast<std::size_t>(reflex_[i]);
+    reflex_[i] = reflex;
+  }
+
+  void clip_ears(std::size_t n, std::vector<Triangle>& triangles) {
+    reflex_.assign(n, false);
+    reflex_count_ = 0;
+    for (std::uint32_t i = 0; i < n; ++i) update_reflex(i);
+    // The budget bounds pathological polygons (thousands of reflex vertices), which then get
+    // the fan fallback for what is left of them.
+    const std::size_t bounded_n = std::min<std::size_t>(n, std::size_t{1} << 24);
+    const std::size_t budget =
+        std::max<std::size_t>(std::size_t{1} << 22, 16 * bounded_n * bounded_n);
     work_ = 0;
-    std::size_t i = 0;
+    std::size_t remaining = n;
+    std::uint32_t i = 0;
     std::size_t misses = 0;
     // Flat ears (collinear or repeated vertices) are clipped only when no proper ear is left.
     bool allow_flat = false;
-    while (remaining_.size() > 3 && work_ < budget) {
-      const std::size_t n = remaining_.size();
-      if (is_ear(i, allow_flat)) {
-        triangles.push_back({corners_[remaining_[(i + n - 1) % n]], corners_[remaining_[i]],
-                             corners_[remaining_[(i + 1) % n]]});
-        remaining_.erase(remaining_.begin() + static_cast<std::ptrdiff_t>(i));
-        if (i == remaining_.size()) i = 0;
+    while (remaining > 3 && work_ < budget) {
+      if (!is_ear(i, allow_flat, remaining)) {
+        i = next_[i];
+        if (++misses < remaining) continue;
+        if (allow_flat) break;  // Self-intersecting or numerically hopeless: fan the rest.
+        allow_flat = true;
         misses = 0;
-        allow_flat = false;
         continue;
       }
-      i = (i + 1) % n;
-      if (++misses < n) continue;
-      if (allow_flat) break;  // Self-intersecting or numerically hopeless: fan the rest.
-      allow_flat = true;
+      const std::uint32_t before = previous_[i];
+      const std::uint32_t after = next_[i];
+      triangles.push_back({corners_[before], corners_[i], corners_[after]});
+      next_[before] = after;
+      previous_[after] = before;
+      if (reflex_[i]) --reflex_count_;
+      reflex_[i] = false;
+      --remaining;
+      update_reflex(before);
+      update_reflex(after);
+      i = after;
       misses = 0;
+      allow_flat = false;
     }
-    for (std::uint32_t& r : remaining_) r = corners_[r];
-    fan_remaining(triangles);
+    fan(i, remaining, triangles);
   }
 
-  void fan_remaining(std::vector<Triangle>& triangles) const {
-    for (std::size_t i = 1; i + 1 < remaining_.size(); ++i) {
-      triangles.push_back({remaining_[0], remaining_[i], remaining_[i + 1]});
+  // Fans the `count` vertices left in the linked loop, starting at `first`.
+  void fan(std::uint32_t first, std::size_t count, std::vector<Triangle>& triangles) const {
+    std::uint32_t b = next_[first];
+    for (std::size_t k = 2; k < count; ++k) {
+      triangles.push_back({corners_[first], corners_[b], corners_[next_[b]]});
+      b = next_[b];
     }
   }
 
-  std::vector<std::uint32_t> remaining_;
-  std::vector<std::uint32_t> corners_;
+  std::vector<std::uint32_t> corners_;  // Vertex ids, in loop order.
   std::vector<Point2> projected_;
+  std::vector<std::uint32_t> next_;
+  std::vector<std::uint32_t> previous_;
+  std::vector<bool> reflex_;  // Turn <= 0: blocks ears it lies in.
+  std::size_t reflex_count_ = 0;
   std::size_t work_ = 0;
 };
 
@@ -215,13 +250,16 @@ Mesh Mesh::from_polygons(std::vector<Vec3> positions, std::vector<std::uint32_t>
   mesh.face_of_triangle.reserve(triangle_estimate);
 
   EarClipper clipper;
+  const std::uint32_t* corners = mesh.polygon_vertices.data();
   for (std::uint32_t f = 0; f < faces; ++f) {
-    const std::span<const std::uint32_t> loop = mesh.polygon(f);
-    if (loop.size() == 3) {
-      mesh.triangles.push_back({loop[0], loop[1], loop[2]});
-    } else {
-      clipper.triangulate(loop, mesh.positions, mesh.triangles);
+    const std::uint32_t begin = mesh.polygon_offsets[f];
+    const std::uint32_t end = mesh.polygon_offsets[f + 1];
+    if (end - begin == 3) {
+      mesh.triangles.push_back({corners[begin], corners[begin + 1], corners[begin + 2]});
+      mesh.face_of_triangle.push_back(f);
+      continue;
     }
+    clipper.triangulate(mesh.polygon(f), mesh.positions, mesh.triangles);
     mesh.face_of_triangle.resize(mesh.triangles.size(), f);
   }
   return mesh;
@@ -235,7 +273,8 @@ Mesh Mesh::from_triangles(std::vector<Vec3> positions, std::vector<Triangle> tri
             " triangles, more than 32-bit offsets can address");
   }
   Mesh mesh;
-  mesh.polygon_offsets.resize(triangles.size() + 1);
+  // A fresh vector, not a resize of the default {0}: g++ 12 warns falsely about the latter.
+  mesh.polygon_offsets = std::vector<std::uint32_t>(triangles.size() + 1, 0);
   mesh.polygon_vertices.reserve(3 * triangles.size());
   mesh.face_of_triangle.resize(triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {

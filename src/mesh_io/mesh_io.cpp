@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,7 +31,12 @@ std::string lower_ascii(std::string text) {
 }
 
 /// The whole file in one block: every reader parses from memory, never through a stream.
-std::vector<char> read_file(const std::filesystem::path& path) {
+struct FileImage {
+  std::unique_ptr<char[]> bytes;
+  std::size_t size = 0;
+};
+
+FileImage read_file(const std::filesystem::path& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) io_failure(path, "open", errno);
   struct FdCloser {
@@ -42,23 +48,25 @@ std::vector<char> read_file(const std::filesystem::path& path) {
   if (::fstat(fd, &status) != 0) io_failure(path, "stat", errno);
   if (S_ISDIR(status.st_mode)) io_failure(path, "read", EISDIR);
 
-  std::vector<char> bytes(static_cast<std::size_t>(status.st_size));
-  std::size_t filled = 0;
+  // The size from fstat may be stale (a growing file): read until end of file regardless.
+  std::size_t capacity = static_cast<std::size_t>(status.st_size) + 1;
+  FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
   while (true) {
-    if (filled == bytes.size()) {
-      // The size from fstat may be stale (growing file, /proc-like files): probe for more.
-      bytes.resize(bytes.size() + (bytes.size() < 65536 ? 65536 : bytes.size() / 2));
+    if (image.size == capacity) {
+      const std::size_t grown = capacity + capacity / 2 + 4096;
+      auto larger = std::make_unique_for_overwrite<char[]>(grown);
+      std::memcpy(larger.get(), image.bytes.get(), image.size);
+      image.bytes = std::move(larger);
+      capacity = grown;
     }
-    const ssize_t got = ::read(fd, bytes.data() + filled, bytes.size() - filled);
+    const ssize_t got = ::read(fd, image.bytes.get() + image.size, capacity - image.size);
     if (got < 0) {
       if (errno == EINTR) continue;
       io_failure(path, "read", errno);
     }
-    if (got == 0) break;
-    filled += static_cast<std::size_t>(got);
+    if (got == 0) return image;
+    image.size += static_cast<std::size_t>(got);
   }
-  bytes.resize(filled);
-  return bytes;
 }
 
 }  // namespace
@@ -75,8 +83,8 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
 
 Mesh read_mesh(const std::filesystem::path& path) {
   const MeshFormat format = mesh_format_from_path(path);
-  const std::vector<char> bytes = read_file(path);
-  return read_mesh(bytes, format, path.string());
+  const FileImage image = read_file(path);
+  return read_mesh(std::span<const char>(image.bytes.get(), image.size), format, path.string());
 }
 
 Mesh read_mesh(std::span<const char> bytes, MeshFormat format, std::string_view name) {

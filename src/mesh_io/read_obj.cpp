@@ -1,5 +1,6 @@
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <utility>
@@ -17,6 +18,7 @@ class ObjReader {
 
   Mesh read() {
     if (in_.remaining() == 0) in_.fail_at(in_.cursor(), "file is empty");
+    reserve_for_statements();
     while (!in_.at_end()) {
       const std::string_view keyword = in_.read_token();
       if (keyword == "v") {
@@ -42,6 +44,26 @@ class ObjReader {
   }
 
  private:
+  // Growing the arrays as statements come costs more than this pass over the line starts.
+  void reserve_for_statements() {
+    std::size_t vertices = 0;
+    std::size_t faces = 0;
+    const char* line = in_.begin();
+    const char* const end = in_.end();
+    while (line != end) {
+      while (line != end && is_blank(*line)) ++line;
+      if (end - line >= 2 && is_blank(line[1])) {
+        vertices += line[0] == 'v';
+        faces += line[0] == 'f';
+      }
+      const void* newline = std::memchr(line, '\n', static_cast<std::size_t>(end - line));
+      line = newline == nullptr ? end : static_cast<const char*>(newline) + 1;
+    }
+    soup_.positions.reserve(vertices);
+    soup_.offsets.reserve(faces + 1);
+    soup_.vertices.reserve(3 * faces);
+  }
+
   void read_vertex() {
     Vec3& position = soup_.positions.emplace_back();
     for (double& coordinate : position) {

@@ -246,8 +246,14 @@ void write_stl(OutputBuffer& out, const Mesh& mesh, bool binary) {
 void write_atomically(const std::filesystem::path& path, const std::string& bytes) {
   static std::atomic<unsigned> counter{0};
   std::filesystem::path temporary = path;
-  temporary.replace_filename("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) +
-                             "_" + std::to_string(counter++));
+  // Appended piecewise: `"." + string` trips a false -Wrestrict in g++ 12 release builds.
+  std::string name(1, '.');
+  name.append(path.filename().string())
+      .append(".tmp")
+      .append(std::to_string(::getpid()))
+      .append("_")
+      .append(std::to_string(counter++));
+  temporary.replace_filename(name);
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) io_failure(path, "create a temporary file for", errno);
   const auto abandon = [&](std::string_view action) {
