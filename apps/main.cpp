@@ -85,6 +85,8 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
   command.add_option("--json", options.files.json, "Write clusters and primitives as JSON");
   command.add_option("--colored", options.files.colored,
                      "Write the mesh coloured by cluster (.ply colours or .obj groups)");
+  command.add_option("--png", options.files.png,
+                     "Render the clusters to a PNG picture (800x600, three-quarter view)");
   command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
 }
 

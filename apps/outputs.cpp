@@ -7,6 +7,7 @@
 #include "../src/atomic_write.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/render.hpp"
 
 namespace primseg::cli {
 namespace {
@@ -70,6 +71,12 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     MeshWriteOptions options;
     options.face_groups = segmentation.labels;
     write_mesh(path, hierarchy.mesh(), options);
+  }
+  if (files.png) {
+    const auto palette = distinct_colors(segmentation.cluster_count());
+    std::vector<std::array<std::uint8_t, 3>> colors(segmentation.labels.size());
+    for (std::size_t f = 0; f < colors.size(); ++f) colors[f] = palette[segmentation.labels[f]];
+    write_png(*files.png, hierarchy.mesh(), colors);
   }
 }
 

@@ -14,6 +14,7 @@ struct OutputFiles {
   std::optional<std::string> json;     // clusters with primitives
   std::optional<std::string> colored;  // .ply (face colours) or .obj (groups)
   std::optional<std::string> tree;     // whole hierarchy (segment only)
+  std::optional<std::string> png;      // picture of the clusters
 };
 
 /// JSON parameters of a primitive, input units.

@@ -2,11 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <mutex>
 
 namespace primseg::testing {
@@ -88,6 +91,102 @@ ClusterStats whole_mesh_stats(const DualGraph& graph) {
   for (std::uint32_t f = 1; f < graph.face_count(); ++f) stats.merge(graph.face_stats(f), {});
   for (const DualEdge& e : graph.edges()) stats.edges += e.shared;
   return stats.centred();
+}
+
+}  // namespace primseg::testing
+
+namespace primseg::testing {
+namespace {
+
+// Minimum-cost assignment of rows to columns (rows <= columns), O(n² m): the classic
+// potentials formulation of the Hungarian method. Returns the column of each row.
+std::vector<int> hungarian(const std::vector<std::vector<double>>& cost) {
+  const int n = static_cast<int>(cost.size()), m = static_cast<int>(cost[0].size());
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> u(n + 1, 0), v(m + 1, 0), way_cost(m + 1);
+  std::vector<int> match(m + 1, 0), way(m + 1, 0);
+  for (int row = 1; row <= n; ++row) {
+    match[0] = row;
+    int column = 0;
+    std::fill(way_cost.begin(), way_cost.end(), inf);
+    std::vector<char> used(m + 1, 0);
+    do {
+      used[column] = 1;
+      const int r = match[column];
+      double delta = inf;
+      int next = 0;
+      for (int c = 1; c <= m; ++c) {
+        if (used[c]) continue;
+        const double reduced = cost[r - 1][c - 1] - u[r] - v[c];
+        if (reduced < way_cost[c]) {
+          way_cost[c] = reduced;
+          way[c] = column;
+        }
+        if (way_cost[c] < delta) {
+          delta = way_cost[c];
+          next = c;
+        }
+      }
+      for (int c = 0; c <= m; ++c) {
+        if (used[c]) {
+          u[match[c]] += delta;
+          v[c] -= delta;
+        } else {
+          way_cost[c] -= delta;
+        }
+      }
+      column = next;
+    } while (match[column] != 0);
+    do {
+      const int previous = way[column];
+      match[column] = match[previous];
+      column = previous;
+    } while (column);
+  }
+  std::vector<int> column_of_row(n, -1);
+  for (int c = 1; c <= m; ++c)
+    if (match[c]) column_of_row[match[c] - 1] = c - 1;
+  return column_of_row;
+}
+
+}  // namespace
+
+SegmentationScore score_segmentation(const std::vector<std::uint32_t>& labels,
+                                     const std::vector<std::uint32_t>& truth,
+                                     const std::vector<double>& area,
+                                     const std::vector<PrimitiveType>& types,
+                                     const std::vector<PrimitiveType>& truth_types) {
+  const std::size_t regions = truth_types.size(), clusters = types.size();
+  std::vector<std::vector<double>> overlap(regions, std::vector<double>(clusters, 0.0));
+  std::vector<double> region_area(regions, 0.0), cluster_area(clusters, 0.0);
+  for (std::size_t f = 0; f < labels.size(); ++f) {
+    overlap[truth[f]][labels[f]] += area[f];
+    region_area[truth[f]] += area[f];
+    cluster_area[labels[f]] += area[f];
+  }
+  auto iou = [&](std::size_t r, std::size_t c) {
+    return overlap[r][c] / (region_area[r] + cluster_area[c] - overlap[r][c]);
+  };
+  // Pad with empty clusters so every region gets a column.
+  const std::size_t columns = std::max(regions, clusters);
+  std::vector<std::vector<double>> cost(regions, std::vector<double>(columns, 0.0));
+  for (std::size_t r = 0; r < regions; ++r)
+    for (std::size_t c = 0; c < clusters; ++c) cost[r][c] = -overlap[r][c];
+  const std::vector<int> match = hungarian(cost);
+  SegmentationScore score;
+  score.min_iou = 1;
+  double total_area = 0, typed_area = 0;
+  for (std::size_t r = 0; r < regions; ++r) {
+    const int c = match[r];
+    const double value = c >= 0 && std::size_t(c) < clusters ? iou(r, std::size_t(c)) : 0.0;
+    score.mean_iou += value / double(regions);
+    score.min_iou = std::min(score.min_iou, value);
+    total_area += region_area[r];
+    if (c >= 0 && std::size_t(c) < clusters && types[std::size_t(c)] == truth_types[r])
+      typed_area += region_area[r];
+  }
+  score.type_accuracy = total_area > 0 ? typed_area / total_area : 0;
+  return score;
 }
 
 }  // namespace primseg::testing

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "primseg/mesh.hpp"
+#include "primseg/primitive.hpp"
 
 namespace primseg::testing {
 
@@ -63,5 +64,24 @@ Mesh grid_mesh(int rows, int cols, Surface&& p, bool alternate = false) {
 /// Statistics of the whole mesh as one cluster, accumulated face by face and edge by edge the way
 /// the engine does, with moments centred at the centroid.
 ClusterStats whole_mesh_stats(const DualGraph& graph);
+
+}  // namespace primseg::testing
+
+namespace primseg::testing {
+
+/// Ground-truth regions matched one-to-one to clusters by the Hungarian method on area overlap.
+struct SegmentationScore {
+  double mean_iou = 0;       ///< mean over ground-truth regions of IoU (by area) with its match
+  double min_iou = 0;        ///< worst region
+  double type_accuracy = 0;  ///< area-weighted fraction of regions whose match has the right type
+};
+
+/// `area` holds each face's area; `types` the reported type of each cluster, `truth_types` of
+/// each region.
+SegmentationScore score_segmentation(const std::vector<std::uint32_t>& labels,
+                                     const std::vector<std::uint32_t>& truth,
+                                     const std::vector<double>& area,
+                                     const std::vector<PrimitiveType>& types,
+                                     const std::vector<PrimitiveType>& truth_types);
 
 }  // namespace primseg::testing

@@ -1,0 +1,305 @@
+// The hierarchy on shapes with known answers: generated CAD-like solids, several components,
+// determinism, scale invariance, and the exact-cost reference mode.
+#include "primseg/hierarchy.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "primseg/cut.hpp"
+#include "primseg/error.hpp"
+#include "primseg/mesh_io.hpp"
+#include "primseg/shape_generator.hpp"
+#include "primseg/tree_io.hpp"
+#include "support/test_support.hpp"
+
+namespace primseg {
+namespace {
+
+using testing::score_segmentation;
+using testing::SegmentationScore;
+
+std::vector<double> face_areas(const Hierarchy& h) {
+  std::vector<double> area(h.face_count(), 0.0);
+  for (std::uint32_t t = 0; t < h.mesh().triangle_count(); ++t)
+    area[h.mesh().face_of_triangle[t]] += h.graph().triangle_area(t);
+  return area;
+}
+
+SegmentationScore score_at_true_count(const GroundTruthShape& shape, const Hierarchy& h) {
+  const Segmentation seg = cut_by_count(h, static_cast<std::uint32_t>(shape.regions.size()));
+  std::vector<PrimitiveType> types, truth_types;
+  for (const ClusterReport& r : describe_clusters(h, seg)) types.push_back(r.primitive.type);
+  for (const Primitive& p : shape.regions) truth_types.push_back(p.type);
+  return score_segmentation(seg.labels, shape.region_of_face, face_areas(h), types, truth_types);
+}
+
+struct Variant {
+  Tessellation tessellation;
+  std::uint64_t seed;
+};
+
+// The fixed list of shapes and seeds of the quality tests.
+const Variant kVariants[] = {{Tessellation::Cad, 1},
+                             {Tessellation::Cad, 2},
+                             {Tessellation::Uniform, 3},
+                             {Tessellation::Uniform, 4}};
+
+TEST(Hierarchy, RecoversEveryRegionOfCleanCadShapesWithTheRightType) {
+  for (const Variant& variant : kVariants)
+    for (const std::string& name : shape_names()) {
+      ShapeOptions options;
+      options.tessellation = variant.tessellation;
+      options.random_motion = true;
+      options.seed = variant.seed;
+      const GroundTruthShape shape = make_shape(name, options);
+      const Hierarchy h = build_hierarchy(shape.mesh);
+      const SegmentationScore score = score_at_true_count(shape, h);
+      EXPECT_GE(score.min_iou, 0.95) << name << " seed " << variant.seed;
+      EXPECT_EQ(score.type_accuracy, 1.0) << name << " seed " << variant.seed;
+    }
+}
+
+TEST(Hierarchy, NoisyCadShapesKeepAMeanIouAboveNinetyPercent) {
+  double sum = 0;
+  int count = 0;
+  for (const Variant& variant : kVariants)
+    for (const std::string& name : shape_names()) {
+      ShapeOptions options;
+      options.tessellation = variant.tessellation;
+      options.random_motion = true;
+      options.seed = variant.seed;
+      options.noise = 0.002;  // 0.2% of the bounding-box diagonal, along the normals
+      const GroundTruthShape shape = make_shape(name, options);
+      const SegmentationScore score = score_at_true_count(shape, build_hierarchy(shape.mesh));
+      EXPECT_GE(score.mean_iou, 0.8) << name << " seed " << variant.seed;
+      sum += score.mean_iou;
+      ++count;
+    }
+  EXPECT_GE(sum / count, 0.90);
+}
+
+TEST(Hierarchy, IsAFullBinaryTreeWithCostsAndTypes) {
+  const GroundTruthShape shape = make_shape("box_with_boss", {});
+  const Hierarchy h = build_hierarchy(shape.mesh);
+  const std::uint32_t f = h.face_count();
+  ASSERT_EQ(h.merges().size(), f - 1);
+  std::vector<int> seen(h.node_count(), 0);
+  for (std::uint32_t i = 0; i < f - 1; ++i) {
+    const Merge& m = h.merges()[i];
+    EXPECT_LT(m.first, m.second);
+    EXPECT_LT(m.second, f + i);
+    ++seen[m.first];
+    ++seen[m.second];
+    EXPECT_EQ(m.face_count, h.face_count(m.first) + h.face_count(m.second));
+    EXPECT_GE(m.cost, 0);
+    EXPECT_TRUE(std::isfinite(m.cost));
+    EXPECT_FALSE(m.trailing);
+  }
+  for (std::uint32_t node = 0; node + 1 < h.node_count(); ++node) EXPECT_EQ(seen[node], 1);
+  EXPECT_EQ(h.merges().back().face_count, f);
+}
+
+TEST(Hierarchy, ComponentsAreJoinedOnlyByTrailingMergesCostedAboveAll) {
+  // Two boxes side by side, not touching.
+  GroundTruthShape a = make_shape("box", {}), b = make_shape("box_with_hole", {});
+  Mesh mesh = a.mesh;
+  const auto offset = static_cast<std::uint32_t>(mesh.positions.size());
+  std::vector<Vec3> positions = mesh.positions;
+  for (Vec3 p : b.mesh.positions) positions.push_back({p[0] + 10, p[1], p[2]});
+  std::vector<Triangle> triangles = mesh.triangles;
+  for (Triangle t : b.mesh.triangles)
+    triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  mesh = Mesh::from_triangles(std::move(positions), std::move(triangles));
+  const Hierarchy h = build_hierarchy(mesh);
+  EXPECT_EQ(h.component_count(), 2u);
+  const auto merges = h.merges();
+  ASSERT_EQ(merges.size(), h.face_count() - 1);
+  double highest_real = 0;
+  for (std::size_t i = 0; i + 1 < merges.size(); ++i) {
+    EXPECT_FALSE(merges[i].trailing);
+    highest_real = std::max(highest_real, merges[i].cost);
+  }
+  EXPECT_TRUE(merges.back().trailing);
+  EXPECT_GT(merges.back().cost, highest_real);
+  // Cuts never apply the trailing merge.
+  EXPECT_EQ(cut_by_count(h, 1).cluster_count(), 2u);
+  const Segmentation thirteen = cut_by_count(h, 13);
+  EXPECT_EQ(thirteen.cluster_count(), 13u);
+  for (std::uint32_t f = 0; f < a.mesh.face_count(); ++f)
+    for (std::uint32_t g = a.mesh.face_count(); g < h.face_count(); ++g)
+      ASSERT_NE(thirteen.labels[f], thirteen.labels[g]);
+  EXPECT_EQ(cut_by_tolerance(h, 1e300).cluster_count(), 2u);
+}
+
+TEST(Hierarchy, SameInputGivesTheSameTreeBitForBit) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.noise = 0.003;
+  options.random_motion = true;
+  const GroundTruthShape shape = make_shape("box_with_dome", options);
+  const std::string first = serialize_tree(build_hierarchy(shape.mesh));
+  const std::string second = serialize_tree(build_hierarchy(shape.mesh));
+  EXPECT_EQ(first, second);
+}
+
+TEST(Hierarchy, ScalingByAPowerOfTwoKeepsEveryMergeAndLabel) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.noise = 0.002;
+  options.random_motion = true;
+  const GroundTruthShape shape = make_shape("cylinder_with_sphere_cap", options);
+  const Hierarchy reference = build_hierarchy(shape.mesh);
+  for (int exponent : {-490, -37, 11, 480}) {
+    Mesh scaled = shape.mesh;
+    for (Vec3& p : scaled.positions)
+      for (double& x : p) x = std::ldexp(x, exponent);
+    const Hierarchy h = build_hierarchy(scaled);
+    ASSERT_EQ(h.merges().size(), reference.merges().size());
+    for (std::size_t i = 0; i < h.merges().size(); ++i) {
+      EXPECT_EQ(h.merges()[i].first, reference.merges()[i].first) << "exponent " << exponent;
+      EXPECT_EQ(h.merges()[i].second, reference.merges()[i].second);
+      EXPECT_EQ(h.merges()[i].cost, reference.merges()[i].cost);
+    }
+    for (std::uint32_t k : {1u, 3u, 10u, 100u})
+      EXPECT_EQ(cut_by_count(h, k).labels, cut_by_count(reference, k).labels);
+    // Parameters are reported in input units.
+    const Primitive p = h.primitive(h.node_count() - 2),
+                    q = reference.primitive(reference.node_count() - 2);
+    EXPECT_EQ(p.radius, std::ldexp(q.radius, exponent));
+  }
+}
+
+TEST(Hierarchy, ExactCostModeAgreesWithTheConstantTimeCostsOnCleanShapes) {
+  HierarchyOptions exact;
+  exact.exact_costs = true;
+  for (const std::string name : {"box_with_hole", "capped_cylinder", "box_with_dome"}) {
+    const GroundTruthShape shape = make_shape(name, {});
+    const Hierarchy fast = build_hierarchy(shape.mesh);
+    const Hierarchy slow = build_hierarchy(shape.mesh, exact);
+    const auto k = static_cast<std::uint32_t>(shape.regions.size());
+    EXPECT_EQ(cut_by_count(fast, k).labels, cut_by_count(slow, k).labels) << name;
+    EXPECT_GE(score_at_true_count(shape, slow).min_iou, 0.95) << name;
+  }
+}
+
+TEST(Hierarchy, DegenerateAndNonManifoldInputIsHandled) {
+  // A zero-area face, a duplicate face, a non-manifold fin and an isolated vertex on a box.
+  const GroundTruthShape box = make_shape("box", {});
+  std::vector<Vec3> positions = box.mesh.positions;
+  std::vector<Triangle> triangles = box.mesh.triangles;
+  const Triangle first = triangles[0];
+  triangles.push_back(first);                           // duplicate
+  triangles.push_back({first[0], first[1], first[0]});  // zero area, repeated vertex
+  positions.push_back({9, 9, 9});                       // isolated
+  positions.push_back({0.123, 5, 0.321});
+  triangles.push_back(
+      {first[0], first[1], static_cast<std::uint32_t>(positions.size() - 1)});  // fin
+  const Mesh mesh = Mesh::from_triangles(std::move(positions), std::move(triangles));
+  const Hierarchy h = build_hierarchy(mesh);
+  EXPECT_EQ(h.merges().size(), h.face_count() - 1);
+  EXPECT_EQ(h.component_count(), 1u);
+  for (std::uint32_t k = 1; k <= h.face_count(); ++k) {
+    const Segmentation seg = cut_by_count(h, k);
+    EXPECT_EQ(seg.cluster_count(), k);
+    for (const ClusterReport& r : describe_clusters(h, seg)) {
+      EXPECT_TRUE(std::isfinite(r.rms));
+      EXPECT_TRUE(std::isfinite(r.primitive.radius));
+    }
+  }
+}
+
+TEST(Hierarchy, ManyFacesOnOneEdgeGiveLinearlyManyDualEdges) {
+  // A fan of 2000 triangles all sharing the edge (0, 1).
+  std::vector<Vec3> positions{{0, 0, 0}, {1, 0, 0}};
+  std::vector<Triangle> triangles;
+  for (int i = 0; i < 2000; ++i) {
+    const double angle = 2 * M_PI * i / 2000;
+    positions.push_back({0.5, std::cos(angle), std::sin(angle)});
+    triangles.push_back({0, 1, static_cast<std::uint32_t>(positions.size() - 1)});
+  }
+  const Mesh mesh = Mesh::from_triangles(std::move(positions), std::move(triangles));
+  const DualGraph graph(mesh, VertexWeights::Area);
+  EXPECT_EQ(graph.edges().size(), 1999u);
+  EXPECT_EQ(graph.component_count(), 1u);
+  const Hierarchy h = build_hierarchy(mesh);
+  EXPECT_EQ(h.merges().size(), 1999u);
+}
+
+TEST(Hierarchy, SingleFaceMeshHasNoMerges) {
+  const Mesh mesh = Mesh::from_triangles({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {Triangle{0, 1, 2}});
+  const Hierarchy h = build_hierarchy(mesh);
+  EXPECT_TRUE(h.merges().empty());
+  EXPECT_EQ(cut_by_count(h, 1).labels, std::vector<std::uint32_t>{0});
+  EXPECT_EQ(h.primitive(0).type, PrimitiveType::Plane);
+}
+
+TEST(Hierarchy, InvalidOptionsAreRejected) {
+  const Mesh mesh = make_shape("box", {}).mesh;
+  HierarchyOptions none;
+  none.primitives.clear();
+  EXPECT_THROW(build_hierarchy(mesh, none), InvalidInputError);
+  HierarchyOptions twice;
+  twice.primitives = {PrimitiveType::Plane, PrimitiveType::Plane};
+  EXPECT_THROW(build_hierarchy(mesh, twice), InvalidInputError);
+  HierarchyOptions negative;
+  negative.type_penalty[1] = -1;
+  EXPECT_THROW(build_hierarchy(mesh, negative), InvalidInputError);
+}
+
+TEST(Hierarchy, SinglePrimitiveTypesStillBuildATree) {
+  const GroundTruthShape shape = make_shape("capped_cylinder", {});
+  for (PrimitiveType type :
+       {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere}) {
+    HierarchyOptions options;
+    options.primitives = {type};
+    const Hierarchy h = build_hierarchy(shape.mesh, options);
+    EXPECT_EQ(h.merges().size(), h.face_count() - 1);
+    // The cylinder is found whenever cylinders are allowed.
+    if (type == PrimitiveType::Cylinder) {
+      bool found = false;
+      for (const ClusterReport& r : describe_clusters(h, cut_by_count(h, 3)))
+        found |= r.primitive.type == PrimitiveType::Cylinder && r.rms < 1e-9;
+      EXPECT_TRUE(found);
+    }
+  }
+}
+
+TEST(Hierarchy, FandiskCutsGiveConnectedClustersAndFlatFacesArePlanes) {
+  const Mesh mesh = read_mesh(testing::cgal_mesh("fandisk.off"));
+  const Hierarchy h = build_hierarchy(mesh);
+  ASSERT_EQ(h.face_count(), 12946u);
+  // Face adjacency for the connectivity check.
+  const DualGraph& graph = h.graph();
+  for (std::uint32_t k : {10u, 25u, 60u, 200u}) {
+    const Segmentation seg = cut_by_count(h, k);
+    ASSERT_EQ(seg.cluster_count(), k);
+    std::vector<std::uint32_t> parent(h.face_count());
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](std::uint32_t x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    for (const DualEdge& e : graph.edges())
+      if (seg.labels[e.first] == seg.labels[e.second]) parent[find(e.first)] = find(e.second);
+    std::vector<std::uint32_t> root_of_label(k, UINT32_MAX);
+    for (std::uint32_t f = 0; f < h.face_count(); ++f) {
+      std::uint32_t& root = root_of_label[seg.labels[f]];
+      if (root == UINT32_MAX) root = find(f);
+      EXPECT_EQ(root, find(f)) << "cluster " << seg.labels[f] << " of K=" << k << " is split";
+    }
+  }
+  // Fandisk's large flat faces: every cluster at K=25 that a plane fits to 1e-9 of the diagonal
+  // is reported as a plane, and the largest cluster is flat.
+  const Segmentation seg = cut_by_count(h, 25);
+  const auto reports = describe_clusters(h, seg);
+  int planes = 0;
+  for (const ClusterReport& r : reports) planes += r.primitive.type == PrimitiveType::Plane;
+  EXPECT_GE(planes, 8);
+  EXPECT_EQ(reports[0].primitive.type, PrimitiveType::Plane);
+  EXPECT_LT(reports[0].max, 1e-9 * bounding_box_diagonal(mesh));
+}
+
+}  // namespace
+}  // namespace primseg
