@@ -1,5 +1,6 @@
 #include "primseg/cluster_stats.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace primseg {
@@ -61,6 +62,15 @@ constexpr auto make_translation_terms() {
 }
 constexpr auto kTranslationTerms = make_translation_terms();
 
+constexpr std::size_t count_terms_up_to_degree2() {
+  std::size_t n = 0;
+  while (n < kTranslationTerms.size() && kTranslationTerms[n].target < Moments::kCountUpToDegree2)
+    ++n;
+  return n;
+}
+constexpr std::size_t kTermsUpToDegree2 = count_terms_up_to_degree2();
+static_assert(kTermsUpToDegree2 == 28);
+
 // Monomial index of the full tensor entry with axes (a, b, c, d) (a 4-digit base-3 number;
 // lower degrees pad with the axis value 3, which adds no exponent).
 constexpr std::array<std::uint8_t, 256> make_axes_index() {
@@ -107,7 +117,7 @@ void Moments::add_point(const Eigen::Vector3d& x, double w) {
   }
 }
 
-Moments Moments::translated(const Eigen::Vector3d& new_origin) const {
+Moments Moments::translated(const Eigen::Vector3d& new_origin, int max_degree) const {
   // Σ w (y − d)^α with y = x − o and d = o' − o: each target monomial α is a fixed combination
   // Σ_β C(α, β) (−d)^(α−β) M_β over sub-monomials β ≤ α, listed once in kTranslationTerms.
   const Eigen::Vector3d d = new_origin - origin_;
@@ -122,18 +132,24 @@ Moments Moments::translated(const Eigen::Vector3d& new_origin) const {
   for (int n = 0; n < kCount; ++n)
     shift[n] = px[kMonomials[n].i] * py[kMonomials[n].j] * pz[kMonomials[n].k];
   Moments result(new_origin);
-  for (const TranslationTerm& term : kTranslationTerms)
+  // Terms are listed by target monomial, and monomials by degree.
+  const std::size_t term_count = max_degree >= 4 ? kTranslationTerms.size() : kTermsUpToDegree2;
+  for (std::size_t n = 0; n < term_count; ++n) {
+    const TranslationTerm& term = kTranslationTerms[n];
     result.values_[term.target] += term.coefficient * shift[term.shift] * values_[term.source];
+  }
   return result;
 }
 
-Moments& Moments::operator+=(const Moments& other) {
+Moments& Moments::add(const Moments& other, int max_degree) {
+  const int count = max_degree >= 4 ? kCount : kCountUpToDegree2;
   if (other.origin_ == origin_) {
-    for (int n = 0; n < kCount; ++n) values_[n] += other.values_[n];
+    for (int n = 0; n < count; ++n) values_[n] += other.values_[n];
   } else {
-    const Moments moved = other.translated(origin_);
-    for (int n = 0; n < kCount; ++n) values_[n] += moved.values_[n];
+    const Moments moved = other.translated(origin_, max_degree);
+    for (int n = 0; n < count; ++n) values_[n] += moved.values_[n];
   }
+  if (count < kCount) std::fill(values_.begin() + count, values_.end(), 0.0);
   return *this;
 }
 
@@ -161,11 +177,11 @@ double Moments::fourth_moment_contracted(const Eigen::Matrix3d& q) const {
   return sum;
 }
 
-void ClusterStats::merge(const ClusterStats& other, const EdgeStats& shared_edges) {
+void ClusterStats::merge(const ClusterStats& other, const EdgeStats& shared_edges, int max_degree) {
   // (c − o) = (c − o_other) + (o_other − o).
   normal_position += other.normal_position +
                      (other.moments.origin() - moments.origin()) * other.normal_sum.transpose();
-  moments += other.moments;
+  moments.add(other.moments, max_degree);
   edges += other.edges;
   edges += shared_edges;
   normal_sum += other.normal_sum;
@@ -173,10 +189,10 @@ void ClusterStats::merge(const ClusterStats& other, const EdgeStats& shared_edge
   triangle_count += other.triangle_count;
 }
 
-ClusterStats ClusterStats::translated(const Eigen::Vector3d& new_origin) const {
+ClusterStats ClusterStats::translated(const Eigen::Vector3d& new_origin, int max_degree) const {
   ClusterStats result = *this;
   result.normal_position -= (new_origin - moments.origin()) * normal_sum.transpose();
-  result.moments = moments.translated(new_origin);
+  result.moments = moments.translated(new_origin, max_degree);
   return result;
 }
 

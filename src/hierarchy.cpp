@@ -43,10 +43,6 @@ struct LiveEdge {
   EdgeStats shared;  // the mesh edges between the two clusters
 };
 
-ClusterStats centred(const ClusterStats& stats) {
-  return stats.centred();
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -88,14 +84,14 @@ Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
 Primitive Hierarchy::primitive(std::uint32_t node) const {
   if (!is_leaf(node)) return merges_[node - face_count()].primitive;
   const detail::ModelSelector selector(options_);
-  const ClusterStats stats = centred(graph_->face_stats(node));
+  const ClusterStats stats = graph_->face_stats(node).centred();
   return graph_->frame().to_input(selector.select(stats).fit.primitive);
 }
 
 double Hierarchy::error(std::uint32_t node) const {
   if (!is_leaf(node)) return merges_[node - face_count()].error;
   const detail::ModelSelector selector(options_);
-  return selector.select(centred(graph_->face_stats(node))).fit.error;
+  return selector.select(graph_->face_stats(node).centred()).fit.error;
 }
 
 double Hierarchy::weight(std::uint32_t node) const {
@@ -225,14 +221,19 @@ class HierarchyBuilder::Impl {
     return degree;
   }
 
-  ClusterStats union_stats(const LiveEdge& e) const {
-    ClusterStats stats = stats_[slot_of_node_[e.a]];
-    stats.merge(stats_[slot_of_node_[e.b]], e.shared);
+  // The statistics of a ∪ b, moments up to the degree the fits will use (all of them when the
+  // result is kept).
+  ClusterStats union_stats(const LiveEdge& e, bool keep) const {
+    const ClusterStats& a = stats_[slot_of_node_[e.a]];
+    const ClusterStats& b = stats_[slot_of_node_[e.b]];
+    const int degree = keep ? 4 : selector_.moment_degree(a.triangle_count + b.triangle_count);
+    ClusterStats stats = a;
+    stats.merge(b, e.shared, degree);
     return stats;
   }
 
   detail::SelectedModel select(const ClusterStats& stats, const LiveEdge& e) const {
-    const ClusterStats centred_stats = centred(stats);
+    const ClusterStats centred_stats = stats.centred(selector_.moment_degree(stats.triangle_count));
     if (!options_.exact_costs) return selector_.select(centred_stats);
     const detail::ExactError exact = [&](const Primitive& primitive) {
       double sum = 0;
@@ -254,7 +255,7 @@ class HierarchyBuilder::Impl {
 
   HeapEntry candidate(std::uint32_t id) {
     const LiveEdge& e = edges_[id];
-    const detail::SelectedModel model = select(union_stats(e), e);
+    const detail::SelectedModel model = select(union_stats(e, false), e);
     return {model.cost,         model.fit.primitive.type, merged_degree(e.a, e.b),
             std::min(e.a, e.b), std::max(e.a, e.b),       id,
             e.version};
@@ -264,7 +265,7 @@ class HierarchyBuilder::Impl {
     LiveEdge& edge = edges_[edge_id];
     const std::uint32_t a = edge.a, b = edge.b;
     const std::uint32_t slot_a = slot_of_node_[a], slot_b = slot_of_node_[b];
-    ClusterStats merged = union_stats(edge);
+    ClusterStats merged = union_stats(edge, true);
     const detail::SelectedModel model = select(merged, edge);
     const std::uint32_t node = next_node();
 

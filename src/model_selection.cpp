@@ -32,7 +32,11 @@ ModelSelector::ModelSelector(const HierarchyOptions& options) : options_(options
   validate(options);
   std::vector<PrimitiveType> types = options.primitives;
   std::sort(types.begin(), types.end());
-  for (PrimitiveType t : types) fitters_.push_back(&fitter_for(t));
+  for (PrimitiveType t : types) {
+    fitters_.push_back(&fitter_for(t));
+    if (t != PrimitiveType::Plane)
+      min_curved_triangles_ = std::min(min_curved_triangles_, fitters_.back()->min_triangles());
+  }
 }
 
 SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactError* exact) const {

@@ -23,12 +23,19 @@ using ExactError = std::function<double(const Primitive&)>;
 class ModelSelector {
  public:
   explicit ModelSelector(const HierarchyOptions& options);
-  /// `centred`: statistics with moments about the cluster's centroid. `exact`: if given, replaces
-  /// each fit's error by the exact one.
+  /// Highest moment degree the fits of a cluster of this many triangles use: 2 when only a plane
+  /// can be fitted (too few triangles for any curved type), else 4.
+  int moment_degree(std::uint32_t triangle_count) const {
+    return triangle_count >= min_curved_triangles_ ? 4 : 2;
+  }
+  /// `centred`: statistics with moments about the cluster's centroid, up to
+  /// moment_degree(centred.triangle_count). `exact`: if given, replaces each fit's error by the
+  /// exact one.
   SelectedModel select(const ClusterStats& centred, const ExactError* exact = nullptr) const;
 
  private:
   std::vector<const PrimitiveFitter*> fitters_;  // ascending type
+  std::uint32_t min_curved_triangles_ = UINT32_MAX;
   HierarchyOptions options_;
 };
 

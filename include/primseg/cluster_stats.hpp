@@ -37,10 +37,15 @@ class Moments {
 
   /// Adds the point x with weight w.
   void add_point(const Eigen::Vector3d& x, double w);
-  /// The same moments about another origin.
-  Moments translated(const Eigen::Vector3d& new_origin) const;
-  /// Adds other's moments (translated to this origin).
-  Moments& operator+=(const Moments& other);
+  /// Number of monomials of degree at most 2 (the first entries of values()).
+  static constexpr int kCountUpToDegree2 = 10;
+
+  /// The same moments about another origin. With max_degree 2 only the moments up to degree 2
+  /// are computed (28 of the 210 terms) and the others are left zero: enough for a plane.
+  Moments translated(const Eigen::Vector3d& new_origin, int max_degree = 4) const;
+  /// Adds other's moments (translated to this origin), up to max_degree (see translated()).
+  Moments& add(const Moments& other, int max_degree = 4);
+  Moments& operator+=(const Moments& other) { return add(other); }
 
   /// Σ w (x−o)(x−o)ᵀ, the second moment matrix about the origin.
   Eigen::Matrix3d second_moment() const;
@@ -83,12 +88,15 @@ struct ClusterStats {
   /// Number of triangles (the fits' minimum support is counted in triangles).
   std::uint32_t triangle_count = 0;
 
-  /// Adds other (which must not share triangles with this) and the edges between the two.
-  void merge(const ClusterStats& other, const EdgeStats& shared_edges);
-  /// The same statistics about another origin.
-  ClusterStats translated(const Eigen::Vector3d& new_origin) const;
+  /// Adds other (which must not share triangles with this) and the edges between the two. With
+  /// max_degree 2 the moments of degree 3 and 4 are left zero (see Moments::translated).
+  void merge(const ClusterStats& other, const EdgeStats& shared_edges, int max_degree = 4);
+  /// The same statistics about another origin (moments up to max_degree).
+  ClusterStats translated(const Eigen::Vector3d& new_origin, int max_degree = 4) const;
   /// The same statistics about the centroid (what the fitters take).
-  ClusterStats centred() const { return translated(moments.centroid()); }
+  ClusterStats centred(int max_degree = 4) const {
+    return translated(moments.centroid(), max_degree);
+  }
   /// Area-weighted mean of |n · ν| over the triangles, where ν(x) = Q (x − point) / radius is the
   /// unit normal field of a sphere (Q = I) or cylinder (Q = I − a aᵀ) at the triangle centroids
   /// (first order). 1 when every face agrees with the surface, about cos(θ/2) for facets that
