@@ -68,7 +68,6 @@ Segmentation cut_by_count(const Hierarchy& hierarchy, std::uint32_t clusters) {
   if (clusters < 1 || clusters > f)
     throw InvalidInputError("the number of clusters must be between 1 and " + std::to_string(f) +
                             ", not " + std::to_string(clusters));
-  const auto merges = hierarchy.merges();
   const std::uint32_t real = f - hierarchy.component_count();
   const std::uint32_t applied = std::min(real, f - clusters);
   // The kept nodes: applied merges' nodes whose parent is not applied, and leaves whose parent
