@@ -1,0 +1,78 @@
+#include "bench_support.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+#include <stdexcept>
+#include <system_error>
+
+namespace primseg::bench {
+namespace {
+
+/// `text` quoted for /bin/sh.
+std::string shell_quote(const std::string& text) {
+  std::string quoted = "'";
+  for (const char c : text) {
+    if (c == '\'')
+      quoted += "'\\''";
+    else
+      quoted += c;
+  }
+  return quoted + "'";
+}
+
+}  // namespace
+
+std::filesystem::path cgal_mesh(const std::string& name) {
+  namespace fs = std::filesystem;
+  static std::mutex mutex;
+  const std::lock_guard<std::mutex> lock(mutex);
+
+  if (const char* dir = std::getenv("PRIMSEG_BENCH_DATA"); dir != nullptr && *dir != '\0') {
+    const fs::path path = fs::path(dir) / name;
+    if (!fs::exists(path))
+      throw std::runtime_error(path.string() + " does not exist (PRIMSEG_BENCH_DATA)");
+    return path;
+  }
+
+  const fs::path archive = "/usr/share/doc/libcgal-dev/data.tar.gz";
+  const fs::path cache = fs::temp_directory_path() / "primseg-cgal-data";
+  const fs::path path = cache / "data" / "meshes" / name;
+  if (fs::exists(path)) return path;
+  if (!fs::exists(archive))
+    throw std::runtime_error(archive.string() + " is missing: install Debian's libcgal-demo");
+
+  const fs::path staging = cache / ("staging-" + std::to_string(::getpid()));
+  fs::remove_all(staging);
+  fs::create_directories(staging);
+  fs::create_directories(path.parent_path());
+  const std::string command = "tar xzf " + shell_quote(archive.string()) + " -C " +
+                              shell_quote(staging.string()) + " " +
+                              shell_quote("data/meshes/" + name) + " >/dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  const fs::path extracted = staging / "data" / "meshes" / name;
+  std::error_code error;
+  if (status == 0 && fs::exists(extracted)) fs::rename(extracted, path, error);
+  fs::remove_all(staging, error);
+  if (!fs::exists(path))
+    throw std::runtime_error("could not extract " + name + " from " + archive.string());
+  return path;
+}
+
+std::size_t peak_rss_bytes() {
+  rusage usage{};
+  if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // Linux: kilobytes
+}
+
+std::size_t current_rss_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  std::size_t pages = 0, resident = 0;
+  if (!(statm >> pages >> resident)) return 0;
+  return resident * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+}
+
+}  // namespace primseg::bench

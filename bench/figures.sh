@@ -1,0 +1,135 @@
+#!/usr/bin/env bash
+# Prints primseg's performance figures as a Markdown table (see bench/README.md).
+#
+#   bench/figures.sh [BUILD_DIR]               the working tree; default BUILD_DIR <repo>/build-bench
+#   bench/figures.sh --commit REV [BUILD_DIR]  a clean `git archive` of REV in the temp dir, built
+#                                              there (default BUILD_DIR <export>/build): figures of
+#                                              exactly that commit, whatever the tree holds
+#
+# Configures BUILD_DIR as a Release build if it has no build.ninja yet, brings primseg_bench and
+# primseg_bench_memory up to date (ninja), lets them extract fandisk.off and bunny00.off from
+# Debian's libcgal-demo archive into the temp dir, runs the timings (5 repetitions each) and one
+# peak-memory run per input, then prints the table on stdout. Progress and the raw Google
+# Benchmark console output go to stderr; the raw JSON is kept in BUILD_DIR/bench-figures.json.
+# About 1.5 minutes on 2 cores once built.
+set -euo pipefail
+
+repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build_default=$repo/build-bench
+if [[ ${1:-} == --commit ]]; then
+  [[ $# -ge 2 ]] || { echo "usage: $0 [--commit REV] [BUILD_DIR]" >&2; exit 2; }
+  sha=$(git -C "$repo" rev-parse --verify "$2^{commit}")
+  export_dir=${TMPDIR:-/tmp}/primseg-figures-${sha:0:12}
+  if [[ ! -f $export_dir/CMakeLists.txt ]]; then
+    echo "== exporting $sha to $export_dir" >&2
+    rm -rf "$export_dir.partial" && mkdir -p "$export_dir.partial"
+    git -C "$repo" archive "$sha" | tar -x -C "$export_dir.partial"
+    rm -rf "$export_dir" && mv "$export_dir.partial" "$export_dir"
+  fi
+  repo=$export_dir
+  build_default=$export_dir/build
+  commit=${sha:0:7}
+  shift 2
+else
+  commit="$(git -C "$repo" rev-parse --short HEAD)$(git -C "$repo" diff --quiet HEAD -- src include \
+    || echo ' + uncommitted changes in src/ or include/')"
+fi
+build=${1:-$build_default}
+json=$build/bench-figures.json
+memory=$build/bench-figures-memory.txt
+
+if [[ ! -f $build/build.ninja ]]; then
+  echo "== configuring $build (Release)" >&2
+  cmake -S "$repo" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >&2
+fi
+build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build/CMakeCache.txt")
+if [[ $build_type != Release ]]; then
+  echo "warning: $build is a '$build_type' build, figures are only meaningful in Release" >&2
+fi
+echo "== building primseg_bench primseg_bench_memory" >&2
+ninja -C "$build" primseg_bench primseg_bench_memory >&2
+
+echo "== timings (load average: $(cut -d' ' -f1-3 /proc/loadavg))" >&2
+"$build/bench/primseg_bench" --benchmark_out="$json" --benchmark_out_format=json >&2
+
+echo "== peak memory" >&2
+: >"$memory"
+for input in "--cgal fandisk.off" "--cgal bunny00.off" "--shape box_with_hole 0.01" \
+             "--cgal fandisk.off --exact-costs"; do
+  # shellcheck disable=SC2086  # the input is several words on purpose
+  echo "$input $("$build/bench/primseg_bench_memory" $input)" | tee -a "$memory" >&2
+done
+
+python3 - "$json" "$memory" "$commit" \
+  "$(cut -d' ' -f1-3 /proc/loadavg)" <<'PY'
+import json, sys
+
+json_path, memory_path, commit, load = sys.argv[1:5]
+with open(json_path) as f:
+    report = json.load(f)
+
+def aggregate(prefix, name):
+    """The `name` aggregate (median, cv, ...) of the benchmark whose run_name starts with prefix."""
+    for b in report["benchmarks"]:
+        if b.get("run_type") == "aggregate" and b["run_name"].startswith(prefix) \
+                and b["aggregate_name"] == name:
+            if b.get("error_occurred"):
+                sys.exit(f"{prefix}: {b.get('error_message')}")
+            return b
+    for b in report["benchmarks"]:
+        if b["run_name"].startswith(prefix) and b.get("error_occurred"):
+            sys.exit(f"{prefix}: {b.get('error_message')}")
+    return None
+
+def ms(b, key="real_time"):
+    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b["time_unit"]]
+    return b[key] * scale
+
+memory = {}
+with open(memory_path) as f:
+    for line in f:
+        fields = dict(kv.split("=", 1) for kv in line.split() if "=" in kv)
+        memory[line.split("input=")[0].strip()] = fields
+
+rows = [
+    ("fandisk.off", "hierarchy/fandisk/", "read_mesh/fandisk/", "--cgal fandisk.off"),
+    ("bunny00.off", "hierarchy/bunny00/", "read_mesh/bunny00/", "--cgal bunny00.off"),
+    ("box_with_hole (Uniform, edge 0.01)", "hierarchy/box_with_hole_uniform_0.01/", None,
+     "--shape box_with_hole 0.01"),
+    ("fandisk.off, `exact_costs` (reference mode)", "hierarchy_exact_costs/fandisk/", None,
+     "--cgal fandisk.off --exact-costs"),
+]
+
+print("| input | faces | full hierarchy, median of 5 (ms) | faces/s | peak RSS (MB) "
+      "| bytes/face | read_mesh (MB/s) |")
+print("|---|---:|---:|---:|---:|---:|---:|")
+notes = []
+for label, hierarchy, read, mem in rows:
+    median, cv = aggregate(hierarchy, "median"), aggregate(hierarchy, "cv")
+    if median is None:
+        continue
+    faces = int(median["faces"])
+    m = memory.get(mem, {})
+    peak = int(m.get("peak_rss", 0))
+    read_cell = "–"
+    if read:
+        r = aggregate(read, "median")
+        if r is not None:
+            read_cell = f"{r['bytes_per_second'] / 1e6:.0f} ({ms(r):.2f} ms)"
+    print(f"| {label} | {faces:,} | {ms(median):,.0f} | {faces / (ms(median) / 1e3):,.0f} "
+          f"| {peak / 1e6:.1f} | {peak / faces:,.0f} | {read_cell} |")
+    notes.append(f"{label.split(',')[0].split(' (')[0]}"
+                 f"{' exact' if 'exact' in hierarchy else ''}: CPU {ms(median, 'cpu_time'):,.0f} ms,"
+                 f" CV {100 * cv['real_time']:.0f}%")
+
+cut = aggregate("cut_describe_k30/fandisk/", "median")
+print()
+if cut is not None:
+    print(f"`cut_by_count` + `describe_clusters` at K = 30 on fandisk.off: "
+          f"{ms(cut):.2f} ms (median of 5).")
+print()
+ctx = report["context"]
+print(f"Commit {commit}, Release, {ctx['num_cpus']} × {ctx['mhz_per_cpu']} MHz, "
+      f"load average {load} at the end. Wall-clock times; per hierarchy, median CPU time and "
+      f"coefficient of variation of the 5 runs: " + "; ".join(notes) + ".")
+PY
