@@ -19,6 +19,14 @@ double parse_tolerance(const std::string& text, double bounding_box_diagonal) {
   return percent ? value / 100 * bounding_box_diagonal : value;
 }
 
+void validate_level(const LevelChoice& level, std::uint32_t face_count) {
+  if (level.clusters && (*level.clusters < 1 || *level.clusters > face_count))
+    throw InvalidInputError("--clusters: must be between 1 and the number of faces (" +
+                            std::to_string(face_count) + "), not " +
+                            std::to_string(*level.clusters));
+  if (level.tolerance) parse_tolerance(*level.tolerance, 1.0);
+}
+
 Segmentation cut(const Hierarchy& hierarchy, const LevelChoice& level) {
   if (level.clusters) return cut_by_count(hierarchy, *level.clusters);
   const std::string tolerance = level.tolerance.value_or(kDefaultTolerance);

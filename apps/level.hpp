@@ -16,6 +16,10 @@ struct LevelChoice {
 /// Parses "T" or "T%" into input units. Throws InvalidInputError naming the option.
 double parse_tolerance(const std::string& text, double bounding_box_diagonal);
 
+/// Throws InvalidInputError unless the level can be cut from a mesh of `face_count` faces (K in
+/// 1..F, a well-formed tolerance): checked before the hierarchy is built.
+void validate_level(const LevelChoice& level, std::uint32_t face_count);
+
 /// The segmentation for a level choice; with neither option, the default tolerance below.
 Segmentation cut(const Hierarchy& hierarchy, const LevelChoice& level);
 

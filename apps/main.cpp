@@ -15,6 +15,7 @@
 #include "primseg/error.hpp"
 #include "primseg/mesh_info.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/primitives/primitive_fitter.hpp"
 #include "primseg/tree_io.hpp"
 
 namespace primseg::cli {
@@ -33,9 +34,15 @@ std::vector<PrimitiveType> parse_primitives(const std::string& list) {
     const std::size_t end = std::min(list.find(',', begin), list.size());
     const std::string name = list.substr(begin, end - begin);
     const auto type = primitive_type_from_string(name);
-    if (!type)
+    if (!type || !has_fitter(*type)) {
+      std::string known;
+      for (int t = 0; t < kPrimitiveTypeCount; ++t)
+        if (has_fitter(static_cast<PrimitiveType>(t)))
+          known +=
+              (known.empty() ? "" : ", ") + std::string(to_string(static_cast<PrimitiveType>(t)));
       throw InvalidInputError("--primitives: unknown primitive '" + name +
-                              "' (known: plane, cylinder, sphere, cone, torus)");
+                              "' (available: " + known + ")");
+    }
     types.push_back(*type);
     begin = end + 1;
   }
@@ -101,6 +108,7 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohm
   else
     summary["level"]["tolerance"] = options.level.tolerance.value_or(kDefaultTolerance);
   write_level_outputs(hierarchy, segmentation, reports, options.files, summary);
+  if (options.files.tree) write_tree(*options.files.tree, hierarchy);
   if (!options.quiet) print_summary(reports);
 }
 
@@ -139,6 +147,12 @@ int run(int argc, char** argv) {
   auto* info = app.add_subcommand("info", "Print counts and defects of a mesh");
   info->add_option("MESH", info_path, "Input mesh")->required();
 
+  // Name an unknown command instead of CLI11's "A subcommand is required".
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string command = argv[1];
+    if (command != "segment" && command != "cut" && command != "info")
+      throw InvalidInputError("unknown command '" + command + "' (commands: segment, cut, info)");
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -152,14 +166,15 @@ int run(int argc, char** argv) {
     options.weights = weights == "uniform" ? VertexWeights::Uniform : VertexWeights::Area;
     options.exact_costs = exact_costs;
     validate(options);
+    validate_output_files(segment_options.files);
     const auto read_start = Clock::now();
     auto mesh = std::make_shared<const Mesh>(read_mesh(mesh_path));
     const double read_seconds = seconds_since(read_start);
+    validate_level(segment_options.level, mesh->face_count());
     const auto build_start = Clock::now();
     HierarchyBuilder builder(mesh, options);
     const Hierarchy hierarchy = builder.finish(Progress("hierarchy", segment_options.quiet));
     const double build_seconds = seconds_since(build_start);
-    if (segment_options.files.tree) write_tree(*segment_options.files.tree, hierarchy);
     nlohmann::json summary;
     summary["mesh"] = mesh_summary(mesh_path, hierarchy);
     summary["primitives"] = primitives;
@@ -170,8 +185,12 @@ int run(int argc, char** argv) {
                   mesh->face_count(), hierarchy.component_count(), build_seconds);
     report_level(hierarchy, segment_options, summary, Clock::now());
   } else if (*cut_command) {
+    if (!cut_options.level.clusters && !cut_options.level.tolerance)
+      throw InvalidInputError("cut: give the level with --clusters K or --tolerance T");
+    validate_output_files(cut_options.files);
     const auto read_start = Clock::now();
     const Hierarchy hierarchy = read_tree(tree_path);
+    validate_level(cut_options.level, hierarchy.face_count());
     nlohmann::json summary;
     summary["mesh"] = mesh_summary(tree_path, hierarchy);
     summary["timing"] = {{"read_seconds", seconds_since(read_start)}};

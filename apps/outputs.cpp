@@ -1,5 +1,6 @@
 #include "outputs.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -17,6 +18,17 @@ nlohmann::json vec(const Vec3& v) {
 }
 
 }  // namespace
+
+void validate_output_files(const OutputFiles& files) {
+  if (files.colored) {
+    const std::string extension = std::filesystem::path(*files.colored).extension().string();
+    std::string lower;
+    for (char c : extension)
+      lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (lower != ".ply" && lower != ".obj")
+      throw InvalidInputError("--colored: '" + *files.colored + "' must end in .ply or .obj");
+  }
+}
 
 nlohmann::json primitive_params(const Primitive& p) {
   switch (p.type) {
@@ -61,13 +73,12 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
                           {"max", r.max},
                           {"params", primitive_params(r.primitive)}});
     json["clusters"] = std::move(clusters);
-    detail::write_file_atomically(*files.json, json.dump(2) + "\n");
+    // File names need not be UTF-8: replace what JSON cannot hold rather than fail.
+    detail::write_file_atomically(
+        *files.json, json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   if (files.colored) {
     const std::filesystem::path path(*files.colored);
-    const MeshFormat format = mesh_format_from_path(path);
-    if (format != MeshFormat::Ply && format != MeshFormat::Obj)
-      throw InvalidInputError("--colored: " + path.string() + " must end in .ply or .obj");
     MeshWriteOptions options;
     options.face_groups = segmentation.labels;
     write_mesh(path, hierarchy.mesh(), options);

@@ -17,6 +17,9 @@ struct OutputFiles {
   std::optional<std::string> png;      // picture of the clusters
 };
 
+/// Throws InvalidInputError for output names that cannot be written (checked before any work).
+void validate_output_files(const OutputFiles& files);
+
 /// JSON parameters of a primitive, input units.
 nlohmann::json primitive_params(const Primitive& primitive);
 

@@ -1010,8 +1010,10 @@ TEST(Cli, DegenerateMeshesAreSegmented) {
         EXPECT_TRUE(std::isfinite(c["rms"].get<double>())) << c.dump();
       }
       EXPECT_EQ(read_mesh(dir / "c.ply").face_count(), f);
+      // cut needs the level spelled out: segment's default is --tolerance 0.1%.
+      const std::string cut_level = level.empty() ? "--tolerance 0.1%" : level;
       const CliRun cut =
-          run("cut " + dir.q("t.tree") + " --quiet " + level + " --labels " + dir.q("cl.txt"));
+          run("cut " + dir.q("t.tree") + " --quiet " + cut_level + " --labels " + dir.q("cl.txt"));
       ASSERT_EXIT_OK(cut);
       EXPECT_EQ(read_labels(dir / "cl.txt"), labels);
     }
