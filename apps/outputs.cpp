@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#include "../src/atomic_write.hpp"
+#include "../src/file_io.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/render.hpp"

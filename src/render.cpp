@@ -6,7 +6,7 @@
 #include <string_view>
 #include <utility>
 
-#include "atomic_write.hpp"
+#include "file_io.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg {

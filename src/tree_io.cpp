@@ -2,9 +2,8 @@
 
 #include <bit>
 #include <cstring>
-#include <fstream>
 
-#include "atomic_write.hpp"
+#include "file_io.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg {
@@ -213,12 +212,9 @@ void write_tree(const std::filesystem::path& path, const Hierarchy& hierarchy) {
 }
 
 Hierarchy read_tree(const std::filesystem::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw IoError("cannot open " + path.string());
-  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (file.bad()) throw IoError("cannot read " + path.string());
-  if (bytes.empty()) throw ParseError(path.string() + ": empty file");
-  return deserialize_tree(bytes, path.string());
+  const detail::FileImage file = detail::read_file(path);
+  if (file.size == 0) throw ParseError(path.string() + ": empty file");
+  return deserialize_tree({file.bytes.get(), file.size}, path.string());
 }
 
 }  // namespace primseg

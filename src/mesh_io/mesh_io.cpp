@@ -1,5 +1,7 @@
 #include "primseg/mesh_io.hpp"
 
+#include "file_io.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -24,51 +26,6 @@ std::string lower_ascii(std::string text) {
   return text;
 }
 
-[[noreturn]] void io_failure(const std::filesystem::path& path, std::string_view action,
-                             int error_number) {
-  throw IoError("cannot " + std::string(action) + " '" + path.string() +
-                "': " + std::strerror(error_number));
-}
-
-/// The whole file in one block: every reader parses from memory, never through a stream.
-struct FileImage {
-  std::unique_ptr<char[]> bytes;
-  std::size_t size = 0;
-};
-
-FileImage read_file(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) io_failure(path, "open", errno);
-  struct FdCloser {
-    int fd;
-    ~FdCloser() { ::close(fd); }
-  } closer{fd};
-
-  struct stat status {};
-  if (::fstat(fd, &status) != 0) io_failure(path, "stat", errno);
-  if (S_ISDIR(status.st_mode)) io_failure(path, "read", EISDIR);
-
-  // The size from fstat may be stale (a growing file): read until end of file regardless.
-  std::size_t capacity = static_cast<std::size_t>(status.st_size) + 1;
-  FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
-  while (true) {
-    if (image.size == capacity) {
-      const std::size_t grown = capacity + capacity / 2 + 4096;
-      auto larger = std::make_unique_for_overwrite<char[]>(grown);
-      std::memcpy(larger.get(), image.bytes.get(), image.size);
-      image.bytes = std::move(larger);
-      capacity = grown;
-    }
-    const ssize_t got = ::read(fd, image.bytes.get() + image.size, capacity - image.size);
-    if (got < 0) {
-      if (errno == EINTR) continue;
-      io_failure(path, "read", errno);
-    }
-    if (got == 0) return image;
-    image.size += static_cast<std::size_t>(got);
-  }
-}
-
 }  // namespace
 
 MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
@@ -83,7 +40,7 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
 
 Mesh read_mesh(const std::filesystem::path& path) {
   const MeshFormat format = mesh_format_from_path(path);
-  const FileImage image = read_file(path);
+  const detail::FileImage image = detail::read_file(path);
   return read_mesh(std::span<const char>(image.bytes.get(), image.size), format, path.string());
 }
 

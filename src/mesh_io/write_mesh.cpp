@@ -15,6 +15,8 @@
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 
+#include "file_io.hpp"
+
 namespace primseg {
 namespace {
 
@@ -235,55 +237,6 @@ void write_stl(OutputBuffer& out, const Mesh& mesh, bool binary) {
   }
 }
 
-[[noreturn]] void io_failure(const std::filesystem::path& path, std::string_view action,
-                             int error_number) {
-  throw IoError("cannot " + std::string(action) + " '" + path.string() +
-                "': " + std::strerror(error_number));
-}
-
-/// Writes to a fresh name in the target's directory, then renames over the target: readers see
-/// the old file or the complete new one, never a partial write.
-void write_atomically(const std::filesystem::path& path, const std::string& bytes) {
-  static std::atomic<unsigned> counter{0};
-  std::filesystem::path temporary = path;
-  // Appended piecewise: `"." + string` trips a false -Wrestrict in g++ 12 release builds.
-  std::string name(1, '.');
-  name.append(path.filename().string())
-      .append(".tmp")
-      .append(std::to_string(::getpid()))
-      .append("_")
-      .append(std::to_string(counter++));
-  temporary.replace_filename(name);
-  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) io_failure(path, "create a temporary file for", errno);
-  const auto abandon = [&](std::string_view action) {
-    const int error_number = errno;
-    ::close(fd);
-    ::unlink(temporary.c_str());
-    io_failure(path, action, error_number);
-  };
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t result = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (result < 0) {
-      if (errno == EINTR) continue;
-      abandon("write");
-    }
-    written += static_cast<std::size_t>(result);
-  }
-  if (::fsync(fd) != 0) abandon("flush");
-  if (::close(fd) != 0) {
-    const int error_number = errno;
-    ::unlink(temporary.c_str());
-    io_failure(path, "write", error_number);
-  }
-  if (::rename(temporary.c_str(), path.c_str()) != 0) {
-    const int error_number = errno;
-    ::unlink(temporary.c_str());
-    io_failure(path, "rename a temporary file onto", error_number);
-  }
-}
-
 }  // namespace
 
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
@@ -306,7 +259,7 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
       write_stl(out, mesh, options.binary);
       break;
   }
-  write_atomically(path, out.text());
+  detail::write_file_atomically(path, out.text());
 }
 
 std::vector<std::array<std::uint8_t, 3>> distinct_colors(std::size_t count) {

@@ -1099,7 +1099,9 @@ TEST(Cli, PrimitivesAndWeightsOptionsAreHonoured) {
   // A sphere-only run still reports spheres, in a different order of the list.
   ASSERT_EXIT_OK(run("segment " + dir.q("in.off") +
                      " --quiet --primitives sphere,plane --clusters 7 --json " + dir.q("s.json")));
-  for (const json& c : read_json(dir / "s.json")["clusters"])
+  // Keep the document alive: a range-for over a member of a temporary would dangle.
+  const json sphere_run = read_json(dir / "s.json");
+  for (const json& c : sphere_run["clusters"])
     EXPECT_TRUE(c["type"] == "plane" || c["type"] == "sphere") << c.dump();
 
   // Uniform weights: a valid segmentation, still perfect at the true K on this clean shape.
