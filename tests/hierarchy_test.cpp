@@ -46,14 +46,19 @@ const Variant kVariants[] = {{Tessellation::Cad, 1},
                              {Tessellation::Uniform, 3},
                              {Tessellation::Uniform, 4}};
 
+ShapeOptions variant_options(const Variant& variant, double noise) {
+  ShapeOptions options;
+  options.tessellation = variant.tessellation;
+  options.random_motion = true;
+  options.seed = variant.seed;
+  options.noise = noise;
+  return options;
+}
+
 TEST(Hierarchy, RecoversEveryRegionOfCleanCadShapesWithTheRightType) {
   for (const Variant& variant : kVariants)
     for (const std::string& name : shape_names()) {
-      ShapeOptions options;
-      options.tessellation = variant.tessellation;
-      options.random_motion = true;
-      options.seed = variant.seed;
-      const GroundTruthShape shape = make_shape(name, options);
+      const GroundTruthShape shape = make_shape(name, variant_options(variant, 0));
       const Hierarchy h = build_hierarchy(shape.mesh);
       const SegmentationScore score = score_at_true_count(shape, h);
       EXPECT_GE(score.min_iou, 0.95) << name << " seed " << variant.seed;
@@ -66,12 +71,8 @@ TEST(Hierarchy, NoisyCadShapesKeepAMeanIouAboveNinetyPercent) {
   int count = 0;
   for (const Variant& variant : kVariants)
     for (const std::string& name : shape_names()) {
-      ShapeOptions options;
-      options.tessellation = variant.tessellation;
-      options.random_motion = true;
-      options.seed = variant.seed;
-      options.noise = 0.002;  // 0.2% of the bounding-box diagonal, along the normals
-      const GroundTruthShape shape = make_shape(name, options);
+      // Noise: 0.2% of the bounding-box diagonal, along the normals.
+      const GroundTruthShape shape = make_shape(name, variant_options(variant, 0.002));
       const SegmentationScore score = score_at_true_count(shape, build_hierarchy(shape.mesh));
       EXPECT_GE(score.mean_iou, 0.8) << name << " seed " << variant.seed;
       sum += score.mean_iou;

@@ -33,8 +33,9 @@ Mesh read_mesh(std::span<const char> bytes, MeshFormat format, std::string_view 
 /// What write_mesh writes besides the geometry.
 struct MeshWriteOptions {
   /// Optional group (cluster) of each input face, shape (F). Empty: no groups.
-  /// PLY: faces get the group's colour as uchar red/green/blue properties; OBJ: one `g cluster_<id>`
-  /// statement per group, faces grouped by id; OFF: per-face RGB colours; STL: ignored.
+  /// PLY: faces get the group's colour as uchar red/green/blue properties; OBJ: one `g
+  /// cluster_<id>` statement per group, faces grouped by id; OFF: per-face RGB colours; STL:
+  /// ignored.
   std::span<const std::uint32_t> face_groups;
   /// Colour of each group, shape (number of groups). Empty with groups: a built-in palette of
   /// well-separated colours.

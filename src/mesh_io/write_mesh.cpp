@@ -86,9 +86,10 @@ void write_position(OutputBuffer& out, const Vec3& p) {
   out << p[0] << ' ' << p[1] << ' ' << p[2];
 }
 
-void write_off(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_t> groups,
-               const std::vector<Color>& palette) {
-  out << "OFF\n" << mesh.vertex_count() << ' ' << mesh.face_count() << " 0\n";
+// One vertex per line, then one "n v0 .. v(n-1) [r g b]" line per polygon: the body shared by
+// OFF and ascii PLY.
+void write_ascii_body(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_t> groups,
+                      const std::vector<Color>& palette) {
   for (const Vec3& p : mesh.positions) {
     write_position(out, p);
     out << '\n';
@@ -102,6 +103,12 @@ void write_off(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_
     }
     out << '\n';
   }
+}
+
+void write_off(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_t> groups,
+               const std::vector<Color>& palette) {
+  out << "OFF\n" << mesh.vertex_count() << ' ' << mesh.face_count() << " 0\n";
+  write_ascii_body(out, mesh, groups, palette);
 }
 
 void write_obj(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_t> groups) {
@@ -150,19 +157,7 @@ void write_ply(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_
   out << "end_header\n";
 
   if (!binary) {
-    for (const Vec3& p : mesh.positions) {
-      write_position(out, p);
-      out << '\n';
-    }
-    for (std::uint32_t f = 0; f < mesh.face_count(); ++f) {
-      const auto loop = mesh.polygon(f);
-      out << static_cast<std::uint32_t>(loop.size());
-      for (const std::uint32_t v : loop) out << ' ' << v;
-      if (!groups.empty()) {
-        for (const std::uint8_t channel : palette[groups[f]]) out << ' ' << std::uint32_t{channel};
-      }
-      out << '\n';
-    }
+    write_ascii_body(out, mesh, groups, palette);
     return;
   }
   out.text().reserve(out.text().size() + 24 * mesh.positions.size() +
