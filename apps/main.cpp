@@ -94,6 +94,9 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
                      "Write the mesh coloured by cluster (.ply colours or .obj groups)");
   command.add_option("--png", options.files.png,
                      "Render the clusters to a PNG picture (800x600, three-quarter view)");
+  command.add_option("--linkage", options.files.linkage,
+                     "Write the whole tree as a SciPy linkage matrix (text: a b cost size per "
+                     "merge, numpy.loadtxt)");
   command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
 }
 

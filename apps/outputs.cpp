@@ -83,6 +83,17 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     options.face_groups = segmentation.labels;
     write_mesh(path, hierarchy.mesh(), options);
   }
+  if (files.linkage) {
+    // numpy.loadtxt gives SciPy's (F − 1, 4) linkage matrix: children, cost, size.
+    std::string text;
+    char line[128];
+    for (const auto& row : hierarchy.linkage()) {
+      const int n = std::snprintf(line, sizeof line, "%.0f %.0f %.17g %.0f\n", row[0], row[1],
+                                  row[2], row[3]);
+      text.append(line, static_cast<std::size_t>(n));
+    }
+    detail::write_file_atomically(*files.linkage, text);
+  }
   if (files.png) {
     const auto palette = distinct_colors(segmentation.cluster_count());
     std::vector<std::array<std::uint8_t, 3>> colors(segmentation.labels.size());

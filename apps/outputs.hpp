@@ -15,6 +15,7 @@ struct OutputFiles {
   std::optional<std::string> colored;  // .ply (face colours) or .obj (groups)
   std::optional<std::string> tree;     // whole hierarchy (segment only)
   std::optional<std::string> png;      // picture of the clusters
+  std::optional<std::string> linkage;  // SciPy linkage matrix of the whole tree, as text
 };
 
 /// Throws InvalidInputError for output names that cannot be written (checked before any work).

@@ -1166,5 +1166,39 @@ TEST(Cli, OutputsOverwriteExistingFiles) {
   expect_valid_labels(read_labels(dir / "l.txt"), 12, 6);
 }
 
+TEST(Cli, LinkageIsAValidScipyLinkageMatrixOfTheWholeTree) {
+  TempDir dir("linkage");
+  const GroundTruthShape shape = make_shape("box_with_hole");
+  write_mesh(dir / "in.off", shape.mesh);
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --clusters 7 --tree " +
+                     dir.q("t.tree") + " --linkage " + dir.q("z.txt")));
+  ASSERT_EXIT_OK(
+      run("cut " + dir.q("t.tree") + " --quiet --clusters 3 --linkage " + dir.q("z2.txt")));
+  EXPECT_EQ(read_file(dir / "z.txt"), read_file(dir / "z2.txt"));
+  // SciPy's rules (scipy.cluster.hierarchy.is_valid_linkage): n − 1 rows; row i joins two
+  // existing clusters (< n + i), each used once; the size is the sum of the children's sizes.
+  const std::uint32_t n = shape.mesh.face_count();
+  std::ifstream in(dir / "z.txt");
+  std::vector<double> size(2 * n - 1, 1.0);
+  std::vector<int> used(2 * n - 1, 0);
+  double a, b, cost, count;
+  std::uint32_t rows = 0;
+  while (in >> a >> b >> cost >> count) {
+    ASSERT_LT(rows, n - 1);
+    const auto i = static_cast<std::uint32_t>(a), j = static_cast<std::uint32_t>(b);
+    EXPECT_EQ(double(i), a);
+    EXPECT_LT(i, n + rows);
+    EXPECT_LT(j, n + rows);
+    EXPECT_EQ(used[i]++, 0);
+    EXPECT_EQ(used[j]++, 0);
+    EXPECT_TRUE(std::isfinite(cost) && cost >= 0) << cost;
+    EXPECT_EQ(count, size[i] + size[j]);
+    size[n + rows] = count;
+    ++rows;
+  }
+  EXPECT_EQ(rows, n - 1);
+  EXPECT_EQ(size[2 * n - 2], double(n));
+}
+
 }  // namespace
 }  // namespace primseg
