@@ -113,6 +113,14 @@ TEST(CylinderFitter, RecoversRingByGeneratorCylindersExactly) {
     EXPECT_NEAR(cylinder.radius, r, 1e-9 * r);
     EXPECT_LT(angle_between_axes(cylinder.axis, pose.rotation.col(2)), 1e-9);
     for (const Vec3& p : mesh.positions) EXPECT_LT(cylinder.distance(p), 1e-9 * r);
+    // Canonical form: axis with its largest-magnitude component positive, point = the centroid
+    // of the vertices' weights projected on the axis (on the axis, at the patch's middle height).
+    const Eigen::Vector3d axis(cylinder.axis[0], cylinder.axis[1], cylinder.axis[2]);
+    Eigen::Index largest;
+    axis.cwiseAbs().maxCoeff(&largest);
+    EXPECT_GT(axis(largest), 0);
+    const Vec3 middle = pose.apply(Eigen::Vector3d(0, 0, 0.75));
+    EXPECT_LT(distance(cylinder.point, middle), 1e-9 * r);
   }
 }
 
