@@ -229,6 +229,21 @@ TEST(Hierarchy, ManyFacesOnOneEdgeGiveLinearlyManyDualEdges) {
   EXPECT_EQ(h.merges().size(), 1999u);
 }
 
+TEST(HierarchyBuilder, SteppingGivesTheOneShotTree) {
+  const GroundTruthShape shape = make_shape("box_with_blind_hole", {});
+  auto mesh = std::make_shared<const Mesh>(shape.mesh);
+  HierarchyBuilder builder(mesh);
+  EXPECT_EQ(builder.total_merge_count(), mesh->face_count() - 1);
+  std::uint32_t steps = 0;
+  while (builder.step()) EXPECT_EQ(builder.merge_count(), ++steps);
+  EXPECT_EQ(steps, builder.total_merge_count());
+  std::vector<double> progress;
+  const Hierarchy stepped = builder.finish([&](double f) { progress.push_back(f); });
+  EXPECT_EQ(serialize_tree(stepped), serialize_tree(build_hierarchy(shape.mesh)));
+  ASSERT_FALSE(progress.empty());
+  EXPECT_EQ(progress.back(), 1.0);
+}
+
 TEST(Hierarchy, SingleFaceMeshHasNoMerges) {
   const Mesh mesh = Mesh::from_triangles({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {Triangle{0, 1, 2}});
   const Hierarchy h = build_hierarchy(mesh);

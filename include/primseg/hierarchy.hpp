@@ -6,8 +6,8 @@
 /// smallest L2 error over the enabled primitive types. The result is a full binary tree that can
 /// be cut at any level without recomputation (cut.hpp).
 ///
-/// One-shot use: `Hierarchy h = build_hierarchy(mesh);`. Step-by-step control (progress, early
-/// stop, inspecting the live clusters): HierarchyBuilder.
+/// One-shot use: `Hierarchy h = build_hierarchy(mesh);`. Step-by-step control (one merge per
+/// step() call, to interleave with other work or report progress): HierarchyBuilder.
 
 #include <array>
 #include <cstdint>
