@@ -155,6 +155,7 @@ class HierarchyBuilder::Impl {
     heap_.reserve(edges_.size());
     for (std::uint32_t id = 0; id < edges_.size(); ++id) heap_.push_back(candidate(id));
     std::make_heap(heap_.begin(), heap_.end(), comes_after);
+    live_edges_ = static_cast<std::uint32_t>(edges_.size());
     total_merges_ = f - graph_->component_count();
   }
 
@@ -291,6 +292,7 @@ class HierarchyBuilder::Impl {
       list_tail_[slot_a] = list_tail_[slot_b];
     }
     edge.alive = false;
+    --live_edges_;
 
     // Rename a and b to the new node; two edges to a common neighbour become one.
     std::vector<std::uint32_t> kept;
@@ -309,6 +311,7 @@ class HierarchyBuilder::Impl {
           LiveEdge& into = edges_[marker_[other]];
           into.shared += e.shared;
           e.alive = false;
+          --live_edges_;
         }
       }
     }
@@ -321,6 +324,18 @@ class HierarchyBuilder::Impl {
       heap_.push_back(candidate(id));
       std::push_heap(heap_.begin(), heap_.end(), comes_after);
     }
+    compact_heap_if_stale();
+  }
+
+  // Re-evaluated candidates leave their old entries behind; drop them once they outnumber the
+  // live ones. The pop order does not change: live entries have distinct keys.
+  void compact_heap_if_stale() {
+    if (heap_.size() <= 2 * std::size_t{live_edges_} + 1024) return;
+    std::erase_if(heap_, [&](const HeapEntry& entry) {
+      const LiveEdge& e = edges_[entry.edge];
+      return !e.alive || e.version != entry.version;
+    });
+    std::make_heap(heap_.begin(), heap_.end(), comes_after);
   }
 
   // Components are joined in the order of their lowest face, each trailing merge costed above
@@ -366,6 +381,7 @@ class HierarchyBuilder::Impl {
   std::vector<std::uint32_t> marker_;
   std::vector<std::uint32_t> next_face_, list_head_, list_tail_;  // exact_costs only
   std::uint32_t total_merges_ = 0;
+  std::uint32_t live_edges_ = 0;
   double max_cost_ = 0;
 };
 
