@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace primseg {
 namespace {
@@ -71,6 +72,15 @@ constexpr std::size_t count_terms_up_to_degree2() {
 constexpr std::size_t kTermsUpToDegree2 = count_terms_up_to_degree2();
 static_assert(kTermsUpToDegree2 == 28);
 
+template <std::size_t... n>
+inline void apply_translation_terms(std::index_sequence<n...>, const double* shift,
+                                    const double* source, double* target) {
+  ((target[kTranslationTerms[n].target] += kTranslationTerms[n].coefficient *
+                                           shift[kTranslationTerms[n].shift] *
+                                           source[kTranslationTerms[n].source]),
+   ...);
+}
+
 // Monomial index of the full tensor entry with axes (a, b, c, d) (a 4-digit base-3 number;
 // lower degrees pad with the axis value 3, which adds no exponent).
 constexpr std::array<std::uint8_t, 256> make_axes_index() {
@@ -132,12 +142,15 @@ Moments Moments::translated(const Eigen::Vector3d& new_origin, int max_degree) c
   for (int n = 0; n < kCount; ++n)
     shift[n] = px[kMonomials[n].i] * py[kMonomials[n].j] * pz[kMonomials[n].k];
   Moments result(new_origin);
-  // Terms are listed by target monomial, and monomials by degree.
-  const std::size_t term_count = max_degree >= 4 ? kTranslationTerms.size() : kTermsUpToDegree2;
-  for (std::size_t n = 0; n < term_count; ++n) {
-    const TranslationTerm& term = kTranslationTerms[n];
-    result.values_[term.target] += term.coefficient * shift[term.shift] * values_[term.source];
-  }
+  // Terms are listed by target monomial, and monomials by degree. Unrolled at compile time: with
+  // constant indices the compiler interleaves the 35 independent sums (each still added in the
+  // listed order, so results are the same bit for bit).
+  if (max_degree >= 4)
+    apply_translation_terms(std::make_index_sequence<kTranslationTerms.size()>(), shift,
+                            values_.data(), result.values_.data());
+  else
+    apply_translation_terms(std::make_index_sequence<kTermsUpToDegree2>(), shift, values_.data(),
+                            result.values_.data());
   return result;
 }
 
