@@ -12,10 +12,14 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "bench_support.hpp"
+#include "model_selection.hpp"
 #include "primseg/cut.hpp"
+#include "primseg/dual_graph.hpp"
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/shape_generator.hpp"
@@ -109,6 +113,74 @@ void cut_and_describe(benchmark::State& state, const std::string& input, std::ui
   });
 }
 
+/// One candidate evaluation (what each candidate merge costs, less the queue): the union of two
+/// adjacent clusters' statistics, centring, and model selection over plane, cylinder and sphere.
+/// The clusters have `faces` faces each, grown breadth-first on a finely tessellated sphere: the
+/// time must not depend on `faces` (the constant-time claim).
+void candidate_evaluation(benchmark::State& state, std::uint32_t faces) {
+  guarded(state, [&] {
+    static std::shared_ptr<const Mesh> mesh;
+    static std::unique_ptr<DualGraph> graph;
+    if (!graph) {
+      ShapeOptions options;
+      options.tessellation = Tessellation::Uniform;
+      options.edge_length = 0.0025;  // about 300k faces: room for two clusters of 100k
+      mesh = std::make_shared<const Mesh>(make_shape("sphere", options).mesh);
+      graph = std::make_unique<DualGraph>(*mesh, VertexWeights::Area);
+    }
+    if (2 * faces > graph->face_count()) throw std::runtime_error("mesh too small");
+    // Breadth-first order from face 0: the first `faces` faces are A, the next `faces` are B.
+    std::vector<std::vector<std::uint32_t>> neighbours(graph->face_count());
+    for (std::uint32_t e = 0; e < graph->edges().size(); ++e) {
+      neighbours[graph->edges()[e].first].push_back(e);
+      neighbours[graph->edges()[e].second].push_back(e);
+    }
+    std::vector<int> cluster(graph->face_count(), -1);
+    std::vector<std::uint32_t> queue{0};
+    std::vector<char> seen(graph->face_count(), 0);
+    seen[0] = 1;
+    for (std::size_t head = 0; head < queue.size() && head < 2 * std::size_t{faces}; ++head) {
+      cluster[queue[head]] = head < faces ? 0 : 1;
+      for (std::uint32_t e : neighbours[queue[head]]) {
+        const DualEdge& edge = graph->edges()[e];
+        const std::uint32_t other = edge.first == queue[head] ? edge.second : edge.first;
+        if (!seen[other]) {
+          seen[other] = 1;
+          queue.push_back(other);
+        }
+      }
+    }
+    ClusterStats stats[2];
+    EdgeStats shared;
+    bool started[2] = {false, false};
+    for (std::uint32_t f = 0; f < graph->face_count(); ++f) {
+      const int c = cluster[f];
+      if (c < 0) continue;
+      if (!started[c])
+        stats[c] = graph->face_stats(f);
+      else
+        stats[c].merge(graph->face_stats(f), {});
+      started[c] = true;
+    }
+    for (const DualEdge& e : graph->edges()) {
+      const int a = cluster[e.first], b = cluster[e.second];
+      if (a < 0 || b < 0) continue;
+      if (a == b)
+        stats[a].edges += e.shared;
+      else
+        shared += e.shared;
+    }
+    const detail::ModelSelector selector{HierarchyOptions{}};
+    for (auto _ : state) {
+      ClusterStats merged = stats[0];
+      merged.merge(stats[1], shared);
+      const detail::SelectedModel model = selector.select(merged.centred());
+      benchmark::DoNotOptimize(model.cost);
+    }
+    state.counters["cluster_faces"] = benchmark::Counter(double(faces));
+  });
+}
+
 benchmark::internal::Benchmark* configure(benchmark::internal::Benchmark* b) {
   return b->UseRealTime()
       ->Repetitions(kRepetitions)
@@ -134,6 +206,11 @@ void register_benchmarks() {
   configure(benchmark::RegisterBenchmark("read_mesh/bunny00", read, "bunny00.off"));
   configure(benchmark::RegisterBenchmark("cut_describe_k30/fandisk", cut_and_describe,
                                          "fandisk.off", std::uint32_t{30}));
+  for (std::uint32_t faces : {10u, 1000u, 100000u})
+    configure(
+        benchmark::RegisterBenchmark(("candidate_evaluation/" + std::to_string(faces)).c_str(),
+                                     candidate_evaluation, faces))
+        ->Unit(benchmark::kNanosecond);
 }
 
 }  // namespace
