@@ -125,6 +125,7 @@ int run(int argc, char** argv) {
   // segment
   std::string mesh_path, primitives = "plane,cylinder,sphere", weights = "area";
   bool exact_costs = false;
+  unsigned threads = 0;
   LevelOptions segment_options;
   auto* segment = app.add_subcommand("segment", "Build the hierarchy of a mesh and report a level");
   segment->add_option("MESH", mesh_path, "Input mesh (.off .obj .ply .stl)")->required();
@@ -135,6 +136,11 @@ int run(int argc, char** argv) {
       ->check(CLI::IsMember({"area", "uniform"}))
       ->capture_default_str();
   segment->add_option("--tree", segment_options.files.tree, "Write the whole hierarchy");
+  segment
+      ->add_option("--threads", threads,
+                   "Threads for the parallel parts (0: all cores); the tree does not depend "
+                   "on it")
+      ->capture_default_str();
   segment->add_flag("--exact-costs", exact_costs,
                     "Reference mode: exact Euclidean errors, O(cluster size) per candidate");
 
@@ -168,6 +174,7 @@ int run(int argc, char** argv) {
     options.primitives = parse_primitives(primitives);
     options.weights = weights == "uniform" ? VertexWeights::Uniform : VertexWeights::Area;
     options.exact_costs = exact_costs;
+    options.threads = threads;
     validate(options);
     validate_output_files(segment_options.files);
     const auto read_start = Clock::now();

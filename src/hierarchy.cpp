@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "model_selection.hpp"
+#include "parallel.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg {
@@ -128,8 +129,11 @@ class HierarchyBuilder::Impl {
     mesh_->validate();
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights);
     const std::uint32_t f = mesh_->face_count();
+    const unsigned threads = detail::thread_count(options_.threads);
     stats_.resize(f);
-    for (std::uint32_t face = 0; face < f; ++face) stats_[face] = graph_->face_stats(face);
+    detail::parallel_for(f, threads, [&](std::size_t face) {
+      stats_[face] = graph_->face_stats(static_cast<std::uint32_t>(face));
+    });
     slot_of_node_.assign(2 * std::size_t{f}, kNone);
     for (std::uint32_t face = 0; face < f; ++face) slot_of_node_[face] = face;
     face_count_of_slot_.assign(f, 1);
@@ -152,8 +156,13 @@ class HierarchyBuilder::Impl {
     }
     stamp_.assign(2 * std::size_t{f}, 0);
     marker_.assign(2 * std::size_t{f}, kNone);
-    heap_.reserve(edges_.size());
-    for (std::uint32_t id = 0; id < edges_.size(); ++id) heap_.push_back(candidate(id));
+    // Every candidate's cost is independent of the others: evaluate them in parallel, then the
+    // degrees (which share scratch arrays) in order.
+    heap_.resize(edges_.size());
+    detail::parallel_for(edges_.size(), threads, [&](std::size_t id) {
+      heap_[id] = evaluate(static_cast<std::uint32_t>(id));
+    });
+    for (HeapEntry& entry : heap_) entry.degree = merged_degree(entry.low, entry.high);
     std::make_heap(heap_.begin(), heap_.end(), comes_after);
     live_edges_ = static_cast<std::uint32_t>(edges_.size());
     total_merges_ = f - graph_->component_count();
@@ -254,12 +263,18 @@ class HierarchyBuilder::Impl {
     return selector_.select(centred_stats, &exact);
   }
 
-  HeapEntry candidate(std::uint32_t id) {
+  // A candidate's entry without its degree; reads shared state only (safe in parallel).
+  HeapEntry evaluate(std::uint32_t id) const {
     const LiveEdge& e = edges_[id];
     const detail::SelectedModel model = select(union_stats(e, false), e);
-    return {model.cost,         model.fit.primitive.type, merged_degree(e.a, e.b),
-            std::min(e.a, e.b), std::max(e.a, e.b),       id,
+    return {model.cost, model.fit.primitive.type, 0, std::min(e.a, e.b), std::max(e.a, e.b), id,
             e.version};
+  }
+
+  HeapEntry candidate(std::uint32_t id) {
+    HeapEntry entry = evaluate(id);
+    entry.degree = merged_degree(edges_[id].a, edges_[id].b);
+    return entry;
   }
 
   void merge(std::uint32_t edge_id) {

@@ -145,6 +145,23 @@ TEST(Hierarchy, SameInputGivesTheSameTreeBitForBit) {
   EXPECT_EQ(first, second);
 }
 
+TEST(Hierarchy, AnyThreadCountGivesTheSameTreeBitForBit) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.edge_length = 0.02;  // about 10k faces: enough work for every thread
+  options.noise = 0.002;
+  options.random_motion = true;
+  const GroundTruthShape shape = make_shape("box_with_boss", options);
+  HierarchyOptions one_thread;
+  one_thread.threads = 1;
+  const std::string reference = serialize_tree(build_hierarchy(shape.mesh, one_thread));
+  for (unsigned threads : {2u, 3u, 0u}) {
+    HierarchyOptions parallel = one_thread;
+    parallel.threads = threads;
+    EXPECT_EQ(serialize_tree(build_hierarchy(shape.mesh, parallel)), reference) << threads;
+  }
+}
+
 TEST(Hierarchy, ScalingByAPowerOfTwoKeepsEveryMergeAndLabel) {
   ShapeOptions options;
   options.tessellation = Tessellation::Uniform;

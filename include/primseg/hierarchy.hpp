@@ -42,6 +42,10 @@ struct HierarchyOptions {
   /// (Euclidean distance to the same fitted primitive), as the paper's prototype computed it.
   /// Cost O(|A| + |B|) per candidate instead of O(1): for comparison only.
   bool exact_costs = false;
+  /// Threads for the parallel parts (the statistics of every face and the first evaluation of
+  /// every candidate); 0 uses all hardware threads. The tree is the same, bit for bit, for any
+  /// number of threads.
+  unsigned threads = 0;
 };
 
 /// Throws InvalidInputError if options are unusable (no primitive, a type without a fitter, a
