@@ -1166,6 +1166,16 @@ TEST(Cli, OutputsOverwriteExistingFiles) {
   expect_valid_labels(read_labels(dir / "l.txt"), 12, 6);
 }
 
+TEST(Cli, ThreadCountDoesNotChangeTheTree) {
+  TempDir dir("threads");
+  write_mesh(dir / "in.off", read_mesh(testing::cgal_mesh("fandisk.off")));
+  for (const char* threads : {"1", "2", "3"})
+    ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --threads " + threads +
+                       " --tree " + dir.q(std::string("t") + threads + ".tree")));
+  EXPECT_EQ(read_file(dir / "t1.tree"), read_file(dir / "t2.tree"));
+  EXPECT_EQ(read_file(dir / "t1.tree"), read_file(dir / "t3.tree"));
+}
+
 TEST(Cli, LinkageIsAValidScipyLinkageMatrixOfTheWholeTree) {
   TempDir dir("linkage");
   const GroundTruthShape shape = make_shape("box_with_hole");
