@@ -51,10 +51,10 @@ struct LiveEdge {
 
 Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
                      std::vector<Merge> merges)
-    : Hierarchy(std::move(mesh), std::move(options), std::move(merges), nullptr, 0) {}
+    : Hierarchy(std::move(mesh), std::move(options), std::move(merges), nullptr) {}
 
 Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
-                     std::vector<Merge> merges, std::unique_ptr<DualGraph> graph, int)
+                     std::vector<Merge> merges, std::unique_ptr<DualGraph> graph)
     : mesh_(std::move(mesh)),
       options_(std::move(options)),
       graph_(std::move(graph)),
@@ -77,10 +77,6 @@ Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
     parents_[m.first] = parents_[m.second] = node;
   }
 }
-
-Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
-                     std::vector<Merge> merges, std::unique_ptr<DualGraph> graph)
-    : Hierarchy(std::move(mesh), std::move(options), std::move(merges), std::move(graph), 0) {}
 
 Primitive Hierarchy::primitive(std::uint32_t node) const {
   if (!is_leaf(node)) return merges_[node - face_count()].primitive;
@@ -193,7 +189,15 @@ class HierarchyBuilder::Impl {
   std::uint32_t merge_count() const { return static_cast<std::uint32_t>(merges_.size()); }
   std::uint32_t total_merge_count() const { return total_merges_; }
 
-  Hierarchy finish(const std::function<void(double)>& progress) {
+  struct Parts {
+    std::shared_ptr<const Mesh> mesh;
+    HierarchyOptions options;
+    std::vector<Merge> merges;
+    std::unique_ptr<DualGraph> graph;
+  };
+
+  Parts finish(const std::function<void(double)>& progress) {
+    if (!graph_) throw Error("HierarchyBuilder::finish() was already called");
     const std::uint32_t report_every = std::max<std::uint32_t>(1, total_merges_ / 100);
     if (progress) progress(0);
     while (step())
@@ -201,8 +205,7 @@ class HierarchyBuilder::Impl {
         progress(double(merges_.size()) / std::max<std::uint32_t>(1, total_merges_));
     add_trailing_merges();
     if (progress) progress(1);
-    auto merges = std::move(merges_);
-    return Hierarchy(std::move(mesh_), std::move(options_), std::move(merges), std::move(graph_));
+    return {std::move(mesh_), std::move(options_), std::move(merges_), std::move(graph_)};
   }
 
  private:
@@ -413,7 +416,9 @@ std::uint32_t HierarchyBuilder::total_merge_count() const {
   return impl_->total_merge_count();
 }
 Hierarchy HierarchyBuilder::finish(const std::function<void(double)>& progress) {
-  return impl_->finish(progress);
+  Impl::Parts parts = impl_->finish(progress);
+  return Hierarchy(std::move(parts.mesh), std::move(parts.options), std::move(parts.merges),
+                   std::move(parts.graph));
 }
 
 Hierarchy build_hierarchy(const Mesh& mesh, const HierarchyOptions& options) {

@@ -259,6 +259,7 @@ TEST(HierarchyBuilder, SteppingGivesTheOneShotTree) {
   EXPECT_EQ(serialize_tree(stepped), serialize_tree(build_hierarchy(shape.mesh)));
   ASSERT_FALSE(progress.empty());
   EXPECT_EQ(progress.back(), 1.0);
+  EXPECT_THROW(builder.finish(), Error);
 }
 
 TEST(Hierarchy, SingleFaceMeshHasNoMerges) {

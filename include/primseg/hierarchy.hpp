@@ -76,9 +76,6 @@ class Hierarchy {
   /// A tree from its parts (as read from a tree file). Throws InvalidInputError unless `merges`
   /// form a binary tree over the mesh's F faces (F − 1 merges, children before parents).
   Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options, std::vector<Merge> merges);
-  /// The same, adopting the dual graph the builder already made (of this mesh and weights).
-  Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options, std::vector<Merge> merges,
-            std::unique_ptr<DualGraph> graph);
 
   const Mesh& mesh() const { return *mesh_; }
   std::shared_ptr<const Mesh> shared_mesh() const { return mesh_; }
@@ -108,8 +105,10 @@ class Hierarchy {
   std::vector<std::array<double, 4>> linkage() const;
 
  private:
+  friend class HierarchyBuilder;
+  // Adopts the dual graph the builder made (of this mesh, with these options' weights).
   Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options, std::vector<Merge> merges,
-            std::unique_ptr<DualGraph> graph, int);
+            std::unique_ptr<DualGraph> graph);
 
   std::shared_ptr<const Mesh> mesh_;
   HierarchyOptions options_;
@@ -135,7 +134,8 @@ class HierarchyBuilder {
   /// Number of real merges the build will make: F − number of components.
   std::uint32_t total_merge_count() const;
   /// Runs the remaining steps, adds the trailing merges and returns the tree. `progress`, if
-  /// given, is called now and then with the fraction done (0..1).
+  /// given, is called now and then with the fraction done (0..1). Call it once: a second call
+  /// throws Error.
   Hierarchy finish(const std::function<void(double)>& progress = {});
 
  private:
