@@ -57,6 +57,7 @@ struct DualEdge {
 /// connected to the others. Orientation propagates only across manifold edges.
 class DualGraph {
  public:
+  /// Builds the graph of `mesh`, which must outlive it (the graph refers to it). O(T log T).
   DualGraph(const Mesh& mesh, VertexWeights weights);
 
   const Mesh& mesh() const { return *mesh_; }
