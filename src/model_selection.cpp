@@ -59,6 +59,9 @@ SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactErro
       best = candidate;
       found = true;
     }
+    // Costs are never negative and equal costs keep the earlier (simpler) type: nothing after
+    // an exact fit can win, so the richer fits need not run (most candidates in flat regions).
+    if (found && best.cost == 0) break;
   }
   if (!found) best = finish(fitter_for(PrimitiveType::Plane).fit(centred));
   return best;
