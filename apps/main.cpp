@@ -158,9 +158,15 @@ int run(int argc, char** argv) {
 
   // Name an unknown command instead of CLI11's "A subcommand is required".
   if (argc > 1 && argv[1][0] != '-') {
-    const std::string command = argv[1];
-    if (command != "segment" && command != "cut" && command != "info")
-      throw InvalidInputError("unknown command '" + command + "' (commands: segment, cut, info)");
+    std::string known;
+    bool found = false;
+    for (const CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) {
+      known += (known.empty() ? "" : ", ") + command->get_name();
+      found |= command->get_name() == argv[1];
+    }
+    if (!found)
+      throw InvalidInputError("unknown command '" + std::string(argv[1]) + "' (commands: " + known +
+                              ")");
   }
   try {
     app.parse(argc, argv);

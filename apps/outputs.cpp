@@ -1,6 +1,5 @@
 #include "outputs.hpp"
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -21,11 +20,14 @@ nlohmann::json vec(const Vec3& v) {
 
 void validate_output_files(const OutputFiles& files) {
   if (files.colored) {
-    const std::string extension = std::filesystem::path(*files.colored).extension().string();
-    std::string lower;
-    for (char c : extension)
-      lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (lower != ".ply" && lower != ".obj")
+    bool supported = false;
+    try {
+      const MeshFormat format = mesh_format_from_path(*files.colored);
+      supported = format == MeshFormat::Ply || format == MeshFormat::Obj;
+    } catch (const InvalidInputError&) {
+      // An unknown extension: reported below in the option's own terms.
+    }
+    if (!supported)
       throw InvalidInputError("--colored: '" + *files.colored + "' must end in .ply or .obj");
   }
 }

@@ -78,17 +78,24 @@ Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
   }
 }
 
+namespace {
+
+// Leaves are not stored: their fit is recomputed from the face, by the same rule as merges.
+detail::SelectedModel select_leaf(const HierarchyOptions& options, const DualGraph& graph,
+                                  std::uint32_t face) {
+  return detail::ModelSelector(options).select(graph.face_stats(face).centred());
+}
+
+}  // namespace
+
 Primitive Hierarchy::primitive(std::uint32_t node) const {
   if (!is_leaf(node)) return merges_[node - face_count()].primitive;
-  const detail::ModelSelector selector(options_);
-  const ClusterStats stats = graph_->face_stats(node).centred();
-  return graph_->frame().to_input(selector.select(stats).fit.primitive);
+  return graph_->frame().to_input(select_leaf(options_, *graph_, node).fit.primitive);
 }
 
 double Hierarchy::error(std::uint32_t node) const {
   if (!is_leaf(node)) return merges_[node - face_count()].error;
-  const detail::ModelSelector selector(options_);
-  return selector.select(graph_->face_stats(node).centred()).fit.error;
+  return select_leaf(options_, *graph_, node).fit.error;
 }
 
 double Hierarchy::weight(std::uint32_t node) const {
