@@ -1,0 +1,92 @@
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "command.hpp"
+#include "primseg/error.hpp"
+#include "primseg/mesh_io.hpp"
+#include "primseg/primitives/primitive_fitter.hpp"
+#include "primseg/tree_io.hpp"
+
+namespace primseg::cli {
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::vector<PrimitiveType> parse_primitives(const std::string& list) {
+  std::vector<PrimitiveType> types;
+  std::size_t begin = 0;
+  while (begin <= list.size()) {
+    const std::size_t end = std::min(list.find(',', begin), list.size());
+    const std::string name = list.substr(begin, end - begin);
+    const auto type = primitive_type_from_string(name);
+    if (!type || !has_fitter(*type)) {
+      std::string known;
+      for (int t = 0; t < kPrimitiveTypeCount; ++t)
+        if (has_fitter(static_cast<PrimitiveType>(t)))
+          known +=
+              (known.empty() ? "" : ", ") + std::string(to_string(static_cast<PrimitiveType>(t)));
+      throw InvalidInputError("--primitives: unknown primitive '" + name +
+                              "' (available: " + known + ")");
+    }
+    types.push_back(*type);
+    begin = end + 1;
+  }
+  return types;
+}
+
+Progress::Progress(const char* what, bool quiet) : what_(what), enabled_(!quiet && ::isatty(2)) {}
+
+void Progress::operator()(double fraction) const {
+  if (enabled_) std::fprintf(stderr, "\r%s: %3d%%", what_, static_cast<int>(fraction * 100));
+  if (enabled_ && fraction >= 1) std::fprintf(stderr, "\n");
+}
+
+nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy) {
+  const Mesh& mesh = hierarchy.mesh();
+  return {{"file", file},
+          {"vertices", mesh.vertex_count()},
+          {"faces", mesh.face_count()},
+          {"triangles", mesh.triangle_count()},
+          {"components", hierarchy.component_count()},
+          {"bbox_diagonal", bounding_box_diagonal(mesh)}};
+}
+
+void add_level_options(CLI::App& command, LevelOptions& options) {
+  auto* clusters =
+      command.add_option("--clusters", options.level.clusters, "Number of clusters K (1..F)");
+  auto* tolerance = command.add_option(
+      "--tolerance", options.level.tolerance,
+      std::string("Largest RMS distance of a cluster to its primitive, in input units or T% of "
+                  "the bounding-box diagonal (default ") +
+          kDefaultTolerance + ")");
+  clusters->excludes(tolerance);
+  command.add_option("--labels", options.files.labels, "Write one cluster label per input face");
+  command.add_option("--json", options.files.json, "Write clusters and primitives as JSON");
+  command.add_option("--colored", options.files.colored,
+                     "Write the mesh coloured by cluster (.ply colours or .obj groups)");
+  command.add_option("--png", options.files.png,
+                     "Render the clusters to a PNG picture (800x600, three-quarter view)");
+  command.add_option("--linkage", options.files.linkage,
+                     "Write the whole tree as a SciPy linkage matrix (text: a b cost size per "
+                     "merge, numpy.loadtxt)");
+  command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
+}
+
+void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
+                  Clock::time_point cut_start) {
+  const Segmentation segmentation = cut(hierarchy, options.level);
+  const std::vector<ClusterReport> reports = describe_clusters(hierarchy, segmentation);
+  summary["timing"]["cut_seconds"] = seconds_since(cut_start);
+  summary["level"] = {{"clusters", segmentation.cluster_count()}};
+  if (options.level.clusters)
+    summary["level"]["requested_clusters"] = *options.level.clusters;
+  else
+    summary["level"]["tolerance"] = options.level.tolerance.value_or(kDefaultTolerance);
+  write_level_outputs(hierarchy, segmentation, reports, options.files, summary);
+  if (options.files.tree) write_tree(*options.files.tree, hierarchy);
+  if (!options.quiet) print_summary(reports);
+}
+
+}  // namespace primseg::cli

@@ -1,0 +1,63 @@
+#pragma once
+// One subcommand of the CLI: each lives in its own apps/<name>_command.cpp, registers its options
+// on the parser and returns the action main() runs when the user chose it.
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "level.hpp"
+#include "outputs.hpp"
+#include "primseg/hierarchy.hpp"
+
+namespace primseg::cli {
+
+struct Command {
+  CLI::App* parser = nullptr;  ///< the subcommand, owned by the top-level CLI::App
+  std::function<void()> run;   ///< called after parsing when this subcommand was chosen
+};
+
+Command add_segment_command(CLI::App& app);
+Command add_cut_command(CLI::App& app);
+Command add_info_command(CLI::App& app);
+
+// Helpers shared by the commands.
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start);
+
+/// Parses "plane,sphere,cylinder" into types that have a fitter; throws InvalidInputError
+/// naming the unknown one and the available ones.
+std::vector<PrimitiveType> parse_primitives(const std::string& list);
+
+/// A one-line progress indicator on stderr, only when stderr is a terminal and not --quiet.
+class Progress {
+ public:
+  Progress(const char* what, bool quiet);
+  void operator()(double fraction) const;
+
+ private:
+  const char* what_;
+  bool enabled_;
+};
+
+/// The "mesh" entry of the JSON summary.
+nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy);
+
+/// A level (--clusters / --tolerance), the per-level output files and --quiet.
+struct LevelOptions {
+  LevelChoice level;
+  OutputFiles files;
+  bool quiet = false;
+};
+
+/// Adds --clusters, --tolerance, the per-level output files and --quiet to a command.
+void add_level_options(CLI::App& command, LevelOptions& options);
+
+/// Cuts the chosen level and writes its outputs (and the tree when asked).
+void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
+                  Clock::time_point cut_start);
+
+}  // namespace primseg::cli

@@ -1,0 +1,33 @@
+#include <memory>
+
+#include "command.hpp"
+#include "primseg/error.hpp"
+#include "primseg/tree_io.hpp"
+
+namespace primseg::cli {
+
+Command add_cut_command(CLI::App& app) {
+  struct Options {
+    std::string tree_path;
+    LevelOptions level;
+  };
+  auto o = std::make_shared<Options>();
+  auto* cut_command = app.add_subcommand("cut", "Report a level of a saved hierarchy");
+  cut_command->add_option("TREE", o->tree_path, "Tree file written by segment --tree")->required();
+  add_level_options(*cut_command, o->level);
+
+  return {cut_command, [o] {
+            if (!o->level.level.clusters && !o->level.level.tolerance)
+              throw InvalidInputError("cut: give the level with --clusters K or --tolerance T");
+            validate_output_files(o->level.files);
+            const auto read_start = Clock::now();
+            const Hierarchy hierarchy = read_tree(o->tree_path);
+            validate_level(o->level.level, hierarchy.face_count());
+            nlohmann::json summary;
+            summary["mesh"] = mesh_summary(o->tree_path, hierarchy);
+            summary["timing"] = {{"read_seconds", seconds_since(read_start)}};
+            report_level(hierarchy, o->level, summary, Clock::now());
+          }};
+}
+
+}  // namespace primseg::cli

@@ -1,0 +1,63 @@
+#include <cstdio>
+#include <memory>
+
+#include "command.hpp"
+#include "primseg/mesh_io.hpp"
+
+namespace primseg::cli {
+
+Command add_segment_command(CLI::App& app) {
+  struct Options {
+    std::string mesh_path, primitives = "plane,cylinder,sphere", weights = "area";
+    bool exact_costs = false;
+    unsigned threads = 0;
+    LevelOptions level;
+  };
+  auto o = std::make_shared<Options>();
+  auto* segment = app.add_subcommand("segment", "Build the hierarchy of a mesh and report a level");
+  segment->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl)")->required();
+  add_level_options(*segment, o->level);
+  segment->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
+      ->capture_default_str();
+  segment->add_option("--weights", o->weights, "Vertex weights of the fitting error")
+      ->check(CLI::IsMember({"area", "uniform"}))
+      ->capture_default_str();
+  segment->add_option("--tree", o->level.files.tree, "Write the whole hierarchy");
+  segment
+      ->add_option("--threads", o->threads,
+                   "Threads for the parallel parts (0: all cores); the tree does not depend "
+                   "on it")
+      ->capture_default_str();
+  segment->add_flag("--exact-costs", o->exact_costs,
+                    "Reference mode: exact Euclidean errors, O(cluster size) per candidate");
+
+  return {
+      segment, [o] {
+        HierarchyOptions options;
+        options.primitives = parse_primitives(o->primitives);
+        options.weights = o->weights == "uniform" ? VertexWeights::Uniform : VertexWeights::Area;
+        options.exact_costs = o->exact_costs;
+        options.threads = o->threads;
+        validate(options);
+        validate_output_files(o->level.files);
+        const auto read_start = Clock::now();
+        auto mesh = std::make_shared<const Mesh>(read_mesh(o->mesh_path));
+        const double read_seconds = seconds_since(read_start);
+        validate_level(o->level.level, mesh->face_count());
+        const auto build_start = Clock::now();
+        HierarchyBuilder builder(mesh, options);
+        const Hierarchy hierarchy = builder.finish(Progress("hierarchy", o->level.quiet));
+        const double build_seconds = seconds_since(build_start);
+        nlohmann::json summary;
+        summary["mesh"] = mesh_summary(o->mesh_path, hierarchy);
+        summary["primitives"] = o->primitives;
+        summary["weights"] = o->weights;
+        summary["timing"] = {{"read_seconds", read_seconds}, {"hierarchy_seconds", build_seconds}};
+        if (!o->level.quiet)
+          std::printf("%s: %u faces, %u components, hierarchy in %.3f s\n", o->mesh_path.c_str(),
+                      mesh->face_count(), hierarchy.component_count(), build_seconds);
+        report_level(hierarchy, o->level, summary, Clock::now());
+      }};
+}
+
+}  // namespace primseg::cli
