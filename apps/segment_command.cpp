@@ -9,7 +9,7 @@ namespace primseg::cli {
 Command add_segment_command(CLI::App& app) {
   struct Options {
     std::string mesh_path, primitives = "plane,cylinder,sphere", weights = "area";
-    bool exact_costs = false;
+    bool exact_costs = false, eager = false;
     unsigned threads = 0;
     LevelOptions level;
   };
@@ -28,6 +28,9 @@ Command add_segment_command(CLI::App& app) {
                    "Threads for the parallel parts (0: all cores); the tree does not depend "
                    "on it")
       ->capture_default_str();
+  segment->add_flag(
+      "--eager", o->eager,
+      "Reference mode: evaluate every candidate at once (same tree as the default lazy mode)");
   segment->add_flag("--exact-costs", o->exact_costs,
                     "Reference mode: exact Euclidean errors, O(cluster size) per candidate");
 
@@ -38,6 +41,7 @@ Command add_segment_command(CLI::App& app) {
         options.weights = o->weights == "uniform" ? VertexWeights::Uniform : VertexWeights::Area;
         options.exact_costs = o->exact_costs;
         options.threads = o->threads;
+        options.evaluation = o->eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
         validate(options);
         validate_output_files(o->level.files);
         const auto read_start = Clock::now();

@@ -18,9 +18,14 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 // id). On equal cost (in practice: zero, exact fits) simpler types go first, so flat regions are
 // whole before exact curved fits can reach into them. The version only tells stale entries
 // apart; it never decides between live ones.
+//
+// Lazy evaluation adds entries whose cost is only a lower bound of the candidate's (exact =
+// false). At equal cost a bound comes before every exact entry, so when an exact entry reaches
+// the top every bound left is strictly above it: it is the same minimum the eager scheme finds.
 struct HeapEntry {
   double cost;
   PrimitiveType type;
+  bool exact;
   std::uint32_t degree;
   std::uint32_t low, high;
   std::uint32_t edge;
@@ -30,6 +35,7 @@ struct HeapEntry {
 // std heaps are max-heaps: "a after b" puts the smallest key on top.
 bool comes_after(const HeapEntry& a, const HeapEntry& b) {
   if (a.cost != b.cost) return a.cost > b.cost;
+  if (a.exact != b.exact) return a.exact;
   if (a.type != b.type) return a.type > b.type;
   if (a.degree != b.degree) return a.degree > b.degree;
   if (a.low != b.low) return a.low > b.low;
@@ -42,6 +48,8 @@ struct LiveEdge {
   std::uint32_t version = 0;
   bool alive = true;
   EdgeStats shared;  // the mesh edges between the two clusters
+  // A lower bound of the cost of merging any two clusters that contain a and b (lazy only).
+  double cost_bound = 0;
 };
 
 }  // namespace
@@ -161,11 +169,14 @@ class HierarchyBuilder::Impl {
     marker_.assign(2 * std::size_t{f}, kNone);
     // Every candidate's cost is independent of the others: evaluate them in parallel, then the
     // degrees (which share scratch arrays) in order.
+    lazy_ = options_.evaluation != CandidateEvaluation::Eager && !options_.exact_costs;
+    max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
     heap_.resize(edges_.size());
     detail::parallel_for(edges_.size(), threads, [&](std::size_t id) {
       heap_[id] = evaluate(static_cast<std::uint32_t>(id));
     });
     for (HeapEntry& entry : heap_) entry.degree = merged_degree(entry.low, entry.high);
+    evaluations_ = heap_.size();
     std::make_heap(heap_.begin(), heap_.end(), comes_after);
     live_edges_ = static_cast<std::uint32_t>(edges_.size());
     total_merges_ = f - graph_->component_count();
@@ -178,6 +189,17 @@ class HierarchyBuilder::Impl {
       heap_.pop_back();
       const LiveEdge& edge = edges_[entry.edge];
       if (!edge.alive || edge.version != entry.version) continue;
+      if (!entry.exact) {
+        // A bound reached the top: evaluate the candidate. It keeps the degree it was queued
+        // with, as the eager scheme's entry would have.
+        const std::uint32_t degree = entry.degree;
+        entry = evaluate(entry.edge);
+        ++evaluations_;
+        entry.degree = degree;
+        heap_.push_back(entry);
+        std::push_heap(heap_.begin(), heap_.end(), comes_after);
+        continue;
+      }
       // Neighbours of the two clusters may have merged since this entry was pushed, which only
       // lowers the merged degree: requeue with the current one so the tie rule sees it.
       const std::uint32_t degree = merged_degree(edge.a, edge.b);
@@ -195,6 +217,7 @@ class HierarchyBuilder::Impl {
 
   std::uint32_t merge_count() const { return static_cast<std::uint32_t>(merges_.size()); }
   std::uint32_t total_merge_count() const { return total_merges_; }
+  std::uint64_t evaluation_count() const { return evaluations_; }
 
   struct Parts {
     std::shared_ptr<const Mesh> mesh;
@@ -273,16 +296,41 @@ class HierarchyBuilder::Impl {
     return selector_.select(centred_stats, &exact);
   }
 
-  // A candidate's entry without its degree; reads shared state only (safe in parallel).
-  HeapEntry evaluate(std::uint32_t id) const {
-    const LiveEdge& e = edges_[id];
+  // A candidate's entry without its degree. Reads shared state and writes only this edge's
+  // bound (safe in parallel over distinct edges).
+  HeapEntry evaluate(std::uint32_t id) {
+    LiveEdge& e = edges_[id];
     const detail::SelectedModel model = select(union_stats(e, false), e);
-    return {model.cost, model.fit.primitive.type, 0, std::min(e.a, e.b), std::max(e.a, e.b), id,
-            e.version};
+    if (lazy_) e.cost_bound = std::max(e.cost_bound, model.superset_cost_bound);
+    return {model.cost,         model.fit.primitive.type, true, 0,
+            std::min(e.a, e.b), std::max(e.a, e.b),       id,   e.version};
+  }
+
+  // The edge's cost bound if it holds for the current union, else 0. A cost that would snap to
+  // zero (at most zero_cost_tolerance × the union's spread, for the cheapest type) can be below
+  // any bound from a subset, so the bound holds only above that level. The union's spread is
+  // exact from the parts' (Σ w |x − c|² adds a w_a w_b / (w_a + w_b) |c_a − c_b|² term); the
+  // factor 2 covers round-off.
+  double queued_bound(const LiveEdge& e) const {
+    if (!(e.cost_bound > 0)) return 0;
+    const Moments& a = stats_[slot_of_node_[e.a]].moments;
+    const Moments& b = stats_[slot_of_node_[e.b]].moments;
+    const double wa = a.weight(), wb = b.weight();
+    if (!(wa > 0) || !(wb > 0)) return 0;
+    const double spread = centred_spread(a) + centred_spread(b) +
+                          wa * wb / (wa + wb) * (a.centroid() - b.centroid()).squaredNorm();
+    return e.cost_bound > 2 * max_penalty_ * options_.zero_cost_tolerance * spread ? e.cost_bound
+                                                                                   : 0.0;
+  }
+
+  static double centred_spread(const Moments& m) {
+    const Eigen::Vector3d first(m.at(1, 0, 0), m.at(0, 1, 0), m.at(0, 0, 1));
+    return m.at(2, 0, 0) + m.at(0, 2, 0) + m.at(0, 0, 2) - first.squaredNorm() / m.weight();
   }
 
   HeapEntry candidate(std::uint32_t id) {
     HeapEntry entry = evaluate(id);
+    ++evaluations_;
     entry.degree = merged_degree(edges_[id].a, edges_[id].b);
     return entry;
   }
@@ -335,6 +383,7 @@ class HierarchyBuilder::Impl {
         } else {
           LiveEdge& into = edges_[marker_[other]];
           into.shared += e.shared;
+          into.cost_bound = std::max(into.cost_bound, e.cost_bound);
           e.alive = false;
           --live_edges_;
         }
@@ -345,8 +394,15 @@ class HierarchyBuilder::Impl {
     std::vector<std::uint32_t>().swap(adjacency_[slot_b]);
 
     for (std::uint32_t id : adjacency_[slot_a]) {
-      ++edges_[id].version;
-      heap_.push_back(candidate(id));
+      LiveEdge& e = edges_[id];
+      ++e.version;
+      // A zero bound would reach the top before the next merge anyway: evaluate it now.
+      const double bound = lazy_ ? queued_bound(e) : 0;
+      if (bound > 0)
+        heap_.push_back({bound, PrimitiveType::Plane, false, merged_degree(e.a, e.b),
+                         std::min(e.a, e.b), std::max(e.a, e.b), id, e.version});
+      else
+        heap_.push_back(candidate(id));
       std::push_heap(heap_.begin(), heap_.end(), comes_after);
     }
     compact_heap_if_stale();
@@ -408,6 +464,9 @@ class HierarchyBuilder::Impl {
   std::uint32_t total_merges_ = 0;
   std::uint32_t live_edges_ = 0;
   double max_cost_ = 0;
+  std::uint64_t evaluations_ = 0;
+  bool lazy_ = false;
+  double max_penalty_ = 0;
 };
 
 HierarchyBuilder::HierarchyBuilder(std::shared_ptr<const Mesh> mesh, HierarchyOptions options)
@@ -421,6 +480,9 @@ std::uint32_t HierarchyBuilder::merge_count() const {
 }
 std::uint32_t HierarchyBuilder::total_merge_count() const {
   return impl_->total_merge_count();
+}
+std::uint64_t HierarchyBuilder::evaluation_count() const {
+  return impl_->evaluation_count();
 }
 Hierarchy HierarchyBuilder::finish(const std::function<void(double)>& progress) {
   Impl::Parts parts = impl_->finish(progress);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "primseg/error.hpp"
 
@@ -40,7 +41,10 @@ ModelSelector::ModelSelector(const HierarchyOptions& options) : options_(options
 }
 
 SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactError* exact) const {
-  const double zero_level = options_.zero_cost_tolerance * centred.moments.second_moment().trace();
+  const double spread = centred.moments.second_moment().trace();
+  const double zero_level = options_.zero_cost_tolerance * spread;
+  const bool lazy = options_.evaluation != CandidateEvaluation::Eager && !exact;
+  double bound = std::numeric_limits<double>::infinity();  // min over types of penalised bounds
   auto finish = [&](PrimitiveFit fit) {
     if (exact) fit.error = (*exact)(fit.primitive);
     if (fit.error <= zero_level) fit.error = 0;
@@ -51,8 +55,14 @@ SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactErro
   SelectedModel best;
   bool found = false;
   for (const PrimitiveFitter* fitter : fitters_) {
-    if (centred.triangle_count < fitter->min_triangles()) continue;
+    if (centred.triangle_count < fitter->min_triangles()) {
+      bound = 0;  // the type may fit a larger cluster: nothing is known
+      continue;
+    }
     PrimitiveFit fit = fitter->fit(centred);
+    if (lazy)
+      bound = std::min(bound, fit.superset_error_bound *
+                                  options_.type_penalty[static_cast<int>(fitter->type())]);
     if (!fit.valid || !std::isfinite(fit.error)) continue;
     SelectedModel candidate = finish(std::move(fit));
     if (!found || candidate.cost < best.cost) {
@@ -64,6 +74,13 @@ SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactErro
     if (found && best.cost == 0) break;
   }
   if (!found) best = finish(fitter_for(PrimitiveType::Plane).fit(centred));
+  if (lazy && best.cost > 0 && bound > 0) {
+    // Round-off in the fits is of order 1e-16 of the spread; the margin keeps the bound below
+    // every computed cost of a superset.
+    const double max_penalty =
+        *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
+    best.superset_cost_bound = std::max(0.0, bound - 1e-10 * max_penalty * spread);
+  }
   return best;
 }
 

@@ -11,6 +11,10 @@ namespace primseg::detail {
 struct SelectedModel {
   PrimitiveFit fit;  // working frame; fit.error already zero-snapped
   double cost = 0;   // penalised error: the merge priority
+  /// A lower bound of the cost of every cluster containing this one (see
+  /// PrimitiveFit::superset_error_bound), shrunk by a margin
+  /// far above round-off so that it holds for the computed costs too. 0 under Eager.
+  double superset_cost_bound = 0;
 };
 
 /// Exact Σ w d² of a working-frame primitive over a cluster's corners.

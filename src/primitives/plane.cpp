@@ -28,6 +28,7 @@ PrimitiveFit PlaneFitter::fit(const ClusterStats& centred) const {
   }
   const double alignment = normal.dot(centred.normal_sum);
   if (alignment < 0 || (alignment == 0 && canonical_axis(normal) != normal)) normal = -normal;
+  result.superset_error_bound = result.error;
   result.primitive.point = {centroid.x(), centroid.y(), centroid.z()};
   result.primitive.axis = {normal.x(), normal.y(), normal.z()};
   return result;

@@ -65,6 +65,7 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments) {
       if (value == 0) break;
     }
   }
+  result.objective_minimum = std::max(0.0, eta) / scale2;
   const double gap_to_plane = lambda(0) - eta;
   if (!(gap_to_plane > 1e-12 * lambda(D - 1))) return result;
 

@@ -24,6 +24,9 @@ struct PrattResult {
   double error = 0;                    // the minimum objective (≥ 0)
   Eigen::Matrix<double, D, 1> centre;  // relative to the centroid
   double radius = 0;
+  /// The minimum of Pratt's objective over all circles/spheres and their plane limit (a lower
+  /// bound of it by at most round-off), also when the fit is not valid; 0 for flat or empty data.
+  double objective_minimum = 0;
 };
 
 /// Largest radius, relative to the RMS spread of the points about their centroid, still taken

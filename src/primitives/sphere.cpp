@@ -22,6 +22,7 @@ PrimitiveFit SphereFitter::fit(const ClusterStats& centred) const {
   moments.third = m.third_moment_contracted(Eigen::Matrix3d::Identity());
   moments.fourth = m.fourth_moment_contracted(Eigen::Matrix3d::Identity());
   const detail::PrattResult<3> sphere = detail::pratt_fit(moments);
+  result.superset_error_bound = sphere.objective_minimum;
   if (!sphere.valid) return result;
   const Eigen::Vector3d centre = m.origin() + sphere.centre;
   if (centred.normal_alignment(Eigen::Matrix3d::Identity(), centre, sphere.radius) <

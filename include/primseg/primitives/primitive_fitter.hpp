@@ -22,6 +22,11 @@ struct PrimitiveFit {
   double error = std::numeric_limits<double>::infinity();
   /// Fitted parameters in the working frame.
   Primitive primitive;
+  /// A lower bound of this type's error for every cluster that contains this one, whatever the
+  /// validity rules decide (working-frame units). It holds where the error is an exact minimum
+  /// over the type's parameters of a sum of non-negative per-point terms (plane, Pratt sphere);
+  /// 0 where no bound is known. Lets the hierarchy leave candidates unevaluated (lazy mode).
+  double superset_error_bound = 0;
 };
 
 /// A primitive type's fitter.
