@@ -141,10 +141,11 @@ class HierarchyBuilder::Impl {
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights);
     const std::uint32_t f = mesh_->face_count();
     const unsigned threads = detail::thread_count(options_.threads);
-    stats_.resize(f);
-    detail::parallel_for(f, threads, [&](std::size_t face) {
-      stats_[face] = graph_->face_stats(static_cast<std::uint32_t>(face));
-    });
+    // Statistics are stored for merged clusters only (at most F / 2 live at once); a single
+    // face's are recomputed when needed, which costs less than a fit.
+    stats_index_of_slot_.assign(f, kNone);
+    stats_.reserve(f / 2 + 1);  // address space only: pages are touched as clusters form
+    merges_.reserve(f - 1);
     slot_of_node_.assign(2 * std::size_t{f}, kNone);
     for (std::uint32_t face = 0; face < f; ++face) slot_of_node_[face] = face;
     face_count_of_slot_.assign(f, 1);
@@ -264,11 +265,42 @@ class HierarchyBuilder::Impl {
     return degree;
   }
 
+  // A live cluster's statistics: stored for a merged cluster, computed into `leaf` for a face
+  // (whose slot is its face id).
+  const ClusterStats& stats_of(std::uint32_t node, ClusterStats& leaf) const {
+    const std::uint32_t slot = slot_of_node_[node];
+    const std::uint32_t index = stats_index_of_slot_[slot];
+    if (index != kNone) return stats_[index];
+    leaf = graph_->face_stats(slot);
+    return leaf;
+  }
+
+  void store_stats(std::uint32_t slot, ClusterStats&& stats) {
+    std::uint32_t& index = stats_index_of_slot_[slot];
+    if (index == kNone) {
+      if (free_stats_.empty()) {
+        index = static_cast<std::uint32_t>(stats_.size());
+        stats_.push_back(std::move(stats));
+        return;
+      }
+      index = free_stats_.back();
+      free_stats_.pop_back();
+    }
+    stats_[index] = std::move(stats);
+  }
+
+  void release_stats(std::uint32_t slot) {
+    std::uint32_t& index = stats_index_of_slot_[slot];
+    if (index != kNone) free_stats_.push_back(index);
+    index = kNone;
+  }
+
   // The statistics of a ∪ b, moments up to the degree the fits will use (all of them when the
   // result is kept).
   ClusterStats union_stats(const LiveEdge& e, bool keep) const {
-    const ClusterStats& a = stats_[slot_of_node_[e.a]];
-    const ClusterStats& b = stats_[slot_of_node_[e.b]];
+    ClusterStats leaf_a, leaf_b;
+    const ClusterStats& a = stats_of(e.a, leaf_a);
+    const ClusterStats& b = stats_of(e.b, leaf_b);
     const int degree = keep ? 4 : selector_.moment_degree(a.triangle_count + b.triangle_count);
     ClusterStats stats = a;
     stats.merge(b, e.shared, degree);
@@ -313,8 +345,9 @@ class HierarchyBuilder::Impl {
   // factor 2 covers round-off.
   double queued_bound(const LiveEdge& e) const {
     if (!(e.cost_bound > 0)) return 0;
-    const Moments& a = stats_[slot_of_node_[e.a]].moments;
-    const Moments& b = stats_[slot_of_node_[e.b]].moments;
+    ClusterStats leaf_a, leaf_b;
+    const Moments& a = stats_of(e.a, leaf_a).moments;
+    const Moments& b = stats_of(e.b, leaf_b).moments;
     const double wa = a.weight(), wb = b.weight();
     if (!(wa > 0) || !(wb > 0)) return 0;
     const double spread = centred_spread(a) + centred_spread(b) +
@@ -355,7 +388,8 @@ class HierarchyBuilder::Impl {
     max_cost_ = std::max(max_cost_, model.cost);
 
     // The merged cluster lives in a's slot; b's is released.
-    stats_[slot_a] = std::move(merged);
+    release_stats(slot_b);
+    store_stats(slot_a, std::move(merged));
     face_count_of_slot_[slot_a] = record.face_count;
     min_face_of_slot_[slot_a] = std::min(min_face_of_slot_[slot_a], min_face_of_slot_[slot_b]);
     slot_of_node_[node] = slot_a;
@@ -429,7 +463,8 @@ class HierarchyBuilder::Impl {
     std::sort(roots.begin(), roots.end());
     const double cost = max_cost_ > 0 ? 2 * max_cost_ : 1.0;
     std::uint32_t joined = roots.front().second;
-    double weight = stats_[slot_of_node_[joined]].moments.weight();
+    ClusterStats leaf;
+    double weight = stats_of(joined, leaf).moments.weight();
     std::uint32_t faces = face_count_of_slot_[slot_of_node_[joined]];
     for (std::size_t i = 1; i < roots.size(); ++i) {
       const std::uint32_t other = roots[i].second;
@@ -437,7 +472,7 @@ class HierarchyBuilder::Impl {
       record.first = std::min(joined, other);
       record.second = std::max(joined, other);
       record.cost = cost;
-      record.weight = weight += stats_[slot_of_node_[other]].moments.weight();
+      record.weight = weight += stats_of(other, leaf).moments.weight();
       record.face_count = faces += face_count_of_slot_[slot_of_node_[other]];
       record.trailing = true;
       joined = next_node();
@@ -449,7 +484,9 @@ class HierarchyBuilder::Impl {
   HierarchyOptions options_;
   detail::ModelSelector selector_;
   std::unique_ptr<DualGraph> graph_;
-  std::vector<ClusterStats> stats_;  // per slot
+  std::vector<ClusterStats> stats_;                 // merged clusters' statistics, pooled
+  std::vector<std::uint32_t> stats_index_of_slot_;  // into stats_; kNone for a single face
+  std::vector<std::uint32_t> free_stats_;           // unused entries of stats_
   std::vector<std::uint32_t> slot_of_node_;
   std::vector<std::uint32_t> face_count_of_slot_;
   std::vector<std::uint32_t> min_face_of_slot_;
