@@ -352,7 +352,17 @@ PYBIND11_MODULE(primseg, m) {
 
 denoise, skeleton and distance will mirror the CLI commands once those exist.)"});
   m.attr("__version__") = "0.1.0";
+  // Every docstring starts with its own Python signature (pybind11's would show C++ types).
+  py::options docstring_options;
+  docstring_options.disable_function_signatures();
   register_exceptions(m);
+
+  // Registered before the functions that return it, so that their signatures name it.
+  py::class_<PyHierarchy> hierarchy_class(
+      m, "Hierarchy",
+      join_docs({"The whole merge tree of a mesh (from segment or read_tree).",
+                 cpp_doc("Hierarchy", doc::hierarchy__Hierarchy)})
+          .c_str());
 
   py::class_<PyMesh>(m, "Mesh",
                      join_docs({"A polygon mesh and its triangulation (read-only).",
@@ -459,7 +469,7 @@ coordinates, index out of range, no faces) or bad options.)";
       py::arg("primitives") = py::make_tuple("plane", "cylinder", "sphere"),
       py::arg("weights") = "area", py::arg("threads") = 0u, py::arg("exact_costs") = false,
       join_docs(
-          {segment_doc, cpp_doc("build_hierarchy", doc::hierarchy__build_hierarchy),
+          {segment_doc, cpp_doc("build_hierarchy", doc::hierarchy__build_hierarchy_2),
            cpp_doc("HierarchyOptions::primitives", doc::hierarchy__HierarchyOptions__primitives),
            cpp_doc("HierarchyOptions::weights", doc::hierarchy__HierarchyOptions__weights),
            cpp_doc("HierarchyOptions::threads", doc::hierarchy__HierarchyOptions__threads),
@@ -478,10 +488,7 @@ coordinates, index out of range, no faces) or bad options.)";
                  cpp_doc("read_tree", doc::tree_io__read_tree)})
           .c_str());
 
-  py::class_<PyHierarchy>(m, "Hierarchy",
-                          join_docs({"The whole merge tree of a mesh (from segment or read_tree).",
-                                     cpp_doc("Hierarchy", doc::hierarchy__Hierarchy)})
-                              .c_str())
+  hierarchy_class
       .def(
           "cut",
           [](const PyHierarchy& self, std::optional<std::int64_t> k,

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import primseg
-from conftest import capped_cylinder
+from conftest import capped_cylinder, same_partition
 
 
 @pytest.fixture(scope="module")
@@ -176,3 +176,24 @@ def test_segment_releases_the_gil(fandisk_tree):
     # Holding the GIL would freeze this thread for the whole call: one gap as long as the call.
     gaps = np.diff([span["start"], *inside, span["end"]])
     assert gaps.max() < duration / 2, (gaps.max(), duration)
+
+
+def test_polygon_file_labels_match_the_cli(cli, tmp_path):
+    # The capped cylinder with quads along the tube and one 48-gon per cap.
+    around, rings = 48, 8
+    V, _, _ = capped_cylinder(around=around, rings=rings)
+    V = V[:-2]  # no cap centres: the caps are single polygons
+    quads = [[r * around + i, r * around + (i + 1) % around, (r + 1) * around + (i + 1) % around,
+              (r + 1) * around + i] for r in range(rings) for i in range(around)]
+    caps = [list(range(around))[::-1], list(range(rings * around, (rings + 1) * around))]
+    lines = ["OFF", f"{len(V)} {len(quads) + 2} 0"] + [" ".join(map(repr, v)) for v in V.tolist()]
+    lines += [" ".join(map(str, [len(f), *f])) for f in quads + caps]
+    (tmp_path / "tube.off").write_text("\n".join(lines) + "\n")
+    mesh = primseg.read_mesh(tmp_path / "tube.off")
+    assert mesh.face_count == len(quads) + 2 and mesh.triangle_count == 2 * len(quads) + 2 * (around - 2)
+    h = primseg.segment(mesh)
+    run_cli(cli, "segment", tmp_path / "tube.off", "--clusters", "3", "--labels", tmp_path / "l.txt", "--quiet")
+    labels = h.cut(3)
+    np.testing.assert_array_equal(labels, np.loadtxt(tmp_path / "l.txt"))
+    assert same_partition(labels, [0] * len(quads) + [1, 2])
+    assert sorted(c["type"] for c in h.clusters(3)) == ["cylinder", "plane", "plane"]
