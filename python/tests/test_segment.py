@@ -1,6 +1,7 @@
 """segment, cut, clusters, save/read_tree: the same results as the CLI, from any array layout."""
 
 import json
+import os
 import subprocess
 import threading
 import time
@@ -19,7 +20,10 @@ def fandisk_tree(fandisk):
 
 
 def run_cli(cli, *args):
-    subprocess.run([str(cli), *map(str, args)], check=True, capture_output=True)
+    # Under the sanitizer build the interpreter runs with the ASan runtime preloaded; the CLI
+    # carries its own and must not get a second one.
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+    subprocess.run([str(cli), *map(str, args)], check=True, capture_output=True, env=env)
 
 
 @pytest.mark.parametrize(
