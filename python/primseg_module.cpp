@@ -220,7 +220,7 @@ std::vector<PrimitiveType> parse_primitives(const py::object& names) {
 }
 
 HierarchyOptions hierarchy_options(const py::object& primitives, const std::string& weights,
-                                   unsigned threads, bool exact_costs) {
+                                   unsigned threads, bool exact_costs, bool eager) {
   HierarchyOptions options;
   options.primitives = parse_primitives(primitives);
   if (weights != "area" && weights != "uniform")
@@ -228,6 +228,7 @@ HierarchyOptions hierarchy_options(const py::object& primitives, const std::stri
   options.weights = weights == "uniform" ? VertexWeights::Uniform : VertexWeights::Area;
   options.threads = threads;
   options.exact_costs = exact_costs;
+  options.evaluation = eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
   validate(options);
   return options;
 }
@@ -441,7 +442,7 @@ faces.)",
           .c_str());
 
   const char* segment_doc =
-      R"(segment(mesh, *, primitives=("plane", "cylinder", "sphere"), weights="area", threads=0, exact_costs=False) -> Hierarchy
+      R"(segment(mesh, *, primitives=("plane", "cylinder", "sphere"), weights="area", threads=0, exact_costs=False, eager=False) -> Hierarchy
 segment(V, F, *, ...) -> Hierarchy
 
 Builds the whole hierarchy, with the GIL released. The input is a Mesh (read_mesh: labels are
@@ -449,15 +450,16 @@ per input polygon, like the CLI's) or arrays V (n, 3) float32/float64 and F (m, 
 int32/int64/uint32/uint64, C- or Fortran-ordered, read in place without a converted copy
 (labels are per row of F).
 primitives: names or one name ("plane", "cylinder", "sphere"); weights: "area" or "uniform";
-threads: 0 for all cores (the tree does not depend on it); exact_costs: slow reference mode.
+threads: 0 for all cores (the tree does not depend on it); exact_costs: slow reference mode;
+eager: evaluate every candidate at once (reference mode, the same tree).
 Raises InvalidInputError (a ValueError) for bad arrays (shape, dtype, NaN or infinite
 coordinates, index out of range, no faces) or bad options.)";
   m.def(
       "segment",
       [](const py::object& first, const py::object& faces, const py::object& primitives,
-         const std::string& weights, unsigned threads, bool exact_costs) {
+         const std::string& weights, unsigned threads, bool exact_costs, bool eager) {
         const HierarchyOptions options =
-            hierarchy_options(primitives, weights, threads, exact_costs);
+            hierarchy_options(primitives, weights, threads, exact_costs, eager);
         if (py::isinstance<PyMesh>(first)) {
           if (!faces.is_none()) throw InvalidInputError("segment(mesh) takes no F");
           return segment_mesh(first.cast<const PyMesh&>().mesh, options);
@@ -468,11 +470,13 @@ coordinates, index out of range, no faces) or bad options.)";
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(),
       py::arg("primitives") = py::make_tuple("plane", "cylinder", "sphere"),
       py::arg("weights") = "area", py::arg("threads") = 0u, py::arg("exact_costs") = false,
+      py::arg("eager") = false,
       join_docs(
           {segment_doc, cpp_doc("build_hierarchy", doc::hierarchy__build_hierarchy_2),
            cpp_doc("HierarchyOptions::primitives", doc::hierarchy__HierarchyOptions__primitives),
            cpp_doc("HierarchyOptions::weights", doc::hierarchy__HierarchyOptions__weights),
            cpp_doc("HierarchyOptions::threads", doc::hierarchy__HierarchyOptions__threads),
+           cpp_doc("HierarchyOptions::evaluation", doc::hierarchy__HierarchyOptions__evaluation),
            cpp_doc("HierarchyOptions::exact_costs", doc::hierarchy__HierarchyOptions__exact_costs)})
           .c_str());
 

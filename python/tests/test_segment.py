@@ -157,6 +157,7 @@ def test_deterministic_for_any_thread_count(fandisk_tree):
     for threads in (1, 2, 3):
         np.testing.assert_array_equal(primseg.segment(mesh, threads=threads).linkage(),
                                       fandisk_tree.linkage())
+    np.testing.assert_array_equal(primseg.segment(mesh, eager=True).linkage(), fandisk_tree.linkage())
 
 
 def test_segment_releases_the_gil(fandisk_tree):
