@@ -32,23 +32,11 @@ void validate_output_files(const OutputFiles& files) {
   }
 }
 
-nlohmann::json primitive_params(const Primitive& p) {
-  switch (p.type) {
-    case PrimitiveType::Plane:
-      return {{"normal", vec(p.axis)}, {"point", vec(p.point)}};
-    case PrimitiveType::Sphere:
-      return {{"center", vec(p.point)}, {"radius", p.radius}};
-    case PrimitiveType::Cylinder:
-      return {{"axis", vec(p.axis)}, {"point", vec(p.point)}, {"radius", p.radius}};
-    case PrimitiveType::Cone:
-      return {{"apex", vec(p.point)}, {"axis", vec(p.axis)}, {"half_angle", p.half_angle}};
-    case PrimitiveType::Torus:
-      return {{"center", vec(p.point)},
-              {"axis", vec(p.axis)},
-              {"major_radius", p.radius},
-              {"minor_radius", p.minor_radius}};
-  }
-  return {};
+nlohmann::json primitive_params(const Primitive& primitive) {
+  nlohmann::json params = nlohmann::json::object();
+  for (const NamedParameter& p : named_parameters(primitive))
+    params[std::string(p.name)] = p.is_vector ? vec(p.value) : nlohmann::json(p.value[0]);
+  return params;
 }
 
 void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
@@ -86,10 +74,10 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     write_mesh(path, hierarchy.mesh(), options);
   }
   if (files.linkage) {
-    // numpy.loadtxt gives SciPy's (F − 1, 4) linkage matrix: children, cost, size.
+    // numpy.loadtxt gives SciPy's (F − 1, 4) linkage matrix: children, height, size.
     std::string text;
     char line[128];
-    for (const auto& row : hierarchy.linkage()) {
+    for (const auto& row : scipy_linkage(hierarchy)) {
       const int n = std::snprintf(line, sizeof line, "%.0f %.0f %.17g %.0f\n", row[0], row[1],
                                   row[2], row[3]);
       text.append(line, static_cast<std::size_t>(n));

@@ -3,7 +3,8 @@
 # everything is already present).
 set -euo pipefail
 packages=(build-essential cmake ninja-build clang libclang-rt-14-dev libeigen3-dev libcli11-dev
-          nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-demo)
+          nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-demo
+          python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest python3-scipy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

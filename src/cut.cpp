@@ -162,4 +162,18 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
   return reports;
 }
 
+std::vector<std::array<double, 4>> scipy_linkage(const Hierarchy& hierarchy) {
+  const std::span<const Merge> merges = hierarchy.merges();
+  std::vector<std::array<double, 4>> rows(merges.size());
+  double height = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < merges.size(); ++i) {
+    const Merge& merge = merges[i];
+    height = i == 0 ? merge.cost
+                    : std::max(merge.cost,
+                               std::nextafter(height, std::numeric_limits<double>::infinity()));
+    rows[i] = {double(merge.first), double(merge.second), height, double(merge.face_count)};
+  }
+  return rows;
+}
+
 }  // namespace primseg

@@ -31,6 +31,29 @@ std::string_view to_string(PrimitiveType type) {
   return index < kPrimitiveTypeCount ? kNames[index] : std::string_view("unknown");
 }
 
+std::vector<NamedParameter> named_parameters(const Primitive& p) {
+  const auto vector = [](std::string_view name, const Vec3& v) {
+    return NamedParameter{name, true, v};
+  };
+  const auto scalar = [](std::string_view name, double v) {
+    return NamedParameter{name, false, {v, 0, 0}};
+  };
+  switch (p.type) {
+    case PrimitiveType::Plane:
+      return {vector("normal", p.axis), vector("point", p.point)};
+    case PrimitiveType::Sphere:
+      return {vector("center", p.point), scalar("radius", p.radius)};
+    case PrimitiveType::Cylinder:
+      return {vector("axis", p.axis), vector("point", p.point), scalar("radius", p.radius)};
+    case PrimitiveType::Cone:
+      return {vector("apex", p.point), vector("axis", p.axis), scalar("half_angle", p.half_angle)};
+    case PrimitiveType::Torus:
+      return {vector("center", p.point), vector("axis", p.axis), scalar("major_radius", p.radius),
+              scalar("minor_radius", p.minor_radius)};
+  }
+  return {};
+}
+
 std::optional<PrimitiveType> primitive_type_from_string(std::string_view name) {
   for (int t = 0; t < kPrimitiveTypeCount; ++t)
     if (kNames[t] == name) return static_cast<PrimitiveType>(t);

@@ -3,10 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 #include "primseg/error.hpp"
+#include "primseg/mesh_io.hpp"
 #include "primseg/shape_generator.hpp"
+#include "support/test_support.hpp"
 
 namespace primseg {
 namespace {
@@ -65,6 +68,30 @@ TEST(Cut, ReportsExactDistancesToTheFittedPrimitive) {
       EXPECT_NEAR(r.primitive.radius, truth->radius, 1e-9 * truth->radius);
     }
   }
+}
+
+TEST(Cut, ScipyLinkageIsTheTreeWithStrictlyIncreasingHeights) {
+  const Hierarchy h = build_hierarchy(read_mesh(testing::cgal_mesh("fandisk.off")));
+  const auto rows = scipy_linkage(h);
+  const auto merges = h.merges();
+  ASSERT_EQ(rows.size(), merges.size());
+  std::size_t inversions = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i][0], double(merges[i].first));
+    EXPECT_EQ(rows[i][1], double(merges[i].second));
+    EXPECT_EQ(rows[i][3], double(merges[i].face_count));
+    EXPECT_GE(rows[i][2], merges[i].cost);
+    if (i == 0) continue;
+    // Strictly increasing: SciPy orders merges by height, so it then follows the tree's order.
+    EXPECT_GT(rows[i][2], rows[i - 1][2]) << i;
+    if (merges[i].cost > rows[i - 1][2]) {
+      EXPECT_EQ(rows[i][2], merges[i].cost);
+    } else {
+      ++inversions;
+      EXPECT_EQ(rows[i][2], std::nextafter(rows[i - 1][2], HUGE_VAL));
+    }
+  }
+  EXPECT_GT(inversions, 0u);  // fandisk has greedy costs that drop: the rule is exercised
 }
 
 }  // namespace

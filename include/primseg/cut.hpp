@@ -2,6 +2,7 @@
 /// @file cut.hpp
 /// Levels of a hierarchy: per-face labels and per-cluster primitives, each cut in O(F).
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -46,5 +47,14 @@ struct ClusterReport {
 /// Reports of every cluster of a cut, in label order. O(F) in total.
 std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
                                              const Segmentation& segmentation);
+
+/// The whole tree as SciPy's linkage matrix, shape (F − 1, 4): children node ids, height, face
+/// count; row i creates node F + i (Hierarchy::merges() order, trailing merges last).
+/// The heights are the merge costs made strictly increasing: a merge that costs no more than the
+/// one before it (greedy costs can drop after a merge) gets the next double above the previous
+/// height. So the matrix is monotonic, and scipy.cluster.hierarchy's cut_tree and fcluster,
+/// which order merges by height, apply them in the tree's order and give cut_by_count's levels.
+/// Heights are working-frame costs (weight × length², see Merge::cost), for ordering only.
+std::vector<std::array<double, 4>> scipy_linkage(const Hierarchy& hierarchy);
 
 }  // namespace primseg

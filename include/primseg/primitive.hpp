@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 #include "primseg/mesh.hpp"
 
@@ -51,5 +52,18 @@ struct Primitive {
   /// The point of the primitive's surface closest to x.
   Vec3 closest_point(const Vec3& x) const;
 };
+
+/// One parameter of a primitive as users see it: a named 3-vector or scalar, input units.
+struct NamedParameter {
+  std::string_view name;   ///< e.g. "normal", "radius"
+  bool is_vector = false;  ///< true: all of `value`; false: a scalar in value[0]
+  Vec3 value{0, 0, 0};
+};
+
+/// The parameters that describe a primitive to users, in input units (what the CLI's JSON
+/// "params" and the Python bindings' cluster dictionaries hold): plane {normal, point}, sphere
+/// {center, radius}, cylinder {axis, point, radius}, cone {apex, axis, half_angle (radians)},
+/// torus {center, axis, major_radius, minor_radius}.
+std::vector<NamedParameter> named_parameters(const Primitive& primitive);
 
 }  // namespace primseg

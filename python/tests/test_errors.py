@@ -1,0 +1,130 @@
+"""Every bad input raises a Python exception with a clear message, never a crash."""
+
+import numpy as np
+import pytest
+
+import primseg
+
+V_OK = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+F_OK = np.array([[0, 1, 2], [1, 3, 2]])
+
+
+def test_exception_hierarchy():
+    assert issubclass(primseg.Error, RuntimeError)
+    assert issubclass(primseg.IoError, primseg.Error) and issubclass(primseg.IoError, OSError)
+    assert issubclass(primseg.ParseError, primseg.Error)
+    assert issubclass(primseg.ParseError, RuntimeError)
+    assert issubclass(primseg.InvalidInputError, primseg.Error)
+    assert issubclass(primseg.InvalidInputError, ValueError)
+
+
+BAD_ARRAYS = {
+    "V 1-D": (np.zeros(9), F_OK, r"V must have shape \(n, 3\), not \(9,\)"),
+    "V (n, 2)": (np.zeros((4, 2)), F_OK, r"V must have shape \(n, 3\), not \(4, 2\)"),
+    "V (n, 4)": (np.zeros((4, 4)), F_OK, r"V must have shape \(n, 3\), not \(4, 4\)"),
+    "V 3-D": (np.zeros((4, 3, 1)), F_OK, r"V must have shape \(n, 3\), not \(4, 3, 1\)"),
+    "V int": (V_OK.astype(np.int64), F_OK, "V must be an array of float32 or float64, not 'int64'"),
+    "V float16": (V_OK.astype(np.float16), F_OK, "not 'float16'"),
+    "V complex": (V_OK.astype(np.complex128), F_OK, "not 'complex128'"),
+    "V strings": (V_OK.astype(str), F_OK, "V must be an array of float32 or float64"),
+    "V object": (V_OK.astype(object), F_OK, "not 'object'"),
+    "V NaN": (np.where(np.arange(12).reshape(4, 3) == 7, np.nan, V_OK), F_OK,
+              r"V\[2, 1\] is nan: coordinates must be finite"),
+    "V inf float32": (np.where(np.arange(12).reshape(4, 3) == 3, np.inf, V_OK).astype(np.float32),
+                      F_OK, r"V\[1, 0\] is inf"),
+    "V -inf": (np.where(np.arange(12).reshape(4, 3) == 11, -np.inf, V_OK), F_OK, r"V\[3, 2\] is -inf"),
+    "F float": (V_OK, F_OK.astype(np.float64), "F must be an array of int32, int64, uint32 or uint64, not 'float64'"),
+    "F int16": (V_OK, F_OK.astype(np.int16), "not 'int16'"),
+    "F bool": (V_OK, F_OK.astype(bool), "not 'bool'"),
+    "F (m, 4)": (V_OK, np.array([[0, 1, 2, 3]]), r"F must have shape \(n, 3\), not \(1, 4\)"),
+    "F 1-D": (V_OK, np.array([0, 1, 2]), r"F must have shape \(n, 3\), not \(3,\)"),
+    "F empty": (V_OK, np.zeros((0, 3), dtype=np.int32), "F has no faces"),
+    "F negative": (V_OK, np.array([[0, 1, -1]]), r"F\[0, 2\] = -1 is not a vertex index \(V has 4 rows\)"),
+    "F too large": (V_OK, np.array([[0, 1, 2], [1, 4, 2]]), r"F\[1, 1\] = 4 is not a vertex index"),
+    "F int64 beyond 2^32": (V_OK, np.array([[0, 1, 2**32 + 1]]), r"F\[0, 2\] = 4294967297"),
+    "F uint64 huge": (V_OK, np.array([[0, 2**64 - 1, 1]], dtype=np.uint64), r"F\[0, 1\] = 18446744073709551615"),
+    "F into empty V": (np.zeros((0, 3)), F_OK, r"F\[0, 0\] = 0 is not a vertex index \(V has 0 rows\)"),
+    "ragged list": (V_OK, [[0, 1, 2], [1, 2]], None),
+}
+
+
+@pytest.mark.parametrize("name", BAD_ARRAYS)
+@pytest.mark.parametrize("entry_point", ["Mesh", "segment"])
+def test_bad_arrays_raise_value_error(name, entry_point):
+    V, F, message = BAD_ARRAYS[name]
+    call = primseg.Mesh if entry_point == "Mesh" else primseg.segment
+    with pytest.raises(ValueError, match=message) as raised:
+        call(V, F)
+    if name != "ragged list":  # numpy's own ValueError, before primseg sees the data
+        assert isinstance(raised.value, primseg.InvalidInputError)
+
+
+def test_segment_argument_errors(fandisk):
+    mesh = primseg.read_mesh(fandisk)
+    with pytest.raises(ValueError, match="segment.V, F.: F is missing"):
+        primseg.segment(V_OK)
+    with pytest.raises(ValueError, match="segment.mesh. takes no F"):
+        primseg.segment(mesh, F_OK)
+    with pytest.raises(ValueError, match=r"unknown primitive 'cone' \(available: 'plane', 'cylinder', 'sphere'\)"):
+        primseg.segment(mesh, primitives=("plane", "cone"))
+    with pytest.raises(ValueError, match="primitives: expected names, got 3"):
+        primseg.segment(mesh, primitives=["plane", 3])
+    with pytest.raises(ValueError, match="weights: must be 'area' or 'uniform', not 'volume'"):
+        primseg.segment(mesh, weights="volume")
+    with pytest.raises(ValueError, match="primitive"):
+        primseg.segment(mesh, primitives=())
+    with pytest.raises(ValueError, match="duplicate|twice|more than once"):
+        primseg.segment(mesh, primitives=("plane", "plane"))
+
+
+def test_level_errors():
+    h = primseg.segment(V_OK, F_OK)
+    for k in (0, -1, 3, 2**40):
+        with pytest.raises(ValueError, match=r"k must be between 1 and the number of faces \(2\), not "):
+            h.cut(k)
+        with pytest.raises(ValueError, match="k must be between"):
+            h.clusters(k)
+    with pytest.raises(ValueError, match="at most one of k, tolerance and relative_tolerance"):
+        h.cut(1, tolerance=0.1)
+    with pytest.raises(ValueError, match="at most one"):
+        h.clusters(tolerance=0.1, relative_tolerance=0.1)
+    for bad in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="tolerance"):
+            h.cut(tolerance=bad)
+        with pytest.raises(ValueError, match="relative_tolerance must be a non-negative number"):
+            h.cut(relative_tolerance=bad)
+    with pytest.raises(TypeError):
+        h.cut("3")
+
+
+def test_file_errors(tmp_path, fandisk):
+    missing = tmp_path / "missing.off"
+    with pytest.raises(OSError, match="missing.off") as raised:
+        primseg.read_mesh(missing)
+    assert isinstance(raised.value, primseg.IoError)
+
+    truncated = tmp_path / "truncated.off"
+    truncated.write_bytes(fandisk.read_bytes()[:20000])
+    with pytest.raises(primseg.ParseError, match="truncated.off") as raised:
+        primseg.read_mesh(truncated)
+    assert isinstance(raised.value, RuntimeError) and not isinstance(raised.value, OSError)
+
+    garbage = tmp_path / "garbage.ply"
+    garbage.write_text("not a ply file\n")
+    with pytest.raises(primseg.ParseError, match="garbage.ply"):
+        primseg.read_mesh(garbage)
+
+    with pytest.raises(ValueError, match="mesh.xyz"):
+        primseg.read_mesh(tmp_path / "mesh.xyz")
+
+    nan = tmp_path / "nan.off"
+    nan.write_text("OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n")
+    with pytest.raises(ValueError):
+        primseg.read_mesh(nan)
+
+    with pytest.raises(primseg.ParseError, match="fandisk.off"):
+        primseg.read_tree(fandisk)
+    with pytest.raises(OSError):
+        primseg.read_tree(missing)
+    with pytest.raises(OSError):
+        primseg.segment(V_OK, F_OK).save(tmp_path / "no" / "such" / "dir" / "t.tree")

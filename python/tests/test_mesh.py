@@ -1,0 +1,93 @@
+"""read_mesh, Mesh(V, F) and the arrays they expose."""
+
+import gc
+
+import numpy as np
+import pytest
+
+import primseg
+
+
+def read_off_with_numpy(path):
+    lines = [l for l in path.read_text().splitlines() if l.strip() and not l.startswith("#")]
+    n, m = map(int, lines[1].split()[:2])
+    V = np.array([l.split()[:3] for l in lines[2 : 2 + n]], dtype=np.float64)
+    F = np.array([l.split()[1:4] for l in lines[2 + n : 2 + n + m]], dtype=np.int64)
+    return V, F
+
+
+def test_read_mesh_matches_the_file(fandisk):
+    mesh = primseg.read_mesh(fandisk)
+    V, F = read_off_with_numpy(fandisk)
+    assert mesh.V.dtype == np.float64 and mesh.V.shape == V.shape
+    assert mesh.F.dtype == np.int32 and mesh.F.shape == F.shape
+    np.testing.assert_array_equal(mesh.V, V)
+    np.testing.assert_array_equal(mesh.F, F)
+    np.testing.assert_array_equal(mesh.face_of_triangle, np.arange(len(F)))
+    assert (mesh.vertex_count, mesh.face_count, mesh.triangle_count) == (6475, 12946, 12946)
+
+
+def test_read_mesh_accepts_str_and_pathlike(fandisk):
+    np.testing.assert_array_equal(primseg.read_mesh(str(fandisk)).F, primseg.read_mesh(fandisk).F)
+
+
+def test_polygons_are_split_and_traced_back(tmp_path):
+    path = tmp_path / "quad_and_triangle.off"
+    path.write_text("OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n4 0 1 2 3\n3 1 4 2\n")
+    mesh = primseg.read_mesh(path)
+    assert mesh.face_count == 2 and mesh.triangle_count == 3
+    np.testing.assert_array_equal(mesh.face_of_triangle, [0, 0, 1])
+    quad = [sorted(t) for t in mesh.F[:2].tolist()]
+    assert all(set(t) <= {0, 1, 2, 3} and len(set(t)) == 3 for t in quad) and quad[0] != quad[1]
+    np.testing.assert_array_equal(mesh.F[2], [1, 4, 2])
+    labels = primseg.segment(mesh).cut(1)
+    assert labels.shape == (2,)  # one label per input polygon, not per triangle
+
+
+def test_arrays_are_read_only_views_that_keep_the_mesh_alive(fandisk):
+    mesh = primseg.read_mesh(fandisk)
+    V, F, owner = mesh.V, mesh.F, mesh.face_of_triangle
+    assert V.ctypes.data == mesh.V.ctypes.data  # the same memory on every access: no copy
+    assert F.ctypes.data == mesh.F.ctypes.data and owner.ctypes.data == mesh.face_of_triangle.ctypes.data
+    for array in (V, F, owner):
+        assert not array.flags.writeable
+        with pytest.raises(ValueError):
+            array[0] = 0
+    expected = V.copy()
+    del mesh
+    gc.collect()
+    np.testing.assert_array_equal(V, expected)  # the views own a reference to the mesh
+
+
+def test_hierarchy_shares_the_mesh(fandisk):
+    mesh = primseg.read_mesh(fandisk)
+    h = primseg.segment(mesh, primitives="plane")
+    assert h.mesh.V.ctypes.data == mesh.V.ctypes.data
+
+
+@pytest.mark.parametrize("v_dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("f_dtype", [np.int32, np.int64, np.uint32, np.uint64])
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_mesh_from_arrays_round_trips(fandisk, v_dtype, f_dtype, order):
+    source = primseg.read_mesh(fandisk)
+    V = np.asarray(source.V, dtype=v_dtype, order=order)
+    F = np.asarray(source.F, dtype=f_dtype, order=order)
+    mesh = primseg.Mesh(V, F)
+    np.testing.assert_array_equal(mesh.V, V.astype(np.float64))
+    np.testing.assert_array_equal(mesh.F, F)
+
+
+def test_strided_and_byte_swapped_arrays_are_read_as_given():
+    V = np.arange(36, dtype=np.float64).reshape(12, 3)
+    F = np.array([[0, 1, 2], [9, 9, 9], [2, 1, 3], [9, 9, 9]], dtype=np.int64)
+    mesh = primseg.Mesh(V[::3], F[::2])  # every third vertex, every other face
+    np.testing.assert_array_equal(mesh.V, V[::3])
+    np.testing.assert_array_equal(mesh.F, [[0, 1, 2], [2, 1, 3]])
+    swapped = primseg.Mesh(V[::3].astype(">f8"), F[::2].astype(">i4"))
+    np.testing.assert_array_equal(swapped.V, V[::3])
+    np.testing.assert_array_equal(swapped.F, mesh.F)
+
+
+def test_lists_are_accepted():
+    mesh = primseg.Mesh([[0.0, 0, 0], [1.0, 0, 0], [0.0, 1, 0]], [[0, 1, 2]])
+    assert mesh.face_count == 1

@@ -1,0 +1,204 @@
+"""segment, cut, clusters, save/read_tree: the same results as the CLI, from any array layout."""
+
+import json
+import os
+import subprocess
+import threading
+import time
+import tracemalloc
+
+import numpy as np
+import pytest
+
+import primseg
+from conftest import capped_cylinder, same_partition
+
+
+@pytest.fixture(scope="module")
+def fandisk_tree(fandisk):
+    return primseg.segment(primseg.read_mesh(fandisk))
+
+
+def run_cli(cli, *args):
+    # Under the sanitizer build the interpreter runs with the ASan runtime preloaded; the CLI
+    # carries its own and must not get a second one.
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+    subprocess.run([str(cli), *map(str, args)], check=True, capture_output=True, env=env)
+
+
+@pytest.mark.parametrize(
+    "cli_level, python_level",
+    [((), {}), (("--clusters", "30"), {"k": 30}), (("--clusters", "1"), {"k": 1}),
+     (("--tolerance", "0.05%"), {"relative_tolerance": 0.0005}),
+     (("--tolerance", "0.002"), {"tolerance": 0.002})])
+def test_labels_and_clusters_match_the_cli(cli, fandisk, fandisk_tree, tmp_path, cli_level, python_level):
+    run_cli(cli, "segment", fandisk, *cli_level, "--labels", tmp_path / "l.txt",
+            "--json", tmp_path / "c.json", "--quiet")
+    expected = np.loadtxt(tmp_path / "l.txt", dtype=np.int64)
+    labels = fandisk_tree.cut(**python_level)
+    assert labels.dtype == np.int32 and labels.shape == (12946,)
+    np.testing.assert_array_equal(labels, expected)
+    # Same keys, same numbers, bit for bit (JSON doubles round-trip).
+    assert fandisk_tree.clusters(**python_level) == json.loads((tmp_path / "c.json").read_text())["clusters"]
+
+
+def test_linkage_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path):
+    run_cli(cli, "segment", fandisk, "--linkage", tmp_path / "z.txt", "--quiet")
+    np.testing.assert_array_equal(fandisk_tree.linkage(), np.loadtxt(tmp_path / "z.txt"))
+
+
+def test_tree_file_round_trip_with_the_cli(cli, fandisk_tree, tmp_path):
+    fandisk_tree.save(tmp_path / "f.tree")
+    reread = primseg.read_tree(tmp_path / "f.tree")
+    np.testing.assert_array_equal(reread.linkage(), fandisk_tree.linkage())
+    np.testing.assert_array_equal(reread.mesh.V, fandisk_tree.mesh.V)
+    run_cli(cli, "cut", tmp_path / "f.tree", "--clusters", "12", "--labels", tmp_path / "l.txt", "--quiet")
+    np.testing.assert_array_equal(reread.cut(12), np.loadtxt(tmp_path / "l.txt"))
+
+
+@pytest.mark.parametrize("f_dtype", [np.int32, np.int64, np.uint32, np.uint64])
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_arrays_give_the_tree_of_the_file(fandisk, fandisk_tree, f_dtype, order):
+    mesh = fandisk_tree.mesh
+    V = np.asarray(mesh.V, order=order)
+    F = np.asarray(mesh.F, dtype=f_dtype, order=order)
+    h = primseg.segment(V, F)
+    np.testing.assert_array_equal(h.linkage(), fandisk_tree.linkage())
+    np.testing.assert_array_equal(h.cut(), fandisk_tree.cut())
+
+
+def test_float32_vertices_are_their_float64_values(fandisk_tree):
+    V32 = fandisk_tree.mesh.V.astype(np.float32)
+    F = fandisk_tree.mesh.F
+    np.testing.assert_array_equal(primseg.segment(V32, F).linkage(),
+                                  primseg.segment(V32.astype(np.float64), F).linkage())
+
+
+def test_no_converted_copy_of_the_input(fandisk_tree):
+    # numpy reports its buffers to tracemalloc: a float32 -> float64 or Fortran -> C conversion
+    # would allocate at least V.nbytes * 2 traced bytes.
+    V = np.asfortranarray(fandisk_tree.mesh.V.astype(np.float32))
+    F = np.asfortranarray(fandisk_tree.mesh.F.astype(np.int64))
+    tracemalloc.start()
+    try:
+        primseg.Mesh(V, F)
+        primseg.segment(V, F, primitives="plane")
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < V.nbytes / 4, peak
+
+
+def test_labels_own_their_memory(fandisk_tree):
+    labels = fandisk_tree.cut(5)
+    assert labels.flags.writeable and labels.flags.c_contiguous
+    labels[:] = 0  # the caller's array: editing it changes nothing else
+    assert fandisk_tree.cut(5).max() == 4
+
+
+def test_ground_truth_cylinder_and_planes():
+    V, F, regions = capped_cylinder(radius=2.0, height=5.0, center=(1.0, -2.0, 0.5))
+    h = primseg.segment(V, F)
+    labels = h.cut(3)
+    clusters = h.clusters(3)
+    for label, cluster in enumerate(clusters):
+        assert len(np.unique(regions[labels == label])) == 1  # each cluster is one true region
+        assert cluster["faces"] == np.count_nonzero(labels == label)
+    by_type = sorted(c["type"] for c in clusters)
+    assert by_type == ["cylinder", "plane", "plane"]
+    cylinder = next(c for c in clusters if c["type"] == "cylinder")
+    assert abs(cylinder["params"]["radius"] - 2.0) < 1e-6
+    assert np.allclose(np.abs(cylinder["params"]["axis"]), [0, 0, 1], atol=1e-9)
+    assert np.allclose(cylinder["params"]["point"][:2], [1.0, -2.0], atol=1e-6)
+    assert cylinder["rms"] < 1e-6 and cylinder["max"] < 1e-6
+    for plane in (c for c in clusters if c["type"] == "plane"):
+        assert np.allclose(np.abs(plane["params"]["normal"]), [0, 0, 1], atol=1e-9)
+        assert min(abs(plane["params"]["point"][2] - z) for z in (0.5, 5.5)) < 1e-9
+    json.dumps(clusters)  # plain Python values
+
+
+def test_sphere_radius_and_centre():
+    phi, theta = np.meshgrid(np.linspace(0.2, np.pi - 0.2, 12), np.linspace(0, 2 * np.pi, 24, endpoint=False))
+    points = np.stack([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi)], -1)
+    V = 3.0 * points.reshape(-1, 3) + [10, 20, 30]
+    rows, cols = phi.shape  # theta along rows (periodic), phi along columns
+    F = []
+    for r in range(rows):
+        for c in range(cols - 1):
+            a, b = r * cols + c, ((r + 1) % rows) * cols + c
+            F += [[a, b, b + 1], [a, b + 1, a + 1]]
+    clusters = primseg.segment(V, np.array(F), primitives=("sphere",)).clusters(1)
+    assert len(clusters) == 1 and clusters[0]["type"] == "sphere"
+    assert abs(clusters[0]["params"]["radius"] - 3.0) < 1e-9
+    assert np.allclose(clusters[0]["params"]["center"], [10, 20, 30], atol=1e-9)
+
+
+def test_tolerance_levels(fandisk_tree):
+    diagonal = fandisk_tree.mesh.bounding_box_diagonal
+    np.testing.assert_array_equal(fandisk_tree.cut(relative_tolerance=0.002),
+                                  fandisk_tree.cut(tolerance=0.002 * diagonal))
+    coarse, fine = fandisk_tree.cut(tolerance=1e-2), fandisk_tree.cut(tolerance=1e-4)
+    assert coarse.max() < fine.max()
+    assert fandisk_tree.cut(tolerance=0.0).max() + 1 >= fine.max() + 1
+
+
+def test_options_are_applied(fandisk_tree):
+    mesh = fandisk_tree.mesh
+    planes = primseg.segment(mesh, primitives="plane")
+    assert planes.primitives == ("plane",)
+    assert {c["type"] for c in planes.clusters(30)} == {"plane"}
+    uniform = primseg.segment(mesh, weights="uniform")
+    assert uniform.weights == "uniform" and fandisk_tree.weights == "area"
+    assert not np.array_equal(uniform.linkage(), fandisk_tree.linkage())
+
+
+def test_deterministic_for_any_thread_count(fandisk_tree):
+    mesh = fandisk_tree.mesh
+    for threads in (1, 2, 3):
+        np.testing.assert_array_equal(primseg.segment(mesh, threads=threads).linkage(),
+                                      fandisk_tree.linkage())
+    np.testing.assert_array_equal(primseg.segment(mesh, eager=True).linkage(), fandisk_tree.linkage())
+
+
+def test_segment_releases_the_gil(fandisk_tree):
+    mesh = fandisk_tree.mesh
+    span = {}
+
+    def work():
+        span["start"] = time.perf_counter()
+        primseg.segment(mesh, threads=1)
+        span["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=work)
+    ticks = []
+    worker.start()
+    while worker.is_alive():
+        ticks.append(time.perf_counter())
+        time.sleep(0.001)
+    worker.join()
+    inside = [t for t in ticks if span["start"] < t < span["end"]]
+    duration = span["end"] - span["start"]
+    # Holding the GIL would freeze this thread for the whole call: one gap as long as the call.
+    gaps = np.diff([span["start"], *inside, span["end"]])
+    assert gaps.max() < duration / 2, (gaps.max(), duration)
+
+
+def test_polygon_file_labels_match_the_cli(cli, tmp_path):
+    # The capped cylinder with quads along the tube and one 48-gon per cap.
+    around, rings = 48, 8
+    V, _, _ = capped_cylinder(around=around, rings=rings)
+    V = V[:-2]  # no cap centres: the caps are single polygons
+    quads = [[r * around + i, r * around + (i + 1) % around, (r + 1) * around + (i + 1) % around,
+              (r + 1) * around + i] for r in range(rings) for i in range(around)]
+    caps = [list(range(around))[::-1], list(range(rings * around, (rings + 1) * around))]
+    lines = ["OFF", f"{len(V)} {len(quads) + 2} 0"] + [" ".join(map(repr, v)) for v in V.tolist()]
+    lines += [" ".join(map(str, [len(f), *f])) for f in quads + caps]
+    (tmp_path / "tube.off").write_text("\n".join(lines) + "\n")
+    mesh = primseg.read_mesh(tmp_path / "tube.off")
+    assert mesh.face_count == len(quads) + 2 and mesh.triangle_count == 2 * len(quads) + 2 * (around - 2)
+    h = primseg.segment(mesh)
+    run_cli(cli, "segment", tmp_path / "tube.off", "--clusters", "3", "--labels", tmp_path / "l.txt", "--quiet")
+    labels = h.cut(3)
+    np.testing.assert_array_equal(labels, np.loadtxt(tmp_path / "l.txt"))
+    assert same_partition(labels, [0] * len(quads) + [1, 2])
+    assert sorted(c["type"] for c in h.clusters(3)) == ["cylinder", "plane", "plane"]
