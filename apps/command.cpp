@@ -55,7 +55,9 @@ nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy)
 
 void add_level_options(CLI::App& command, LevelOptions& options) {
   auto* clusters =
-      command.add_option("--clusters", options.level.clusters, "Number of clusters K (1..F)");
+      command.add_option("--clusters", options.level.clusters,
+                         "Number of clusters K (1..F), or 'auto': the level after which the "
+                         "error curve jumps most (candidates and scores in the JSON)");
   auto* tolerance = command.add_option(
       "--tolerance", options.level.tolerance,
       std::string("Largest RMS distance of a cluster to its primitive, in input units or T% of "
@@ -66,6 +68,9 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
   command.add_option("--json", options.files.json, "Write clusters and primitives as JSON");
   command.add_option("--colored", options.files.colored,
                      "Write the mesh coloured by cluster (.ply colours or .obj groups)");
+  command.add_option("--curve", options.files.curve,
+                     "Write the error curve as CSV: k,rms for every number of clusters k (rms: "
+                     "input units)");
   command.add_option("--png", options.files.png,
                      "Render the clusters to a PNG picture (800x600, three-quarter view)");
   command.add_option("--linkage", options.files.linkage,
@@ -76,12 +81,19 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
 
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
                   Clock::time_point cut_start) {
-  const Segmentation segmentation = cut(hierarchy, options.level);
+  const ChosenLevel level = cut(hierarchy, options.level);
+  const Segmentation& segmentation = level.segmentation;
   const std::vector<ClusterReport> reports = describe_clusters(hierarchy, segmentation);
   summary["timing"]["cut_seconds"] = seconds_since(cut_start);
   summary["level"] = {{"clusters", segmentation.cluster_count()}};
-  if (options.level.clusters)
-    summary["level"]["requested_clusters"] = *options.level.clusters;
+  if (level.automatic) {
+    summary["level"]["requested_clusters"] = "auto";
+    nlohmann::json candidates = nlohmann::json::array();
+    for (const LevelCandidate& c : level.automatic->candidates)
+      candidates.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
+    summary["level"]["candidates"] = std::move(candidates);
+  } else if (options.level.clusters)
+    summary["level"]["requested_clusters"] = *parse_cluster_count(*options.level.clusters);
   else
     summary["level"]["tolerance"] = options.level.tolerance.value_or(kDefaultTolerance);
   write_level_outputs(hierarchy, segmentation, reports, options.files, summary);
