@@ -55,12 +55,23 @@ AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& optio
     const double jump = floored(curve[k - 1 - c].rms) / floored(curve[k - c].rms);
     candidates.push_back({k, curve[k - c].rms, jump});
   }
+  // The finest significant level: a coarser jump, however large, only says that the regions
+  // of the finer level are themselves grouped (a small chamfer merging is a smaller jump than
+  // two big faces merging, and is just as real).
+  std::uint32_t chosen = c;
+  for (const LevelCandidate& candidate : candidates)
+    if (candidate.score >= options.min_score) chosen = std::max(chosen, candidate.clusters);
   std::stable_sort(
       candidates.begin(), candidates.end(),
       [](const LevelCandidate& a, const LevelCandidate& b) { return a.score > b.score; });
-  if (candidates.size() > options.max_candidates) candidates.resize(options.max_candidates);
+  // The best-scored ones, and the chosen one wherever it ranks.
+  std::vector<LevelCandidate> kept;
+  for (const LevelCandidate& candidate : candidates)
+    if (kept.size() < options.max_candidates || candidate.clusters == chosen)
+      kept.push_back(candidate);
+  candidates = std::move(kept);
   AutoLevel level;
-  level.clusters = candidates[0].clusters;
+  level.clusters = chosen;
   level.candidates = std::move(candidates);
   return level;
 }
