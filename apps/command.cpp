@@ -6,6 +6,7 @@
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
+#include "primseg/refine.hpp"
 #include "primseg/tree_io.hpp"
 
 namespace primseg::cli {
@@ -76,16 +77,38 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
   command.add_option("--linkage", options.files.linkage,
                      "Write the whole tree as a SciPy linkage matrix (text: a b cost size per "
                      "merge, numpy.loadtxt)");
+  command
+      .add_option("--refine", options.refine,
+                  "Boundary refinement passes after the cut: border faces move to the adjacent "
+                  "cluster whose primitive fits them better (0: none)")
+      ->check(CLI::Range(0u, 1000u))
+      ->capture_default_str();
   command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
 }
 
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
                   Clock::time_point cut_start) {
-  const ChosenLevel level = cut(hierarchy, options.level);
-  const Segmentation& segmentation = level.segmentation;
-  const std::vector<ClusterReport> reports = describe_clusters(hierarchy, segmentation);
+  ChosenLevel level = cut(hierarchy, options.level);
+  Segmentation& segmentation = level.segmentation;
+  std::vector<ClusterReport> reports;
+  nlohmann::json refinement;
+  if (options.refine > 0) {
+    const auto refine_start = Clock::now();
+    BoundaryRefinementOptions refine_options;
+    refine_options.max_passes = options.refine;
+    RefinedLevel refined = refine_boundaries(hierarchy, segmentation, refine_options);
+    segmentation = std::move(refined.segmentation);
+    reports = std::move(refined.reports);
+    refinement = {{"max_passes", options.refine},
+                  {"passes", refined.passes},
+                  {"moved_faces", refined.moved_faces}};
+    summary["timing"]["refine_seconds"] = seconds_since(refine_start);
+  } else {
+    reports = describe_clusters(hierarchy, segmentation);
+  }
   summary["timing"]["cut_seconds"] = seconds_since(cut_start);
   summary["level"] = {{"clusters", segmentation.cluster_count()}};
+  if (!refinement.is_null()) summary["level"]["refinement"] = std::move(refinement);
   if (level.automatic) {
     summary["level"]["requested_clusters"] = "auto";
     nlohmann::json candidates = nlohmann::json::array();

@@ -51,6 +51,7 @@ nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy)
 struct LevelOptions {
   LevelChoice level;
   OutputFiles files;
+  std::uint32_t refine = 0;  // --refine N: boundary refinement passes after the cut
   bool quiet = false;
 };
 

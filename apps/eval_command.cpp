@@ -8,6 +8,7 @@
 #include "primseg/auto_level.hpp"
 #include "primseg/error.hpp"
 #include "primseg/evaluation.hpp"
+#include "primseg/refine.hpp"
 #include "primseg/shape_generator.hpp"
 
 namespace primseg::cli {
@@ -81,7 +82,7 @@ struct Totals {
 Command add_eval_command(CLI::App& app) {
   struct Options {
     std::string variants = "cad,uniform,noisy", shapes, primitives = "plane,cylinder,sphere";
-    std::uint32_t seeds = 3;
+    std::uint32_t seeds = 3, refine = 0;
     unsigned threads = 0;
     std::optional<std::string> json;
     bool quiet = false;
@@ -100,6 +101,9 @@ Command add_eval_command(CLI::App& app) {
   eval->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
       ->capture_default_str();
   eval->add_option("--threads", o->threads, "Threads of the hierarchy (0: all cores)")
+      ->capture_default_str();
+  eval->add_option("--refine", o->refine, "Boundary refinement passes after the cut (0: none)")
+      ->check(CLI::Range(0u, 1000u))
       ->capture_default_str();
   eval->add_option("--json", o->json, "Write every case and the totals as JSON");
   eval->add_flag("--quiet,-q", o->quiet, "Print the totals only");
@@ -140,9 +144,18 @@ Command add_eval_command(CLI::App& app) {
                   const auto start = Clock::now();
                   const Hierarchy hierarchy = build_hierarchy(shape.mesh, options);
                   const auto truth = static_cast<std::uint32_t>(shape.regions.size());
-                  const Segmentation segmentation = cut_by_count(hierarchy, truth);
-                  const std::vector<ClusterReport> reports =
-                      describe_clusters(hierarchy, segmentation);
+                  Segmentation segmentation = cut_by_count(hierarchy, truth);
+                  std::vector<ClusterReport> reports;
+                  if (o->refine > 0) {
+                    BoundaryRefinementOptions refine_options;
+                    refine_options.max_passes = o->refine;
+                    RefinedLevel refined =
+                        refine_boundaries(hierarchy, segmentation, refine_options);
+                    segmentation = std::move(refined.segmentation);
+                    reports = std::move(refined.reports);
+                  } else {
+                    reports = describe_clusters(hierarchy, segmentation);
+                  }
                   const double seconds = seconds_since(start);
                   const AutoLevel level = choose_level(hierarchy);
                   std::vector<PrimitiveType> types, truth_types;

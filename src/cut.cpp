@@ -8,6 +8,7 @@
 #include <string>
 
 #include "primseg/error.hpp"
+#include "working_primitive.hpp"
 
 namespace primseg {
 namespace {
@@ -169,11 +170,7 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
     r.node = segmentation.nodes[c];
     r.algebraic = start[c];
     // Fitted and measured in the working frame (no overflow for huge inputs), scaled back.
-    Primitive working = start[c];
-    const Eigen::Vector3d p = frame.to_working(start[c].point);
-    working.point = {p.x(), p.y(), p.z()};
-    working.radius = std::ldexp(start[c].radius, -frame.exponent);
-    working.minor_radius = std::ldexp(start[c].minor_radius, -frame.exponent);
+    const Primitive working = detail::to_working(frame, start[c]);
     const std::span<const Vec3> cluster_points(points.data() + offset[c],
                                                offset[c + 1] - offset[c]);
     const std::span<const double> cluster_weights(weights.data() + offset[c],
