@@ -118,7 +118,10 @@ SegmentationScore score_segmentation(const std::vector<std::uint32_t>& labels,
     score.area_by_type[t] /= total_area;
     score.correct_area_by_type[t] /= total_area;
   }
-  score.type_accuracy = total_area > 0 ? typed_area / total_area : 0;
+  // Over the same per-region sums as typed_area, so that all regions right gives exactly 1.
+  double region_total = 0;
+  for (double a : region_area) region_total += a;
+  score.type_accuracy = region_total > 0 ? typed_area / region_total : 0;
   // Pairs (with replacement) that disagree: same region but different clusters, or the reverse.
   double same_region = 0, same_cluster = 0, same_both = 0;
   for (std::size_t r = 0; r < regions; ++r) {
