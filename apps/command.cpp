@@ -6,6 +6,7 @@
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
+#include "primseg/refine.hpp"
 #include "primseg/tree_io.hpp"
 
 namespace primseg::cli {
@@ -55,7 +56,9 @@ nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy)
 
 void add_level_options(CLI::App& command, LevelOptions& options) {
   auto* clusters =
-      command.add_option("--clusters", options.level.clusters, "Number of clusters K (1..F)");
+      command.add_option("--clusters", options.level.clusters,
+                         "Number of clusters K (1..F), or 'auto': the level after which the "
+                         "error curve jumps most (candidates and scores in the JSON)");
   auto* tolerance = command.add_option(
       "--tolerance", options.level.tolerance,
       std::string("Largest RMS distance of a cluster to its primitive, in input units or T% of "
@@ -66,22 +69,54 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
   command.add_option("--json", options.files.json, "Write clusters and primitives as JSON");
   command.add_option("--colored", options.files.colored,
                      "Write the mesh coloured by cluster (.ply colours or .obj groups)");
+  command.add_option("--curve", options.files.curve,
+                     "Write the error curve as CSV: k,rms for every number of clusters k (rms: "
+                     "input units)");
   command.add_option("--png", options.files.png,
                      "Render the clusters to a PNG picture (800x600, three-quarter view)");
   command.add_option("--linkage", options.files.linkage,
                      "Write the whole tree as a SciPy linkage matrix (text: a b cost size per "
                      "merge, numpy.loadtxt)");
+  command
+      .add_option("--refine", options.refine,
+                  "Boundary refinement passes after the cut: border faces move to the adjacent "
+                  "cluster whose primitive fits them better (0: none)")
+      ->check(CLI::Range(0u, 1000u))
+      ->capture_default_str();
   command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
 }
 
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
                   Clock::time_point cut_start) {
-  const Segmentation segmentation = cut(hierarchy, options.level);
-  const std::vector<ClusterReport> reports = describe_clusters(hierarchy, segmentation);
+  ChosenLevel level = cut(hierarchy, options.level);
+  Segmentation& segmentation = level.segmentation;
+  std::vector<ClusterReport> reports;
+  nlohmann::json refinement;
+  if (options.refine > 0) {
+    const auto refine_start = Clock::now();
+    BoundaryRefinementOptions refine_options;
+    refine_options.max_passes = options.refine;
+    RefinedLevel refined = refine_boundaries(hierarchy, segmentation, refine_options);
+    segmentation = std::move(refined.segmentation);
+    reports = std::move(refined.reports);
+    refinement = {{"max_passes", options.refine},
+                  {"passes", refined.passes},
+                  {"moved_faces", refined.moved_faces}};
+    summary["timing"]["refine_seconds"] = seconds_since(refine_start);
+  } else {
+    reports = describe_clusters(hierarchy, segmentation);
+  }
   summary["timing"]["cut_seconds"] = seconds_since(cut_start);
   summary["level"] = {{"clusters", segmentation.cluster_count()}};
-  if (options.level.clusters)
-    summary["level"]["requested_clusters"] = *options.level.clusters;
+  if (!refinement.is_null()) summary["level"]["refinement"] = std::move(refinement);
+  if (level.automatic) {
+    summary["level"]["requested_clusters"] = "auto";
+    nlohmann::json candidates = nlohmann::json::array();
+    for (const LevelCandidate& c : level.automatic->candidates)
+      candidates.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
+    summary["level"]["candidates"] = std::move(candidates);
+  } else if (options.level.clusters)
+    summary["level"]["requested_clusters"] = *parse_cluster_count(*options.level.clusters);
   else
     summary["level"]["tolerance"] = options.level.tolerance.value_or(kDefaultTolerance);
   write_level_outputs(hierarchy, segmentation, reports, options.files, summary);

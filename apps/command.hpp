@@ -22,6 +22,7 @@ struct Command {
 Command add_segment_command(CLI::App& app);
 Command add_cut_command(CLI::App& app);
 Command add_info_command(CLI::App& app);
+Command add_eval_command(CLI::App& app);
 
 // Helpers shared by the commands.
 
@@ -50,6 +51,7 @@ nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy)
 struct LevelOptions {
   LevelChoice level;
   OutputFiles files;
+  std::uint32_t refine = 0;  // --refine N: boundary refinement passes after the cut
   bool quiet = false;
 };
 

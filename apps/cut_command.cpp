@@ -18,7 +18,8 @@ Command add_cut_command(CLI::App& app) {
 
   return {cut_command, [o] {
             if (!o->level.level.clusters && !o->level.level.tolerance)
-              throw InvalidInputError("cut: give the level with --clusters K or --tolerance T");
+              throw InvalidInputError(
+                  "cut: give the level with --clusters K, --clusters auto or --tolerance T");
             validate_output_files(o->level.files);
             const auto read_start = Clock::now();
             const Hierarchy hierarchy = read_tree(o->tree_path);

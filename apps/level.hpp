@@ -4,24 +4,35 @@
 #include <optional>
 #include <string>
 
+#include "primseg/auto_level.hpp"
 #include "primseg/cut.hpp"
 
 namespace primseg::cli {
 
 struct LevelChoice {
-  std::optional<std::uint32_t> clusters;  // --clusters K
-  std::optional<std::string> tolerance;   // --tolerance T or T% (of the bounding-box diagonal)
+  std::optional<std::string> clusters;   // --clusters K or auto
+  std::optional<std::string> tolerance;  // --tolerance T or T% (of the bounding-box diagonal)
 };
 
 /// Parses "T" or "T%" into input units. Throws InvalidInputError naming the option.
 double parse_tolerance(const std::string& text, double bounding_box_diagonal);
 
+/// Parses --clusters: a count, or std::nullopt for "auto". Throws InvalidInputError naming the
+/// option for anything else (including counts beyond 32 bits).
+std::optional<std::uint32_t> parse_cluster_count(const std::string& text);
+
 /// Throws InvalidInputError unless the level can be cut from a mesh of `face_count` faces (K in
-/// 1..F, a well-formed tolerance): checked before the hierarchy is built.
+/// 1..F or auto, a well-formed tolerance): checked before the hierarchy is built.
 void validate_level(const LevelChoice& level, std::uint32_t face_count);
 
+/// A cut level, and how it was chosen when --clusters auto.
+struct ChosenLevel {
+  Segmentation segmentation;
+  std::optional<AutoLevel> automatic;
+};
+
 /// The segmentation for a level choice; with neither option, the default tolerance below.
-Segmentation cut(const Hierarchy& hierarchy, const LevelChoice& level);
+ChosenLevel cut(const Hierarchy& hierarchy, const LevelChoice& level);
 
 /// Default level when none is given: clusters whose RMS estimate is within this percentage of
 /// the bounding-box diagonal.

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "../src/file_io.hpp"
+#include "primseg/auto_level.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/render.hpp"
@@ -83,6 +84,15 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
       text.append(line, static_cast<std::size_t>(n));
     }
     detail::write_file_atomically(*files.linkage, text);
+  }
+  if (files.curve) {
+    std::string text = "k,rms\n";
+    char line[64];
+    for (const ErrorCurvePoint& point : error_curve(hierarchy)) {
+      const int n = std::snprintf(line, sizeof line, "%u,%.17g\n", point.clusters, point.rms);
+      text.append(line, static_cast<std::size_t>(n));
+    }
+    detail::write_file_atomically(*files.curve, text);
   }
   if (files.png) {
     const auto palette = distinct_colors(segmentation.cluster_count());

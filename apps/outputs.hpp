@@ -16,6 +16,7 @@ struct OutputFiles {
   std::optional<std::string> tree;     // whole hierarchy (segment only)
   std::optional<std::string> png;      // picture of the clusters
   std::optional<std::string> linkage;  // SciPy linkage matrix of the whole tree, as text
+  std::optional<std::string> curve;    // error curve of the whole tree, CSV k,rms
 };
 
 /// Throws InvalidInputError for output names that cannot be written (checked before any work).

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "primseg/error.hpp"
+#include "working_primitive.hpp"
 
 namespace primseg {
 namespace {
@@ -119,45 +120,66 @@ Segmentation cut_by_tolerance(const Hierarchy& hierarchy, double tolerance) {
 }
 
 std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
-                                             const Segmentation& segmentation) {
+                                             const Segmentation& segmentation,
+                                             const DescribeOptions& options) {
+  std::vector<Primitive> start(segmentation.cluster_count());
+  for (std::uint32_t c = 0; c < start.size(); ++c)
+    start[c] = hierarchy.primitive(segmentation.nodes[c]);
+  return describe_clusters(hierarchy, segmentation, start, options);
+}
+
+std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
+                                             const Segmentation& segmentation,
+                                             const std::vector<Primitive>& start,
+                                             const DescribeOptions& options) {
   const Mesh& mesh = hierarchy.mesh();
   const DualGraph& graph = hierarchy.graph();
   const WorkingFrame& frame = graph.frame();
   const std::uint32_t k = segmentation.cluster_count();
+  if (start.size() != k || segmentation.labels.size() != mesh.face_count())
+    throw InvalidInputError("describe_clusters: the segmentation does not match the mesh");
+  // Every triangle corner of each cluster with its weight, working frame, grouped by cluster.
+  std::vector<std::size_t> offset(k + 1, 0);
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
+    offset[segmentation.labels[mesh.face_of_triangle[t]] + 1] += 3;
+  for (std::uint32_t c = 0; c < k; ++c) offset[c + 1] += offset[c];
+  std::vector<Vec3> points(offset[k]);
+  std::vector<double> weights(offset[k]);
+  std::vector<std::size_t> next(offset.begin(), offset.end() - 1);
   std::vector<ClusterReport> reports(k);
-  std::vector<Primitive> working(k);
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::uint32_t f = mesh.face_of_triangle[t];
+    const std::uint32_t c = segmentation.labels[f];
+    if (c >= k)
+      throw InvalidInputError("describe_clusters: a label is not below the cluster count");
+    const std::array<double, 3> w = graph.corner_weights(t);
+    for (int corner = 0; corner < 3; ++corner) {
+      const Eigen::Vector3d& x = graph.position(mesh.triangles[t][corner]);
+      points[next[c]] = {x.x(), x.y(), x.z()};
+      weights[next[c]++] = w[corner];
+    }
+    reports[c].area += graph.triangle_area(t);
+  }
+  for (std::uint32_t f = 0; f < mesh.face_count(); ++f)
+    ++reports[segmentation.labels[f]].face_count;
+  GeometricFitOptions fit_options = options.fit;
+  if (!options.geometric_fit) fit_options.max_iterations = 0;
   for (std::uint32_t c = 0; c < k; ++c) {
     ClusterReport& r = reports[c];
     r.id = c;
     r.node = segmentation.nodes[c];
-    r.primitive = hierarchy.primitive(r.node);
-    r.face_count = hierarchy.face_count(r.node);
-    // Distances are measured in the working frame (no overflow for huge inputs) and scaled back.
-    Primitive w = r.primitive;
-    const Eigen::Vector3d p = frame.to_working(r.primitive.point);
-    w.point = {p.x(), p.y(), p.z()};
-    w.radius = std::ldexp(r.primitive.radius, -frame.exponent);
-    w.minor_radius = std::ldexp(r.primitive.minor_radius, -frame.exponent);
-    working[c] = w;
-  }
-  std::vector<double> sum_wd2(k, 0.0), sum_w(k, 0.0), max_d(k, 0.0);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
-    const std::uint32_t c = segmentation.labels[mesh.face_of_triangle[t]];
-    const std::array<double, 3> w = graph.corner_weights(t);
-    for (int corner = 0; corner < 3; ++corner) {
-      const Eigen::Vector3d& x = graph.position(mesh.triangles[t][corner]);
-      const double d = working[c].distance({x.x(), x.y(), x.z()});
-      sum_wd2[c] += w[corner] * d * d;
-      sum_w[c] += w[corner];
-      max_d[c] = std::max(max_d[c], d);
-    }
-    reports[c].area += graph.triangle_area(t);
-  }
-  for (std::uint32_t c = 0; c < k; ++c) {
-    reports[c].rms =
-        sum_w[c] > 0 ? std::ldexp(std::sqrt(sum_wd2[c] / sum_w[c]), frame.exponent) : 0.0;
-    reports[c].max = std::ldexp(max_d[c], frame.exponent);
-    reports[c].area = std::ldexp(reports[c].area, 2 * frame.exponent);
+    r.algebraic = start[c];
+    // Fitted and measured in the working frame (no overflow for huge inputs), scaled back.
+    const Primitive working = detail::to_working(frame, start[c]);
+    const std::span<const Vec3> cluster_points(points.data() + offset[c],
+                                               offset[c + 1] - offset[c]);
+    const std::span<const double> cluster_weights(weights.data() + offset[c],
+                                                  offset[c + 1] - offset[c]);
+    const GeometricFit fit = fit_geometric(working, cluster_points, cluster_weights, fit_options);
+    r.primitive = fit.iterations > 0 ? frame.to_input(fit.primitive) : start[c];
+    r.rms = std::ldexp(fit.rms, frame.exponent);
+    r.max = std::ldexp(fit.max, frame.exponent);
+    r.area = std::ldexp(r.area, 2 * frame.exponent);
   }
   return reports;
 }

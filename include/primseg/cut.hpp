@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "primseg/geometric_fit.hpp"
 #include "primseg/hierarchy.hpp"
 
 namespace primseg {
@@ -33,20 +34,40 @@ Segmentation cut_by_tolerance(const Hierarchy& hierarchy, double tolerance);
 /// What a user wants to know about one cluster of a cut.
 struct ClusterReport {
   std::uint32_t id = 0;    ///< its label
-  std::uint32_t node = 0;  ///< its tree node
-  Primitive primitive;     ///< fitted primitive, input units
-  double area = 0;         ///< input units²
+  std::uint32_t node = 0;  ///< its tree node (after boundary refinement: the node it grew from)
+  /// Fitted primitive, input units: the geometric fit (geometric_fit.hpp) started from
+  /// `algebraic`, unless DescribeOptions::geometric_fit is off.
+  Primitive primitive;
+  Primitive algebraic;  ///< the fit the reported one started from (the tree's), input units
+  double area = 0;      ///< input units²
   std::uint32_t face_count = 0;
-  /// Exact weighted RMS Euclidean distance of the cluster's vertices to the primitive
-  /// (the hierarchy's vertex weights), input units.
+  /// Exact weighted RMS Euclidean distance of the cluster's vertices to `primitive` (each
+  /// triangle corner weighted as in the hierarchy), input units.
   double rms = 0;
-  /// Largest Euclidean distance of a cluster vertex to the primitive, input units.
+  /// Largest Euclidean distance of a cluster vertex to `primitive`, input units.
   double max = 0;
 };
 
-/// Reports of every cluster of a cut, in label order. O(F) in total.
+/// Options of describe_clusters().
+struct DescribeOptions {
+  /// Refine each primitive by a geometric least-squares fit to the cluster's vertices
+  /// (fit_geometric); off: report the starting primitive as it is.
+  bool geometric_fit = true;
+  GeometricFitOptions fit;
+};
+
+/// Reports of every cluster of a cut, in label order, each started from its node's primitive.
+/// O(F) per geometric fit iteration.
 std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
-                                             const Segmentation& segmentation);
+                                             const Segmentation& segmentation,
+                                             const DescribeOptions& options = {});
+
+/// The same for clusters that need not be tree nodes (after boundary refinement): `start` holds
+/// the primitive each cluster's fit starts from (input units), shape (K).
+std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
+                                             const Segmentation& segmentation,
+                                             const std::vector<Primitive>& start,
+                                             const DescribeOptions& options = {});
 
 /// The whole tree as SciPy's linkage matrix, shape (F − 1, 4): children node ids, height, face
 /// count; row i creates node F + i (Hierarchy::merges() order, trailing merges last).

@@ -1,7 +1,7 @@
 #pragma once
 /// @file shape_generator.hpp
 /// CAD-like test solids with known ground-truth segmentation: every face is labelled with the
-/// analytic primitive (plane, cylinder, sphere) it was sampled from.
+/// analytic primitive (plane, cylinder, sphere, cone, torus) it was sampled from.
 ///
 /// Shapes are closed, manifold and consistently outward-oriented, and every ground-truth region
 /// is edge-connected. Vertices along a boundary between two regions are shared by both, so the
@@ -61,7 +61,9 @@ struct GroundTruthShape {
   /// canonical form of primitive.hpp: a plane's point is the area-weighted centroid of its
   /// noise-free region and its axis the outward unit normal; a cylinder's axis has its
   /// largest-magnitude component positive and its point is the region's area-weighted centroid
-  /// projected on the axis; a sphere is its centre and radius. Lengths in mesh units.
+  /// projected on the axis; a sphere is its centre and radius; a cone its apex, unit axis from the
+  /// apex into the cone and half-angle; a torus its centre, unit axis (largest-magnitude
+  /// component positive), major and minor radius. Lengths in mesh units.
   std::vector<Primitive> regions;
 };
 
@@ -76,7 +78,12 @@ struct GroundTruthShape {
 /// - `box_with_boss`: 6 box planes, the boss cylinder and the boss cap plane (8);
 /// - `box_with_dome`: 6 box planes and a spherical cap rising from the top face (7);
 /// - `stepped_block`: an L-shaped extrusion, 8 planes;
-/// - `cylinder_with_sphere_cap`: a capsule-like solid: cylinder, hemisphere and bottom disc.
+/// - `cylinder_with_sphere_cap`: a capsule-like solid: cylinder, hemisphere and bottom disc;
+/// - `chamfered_cylinder`: cylinder, its top edge chamfered at 45 degrees (a cone), 2 discs (4);
+/// - `filleted_cylinder`: cylinder, its top edge rounded by a tangent fillet (a quarter torus),
+///   2 discs (4);
+/// - `box_with_countersink`: 6 planes, a through-hole's concave cylinder and the countersink's
+///   concave cone (8).
 std::vector<std::string> shape_names();
 
 /// Generates the catalogue shape `name`.

@@ -220,6 +220,84 @@ PatchBuilder cylinder_with_sphere_cap(const ShapeOptions& options) {
   return builder;
 }
 
+/// A capped cylinder (radius 0.5, height 1.2) whose top edge is chamfered at 45 degrees: the
+/// chamfer is a cone with its apex above the top, on the axis.
+PatchBuilder chamfered_cylinder(const ShapeOptions& options) {
+  const double radius = 0.5, height = 1.2, chamfer = 0.1;
+  PatchBuilder builder(options, diagonal({2 * radius, 2 * radius, height}));
+  const CircleFrame frame = CircleFrame::around({0, 0, -height / 2}, kUp);
+  const int count = builder.arc_segments(radius, 2 * kPi);
+  const double shoulder = height - chamfer;
+  const Ring bottom = builder.circle(frame, radius, 0, count);
+  const Ring edge = builder.circle(frame, radius, shoulder, count);
+  const Ring top = builder.circle(frame, radius - chamfer, height,
+                                  builder.arc_segments(radius - chamfer, 2 * kPi));
+  builder.cylinder_patch(builder.add_cylinder(frame, radius, false), frame, radius, 0, shoulder,
+                         bottom, edge);
+  const Vec3 apex = frame.cylinder_point(0, shoulder + radius, 0);
+  builder.revolution_patch(
+      builder.add_cone(apex, {0, 0, -1}, kPi / 4, false), frame,
+      [&](double s) {
+        return std::pair{radius - s * chamfer, shoulder + s * chamfer};
+      },
+      chamfer * std::sqrt(2.0), 1, edge, top);
+  disc_face(builder, bottom, {0, 0, -1});
+  disc_face(builder, top, kUp);
+  return builder;
+}
+
+/// A capped cylinder (radius 0.5, height 1.2) whose top edge is rounded by a fillet of radius
+/// 0.15: a quarter of a torus, tangent to the side and to the top.
+PatchBuilder filleted_cylinder(const ShapeOptions& options) {
+  const double radius = 0.5, height = 1.2, fillet = 0.15;
+  PatchBuilder builder(options, diagonal({2 * radius, 2 * radius, height}));
+  const CircleFrame frame = CircleFrame::around({0, 0, -height / 2}, kUp);
+  const int count = builder.arc_segments(radius, 2 * kPi);
+  const double shoulder = height - fillet, inner = radius - fillet;
+  const Ring bottom = builder.circle(frame, radius, 0, count);
+  const Ring edge = builder.circle(frame, radius, shoulder, count);
+  const Ring top = builder.circle(frame, inner, height, builder.arc_segments(inner, 2 * kPi));
+  builder.cylinder_patch(builder.add_cylinder(frame, radius, false), frame, radius, 0, shoulder,
+                         bottom, edge);
+  const double quarter = kPi / 2;
+  builder.revolution_patch(
+      builder.add_torus(frame.cylinder_point(0, shoulder, 0), kUp, inner, fillet, false), frame,
+      [&](double s) {
+        return std::pair{inner + fillet * std::cos(s * quarter),
+                         shoulder + fillet * std::sin(s * quarter)};
+      },
+      fillet * quarter, builder.arc_segments(fillet, quarter), edge, top);
+  disc_face(builder, bottom, {0, 0, -1});
+  disc_face(builder, top, kUp);
+  return builder;
+}
+
+/// The box with a through-hole of radius 0.2 whose top is countersunk at 90 degrees (a cone of
+/// half-angle 45 degrees from radius 0.35 at the top face).
+PatchBuilder box_with_countersink(const ShapeOptions& options) {
+  PatchBuilder builder(options, diagonal(kBoxHi - kBoxLo));
+  const double radius = 0.2, countersink = 0.35;
+  const double depth = countersink - radius;  // 45 degrees
+  const double thickness = kBoxHi[2] - kBoxLo[2];
+  const CircleFrame frame = CircleFrame::around({0.15, 0, kBoxLo[2]}, kUp);
+  const int count = builder.arc_segments(radius, 2 * kPi);
+  const Ring rim_bottom = builder.circle(frame, radius, 0, count);
+  const Ring rim_top = builder.circle(frame, radius, thickness - depth, count);
+  const Ring mouth =
+      builder.circle(frame, countersink, thickness, builder.arc_segments(countersink, 2 * kPi));
+  box_faces(builder, box_corners(builder, kBoxLo, kBoxHi), {rim_bottom.vertices}, {mouth.vertices});
+  builder.cylinder_patch(builder.add_cylinder(frame, radius, true), frame, radius, 0,
+                         thickness - depth, rim_bottom, rim_top);
+  const Vec3 apex = frame.cylinder_point(0, thickness - countersink, 0);
+  builder.revolution_patch(
+      builder.add_cone(apex, kUp, kPi / 4, true), frame,
+      [&](double s) {
+        return std::pair{radius + s * depth, thickness - depth + s * depth};
+      },
+      depth * std::sqrt(2.0), 1, rim_top, mouth);
+  return builder;
+}
+
 }  // namespace
 
 const std::vector<CatalogueEntry>& catalogue() {
@@ -234,6 +312,9 @@ const std::vector<CatalogueEntry>& catalogue() {
       {"box_with_dome", box_with_dome},
       {"stepped_block", stepped_block},
       {"cylinder_with_sphere_cap", cylinder_with_sphere_cap},
+      {"chamfered_cylinder", chamfered_cylinder},
+      {"filleted_cylinder", filleted_cylinder},
+      {"box_with_countersink", box_with_countersink},
   };
   return entries;
 }

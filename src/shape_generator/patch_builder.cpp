@@ -42,6 +42,17 @@ Vec3 RegionSurface::outward_normal(const Vec3& x) const {
     }
     case PrimitiveType::Sphere:
       return outward_sign * normalized(x - primitive.point);
+    case PrimitiveType::Cone: {
+      const Vec3 d = x - primitive.point;
+      const Vec3 radial = normalized(d - dot(d, primitive.axis) * primitive.axis);
+      return outward_sign * (std::cos(primitive.half_angle) * radial -
+                             std::sin(primitive.half_angle) * primitive.axis);
+    }
+    case PrimitiveType::Torus: {
+      const Vec3 d = x - primitive.point;
+      const Vec3 radial = normalized(d - dot(d, primitive.axis) * primitive.axis);
+      return outward_sign * normalized(x - (primitive.point + primitive.radius * radial));
+    }
     default:
       throw std::logic_error("shape generator: unsupported region surface");
   }
@@ -102,6 +113,35 @@ std::uint32_t PatchBuilder::add_sphere(const Vec3& centre, double radius, bool h
   surface.outward_sign = hole ? -1 : 1;
   regions_.push_back(surface);
   return static_cast<std::uint32_t>(regions_.size() - 1);
+}
+
+std::uint32_t PatchBuilder::add_cone(const Vec3& apex, const Vec3& axis, double half_angle,
+                                     bool hole) {
+  RegionSurface surface;
+  surface.primitive.type = PrimitiveType::Cone;
+  surface.primitive.point = apex;
+  surface.primitive.axis = normalized(axis);
+  surface.primitive.half_angle = half_angle;
+  surface.outward_sign = hole ? -1 : 1;
+  regions_.push_back(surface);
+  return static_cast<std::uint32_t>(regions_.size() - 1);
+}
+
+std::uint32_t PatchBuilder::add_torus(const Vec3& centre, const Vec3& axis, double major_radius,
+                                      double minor_radius, bool hole) {
+  RegionSurface surface;
+  surface.primitive.type = PrimitiveType::Torus;
+  surface.primitive.point = centre;
+  surface.primitive.axis = normalized(axis);
+  surface.primitive.radius = major_radius;
+  surface.primitive.minor_radius = minor_radius;
+  surface.outward_sign = hole ? -1 : 1;
+  regions_.push_back(surface);
+  return static_cast<std::uint32_t>(regions_.size() - 1);
+}
+
+int PatchBuilder::uniform_bands(double length) const {
+  return std::max(1, static_cast<int>(std::lround(length / (kRowSpacing * target_edge_))));
 }
 
 std::vector<std::uint32_t> PatchBuilder::straight_edge(std::uint32_t from, std::uint32_t to) {
@@ -340,7 +380,14 @@ void PatchBuilder::emit(std::uint32_t region, std::uint32_t a, std::uint32_t b, 
   const Vec3 &pa = positions_[a], &pb = positions_[b], &pc = positions_[c];
   const Vec3 centroid = (1.0 / 3) * (pa + pb + pc);
   const Vec3 normal = cross(pb - pa, pc - pa);
-  if (dot(normal, regions_[region].outward_normal(centroid)) < 0) std::swap(b, c);
+  const RegionSurface& surface = regions_[region];
+  // A coarse facet of a torus can have its centroid past the tube's centre circle, where the
+  // surface normal points the other way: its vertices (on the surface) are reliable.
+  const Vec3 outward =
+      surface.primitive.type == PrimitiveType::Torus
+          ? surface.outward_normal(pa) + surface.outward_normal(pb) + surface.outward_normal(pc)
+          : surface.outward_normal(centroid);
+  if (dot(normal, outward) < 0) std::swap(b, c);
   triangles_.push_back({a, b, c});
   triangle_regions_.push_back(region);
 }

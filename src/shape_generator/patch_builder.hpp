@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <numbers>
 #include <utility>
 #include <vector>
 
@@ -66,6 +67,12 @@ class PatchBuilder {
   std::uint32_t add_plane(const Vec3& point, const Vec3& outward_normal);
   std::uint32_t add_cylinder(const CircleFrame& frame, double radius, bool hole);
   std::uint32_t add_sphere(const Vec3& centre, double radius, bool hole);
+  /// A cone with its apex, unit axis from the apex into the cone, and half-angle (radians).
+  std::uint32_t add_cone(const Vec3& apex, const Vec3& axis, double half_angle, bool hole);
+  /// A torus: centre, unit axis, major and minor radius; `hole`: the solid is inside the tube's
+  /// complement (a concave fillet).
+  std::uint32_t add_torus(const Vec3& centre, const Vec3& axis, double major_radius,
+                          double minor_radius, bool hole);
 
   /// Vertices from `from` to `to` (both included) along the straight segment between them. The
   /// segment is sampled on the first request; later requests (either direction) reuse it.
@@ -90,6 +97,24 @@ class PatchBuilder {
   /// Sphere zone between polar angles polar_start < polar_end (0 or pi: `start`/`end` is a pole).
   void sphere_patch(std::uint32_t region, const CircleFrame& frame, double radius,
                     double polar_start, double polar_end, const Ring& start, const Ring& end);
+  /// Surface of revolution around frame.axis between two rings of the frame: `profile(s)` gives
+  /// (distance from the axis, height along it) for s in [0, 1], s = 0 at `start`; `length` is
+  /// the profile's arc length. Cad: `cad_bands` strips; Uniform: bands of the target edge.
+  template <typename Profile>
+  void revolution_patch(std::uint32_t region, const CircleFrame& frame, Profile&& profile,
+                        double length, int cad_bands, const Ring& start, const Ring& end) {
+    const int bands = cad_ ? cad_bands : uniform_bands(length);
+    std::vector<Ring> rings{start};
+    for (int k = 1; k < bands; ++k) {
+      const auto [radius, height] = profile(static_cast<double>(k) / bands);
+      rings.push_back(circle(frame, radius, height, arc_segments(radius, 2 * std::numbers::pi),
+                             (!cad_ && k % 2 == 1) ? 0.5 : 0.0));
+    }
+    rings.push_back(end);
+    ring_strips(region, rings);
+  }
+  /// Number of ring bands of near-equilateral triangles along a profile of this length.
+  int uniform_bands(double length) const;
   /// Whole sphere as a projected subdivided icosahedron.
   void icosphere(std::uint32_t region, const Vec3& centre, double radius);
   /// Strips between consecutive rings (and between the last and first if `wrap`).

@@ -100,6 +100,22 @@ std::vector<Primitive> canonical_regions(const PatchBuilder& builder, const Moti
         moved.radius = motion.scale * local.radius;
         break;
       }
+      case PrimitiveType::Cone:
+        moved.point = motion.apply(local.point);
+        moved.axis = normalized(motion.rotate(local.axis));
+        moved.half_angle = local.half_angle;
+        break;
+      case PrimitiveType::Torus: {
+        Vec3 axis = normalized(motion.rotate(local.axis));
+        const auto largest = std::max_element(
+            axis.begin(), axis.end(), [](double u, double v) { return std::abs(u) < std::abs(v); });
+        if (*largest < 0) axis = -1.0 * axis;
+        moved.point = motion.apply(local.point);
+        moved.axis = axis;
+        moved.radius = motion.scale * local.radius;
+        moved.minor_radius = motion.scale * local.minor_radius;
+        break;
+      }
       default:  // sphere
         moved.point = motion.apply(local.point);
         moved.radius = motion.scale * local.radius;

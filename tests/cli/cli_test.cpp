@@ -143,21 +143,6 @@ void expect_valid_labels(const std::vector<std::uint32_t>& labels, std::size_t f
   for (std::size_t l = 0; l < k; ++l) EXPECT_TRUE(used[l]) << "label " << l << " unused";
 }
 
-double triangle_area(const Mesh& mesh, const Triangle& t) {
-  const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
-  const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const Vec3 v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  const Vec3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-  return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-}
-
-std::vector<double> face_areas(const Mesh& mesh) {
-  std::vector<double> areas(mesh.face_count(), 0.0);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-    areas[mesh.face_of_triangle[t]] += triangle_area(mesh, mesh.triangles[t]);
-  return areas;
-}
-
 double dot(const Vec3& a, const Vec3& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
@@ -744,6 +729,92 @@ TEST(Cli, BadMeshFilesAreRejectedWithAMessage) {
   for (const BadCase& c : cases) expect_rejected(c);
 }
 
+TEST(Cli, ClustersAutoFindsTheRegionsAndReportsCandidatesAndTheCurve) {
+  TempDir dir("auto");
+  ShapeOptions options;
+  options.random_motion = true;
+  options.seed = 7;
+  const GroundTruthShape shape = make_shape("box_with_hole", options);
+  write_mesh(dir / "in.off", shape.mesh);
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --clusters auto --json " +
+                     dir.q("a.json") + " --curve " + dir.q("curve.csv") + " --tree " +
+                     dir.q("t.tree")));
+  const json j = read_json(dir / "a.json");
+  EXPECT_EQ(j["level"]["clusters"], 7);
+  EXPECT_EQ(j["level"]["requested_clusters"], "auto");
+  EXPECT_EQ(j["clusters"].size(), 7u);
+  ASSERT_TRUE(j["level"]["candidates"].is_array()) << j["level"].dump(1);
+  bool listed = false;
+  for (const json& c : j["level"]["candidates"]) {
+    EXPECT_GE(c.at("score").get<double>(), 0.0);
+    EXPECT_GE(c.at("rms").get<double>(), 0.0);
+    listed |= c.at("clusters") == 7;
+  }
+  EXPECT_TRUE(listed);
+
+  // The curve: a header, then k = 1..F in order; one cluster per face fits exactly.
+  std::istringstream lines(read_file(dir / "curve.csv"));
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "k,rms");
+  std::uint32_t expected_k = 1;
+  double last_rms = -1, rms_at_7 = -1, rms_at_6 = -1;
+  while (std::getline(lines, line)) {
+    const std::size_t comma = line.find(',');
+    ASSERT_NE(comma, std::string::npos) << line;
+    EXPECT_EQ(std::stoul(line.substr(0, comma)), expected_k);
+    last_rms = std::stod(line.substr(comma + 1));
+    if (expected_k == 6) rms_at_6 = last_rms;
+    if (expected_k == 7) rms_at_7 = last_rms;
+    ++expected_k;
+  }
+  EXPECT_EQ(expected_k - 1, shape.mesh.face_count());
+  EXPECT_EQ(last_rms, 0.0);
+  EXPECT_LE(rms_at_7, 1e-9 * bounding_box_diagonal(shape.mesh)) << "exact regions at K = 7";
+  EXPECT_GT(rms_at_6, 1e-3 * bounding_box_diagonal(shape.mesh)) << "a jump after it";
+
+  // cut makes the same choice from the saved tree.
+  ASSERT_EXIT_OK(
+      run("cut " + dir.q("t.tree") + " --quiet --clusters auto --json " + dir.q("c.json")));
+  EXPECT_EQ(read_json(dir / "c.json")["clusters"], j["clusters"]);
+}
+
+TEST(Cli, RefineReportsItsPassesAndKeepsEveryFaceLabelled) {
+  TempDir dir("refine");
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.noise = 0.002;
+  options.seed = 2;
+  options.random_motion = true;
+  const GroundTruthShape shape = make_shape("slanted_box", options);
+  write_mesh(dir / "in.off", shape.mesh);
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --clusters 7 --refine 3 --json " +
+                     dir.q("r.json") + " --labels " + dir.q("l.txt")));
+  const json j = read_json(dir / "r.json");
+  ASSERT_TRUE(j["level"].contains("refinement")) << j["level"].dump(1);
+  EXPECT_EQ(j["level"]["refinement"]["max_passes"], 3);
+  EXPECT_LE(j["level"]["refinement"]["passes"].get<int>(), 3);
+  EXPECT_TRUE(j["timing"].contains("refine_seconds"));
+  expect_valid_labels(read_labels(dir / "l.txt"), shape.mesh.face_count(), 7);
+}
+
+TEST(Cli, EvalScoresTheGeneratedShapes) {
+  TempDir dir("eval");
+  const CliRun r =
+      run("eval --shapes box,capped_cylinder --variants cad --seeds 2 --json " + dir.q("e.json"));
+  ASSERT_EXIT_OK(r);
+  EXPECT_NE(r.output.find("mean_iou"), std::string::npos) << r.output;
+  const json j = read_json(dir / "e.json");
+  EXPECT_EQ(j["cases"].size(), 4u);
+  const json& all = j["totals"]["all"];
+  EXPECT_EQ(all["cases"], 4);
+  EXPECT_DOUBLE_EQ(all["mean_iou"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(all["type_accuracy"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(all["rand_index"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(all["auto_level_exact"].get<double>(), 1.0);
+  for (const json& c : j["cases"]) EXPECT_EQ(c["auto_clusters"], c["regions"]);
+}
+
 TEST(Cli, BadOptionsAreRejectedWithAMessage) {
   TempDir dir("bad-options");
   const Mesh box = make_shape("box").mesh;  // 12 triangles
@@ -759,6 +830,11 @@ TEST(Cli, BadOptionsAreRejectedWithAMessage) {
        {"clusters", std::to_string(f)}},
       {"--clusters -3", "segment " + mesh + " --clusters -3", {"clusters"}, false},
       {"--clusters abc", "segment " + mesh + " --clusters abc", {"clusters"}, false},
+      {"--clusters automatic", "segment " + mesh + " --clusters automatic", {"clusters", "auto"}},
+      {"--refine -1", "segment " + mesh + " --refine -1", {"refine"}, false},
+      {"eval --variants banana", "eval --variants banana", {"variants", "banana"}},
+      {"eval --shapes banana", "eval --shapes banana", {"banana"}},
+      {"eval --seeds 0", "eval --seeds 0", {"seeds"}, false},
       {"--clusters 2^32", "segment " + mesh + " --clusters 4294967296", {"clusters"}, false},
       {"--clusters with --tolerance",
        "segment " + mesh + " --clusters 3 --tolerance 1",
@@ -1170,8 +1246,8 @@ TEST(Cli, ThreadCountDoesNotChangeTheTree) {
   TempDir dir("threads");
   write_mesh(dir / "in.off", read_mesh(testing::cgal_mesh("fandisk.off")));
   for (const char* threads : {"1", "2", "3"})
-    ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --threads " + threads +
-                       " --tree " + dir.q(std::string("t") + threads + ".tree")));
+    ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --threads " + threads + " --tree " +
+                       dir.q(std::string("t") + threads + ".tree")));
   EXPECT_EQ(read_file(dir / "t1.tree"), read_file(dir / "t2.tree"));
   EXPECT_EQ(read_file(dir / "t1.tree"), read_file(dir / "t3.tree"));
 }

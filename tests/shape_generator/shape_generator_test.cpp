@@ -55,6 +55,19 @@ double distance_to(const Primitive& primitive, const Vec3& x) {
     }
     case PrimitiveType::Sphere:
       return std::abs(norm(d) - primitive.radius);
+    case PrimitiveType::Cone: {
+      // In the (along, across) half-plane: distance to the generator ray from the apex.
+      const double along = dot(d, primitive.axis);
+      const double across = std::sqrt(std::max(0.0, dot(d, d) - along * along));
+      const double c = std::cos(primitive.half_angle), s = std::sin(primitive.half_angle);
+      if (along * c + across * s < 0) return norm(d);
+      return std::abs(across * c - along * s);
+    }
+    case PrimitiveType::Torus: {
+      const double along = dot(d, primitive.axis);
+      const double across = std::sqrt(std::max(0.0, dot(d, d) - along * along));
+      return std::abs(std::hypot(across - primitive.radius, along) - primitive.minor_radius);
+    }
     default:
       ADD_FAILURE() << "unexpected primitive type";
       return 0;
@@ -118,6 +131,16 @@ const std::map<std::string, Expectation>& expectations() {
        {7, 1.6 * 1.2 * 0.6 + kPi * dome_height * dome_height * (3 * 0.6 - dome_height) / 3}},
       {"stepped_block", {8, 1.2}},
       {"cylinder_with_sphere_cap", {3, kPi * 0.25 + 2.0 / 3 * kPi * 0.125}},
+      // Cylinder to the chamfer, then a frustum of height 0.1 from radius 0.5 to 0.4.
+      {"chamfered_cylinder", {4, kPi * 0.25 * 1.1 + kPi * 0.1 / 3 * (0.25 + 0.2 + 0.16)}},
+      // Cylinder to the fillet, then a disc of radius 0.35 and the quarter disc of radius 0.15
+      // around the tube's centre circle (Pappus).
+      {"filleted_cylinder",
+       {4, kPi * 0.25 * 1.05 + kPi * 0.35 * 0.35 * 0.15 +
+               2 * kPi * (0.35 + 4 * 0.15 / (3 * kPi)) * kPi * 0.15 * 0.15 / 4}},
+      // Through-hole of radius 0.2 below a frustum of height 0.15 from radius 0.2 to 0.35.
+      {"box_with_countersink",
+       {8, box - kPi * 0.04 * 0.65 - kPi * 0.15 / 3 * (0.04 + 0.07 + 0.1225)}},
   };
   return table;
 }
@@ -132,7 +155,10 @@ TEST(ShapeGenerator, CatalogueIsFixed) {
                                           "box_with_boss",
                                           "box_with_dome",
                                           "stepped_block",
-                                          "cylinder_with_sphere_cap"};
+                                          "cylinder_with_sphere_cap",
+                                          "chamfered_cylinder",
+                                          "filleted_cylinder",
+                                          "box_with_countersink"};
   EXPECT_EQ(shape_names(), expected);
 }
 
@@ -215,7 +241,7 @@ TEST_P(EveryShape, IsClosedManifoldAndOutwardOriented) {
   // Euler characteristic of a sphere (every catalogue shape has genus 0 except the through hole).
   const auto v = static_cast<long>(mesh.vertex_count()), f = static_cast<long>(mesh.face_count());
   const long e = static_cast<long>(directed.size()) / 2;
-  EXPECT_EQ(v - e + f, name() == "box_with_hole" ? 0 : 2);
+  EXPECT_EQ(v - e + f, (name() == "box_with_hole" || name() == "box_with_countersink") ? 0 : 2);
   EXPECT_GT(signed_volume(mesh), 0);
 }
 
@@ -297,6 +323,23 @@ void expect_canonical_primitives(const GroundTruthShape& shape) {
       case PrimitiveType::Sphere:
         EXPECT_GT(primitive.radius, 0);
         break;
+      case PrimitiveType::Cone:
+        EXPECT_NEAR(norm(primitive.axis), 1, 1e-12);
+        // The region lies on the side of the apex the axis points to.
+        EXPECT_GT(dot(sub(centroid, primitive.point), primitive.axis), 0);
+        EXPECT_GT(primitive.half_angle, 0);
+        EXPECT_LT(primitive.half_angle, kPi / 2);
+        break;
+      case PrimitiveType::Torus: {
+        EXPECT_NEAR(norm(primitive.axis), 1, 1e-12);
+        const auto largest =
+            *std::max_element(primitive.axis.begin(), primitive.axis.end(),
+                              [](double u, double v) { return std::abs(u) < std::abs(v); });
+        EXPECT_GT(largest, 0);
+        EXPECT_GT(primitive.minor_radius, 0);
+        EXPECT_GT(primitive.radius, primitive.minor_radius);
+        break;
+      }
       default:
         ADD_FAILURE() << "unexpected primitive";
     }

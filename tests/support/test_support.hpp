@@ -35,6 +35,7 @@ void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation,
 
 #include "primseg/cluster_stats.hpp"
 #include "primseg/dual_graph.hpp"
+#include "primseg/evaluation.hpp"
 
 namespace primseg::testing {
 
@@ -69,19 +70,8 @@ ClusterStats whole_mesh_stats(const DualGraph& graph);
 
 namespace primseg::testing {
 
-/// Ground-truth regions matched one-to-one to clusters by the Hungarian method on area overlap.
-struct SegmentationScore {
-  double mean_iou = 0;       ///< mean over ground-truth regions of IoU (by area) with its match
-  double min_iou = 0;        ///< worst region
-  double type_accuracy = 0;  ///< area-weighted fraction of regions whose match has the right type
-};
-
-/// `area` holds each face's area; `types` the reported type of each cluster, `truth_types` of
-/// each region.
-SegmentationScore score_segmentation(const std::vector<std::uint32_t>& labels,
-                                     const std::vector<std::uint32_t>& truth,
-                                     const std::vector<double>& area,
-                                     const std::vector<PrimitiveType>& types,
-                                     const std::vector<PrimitiveType>& truth_types);
+// The scores moved into the library (evaluation.hpp); tests keep their short names.
+using primseg::score_segmentation;
+using primseg::SegmentationScore;
 
 }  // namespace primseg::testing

@@ -1,0 +1,70 @@
+#pragma once
+/// @file auto_level.hpp
+/// The error curve of a hierarchy and the automatic choice of its most significant level(s).
+///
+/// Cutting the tree by count (cut_by_count) gives, for every K, a level whose total fitting
+/// error E(K) only grows as K falls. On objects made of a few regular surfaces the curve stays
+/// near the noise level while merges join pieces of one surface, and jumps when a merge first
+/// joins two different surfaces: the level just before a large jump is significant.
+
+#include <cstdint>
+#include <vector>
+
+#include "primseg/hierarchy.hpp"
+
+namespace primseg {
+
+/// One point of the error curve.
+struct ErrorCurvePoint {
+  std::uint32_t clusters = 0;  ///< K
+  /// sqrt(Σ over the K clusters of their L2 error / Σ of their weights): the RMS distance
+  /// estimate of the whole level (input units).
+  double rms = 0;
+};
+
+/// The error curve for every K from the number of components C up to the face count F, in
+/// increasing K: shape (F − C + 1). O(F).
+std::vector<ErrorCurvePoint> error_curve(const Hierarchy& hierarchy);
+
+/// Options of choose_level().
+struct AutoLevelOptions {
+  /// RMS values below this fraction of the bounding-box diagonal count as this value: on exact
+  /// data the curve wavers at round-off and first-order-fit level (about 1e-6 of the diagonal),
+  /// and such wavering must not look like a jump. 1e-4 stays well below the noise of scanned
+  /// parts, and far below any error a reverse engineer would call a different surface.
+  double rms_floor = 1e-4;
+  /// A jump is significant when its score is at least this.
+  double min_score = 2.0;
+  /// Candidates reported besides the chosen level (the best-scored ones).
+  std::uint32_t max_candidates = 5;
+};
+
+/// A candidate level and how strongly the curve singles it out.
+struct LevelCandidate {
+  std::uint32_t clusters = 0;  ///< K
+  double rms = 0;              ///< rms of the curve at K (input units)
+  /// Significance of K, >= 0: the ratio rms(K − 1) / rms(K) of floored RMS values, the jump of
+  /// the curve when the next merge is applied (a smooth curve scores about 1). One cluster per
+  /// component scores min_score.
+  double score = 0;
+};
+
+/// The chosen level and the candidates.
+struct AutoLevel {
+  /// The chosen K: the finest level with a significant score (a coarser jump, however large,
+  /// only says that the regions of the finer level are themselves grouped: a small chamfer
+  /// joining a face is a smaller jump than two large faces joining, and just as real), or one
+  /// cluster per component when no jump is significant.
+  std::uint32_t clusters = 0;
+  /// Best score first: the best-scored levels, and the chosen one wherever it ranks.
+  std::vector<LevelCandidate> candidates;
+};
+
+/// Picks the most significant level of the hierarchy from its error curve, among K from the
+/// number of components C to max(C, F / 2) (finer levels are left out: there the curve rises
+/// from zero, single triangles fitting exactly, and under noise its first ratios are large
+/// without meaning anything). Deterministic; O(F log F). Throws InvalidInputError for options
+/// out of range (negative or non-finite floor, min_score below 1, no candidate asked for).
+AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& options = {});
+
+}  // namespace primseg

@@ -1,0 +1,314 @@
+#include "primseg/geometric_fit.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <string>
+
+#include "geometric_models.hpp"
+#include "primseg/error.hpp"
+#include "primseg/primitives/primitive_fitter.hpp"
+
+namespace primseg {
+namespace detail {
+namespace {
+
+Eigen::Vector3d to_eigen(const Vec3& v) {
+  return {v[0], v[1], v[2]};
+}
+Vec3 to_vec3(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+// A unit vector orthogonal to the unit vector a, and a third completing a right-handed frame.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> orthonormal_pair(const Eigen::Vector3d& a) {
+  Eigen::Index least;
+  a.cwiseAbs().minCoeff(&least);
+  const Eigen::Vector3d u = a.cross(Eigen::Vector3d::Unit(least)).normalized();
+  return {u, a.cross(u)};
+}
+
+// Parameters: the normal tilted by (α, β) along its two orthogonal directions, the plane
+// shifted by δ along the normal.
+class PlaneModel final : public GeometricModel {
+ public:
+  PlaneModel(const Eigen::Vector3d& point, const Eigen::Vector3d& normal)
+      : point_(point), normal_(normal.normalized()) {
+    std::tie(u_, v_) = orthonormal_pair(normal_);
+  }
+  int parameter_count() const override { return 3; }
+  double residual(const Eigen::Vector3d& x, double* gradient) const override {
+    const Eigen::Vector3d y = x - point_;
+    gradient[0] = u_.dot(y);
+    gradient[1] = v_.dot(y);
+    gradient[2] = -1;
+    return normal_.dot(y);
+  }
+  std::unique_ptr<GeometricModel> stepped(const double* step) const override {
+    return std::make_unique<PlaneModel>(point_ + step[2] * normal_,
+                                        normal_ + step[0] * u_ + step[1] * v_);
+  }
+  Primitive primitive() const override {
+    Primitive p;
+    p.type = PrimitiveType::Plane;
+    p.point = to_vec3(point_);
+    p.axis = to_vec3(normal_);
+    return p;
+  }
+
+ private:
+  Eigen::Vector3d point_, normal_, u_, v_;
+};
+
+// Parameters: the centre's displacement and the radius change.
+class SphereModel final : public GeometricModel {
+ public:
+  SphereModel(const Eigen::Vector3d& centre, double radius) : centre_(centre), radius_(radius) {}
+  int parameter_count() const override { return 4; }
+  double residual(const Eigen::Vector3d& x, double* gradient) const override {
+    const Eigen::Vector3d y = x - centre_;
+    const double length = y.norm();
+    const Eigen::Vector3d direction =
+        length > 0 ? Eigen::Vector3d(y / length) : Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) gradient[i] = -direction[i];
+    gradient[3] = -1;
+    return length - radius_;
+  }
+  std::unique_ptr<GeometricModel> stepped(const double* step) const override {
+    return std::make_unique<SphereModel>(centre_ + Eigen::Vector3d(step[0], step[1], step[2]),
+                                         radius_ + step[3]);
+  }
+  Primitive primitive() const override {
+    Primitive p;
+    p.type = PrimitiveType::Sphere;
+    p.point = to_vec3(centre_);
+    p.radius = radius_;
+    return p;
+  }
+
+ private:
+  Eigen::Vector3d centre_;
+  double radius_;
+};
+
+// Parameters: the axis point moved by (s, t) across the axis, the axis tilted by (α, β), the
+// radius change. Moving the point along the axis changes nothing, so it is not a parameter.
+class CylinderModel final : public GeometricModel {
+ public:
+  CylinderModel(const Eigen::Vector3d& point, const Eigen::Vector3d& axis, double radius)
+      : point_(point), axis_(axis.normalized()), radius_(radius) {
+    std::tie(u_, v_) = orthonormal_pair(axis_);
+  }
+  int parameter_count() const override { return 5; }
+  double residual(const Eigen::Vector3d& x, double* gradient) const override {
+    const Eigen::Vector3d y = x - point_;
+    const double along = axis_.dot(y);
+    const Eigen::Vector3d radial = y - along * axis_;
+    const double length = radial.norm();
+    const Eigen::Vector3d direction =
+        length > 0 ? Eigen::Vector3d(radial / length) : Eigen::Vector3d::Zero();
+    const double du = direction.dot(u_), dv = direction.dot(v_);
+    gradient[0] = -du;
+    gradient[1] = -dv;
+    gradient[2] = -du * along;
+    gradient[3] = -dv * along;
+    gradient[4] = -1;
+    return length - radius_;
+  }
+  std::unique_ptr<GeometricModel> stepped(const double* step) const override {
+    return std::make_unique<CylinderModel>(point_ + step[0] * u_ + step[1] * v_,
+                                           axis_ + step[2] * u_ + step[3] * v_, radius_ + step[4]);
+  }
+  Primitive primitive() const override {
+    Primitive p;
+    p.type = PrimitiveType::Cylinder;
+    p.point = to_vec3(point_);
+    p.axis = to_vec3(axis_);
+    p.radius = radius_;
+    return p;
+  }
+
+ private:
+  Eigen::Vector3d point_, axis_, u_, v_;
+  double radius_;
+};
+
+}  // namespace
+
+std::unique_ptr<GeometricModel> geometric_model_for(const Primitive& p) {
+  switch (p.type) {
+    case PrimitiveType::Plane:
+      return std::make_unique<PlaneModel>(to_eigen(p.point), to_eigen(p.axis));
+    case PrimitiveType::Sphere:
+      return std::make_unique<SphereModel>(to_eigen(p.point), p.radius);
+    case PrimitiveType::Cylinder:
+      return std::make_unique<CylinderModel>(to_eigen(p.point), to_eigen(p.axis), p.radius);
+    case PrimitiveType::Cone:
+    case PrimitiveType::Torus:
+      return nullptr;
+  }
+  return nullptr;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::GeometricModel;
+
+struct Normalised {
+  std::vector<Eigen::Vector3d> points;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  int exponent = 0;  // one normalised unit is 2^exponent input units
+};
+
+// Points centred on their weighted centroid and scaled by a power of two to within the unit
+// ball: conditioning of the normal equations, and no overflow of squared distances.
+Normalised normalise(std::span<const Vec3> points, std::span<const double> weights) {
+  Normalised n;
+  double total = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    sum += weights[i] * Eigen::Vector3d(points[i][0], points[i][1], points[i][2]);
+    total += weights[i];
+  }
+  if (total > 0) n.centre = sum / total;
+  double extent = 0;
+  for (const Vec3& p : points)
+    for (int k = 0; k < 3; ++k) extent = std::max(extent, std::abs(p[k] - n.centre[k]));
+  if (extent > 0) std::frexp(extent, &n.exponent);
+  n.points.reserve(points.size());
+  for (const Vec3& p : points)
+    n.points.emplace_back(std::ldexp(p[0] - n.centre.x(), -n.exponent),
+                          std::ldexp(p[1] - n.centre.y(), -n.exponent),
+                          std::ldexp(p[2] - n.centre.z(), -n.exponent));
+  return n;
+}
+
+Primitive to_normalised(Primitive p, const Normalised& n) {
+  for (int k = 0; k < 3; ++k) p.point[k] = std::ldexp(p.point[k] - n.centre[k], -n.exponent);
+  p.radius = std::ldexp(p.radius, -n.exponent);
+  p.minor_radius = std::ldexp(p.minor_radius, -n.exponent);
+  return p;
+}
+
+Primitive from_normalised(Primitive p, const Normalised& n) {
+  for (int k = 0; k < 3; ++k) p.point[k] = std::ldexp(p.point[k], n.exponent) + n.centre[k];
+  p.radius = std::ldexp(p.radius, n.exponent);
+  p.minor_radius = std::ldexp(p.minor_radius, n.exponent);
+  return p;
+}
+
+double cost(const GeometricModel& model, const Normalised& n, std::span<const double> weights) {
+  double gradient[detail::kMaxParameters];
+  double sum = 0;
+  for (std::size_t i = 0; i < n.points.size(); ++i) {
+    const double d = model.residual(n.points[i], gradient);
+    sum += weights[i] * d * d;
+  }
+  return sum;
+}
+
+// The canonical form of primitive.hpp, in the normalised frame (weighted centroid at 0).
+Primitive canonical(Primitive p, const Primitive& initial_normalised) {
+  const Eigen::Vector3d axis(p.axis[0], p.axis[1], p.axis[2]);
+  const Eigen::Vector3d point(p.point[0], p.point[1], p.point[2]);
+  if (p.type == PrimitiveType::Plane) {
+    const Eigen::Vector3d initial(initial_normalised.axis[0], initial_normalised.axis[1],
+                                  initial_normalised.axis[2]);
+    const Eigen::Vector3d normal = axis.dot(initial) < 0 ? Eigen::Vector3d(-axis) : axis;
+    // The centroid (the origin here) projected on the plane.
+    const Eigen::Vector3d foot = normal * normal.dot(point);
+    p.axis = {normal.x(), normal.y(), normal.z()};
+    p.point = {foot.x(), foot.y(), foot.z()};
+  } else if (p.type == PrimitiveType::Cylinder) {
+    const Eigen::Vector3d a = canonical_axis(axis);
+    const Eigen::Vector3d foot = point - a * a.dot(point);
+    p.axis = {a.x(), a.y(), a.z()};
+    p.point = {foot.x(), foot.y(), foot.z()};
+    p.radius = std::abs(p.radius);
+  } else if (p.type == PrimitiveType::Sphere) {
+    p.radius = std::abs(p.radius);
+  }
+  return p;
+}
+
+}  // namespace
+
+bool has_geometric_model(PrimitiveType type) {
+  Primitive p;
+  p.type = type;
+  p.axis = {0, 0, 1};
+  return detail::geometric_model_for(p) != nullptr;
+}
+
+GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> points,
+                           std::span<const double> weights, const GeometricFitOptions& options) {
+  if (points.size() != weights.size())
+    throw InvalidInputError("fit_geometric: " + std::to_string(points.size()) + " points but " +
+                            std::to_string(weights.size()) + " weights");
+  for (double w : weights)
+    if (!(w >= 0) || !std::isfinite(w))
+      throw InvalidInputError("fit_geometric: weights must be finite and non-negative");
+  const Normalised n = normalise(points, weights);
+  const Primitive start = to_normalised(initial, n);
+  std::unique_ptr<GeometricModel> model = detail::geometric_model_for(start);
+  GeometricFit result;
+  result.primitive = initial;
+  if (model) {
+    const int k = model->parameter_count();
+    double current = cost(*model, n, weights);
+    double lambda = 1e-3;
+    double gradient[detail::kMaxParameters];
+    while (result.iterations < options.max_iterations && current > 0) {
+      Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(k, k);
+      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(k);
+      for (std::size_t i = 0; i < n.points.size(); ++i) {
+        const double d = model->residual(n.points[i], gradient);
+        const Eigen::Map<const Eigen::VectorXd> g(gradient, k);
+        normal.noalias() += weights[i] * g * g.transpose();
+        rhs.noalias() -= weights[i] * d * g;
+      }
+      bool accepted = false;
+      while (lambda < 1e16) {
+        Eigen::MatrixXd damped = normal;
+        for (int j = 0; j < k; ++j) damped(j, j) += lambda * normal(j, j) + 1e-300;
+        const Eigen::VectorXd step = damped.ldlt().solve(rhs);
+        if (!step.allFinite()) {
+          lambda *= 10;
+          continue;
+        }
+        std::unique_ptr<GeometricModel> candidate = model->stepped(step.data());
+        const double trial = cost(*candidate, n, weights);
+        if (trial < current) {
+          const bool converged = current - trial <= options.relative_tolerance * current;
+          model = std::move(candidate);
+          current = trial;
+          lambda = std::max(lambda / 10, 1e-12);
+          accepted = !converged;
+          ++result.iterations;
+          break;
+        }
+        lambda *= 10;
+      }
+      if (!accepted) break;
+    }
+    if (result.iterations > 0)
+      result.primitive = from_normalised(canonical(model->primitive(), start), n);
+  }
+  // Distances of the final primitive, in the normalised frame then scaled back.
+  const Primitive final_normalised = to_normalised(result.primitive, n);
+  double sum = 0, total = 0, largest = 0;
+  for (std::size_t i = 0; i < n.points.size(); ++i) {
+    const Eigen::Vector3d& x = n.points[i];
+    const double d = final_normalised.distance({x.x(), x.y(), x.z()});
+    sum += weights[i] * d * d;
+    total += weights[i];
+    if (weights[i] > 0) largest = std::max(largest, d);
+  }
+  result.rms = total > 0 ? std::ldexp(std::sqrt(sum / total), n.exponent) : 0.0;
+  result.max = std::ldexp(largest, n.exponent);
+  return result;
+}
+
+}  // namespace primseg

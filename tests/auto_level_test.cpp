@@ -1,0 +1,105 @@
+// The error curve and the automatic level on shapes whose number of regions is known.
+#include "primseg/auto_level.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "primseg/cut.hpp"
+#include "primseg/error.hpp"
+#include "primseg/shape_generator.hpp"
+
+namespace primseg {
+namespace {
+
+TEST(ErrorCurve, IsTheRmsOfEveryCutByCount) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.noise = 0.002;
+  const GroundTruthShape shape = make_shape("box_with_boss", options);
+  const Hierarchy h = build_hierarchy(shape.mesh);
+  const std::vector<ErrorCurvePoint> curve = error_curve(h);
+  ASSERT_EQ(curve.size(), h.face_count() - h.component_count() + 1);
+  EXPECT_EQ(curve.front().clusters, h.component_count());
+  EXPECT_EQ(curve.back().clusters, h.face_count());
+  EXPECT_EQ(curve.back().rms, 0.0) << "single triangles fit their plane exactly";
+  double total_weight = 0;
+  for (std::uint32_t f = 0; f < h.face_count(); ++f) total_weight += h.weight(f);
+  const double scale = std::ldexp(1.0, h.graph().frame().exponent);
+  for (std::uint32_t k : {1u, 2u, 8u, 9u, 40u, 500u}) {
+    const Segmentation s = cut_by_count(h, k);
+    double error = 0;
+    for (std::uint32_t node : s.nodes) error += h.error(node);
+    const double expected = std::sqrt(error / total_weight) * scale;
+    EXPECT_NEAR(curve[k - 1].rms, expected, 1e-9 * expected + 1e-15) << "K = " << k;
+    EXPECT_EQ(curve[k - 1].clusters, k);
+  }
+}
+
+// The target: on the generated data set (every shape, CAD, uniform and noisy variants,
+// random rigid motions) the chosen K is the true number of regions on >= 80% of the shapes and
+// within one on >= 95%.
+TEST(AutoLevel, FindsTheTrueNumberOfRegionsOfGeneratedShapes) {
+  struct Variant {
+    Tessellation tessellation;
+    double noise;
+  };
+  int cases = 0, exact = 0, within_one = 0;
+  for (const Variant variant :
+       {Variant{Tessellation::Cad, 0.0}, Variant{Tessellation::Uniform, 0.0},
+        Variant{Tessellation::Uniform, 0.002}})
+    for (const std::string& name : shape_names()) {
+      ShapeOptions options;
+      options.tessellation = variant.tessellation;
+      options.noise = variant.noise;
+      options.random_motion = true;
+      options.seed = 7;
+      const GroundTruthShape shape = make_shape(name, options);
+      const AutoLevel level = choose_level(build_hierarchy(shape.mesh));
+      const auto truth = static_cast<std::uint32_t>(shape.regions.size());
+      ++cases;
+      exact += level.clusters == truth;
+      within_one += level.clusters + 1 >= truth && level.clusters <= truth + 1;
+      ASSERT_FALSE(level.candidates.empty());
+      bool listed = false;
+      for (const LevelCandidate& c : level.candidates) listed |= c.clusters == level.clusters;
+      EXPECT_TRUE(listed) << name << ": the chosen level is among the candidates";
+    }
+  EXPECT_GE(exact, 0.8 * cases) << exact << " of " << cases;
+  EXPECT_GE(within_one, 0.95 * cases) << within_one << " of " << cases;
+}
+
+TEST(AutoLevel, ExactPlaneCylinderSphereShapesGetTheirTrueCount) {
+  for (const std::string name : {"box", "slanted_box", "capped_cylinder", "sphere", "box_with_hole",
+                                 "box_with_dome", "stepped_block"}) {
+    const GroundTruthShape shape = make_shape(name);
+    const AutoLevel level = choose_level(build_hierarchy(shape.mesh));
+    EXPECT_EQ(level.clusters, shape.regions.size()) << name;
+  }
+}
+
+TEST(AutoLevel, CandidatesAreSortedAndBounded) {
+  const GroundTruthShape shape = make_shape("box_with_blind_hole");
+  AutoLevelOptions options;
+  options.max_candidates = 3;
+  const AutoLevel level = choose_level(build_hierarchy(shape.mesh), options);
+  ASSERT_LE(level.candidates.size(), 4u);
+  for (std::size_t i = 1; i < level.candidates.size(); ++i)
+    EXPECT_GE(level.candidates[i - 1].score, level.candidates[i].score);
+}
+
+TEST(AutoLevel, RejectsUnusableOptions) {
+  const Hierarchy h = build_hierarchy(make_shape("box").mesh);
+  AutoLevelOptions bad;
+  bad.rms_floor = -1;
+  EXPECT_THROW(choose_level(h, bad), InvalidInputError);
+  bad = {};
+  bad.min_score = 0.5;
+  EXPECT_THROW(choose_level(h, bad), InvalidInputError);
+  bad = {};
+  bad.max_candidates = 0;
+  EXPECT_THROW(choose_level(h, bad), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace primseg

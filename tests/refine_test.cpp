@@ -1,0 +1,122 @@
+// Boundary refinement: better borders on noisy shapes, nothing to do on exact ones, clusters
+// stay connected and non-empty.
+#include "primseg/refine.hpp"
+
+#include <gtest/gtest.h>
+
+#include "primseg/error.hpp"
+#include "primseg/evaluation.hpp"
+#include "primseg/shape_generator.hpp"
+
+namespace primseg {
+namespace {
+
+// Edge-connected components of every cluster, through the dual graph.
+std::vector<int> components(const Hierarchy& h, const std::vector<std::uint32_t>& labels,
+                            std::uint32_t k) {
+  std::vector<std::uint32_t> parent(labels.size());
+  for (std::uint32_t f = 0; f < parent.size(); ++f) parent[f] = f;
+  auto find = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const DualEdge& e : h.graph().edges())
+    if (labels[e.first] == labels[e.second]) parent[find(e.first)] = find(e.second);
+  std::vector<int> count(k, 0);
+  for (std::uint32_t f = 0; f < parent.size(); ++f)
+    if (find(f) == f) ++count[labels[f]];
+  return count;
+}
+
+SegmentationScore score(const GroundTruthShape& shape, const Segmentation& s,
+                        const std::vector<ClusterReport>& reports) {
+  std::vector<PrimitiveType> types, truth_types;
+  for (const ClusterReport& r : reports) types.push_back(r.primitive.type);
+  for (const Primitive& p : shape.regions) truth_types.push_back(p.type);
+  return score_segmentation(s.labels, shape.region_of_face, face_areas(shape.mesh), types,
+                            truth_types);
+}
+
+TEST(RefineBoundaries, ImprovesNoisyBordersAndKeepsClustersConnected) {
+  double before = 0, after = 0;
+  std::uint32_t moved = 0;
+  int cases = 0;
+  for (const std::string name : {"box", "slanted_box", "box_with_hole", "cylinder_with_sphere_cap"})
+    for (std::uint64_t seed : {1, 2}) {
+      ++cases;
+      ShapeOptions options;
+      options.tessellation = Tessellation::Uniform;
+      options.noise = 0.002;
+      options.random_motion = true;
+      options.seed = seed;
+      const GroundTruthShape shape = make_shape(name, options);
+      const Hierarchy h = build_hierarchy(shape.mesh);
+      const auto k = static_cast<std::uint32_t>(shape.regions.size());
+      const Segmentation cut = cut_by_count(h, k);
+      const RefinedLevel refined = refine_boundaries(h, cut);
+      before += score(shape, cut, describe_clusters(h, cut)).mean_iou;
+      after += score(shape, refined.segmentation, refined.reports).mean_iou;
+      moved += refined.moved_faces;
+      ASSERT_EQ(refined.reports.size(), k);
+      for (int c : components(h, refined.segmentation.labels, k)) EXPECT_EQ(c, 1) << name;
+      for (const ClusterReport& r : refined.reports) EXPECT_GT(r.face_count, 0u) << name;
+      EXPECT_LE(refined.passes, 5u);
+    }
+  EXPECT_GT(moved, 0u);
+  EXPECT_GT(after, before) << "mean IoU before " << before / cases << ", after " << after / cases;
+}
+
+TEST(RefineBoundaries, LeavesExactSegmentationsAlone) {
+  const GroundTruthShape shape = make_shape("box_with_blind_hole");
+  const Hierarchy h = build_hierarchy(shape.mesh);
+  const Segmentation cut = cut_by_count(h, 8);
+  const RefinedLevel refined = refine_boundaries(h, cut);
+  EXPECT_EQ(refined.moved_faces, 0u);
+  EXPECT_EQ(refined.segmentation.labels, cut.labels);
+}
+
+TEST(RefineBoundaries, PutsAMisplacedBorderFaceBack) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  const GroundTruthShape shape = make_shape("box", options);
+  const Hierarchy h = build_hierarchy(shape.mesh);
+  Segmentation cut = cut_by_count(h, 6);
+  const std::vector<std::uint32_t> truth = cut.labels;
+  // Hand a face in the middle of a border of cluster 0 to its neighbour; both stay connected.
+  std::uint32_t moved_face = 0, other = 0;
+  bool found = false;
+  for (const DualEdge& e : h.graph().edges()) {
+    if (cut.labels[e.first] == cut.labels[e.second]) continue;
+    const std::uint32_t face = cut.labels[e.first] == 0 ? e.first : e.second;
+    if (cut.labels[face] != 0) continue;
+    // Every other neighbour of the face is in cluster 0: removing it cannot split cluster 0.
+    int own = 0;
+    for (const DualEdge& n : h.graph().edges())
+      if ((n.first == face || n.second == face) &&
+          cut.labels[n.first == face ? n.second : n.first] == 0)
+        ++own;
+    if (own < 2) continue;
+    moved_face = face;
+    other = cut.labels[e.first] == 0 ? cut.labels[e.second] : cut.labels[e.first];
+    found = true;
+    break;
+  }
+  ASSERT_TRUE(found);
+  cut.labels[moved_face] = other;
+  const RefinedLevel refined = refine_boundaries(h, cut);
+  EXPECT_EQ(refined.segmentation.labels, truth);
+  EXPECT_GE(refined.moved_faces, 1u);
+}
+
+TEST(RefineBoundaries, RejectsBadInput) {
+  const Hierarchy h = build_hierarchy(make_shape("box").mesh);
+  Segmentation cut = cut_by_count(h, 6);
+  BoundaryRefinementOptions bad;
+  bad.improvement = 0;
+  EXPECT_THROW(refine_boundaries(h, cut, bad), InvalidInputError);
+  cut.labels.pop_back();
+  EXPECT_THROW(refine_boundaries(h, cut), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace primseg
