@@ -68,7 +68,7 @@ bool is_space(char c) {
 /// The first whitespace-separated token of the text, skipping lines whose first token starts
 /// with '#' (comments of OFF and OBJ). Looks at the first 64 KiB only.
 std::string_view first_token(std::string_view text) {
-  text = text.substr(0, std::min<std::size_t>(text.size(), 64 * 1024));
+  text = text.substr(0, std::min<std::size_t>(text.size(), std::size_t{64} << 10));
   std::size_t at = 0;
   while (at < text.size()) {
     while (at < text.size() && is_space(text[at])) ++at;
