@@ -23,6 +23,7 @@ Command add_segment_command(CLI::App& app);
 Command add_cut_command(CLI::App& app);
 Command add_info_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
+Command add_batch_command(CLI::App& app);
 
 // Helpers shared by the commands.
 

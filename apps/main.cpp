@@ -27,6 +27,7 @@ int run(int argc, char** argv) {
       add_cut_command(app),
       add_info_command(app),
       add_eval_command(app),
+      add_batch_command(app),
   };
 
   // Name an unknown command instead of CLI11's "A subcommand is required".

@@ -1,7 +1,9 @@
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "command.hpp"
+#include "limits.hpp"
 #include "primseg/mesh_io.hpp"
 
 namespace primseg::cli {
@@ -12,11 +14,13 @@ Command add_segment_command(CLI::App& app) {
     bool exact_costs = false, eager = false;
     unsigned threads = 0;
     LevelOptions level;
+    ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
   auto* segment = app.add_subcommand("segment", "Build the hierarchy of a mesh and report a level");
   segment->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl)")->required();
   add_level_options(*segment, o->level);
+  add_limit_options(*segment, o->limits);
   segment->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
       ->capture_default_str();
   segment->add_option("--weights", o->weights, "Vertex weights of the fitting error")
@@ -44,9 +48,11 @@ Command add_segment_command(CLI::App& app) {
         options.evaluation = o->eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
         validate(options);
         validate_output_files(o->level.files);
+        check_file_limits(o->mesh_path, o->limits);
         const auto read_start = Clock::now();
         auto mesh = std::make_shared<const Mesh>(read_mesh(o->mesh_path));
         const double read_seconds = seconds_since(read_start);
+        check_mesh_limits(*mesh, std::filesystem::file_size(o->mesh_path), o->limits);
         validate_level(o->level.level, mesh->face_count());
         const auto build_start = Clock::now();
         HierarchyBuilder builder(mesh, options);

@@ -2,8 +2,8 @@
 # Installs primseg's build and test dependencies from Debian's packages (root; skipped when
 # everything is already present).
 set -euo pipefail
-packages=(build-essential cmake ninja-build clang libclang-rt-14-dev libeigen3-dev libcli11-dev
-          nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-demo
+packages=(build-essential cmake ninja-build clang clang-tidy libclang-rt-14-dev libeigen3-dev
+          libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-demo
           python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest python3-scipy)
 missing=()
 for p in "${packages[@]}"; do

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -19,6 +20,13 @@ namespace primseg::detail {
                 "': " + std::strerror(error_number));
 }
 
+std::uint64_t physical_memory_bytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES);
+  const long page_size = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page_size <= 0) return 0;
+  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
+}
+
 FileImage read_file(const std::filesystem::path& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) io_failure(path, "open", errno);
@@ -30,6 +38,13 @@ FileImage read_file(const std::filesystem::path& path) {
   struct stat status {};
   if (::fstat(fd, &status) != 0) io_failure(path, "stat", errno);
   if (S_ISDIR(status.st_mode)) io_failure(path, "read", EISDIR);
+
+  // Refused before any allocation: a file larger than the machine's memory cannot be parsed.
+  const std::uint64_t memory = physical_memory_bytes();
+  if (memory != 0 && static_cast<std::uint64_t>(status.st_size) > memory)
+    throw IoError("cannot read '" + path.string() + "': the file has " +
+                  std::to_string(status.st_size) + " bytes, more than this machine's memory (" +
+                  std::to_string(memory) + " bytes)");
 
   // The size from fstat may be stale (a growing file): read until end of file regardless.
   std::size_t capacity = static_cast<std::size_t>(status.st_size) + 1;
@@ -52,7 +67,23 @@ FileImage read_file(const std::filesystem::path& path) {
   }
 }
 
-void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+namespace {
+
+/// Writes all bytes to fd and flushes them to disk; false with errno set on failure.
+bool write_all(int fd, std::string_view bytes) {
+  std::size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t result = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (result < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    written += static_cast<std::size_t>(result);
+  }
+  return ::fsync(fd) == 0;
+}
+
+std::filesystem::path temporary_name_for(const std::filesystem::path& path) {
   static std::atomic<unsigned> counter{0};
   std::filesystem::path temporary = path;
   // Appended piecewise: `"." + string` trips a false -Wrestrict in g++ 12 release builds.
@@ -63,28 +94,41 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
       .append("_")
       .append(std::to_string(counter++));
   temporary.replace_filename(name);
-  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) io_failure(path, "create a temporary file for", errno);
-  const auto abandon = [&](std::string_view action) {
-    const int error_number = errno;
-    ::close(fd);
-    ::unlink(temporary.c_str());
-    io_failure(path, action, error_number);
-  };
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t result = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (result < 0) {
-      if (errno == EINTR) continue;
-      abandon("write");
+  return temporary;
+}
+
+}  // namespace
+
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+  std::filesystem::path directory = path.parent_path();
+  if (directory.empty()) directory = ".";
+  // An unnamed file (O_TMPFILE) vanishes by itself if the process is killed while writing: only
+  // the final link-and-rename, microseconds long, ever gives it a name. Filesystems without
+  // O_TMPFILE get a named temporary file from the start.
+  const int fd = ::open(directory.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+  const std::filesystem::path temporary = temporary_name_for(path);
+  if (fd >= 0) {
+    if (!write_all(fd, bytes)) {
+      const int error_number = errno;
+      ::close(fd);
+      io_failure(path, "write", error_number);
     }
-    written += static_cast<std::size_t>(result);
-  }
-  if (::fsync(fd) != 0) abandon("flush");
-  if (::close(fd) != 0) {
+    const std::string self = "/proc/self/fd/" + std::to_string(fd);
+    if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, temporary.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+      const int error_number = errno;
+      ::close(fd);
+      io_failure(path, "name a temporary file for", error_number);
+    }
+    ::close(fd);
+  } else {
+    const int named = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (named < 0) io_failure(path, "create a temporary file for", errno);
+    const bool written = write_all(named, bytes);
     const int error_number = errno;
-    ::unlink(temporary.c_str());
-    io_failure(path, "write", error_number);
+    if (::close(named) != 0 || !written) {
+      ::unlink(temporary.c_str());
+      io_failure(path, "write", written ? errno : error_number);
+    }
   }
   if (::rename(temporary.c_str(), path.c_str()) != 0) {
     const int error_number = errno;

@@ -2,6 +2,7 @@
 // Whole-file reads and atomic writes: every file primseg reads or writes goes through here.
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string_view>
@@ -19,11 +20,17 @@ struct FileImage {
   std::string_view view() const { return {bytes.get(), size}; }
 };
 
-/// Reads a whole file. Throws IoError (missing, a directory, unreadable).
+/// Physical memory of the machine in bytes (0 if unknown).
+std::uint64_t physical_memory_bytes();
+
+/// Reads a whole file. Throws IoError (missing, a directory, unreadable, larger than the
+/// machine's physical memory).
 FileImage read_file(const std::filesystem::path& path);
 
-/// Writes to a fresh name in the target's directory, then renames over the target: readers see
-/// the old file or the complete new one, never a partial write. Throws IoError.
+/// Writes to an unnamed file in the target's directory (O_TMPFILE; a hidden named one where the
+/// filesystem lacks it), then names it and renames it over the target: readers see the old file
+/// or the complete new one, never a partial write, and a process killed while writing leaves
+/// nothing behind. Throws IoError.
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
 
 }  // namespace primseg::detail

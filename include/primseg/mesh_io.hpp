@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string_view>
 
@@ -29,6 +30,17 @@ Mesh read_mesh(const std::filesystem::path& path);
 
 /// Reads a mesh from an in-memory file image. `name` is only used in error messages.
 Mesh read_mesh(std::span<const char> bytes, MeshFormat format, std::string_view name = "<memory>");
+
+/// Format from the content of a file image, for data without a trustworthy extension (uploads,
+/// pipes): "ply" on the first line; a first token (after '#' comment lines) of the OFF family
+/// (OFF, COFF, NOFF, STOFF, ...); a binary STL whose size matches its triangle count, or text
+/// starting with "solid"; a first token that is an OBJ statement (v, vt, vn, f, o, g, s, l,
+/// mtllib, usemtl). Empty when none applies.
+std::optional<MeshFormat> detect_mesh_format(std::span<const char> bytes);
+
+/// Reads a mesh whose format is detected from its content (detect_mesh_format). Throws
+/// ParseError naming `name` when the format cannot be told, else as read_mesh.
+Mesh read_mesh_detecting_format(std::span<const char> bytes, std::string_view name = "<memory>");
 
 /// What write_mesh writes besides the geometry.
 struct MeshWriteOptions {

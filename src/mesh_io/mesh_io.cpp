@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <memory>
@@ -56,6 +57,71 @@ Mesh read_mesh(std::span<const char> bytes, MeshFormat format, std::string_view 
       return mesh_io_detail::read_stl(bytes, name);
   }
   throw InvalidInputError(std::string(name) + ": unknown mesh format");
+}
+
+namespace {
+
+bool is_space(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
+}
+
+/// The first whitespace-separated token of the text, skipping lines whose first token starts
+/// with '#' (comments of OFF and OBJ). Looks at the first 64 KiB only.
+std::string_view first_token(std::string_view text) {
+  text = text.substr(0, std::min<std::size_t>(text.size(), std::size_t{64} << 10));
+  std::size_t at = 0;
+  while (at < text.size()) {
+    while (at < text.size() && is_space(text[at])) ++at;
+    if (at < text.size() && text[at] == '#') {
+      const std::size_t end_of_line = text.find('\n', at);
+      at = end_of_line == std::string_view::npos ? text.size() : end_of_line + 1;
+      continue;
+    }
+    std::size_t end = at;
+    while (end < text.size() && !is_space(text[end])) ++end;
+    return text.substr(at, end - at);
+  }
+  return {};
+}
+
+bool starts_with_ignoring_case(std::string_view text, std::string_view prefix) {
+  if (text.size() < prefix.size()) return false;
+  for (std::size_t i = 0; i < prefix.size(); ++i) {
+    char c = text[i];
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    if (c != prefix[i]) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<MeshFormat> detect_mesh_format(std::span<const char> bytes) {
+  const std::string_view text(bytes.data(), bytes.size());
+  if (text.starts_with("ply\n") || text.starts_with("ply\r")) return MeshFormat::Ply;
+  // Binary STL: an 80-byte header, a little-endian triangle count, 50 bytes per triangle.
+  if (text.size() >= 84) {
+    std::uint32_t count = 0;
+    for (int i = 3; i >= 0; --i)
+      count = count << 8 | static_cast<unsigned char>(text[80 + static_cast<std::size_t>(i)]);
+    if (84 + 50 * static_cast<std::uint64_t>(count) == text.size()) return MeshFormat::Stl;
+  }
+  if (starts_with_ignoring_case(text, "solid")) return MeshFormat::Stl;
+  const std::string_view token = first_token(text);
+  if (token.size() >= 3 && token.ends_with("OFF")) return MeshFormat::Off;
+  static constexpr std::string_view kObjStatements[] = {"v", "vt", "vn", "vp",     "f",     "o",
+                                                        "g", "s",  "l",  "mtllib", "usemtl"};
+  for (const std::string_view statement : kObjStatements)
+    if (token == statement) return MeshFormat::Obj;
+  return std::nullopt;
+}
+
+Mesh read_mesh_detecting_format(std::span<const char> bytes, std::string_view name) {
+  const std::optional<MeshFormat> format = detect_mesh_format(bytes);
+  if (!format)
+    throw ParseError(std::string(name) +
+                     ": not a mesh file primseg can read (no OFF, OBJ, PLY or STL signature)");
+  return read_mesh(bytes, *format, name);
 }
 
 namespace mesh_io_detail {

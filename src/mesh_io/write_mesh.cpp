@@ -161,7 +161,7 @@ void write_ply(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_
     return;
   }
   out.text().reserve(out.text().size() + 24 * mesh.positions.size() +
-                     4 * mesh.polygon_vertices.size() + 8 * mesh.face_count());
+                     4 * mesh.polygon_vertices.size() + 8 * std::size_t{mesh.face_count()});
   for (const Vec3& p : mesh.positions) {
     for (const double c : p) out.put(c);
   }

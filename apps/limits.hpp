@@ -1,0 +1,34 @@
+#pragma once
+// --max-faces and --max-memory: bounds a service puts on one run, checked before the work they
+// bound (the file size before reading, the face count and the estimated peak before building).
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "primseg/mesh.hpp"
+
+namespace primseg::cli {
+
+/// Peak memory of `segment` per input face, measured with bench/primseg_bench_memory (whole
+/// process, 1,150 to 1,480 bytes per face from 13k to 224k faces), rounded up.
+inline constexpr std::uint64_t kBytesPerFace = 1536;
+
+struct ResourceLimits {
+  std::optional<std::uint32_t> max_faces;  ///< refuse meshes with more input faces
+  std::optional<std::uint64_t>
+      max_memory;  ///< bytes; refuse inputs whose estimated peak exceeds it
+};
+
+/// Adds --max-faces and --max-memory (bytes, or with a K, M, G suffix: powers of 1024).
+void add_limit_options(CLI::App& command, ResourceLimits& limits);
+
+/// Throws InvalidInputError if the file alone exceeds --max-memory (before reading it).
+void check_file_limits(const std::filesystem::path& path, const ResourceLimits& limits);
+
+/// Throws InvalidInputError if the mesh exceeds --max-faces, or if the estimated peak of building
+/// its hierarchy (file bytes + kBytesPerFace per face) exceeds --max-memory.
+void check_mesh_limits(const Mesh& mesh, std::uint64_t file_bytes, const ResourceLimits& limits);
+
+}  // namespace primseg::cli

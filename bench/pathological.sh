@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Pathological but valid inputs, at growing scale: N triangles sharing one edge (a non-manifold
+# "book"), and a fan of N triangles around one vertex (a flat disc). Prints, per input, the
+# median over RUNS of wall-clock seconds and peak RSS of `primseg segment` (GNU time).
+#
+#   bench/pathological.sh BUILD_DIR [N...]     (default N: 10000 100000 1000000; RUNS=3)
+set -euo pipefail
+build=${1:?usage: bench/pathological.sh BUILD_DIR [N...]}
+shift
+sizes=("${@:-10000 100000 1000000}")
+runs=${RUNS:-3}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+generate() {  # kind n file
+  python3 - "$1" "$2" "$3" <<'PY'
+import math, sys
+kind, n, path = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+with open(path, "w") as out:
+    if kind == "book":  # edge (0,0,0)-(0,0,1), one page per triangle
+        out.write("OFF\n%d %d 0\n0 0 0\n0 0 1\n" % (n + 2, n))
+        out.writelines("%.9f %.9f 0.5\n" % (math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n)) for i in range(n))
+        out.writelines("3 0 1 %d\n" % (i + 2) for i in range(n))
+    else:  # fan: centre 0, rim 1..n, closed
+        out.write("OFF\n%d %d 0\n0 0 0\n" % (n + 1, n))
+        out.writelines("%.9f %.9f 0\n" % (math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n)) for i in range(n))
+        out.writelines("3 0 %d %d\n" % (i + 1, (i + 1) % n + 1) for i in range(n))
+PY
+}
+printf "%-6s %9s %10s %12s %14s\n" input faces seconds peak_rss_MB bytes_per_face
+for n in ${sizes[@]}; do
+  for kind in book fan; do
+    file=$work/$kind-$n.off
+    generate "$kind" "$n" "$file"
+    samples=()
+    for ((r = 0; r < runs; ++r)); do
+      samples+=("$(/usr/bin/time -f "%e %M" "$build/primseg" segment "$file" -q --clusters 1 \
+        --labels "$work/out.labels" 2>&1 >/dev/null | tail -1)")
+    done
+    median=$(printf "%s\n" "${samples[@]}" | sort -n | sed -n "$(((runs + 1) / 2))p")
+    read -r seconds rss_kb <<<"$median"
+    printf "%-6s %9d %10s %12d %14d\n" "$kind" "$n" "$seconds" $((rss_kb / 1024)) $((rss_kb * 1024 / n))
+  done
+done

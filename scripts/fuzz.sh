@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets of fuzz/ (clang, ASan+UBSan) and runs each for a bounded time from
+# its committed seed corpus and dictionary. Fails on the first finding, leaving the reproducer in
+# $build/artifacts/ (make it a regression test: fuzz/regressions/ and tests/mesh_io/).
+#
+#   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 45: 6 targets, about 5 minutes)
+#   PRIMSEG_FUZZ_BUILD_DIR=build-fuzz        build directory
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-45}
+build=${PRIMSEG_FUZZ_BUILD_DIR:-build-fuzz}
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+  -DPRIMSEG_FUZZ=ON -DPRIMSEG_WERROR=ON -DPRIMSEG_BUILD_TESTS=OFF -DPRIMSEG_BUILD_CLI=OFF \
+  -DPRIMSEG_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" --target fuzz_read_off fuzz_read_obj fuzz_read_ply fuzz_read_stl \
+  fuzz_read_detect fuzz_segment
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+mkdir -p "$build/artifacts"
+for target in off obj ply stl detect segment; do
+  dict=fuzz/dict/$target.dict
+  case $target in
+    detect) cat fuzz/dict/{off,obj,ply,stl}.dict >"$build/detect.dict"; dict=$build/detect.dict ;;
+    segment) dict= ;;
+  esac
+  binary=$build/fuzz/fuzz_read_$target
+  [[ $target == segment ]] && binary=$build/fuzz/fuzz_segment
+  # New inputs go to a scratch corpus in the build directory, never into the committed seeds.
+  work=$build/corpus/$target
+  mkdir -p "$work"
+  echo "== fuzz $target: ${seconds} s =="
+  "$binary" "$work" "fuzz/corpus/$target" ${dict:+-dict="$dict"} -max_total_time="$seconds" \
+    -max_len=4096 -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 -print_final_stats=1 \
+    -artifact_prefix="$build/artifacts/$target-" 2>&1 | grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|==|SUMMARY|.*ERROR|.*invariant|.*reader returned|.*Test unit written)' || true
+  if compgen -G "$build/artifacts/$target-*" >/dev/null; then
+    echo "fuzz $target: finding(s) in $build/artifacts/" >&2
+    exit 1
+  fi
+done

@@ -1,0 +1,320 @@
+// End-to-end tests of `primseg batch`, the resource limits of `segment` and interruption: run
+// the built executable, check exit codes, output files and reports.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "primseg/mesh_io.hpp"
+#include "primseg/shape_generator.hpp"
+#include "support/test_support.hpp"
+
+namespace primseg {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Paths in these tests come from temp_directory() and fixed names: no shell quoting needed
+// beyond single quotes.
+int primseg(const std::string& args, std::string* output = nullptr) {
+  return testing::run_command("'" + testing::cli_path().string() + "' " + args, output);
+}
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Rows of a summary CSV (header checked), keyed by file: "faces,status".
+std::map<std::string, std::string> summary_rows(const fs::path& csv) {
+  std::istringstream in(slurp(csv));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "file,faces,status,error,seconds") << csv;
+  std::map<std::string, std::string> rows;
+  while (std::getline(in, line)) {
+    const std::size_t first = line.find(','), second = line.find(',', first + 1),
+                      third = line.find(',', second + 1);
+    rows[line.substr(0, first)] = line.substr(first + 1, third - first - 1);
+  }
+  return rows;
+}
+
+/// Every file under `dir` but the summaries, relative, with its content (JSON without timings).
+std::map<std::string, std::string> outputs(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (!entry.is_regular_file()) continue;
+    const std::string name = entry.path().lexically_relative(dir).string();
+    if (name.starts_with("summary")) continue;
+    std::string content = slurp(entry.path());
+    if (entry.path().extension() == ".json") {
+      json parsed = json::parse(content);
+      parsed.erase("timing");
+      content = parsed.dump();
+    }
+    files[name] = content;
+  }
+  return files;
+}
+
+/// A data set: four shapes (one in a subfolder) and a file that is not a mesh.
+fs::path make_data_set(const fs::path& root) {
+  const fs::path in = root / "in";
+  fs::create_directories(in / "parts");
+  write_mesh(in / "box.off", make_shape("box").mesh);
+  write_mesh(in / "parts" / "hole.ply", make_shape("box_with_hole").mesh);
+  write_mesh(in / "dome.obj", make_shape("box_with_dome").mesh);
+  write_mesh(in / "boss.stl", make_shape("box_with_boss").mesh);
+  std::ofstream(in / "broken.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n";
+  std::ofstream(in / "readme.txt") << "not a mesh, not listed\n";
+  return in;
+}
+
+TEST(Batch, OneBadFileIsReportedAndDoesNotStopTheOthers) {
+  const fs::path dir = testing::temp_directory("batch-bad");
+  const fs::path in = make_data_set(dir);
+  std::string output;
+  EXPECT_EQ(primseg("batch '" + in.string() + "' --out '" + (dir / "out").string() +
+                        "' -j 2 --clusters 6 2>&1",
+                    &output),
+            1)
+      << output;
+  EXPECT_NE(output.find("1 of 5 files failed"), std::string::npos) << output;
+  const auto rows = summary_rows(dir / "out" / "summary.csv");
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows.at((in / "broken.off").string()), "0,failed");
+  EXPECT_EQ(rows.at((in / "box.off").string()),
+            std::to_string(make_shape("box").mesh.face_count()) + ",ok");
+  for (const char* name : {"box.off", "parts/hole.ply", "dome.obj", "boss.stl"})
+    EXPECT_EQ(rows.at((in / name).string()).substr(rows.at((in / name).string()).find(',')), ",ok")
+        << name;
+  // The failure's message names the file and the problem.
+  const json report = json::parse(slurp(dir / "out" / "summary.json"));
+  ASSERT_EQ(report.size(), 5u);
+  for (const json& row : report)
+    if (row["status"] == "failed") {
+      EXPECT_NE(row["error"].get<std::string>().find("broken.off"), std::string::npos);
+    }
+  // Batch outputs are exactly what `segment` gives for the same file and options.
+  ASSERT_EQ(primseg("segment '" + (in / "parts" / "hole.ply").string() +
+                    "' -q --clusters 6 --labels '" + (dir / "hole.labels").string() + "'"),
+            0);
+  EXPECT_EQ(slurp(dir / "out" / "parts" / "hole.ply.labels"), slurp(dir / "hole.labels"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "broken.off.json"));
+  fs::remove_all(dir);
+}
+
+TEST(Batch, ResumeSkipsCompletedOutputsAndRedoesTheRest) {
+  const fs::path dir = testing::temp_directory("batch-resume");
+  const fs::path in = make_data_set(dir);
+  fs::remove(in / "broken.off");
+  const std::string base = "batch '" + in.string() + "' --out '" + (dir / "out").string() + "' -q";
+  ASSERT_EQ(primseg(base + " --clusters 6"), 0);
+  const auto first = outputs(dir / "out");
+  ASSERT_EQ(first.size(), 8u);
+  // An interrupted run: one output missing, another file's JSON (the completion mark) missing.
+  fs::remove(dir / "out" / "dome.obj.labels");
+  fs::remove(dir / "out" / "parts" / "hole.ply.json");
+  const auto box_time = fs::last_write_time(dir / "out" / "box.off.labels");
+  ASSERT_EQ(primseg(base + " --clusters 6 --resume"), 0);
+  const auto rows = summary_rows(dir / "out" / "summary.csv");
+  EXPECT_EQ(rows.at((in / "box.off").string()).substr(rows.at((in / "box.off").string()).find(',')),
+            ",skipped");
+  EXPECT_EQ(
+      rows.at((in / "boss.stl").string()).substr(rows.at((in / "boss.stl").string()).find(',')),
+      ",skipped");
+  EXPECT_EQ(
+      rows.at((in / "dome.obj").string()).substr(rows.at((in / "dome.obj").string()).find(',')),
+      ",ok");
+  EXPECT_EQ(rows.at((in / "parts/hole.ply").string())
+                .substr(rows.at((in / "parts/hole.ply").string()).find(',')),
+            ",ok");
+  EXPECT_EQ(fs::last_write_time(dir / "out" / "box.off.labels"), box_time);
+  EXPECT_EQ(outputs(dir / "out"), first);
+  // Other options make other outputs: nothing is skipped.
+  ASSERT_EQ(primseg(base + " --clusters 4 --resume"), 0);
+  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
+    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  fs::remove_all(dir);
+}
+
+TEST(Batch, UnionOfShardsEqualsOneRunAndAListEqualsItsDirectory) {
+  const fs::path dir = testing::temp_directory("batch-shards");
+  const fs::path in = make_data_set(dir);
+  const std::string options = " -q --tolerance 0.5% -j 1";
+  EXPECT_EQ(
+      primseg("batch '" + in.string() + "' --out '" + (dir / "whole").string() + "'" + options), 1);
+  std::map<std::string, std::string> union_rows;
+  for (int shard = 0; shard < 3; ++shard) {
+    primseg("batch '" + in.string() + "' --out '" + (dir / "shards").string() + "' --shard " +
+            std::to_string(shard) + "/3" + options);
+    const auto rows =
+        summary_rows(dir / "shards" / ("summary-shard-" + std::to_string(shard) + "-of-3.csv"));
+    EXPECT_GE(rows.size(), 1u);
+    for (const auto& [file, row] : rows) EXPECT_TRUE(union_rows.emplace(file, row).second) << file;
+  }
+  EXPECT_EQ(union_rows, summary_rows(dir / "whole" / "summary.csv"));
+  EXPECT_EQ(outputs(dir / "shards"), outputs(dir / "whole"));
+
+  // The recipe of the README: a list of files, relative to the current directory.
+  std::ofstream(dir / "list.txt") << "# data set\nin/box.off\nin/parts/hole.ply\n\nin/dome.obj\n"
+                                     "in/boss.stl\nin/broken.off\n";
+  EXPECT_EQ(testing::run_command("cd '" + dir.string() + "' && '" + testing::cli_path().string() +
+                                 "' batch list.txt --out listed" + options),
+            1);
+  auto listed = outputs(dir / "listed");
+  std::map<std::string, std::string> expected;
+  for (auto [name, content] : outputs(dir / "whole")) {
+    // The listed run names its inputs as listed (relative), under in/.
+    if (name.ends_with(".json")) {
+      json parsed = json::parse(content);
+      parsed["mesh"]["file"] =
+          parsed["mesh"]["file"].get<std::string>().substr(dir.string().size() + 1);
+      content = parsed.dump();
+    }
+    expected["in/" + name] = content;
+  }
+  EXPECT_EQ(listed, expected);
+  fs::remove_all(dir);
+}
+
+TEST(Batch, BadArgumentsAreRejectedWithAMessage) {
+  const fs::path dir = testing::temp_directory("batch-args");
+  const fs::path in = make_data_set(dir);
+  const std::string base = "batch '" + in.string() + "' --out '" + (dir / "out").string() + "'";
+  struct Case {
+    std::string args, message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {base + " --shard 3/3", "--shard: '3/3' is not i/n"},
+           {base + " --shard 1", "--shard: '1' is not i/n"},
+           {base + " --primitives cone", "unknown primitive 'cone'"},
+           {"batch '" + (dir / "missing").string() + "' --out '" + (dir / "out").string() + "'",
+            "missing"},
+           {"batch '" + (in / "parts").string() + "/..' --out x --max-memory 0", "--max-memory"},
+       }) {
+    std::string output;
+    EXPECT_EQ(primseg(c.args + " 2>&1", &output), 1) << c.args << "\n" << output;
+    EXPECT_NE(output.find(c.message), std::string::npos) << c.args << "\n" << output;
+  }
+  const fs::path empty = dir / "empty";
+  fs::create_directories(empty);
+  std::string output;
+  EXPECT_EQ(
+      primseg("batch '" + empty.string() + "' --out '" + (dir / "o").string() + "' 2>&1", &output),
+      1);
+  EXPECT_NE(output.find("no mesh files"), std::string::npos) << output;
+  fs::remove_all(dir);
+}
+
+TEST(Limits, MaxFacesAndMaxMemoryRefuseBeforeTheBuild) {
+  const fs::path dir = testing::temp_directory("limits");
+  const Mesh mesh = make_shape("box_with_hole").mesh;
+  write_mesh(dir / "in.off", mesh);
+  const std::string base = "segment '" + (dir / "in.off").string() + "' -q --labels '" +
+                           (dir / "out.labels").string() + "'";
+  const std::string faces = std::to_string(mesh.face_count());
+  std::string output;
+  EXPECT_EQ(
+      primseg(base + " --max-faces " + std::to_string(mesh.face_count() - 1) + " 2>&1", &output),
+      1);
+  EXPECT_NE(output.find("the mesh has " + faces + " faces, more than --max-faces"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(primseg(base + " --max-memory 100K 2>&1", &output), 1);
+  EXPECT_NE(output.find("more than --max-memory 102400"), std::string::npos) << output;
+  // Smaller than the file itself: refused before reading.
+  EXPECT_EQ(primseg(base + " --max-memory 1K 2>&1", &output), 1);
+  EXPECT_NE(output.find("the file has"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "out.labels"));
+  EXPECT_EQ(primseg(base + " --max-faces " + faces + " --max-memory 1G"), 0);
+  EXPECT_TRUE(fs::exists(dir / "out.labels"));
+  for (const char* bad :
+       {"--max-memory 12X", "--max-memory -5", "--max-faces 0", "--max-memory 0"}) {
+    EXPECT_EQ(primseg(base + " " + bad + " 2>&1", &output), 1) << bad;
+    EXPECT_NE(output.find(std::string(bad).substr(0, 11)), std::string::npos) << output;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Limits, ImpossibleDeclaredCountsAreRefusedWithoutAllocating) {
+  const fs::path dir = testing::temp_directory("limits-counts");
+  std::ofstream(dir / "huge.off") << "OFF\n1000000000 2000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  std::ofstream(dir / "huge.ply") << "ply\nformat binary_little_endian 1.0\nelement vertex "
+                                     "4000000000\nproperty float x\nproperty float y\nproperty "
+                                     "float z\nelement face 1\nproperty list uchar int "
+                                     "vertex_indices\nend_header\n";
+  for (const char* name : {"huge.off", "huge.ply"}) {
+    std::string output;
+    // ulimit -v: an attempt to allocate for the declared count would fail as out of memory.
+    EXPECT_EQ(testing::run_command("ulimit -v 1000000; '" + testing::cli_path().string() +
+                                       "' segment '" + (dir / name).string() + "' -q 2>&1",
+                                   &output),
+              1)
+        << name;
+    EXPECT_NE(output.find(name), std::string::npos) << output;
+    EXPECT_EQ(output.find("out of memory"), std::string::npos) << output;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Interrupt, CtrlCLeavesCompleteOutputsOrNone) {
+  const fs::path dir = testing::temp_directory("interrupt");
+  const fs::path mesh = testing::cgal_mesh("fandisk.off");
+  const std::string command = "'" + testing::cli_path().string() + "' segment '" + mesh.string() +
+                              "' -q --clusters 20 --labels '" + (dir / "out.labels").string() +
+                              "' --json '" + (dir / "out.json").string() + "' --tree '" +
+                              (dir / "out.tree").string() + "' --colored '" +
+                              (dir / "out.ply").string() + "'";
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_EQ(testing::run_command(command), 0);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::string labels = slurp(dir / "out.labels"), tree = slurp(dir / "out.tree");
+  int interrupted = 0;
+  for (int step = 0; step < 12; ++step) {
+    for (const auto& entry : fs::directory_iterator(dir)) fs::remove(entry.path());
+    // SIGINT from 30% to 140% of a full run: before, during and after the writes.
+    const double delay = seconds * (0.3 + 0.1 * step);
+    const int status =
+        testing::run_command("timeout -s INT " + std::to_string(delay) + " " + command);
+    interrupted += status != 0;
+    std::set<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir))
+      names.insert(entry.path().filename().string());
+    for (const std::string& name : names)
+      EXPECT_TRUE(name == "out.labels" || name == "out.json" || name == "out.tree" ||
+                  name == "out.ply")
+          << "left behind: " << name;
+    if (names.count("out.labels")) {
+      EXPECT_EQ(slurp(dir / "out.labels"), labels);
+    }
+    if (names.count("out.tree")) {
+      EXPECT_EQ(slurp(dir / "out.tree"), tree);
+    }
+    if (names.count("out.json")) {
+      EXPECT_NO_THROW(json::parse(slurp(dir / "out.json")));
+    }
+    if (names.count("out.ply")) {
+      EXPECT_NO_THROW(read_mesh(dir / "out.ply"));
+    }
+  }
+  EXPECT_GE(interrupted, 1);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace primseg
