@@ -13,6 +13,7 @@ Command add_denoise_command(CLI::App& app) {
   struct Options {
     std::string mesh_path, output_path, primitives = "plane,cylinder,sphere";
     int iterations = 1;
+    int smoothing_steps = DenoiseOptions{}.smoothing_steps;
     bool stylize = false;
     double max_move = DenoiseOptions{}.max_move_edge_lengths;
     double min_crease_angle = DenoiseOptions{}.min_crease_angle_degrees;
@@ -31,6 +32,12 @@ Command add_denoise_command(CLI::App& app) {
       ->add_option("--iterations", o->iterations,
                    "Segment-and-snap rounds, each on the previous round's result")
       ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  denoise
+      ->add_option("--smooth", o->smoothing_steps,
+                   "Taubin smoothing steps of the copy that is segmented (the vertices are "
+                   "snapped from their own positions)")
+      ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   denoise->add_flag("--stylize", o->stylize,
                     "Snap each vertex onto its own cluster's primitive only (a boundary vertex "
@@ -53,6 +60,7 @@ Command add_denoise_command(CLI::App& app) {
             DenoiseOptions options;
             options.mode = o->stylize ? SnapMode::NearestIncident : SnapMode::AllIncident;
             options.max_move_edge_lengths = o->max_move;
+            options.smoothing_steps = o->smoothing_steps;
             options.min_crease_angle_degrees = o->min_crease_angle;
             options.hierarchy.primitives = parse_primitives(o->primitives);
             options.hierarchy.threads = o->threads;
@@ -66,8 +74,8 @@ Command add_denoise_command(CLI::App& app) {
             std::unique_ptr<Hierarchy> hierarchy;
             nlohmann::json rounds = nlohmann::json::array();
             for (int i = 0; i < o->iterations; ++i) {
-              hierarchy = std::make_unique<Hierarchy>(build_hierarchy(
-                  std::make_shared<const Mesh>(denoiser.mesh()), options.hierarchy));
+              hierarchy = std::make_unique<Hierarchy>(
+                  build_hierarchy(denoiser.segmented_mesh(), options.hierarchy));
               const SnapReport r = denoiser.snap(*hierarchy, cut(*hierarchy, o->level.level));
               rounds.push_back({{"clusters", r.clusters},
                                 {"boundary_vertices", r.boundary_vertices},

@@ -213,6 +213,8 @@ void validate(const DenoiseOptions& options) {
     throw InvalidInputError("denoise: the smallest crease angle must be in [0, 90) degrees");
   if (!(options.refit_outlier_threshold >= 0) || !std::isfinite(options.refit_outlier_threshold))
     throw InvalidInputError("denoise: the refit outlier threshold must be a non-negative number");
+  if (options.smoothing_steps < 0)
+    throw InvalidInputError("denoise: the smoothing steps must be a non-negative count");
   if (options.max_solver_steps < 1)
     throw InvalidInputError("denoise: the solver needs at least one step");
   validate(options.hierarchy);
@@ -262,9 +264,35 @@ Denoiser::Denoiser(Mesh mesh, DenoiseOptions options)
     local_edge_length_[v] = edge_count[v] ? edge_sum[v] / edge_count[v] : 0;
 }
 
+std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
+  // Taubin's λ|μ smoothing with uniform weights over the edge neighbours: shrinks noise, not the
+  // shape. Neighbours come from the triangles around each vertex (each edge seen twice: same
+  // weights for all, so the average is unchanged).
+  constexpr double kLambda = 0.5, kMu = -0.53;
+  auto segmented = std::make_shared<Mesh>(mesh_);
+  std::vector<Vec3>& positions = segmented->positions;
+  std::vector<Vec3> next(positions.size());
+  for (int step = 0; step < 2 * options_.smoothing_steps; ++step) {
+    const double factor = step % 2 == 0 ? kLambda : kMu;
+    for (std::uint32_t v = 0; v < mesh_.vertex_count(); ++v) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int count = 0;
+      for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i)
+        for (const std::uint32_t u : mesh_.triangles[vertex_triangles_[i]])
+          if (u != v) {
+            sum += to_eigen(positions[u]);
+            ++count;
+          }
+      const Eigen::Vector3d x = to_eigen(positions[v]);
+      next[v] = count ? to_vec3(x + factor * (sum / count - x)) : positions[v];
+    }
+    positions.swap(next);
+  }
+  return segmented;
+}
+
 SnapReport Denoiser::iterate(const LevelSelector& level) {
-  const Hierarchy hierarchy =
-      build_hierarchy(std::make_shared<const Mesh>(mesh_), options_.hierarchy);
+  const Hierarchy hierarchy = build_hierarchy(segmented_mesh(), options_.hierarchy);
   return snap(hierarchy, level(hierarchy));
 }
 
@@ -335,7 +363,7 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
 
 SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmentation) {
   const Mesh& segmented = hierarchy.mesh();
-  if (segmented.positions != mesh_.positions || segmented.triangles != mesh_.triangles ||
+  if (segmented.vertex_count() != mesh_.vertex_count() || segmented.triangles != mesh_.triangles ||
       segmented.face_of_triangle != mesh_.face_of_triangle)
     throw InvalidInputError("denoise: the hierarchy was not built on the mesh being denoised");
   if (segmentation.labels.size() != mesh_.face_count())

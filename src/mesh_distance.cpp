@@ -58,9 +58,9 @@ struct Box {
   }
 };
 
-}  // namespace
-
-Vec3 closest_point_on_triangle(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c) {
+// Ericson's Voronoi-region walk; exact for triangles of some width, unreliable for slivers
+// (returns a point of the triangle, but maybe not the nearest).
+Vec3 voronoi_closest_point(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c) {
   // Voronoi regions of the corners, then of the edges, then the interior (barycentric).
   const Vec3 ab = sub(b, a), ac = sub(c, a), ax = sub(x, a);
   const double d1 = dot(ab, ax), d2 = dot(ac, ax);
@@ -79,18 +79,27 @@ Vec3 closest_point_on_triangle(const Vec3& x, const Vec3& a, const Vec3& b, cons
   if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
     return along(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)));
   const double denominator = va + vb + vc;
-  if (!(denominator > 0)) {
-    // Degenerate (collinear corners): the nearest of the three edges.
-    const std::array<Vec3, 3> candidates = {closest_point_on_segment(x, a, b),
-                                            closest_point_on_segment(x, b, c),
-                                            closest_point_on_segment(x, c, a)};
-    const Vec3* best = &candidates[0];
-    for (const Vec3& candidate : candidates)
-      if (squared_distance(x, candidate) < squared_distance(x, *best)) best = &candidate;
-    return *best;
-  }
+  if (!(denominator > 0)) return a;  // degenerate: the caller checks the edges
   const double v = vb / denominator, w = vc / denominator;
   return {a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w};
+}
+
+}  // namespace
+
+Vec3 closest_point_on_triangle(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 candidate = voronoi_closest_point(x, a, b, c);
+  const Vec3 ab = sub(b, a), ac = sub(c, a);
+  const Vec3 n = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
+                  ab[0] * ac[1] - ab[1] * ac[0]};
+  // A sliver (corner angles below about 1e-6 rad): the nearest of the candidate and the edges.
+  if (dot(n, n) > 1e-12 * dot(ab, ab) * dot(ac, ac)) return candidate;
+  const std::array<Vec3, 4> candidates = {candidate, closest_point_on_segment(x, a, b),
+                                          closest_point_on_segment(x, b, c),
+                                          closest_point_on_segment(x, c, a)};
+  const Vec3* best = &candidates[0];
+  for (const Vec3& p : candidates)
+    if (squared_distance(x, p) < squared_distance(x, *best)) best = &p;
+  return *best;
 }
 
 struct TriangleBvh::Impl {

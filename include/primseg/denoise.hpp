@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "primseg/cut.hpp"
@@ -54,6 +55,11 @@ struct DenoiseOptions {
   /// geometric distance from the hierarchy's fit, kept only when it lowers the error; other types
   /// keep the hierarchy's fit. 0 disables the refit.
   double refit_outlier_threshold = 2.5;
+  /// The segmentation of each iteration is computed on a copy of the mesh smoothed by this many
+  /// Taubin λ|μ steps (λ = 0.5, μ = −0.53, uniform weights), so that noise does not fragment it
+  /// into small planes; the primitives are then refitted, and the vertices snapped, on the
+  /// unsmoothed positions. 0 segments the mesh as it is.
+  int smoothing_steps = 0;
   /// Gauss–Newton steps for curved primitives (a plane-only system converges in one).
   int max_solver_steps = 20;
   /// Hierarchy options used to segment the mesh at each iteration.
@@ -94,10 +100,14 @@ class Denoiser {
   /// One iteration: builds the hierarchy of the current mesh, cuts it with `level` and snaps.
   SnapReport iterate(const LevelSelector& level);
 
-  /// Snaps the current positions onto a segmentation of the current mesh (`hierarchy` must have
-  /// been built on a mesh with the same connectivity and positions as mesh()). Throws
-  /// InvalidInputError when the hierarchy's mesh does not match.
+  /// Snaps the current positions onto a segmentation of the current mesh. `hierarchy` must have
+  /// been built on a mesh with the same vertices and triangles as mesh(), with these positions or
+  /// others (a smoothed copy); its primitives are refitted on mesh()'s positions unless
+  /// refit_outlier_threshold is 0. Throws InvalidInputError when the connectivity differs.
   SnapReport snap(const Hierarchy& hierarchy, const Segmentation& segmentation);
+
+  /// The mesh the next iteration segments: mesh(), smoothed when smoothing_steps > 0.
+  std::shared_ptr<const Mesh> segmented_mesh() const;
 
   /// The current mesh (the input after the iterations so far).
   const Mesh& mesh() const { return mesh_; }

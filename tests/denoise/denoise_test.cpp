@@ -251,7 +251,7 @@ TEST(Denoise, RejectsBadOptionsAndAMismatchedHierarchy) {
   EXPECT_THROW(Denoiser(box.noisy.mesh, options), InvalidInputError);
 
   Denoiser denoiser(box.noisy.mesh);
-  const Hierarchy other = build_hierarchy(box.clean.mesh);
+  const Hierarchy other = build_hierarchy(noisy_shape("box", 0.004, 0.2).noisy.mesh);
   EXPECT_THROW(denoiser.snap(other, cut_by_count(other, 6)), InvalidInputError);
 }
 
