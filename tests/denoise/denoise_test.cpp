@@ -6,12 +6,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <limits>
 
 #include "denoise_test_support.hpp"
 #include "marching_tetrahedra.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_distance.hpp"
+#include "primseg/render.hpp"
 #include "primseg/shape_generator.hpp"
 
 namespace primseg {
@@ -155,6 +158,15 @@ TEST(Denoise, ChamferedBoxFromMarchingTetrahedraGetsItsSharpEdgesBack) {
   EXPECT_GT(before.hausdorff, 0.02);  // the chamfer is real
   EXPECT_LE(after.hausdorff * 5, before.hausdorff);
   EXPECT_EQ(inverted_triangles(chamfered, restored), 0u);
+  if (const char* figures = std::getenv("PRIMSEG_FIGURES_DIR")) {
+    RenderOptions view;
+    view.width = 400;
+    view.height = 300;
+    view.edges = true;
+    view.frame_box = {{Vec3{-half[0], -half[1], -half[2]}, half}};
+    write_png(std::filesystem::path(figures) / "box-chamfered.png", chamfered, {}, view);
+    write_png(std::filesystem::path(figures) / "box-restored.png", restored, {}, view);
+  }
 
   // No vertex moved farther than the bound.
   std::vector<double> edge_sum(chamfered.vertex_count(), 0),

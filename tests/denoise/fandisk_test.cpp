@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -65,6 +66,13 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     view.width = 600;
     view.height = 450;
     view.view_direction = {-1.0, -0.6, -0.9};
+    Vec3 low = clean.positions[0], high = clean.positions[0];
+    for (const Vec3& p : clean.positions)
+      for (int d = 0; d < 3; ++d) {
+        low[d] = std::min(low[d], p[d]);
+        high[d] = std::max(high[d], p[d]);
+      }
+    view.frame_box = {{low, high}};
     for (const auto& [name, mesh] :
          {std::pair<const char*, const Mesh*>{"fandisk-clean.png", &clean},
           {"fandisk-noisy.png", &noisy},
