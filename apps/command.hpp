@@ -24,6 +24,8 @@ Command add_cut_command(CLI::App& app);
 Command add_info_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
 Command add_batch_command(CLI::App& app);
+Command add_denoise_command(CLI::App& app);
+Command add_distance_command(CLI::App& app);
 
 // Helpers shared by the commands.
 

@@ -28,6 +28,8 @@ int run(int argc, char** argv) {
       add_info_command(app),
       add_eval_command(app),
       add_batch_command(app),
+      add_denoise_command(app),
+      add_distance_command(app),
   };
 
   // Name an unknown command instead of CLI11's "A subcommand is required".

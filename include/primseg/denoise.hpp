@@ -1,0 +1,133 @@
+#pragma once
+/// @file denoise.hpp
+/// Denoising and sharp-feature recovery by snapping vertices onto the primitives of a
+/// segmentation (Attene, Falcidieno, Spagnuolo 2006, section 7), and stylization (after Wu and
+/// Kobbelt 2005).
+///
+/// A vertex inside a cluster moves to the closest point of the cluster's primitive. A vertex
+/// shared by several clusters moves to the point nearest to it that minimises the sum of squared
+/// distances to all the incident primitives: two planes put it on their intersection line, three
+/// on their corner, which restores edges and corners that noise or resampling chamfered.
+///
+/// One-shot use: `Mesh clean = denoise(mesh, level_by_count(30));`. Step-by-step control (one
+/// iteration at a time, or snapping onto a segmentation the caller already has): Denoiser.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "primseg/cut.hpp"
+#include "primseg/hierarchy.hpp"
+#include "primseg/mesh.hpp"
+
+namespace primseg {
+
+/// What a vertex shared by several clusters is snapped onto.
+enum class SnapMode {
+  /// Onto all incident primitives at once (least squares): denoising and feature recovery.
+  AllIncident,
+  /// Onto the nearest incident primitive only: every vertex lies on its own cluster's primitive,
+  /// which stylizes a shape when the clusters are few.
+  NearestIncident,
+};
+
+/// Options of the snapping. Defaults are those of `primseg denoise`.
+struct DenoiseOptions {
+  SnapMode mode = SnapMode::AllIncident;
+  /// A vertex never moves farther than this many times its local edge length (the mean length of
+  /// its incident edges in the input mesh); a move that would is replaced by one onto fewer
+  /// primitives, or not made. Tied to the edge length rather than to the cluster's RMS, which
+  /// would forbid the long moves that sharpen a chamfer. Infinity disables the bound; it is not
+  /// applied in NearestIncident mode, whose moves are large by design. Must be positive.
+  double max_move_edge_lengths = 4.0;
+  /// Primitives whose normals at the snapped point make an angle below this (degrees, in
+  /// [0, 90)) do not constrain the point along the direction they share: the least-squares system
+  /// is solved with its eigenvalues below tan²(angle / 2) · largest eigenvalue dropped (minimum
+  /// displacement along dropped directions). Two near-parallel planes thus give one averaged
+  /// constraint instead of a far-away, ill-conditioned intersection.
+  double min_crease_angle_degrees = 10.0;
+  /// Before snapping, each cluster's primitive is refitted robustly on the vertices of its faces:
+  /// vertices farther from the current fit than this many robust standard deviations (1.4826 ×
+  /// the median distance) are left out and the rest refitted, three times. The vertices left out
+  /// are those of chamfers and of misassigned faces along the borders, which tilt and offset the
+  /// hierarchy's fit. Planes by weighted PCA; spheres and cylinders by Gauss-Newton on the
+  /// geometric distance from the hierarchy's fit, kept only when it lowers the error; other types
+  /// keep the hierarchy's fit. 0 disables the refit.
+  double refit_outlier_threshold = 2.5;
+  /// The segmentation of each iteration is computed on a copy of the mesh smoothed by this many
+  /// Taubin λ|μ steps (λ = 0.5, μ = −0.53, uniform weights), so that noise does not fragment it
+  /// into small planes; the primitives are then refitted, and the vertices snapped, on the
+  /// unsmoothed positions. 0 segments the mesh as it is.
+  int smoothing_steps = 0;
+  /// Gauss–Newton steps for curved primitives (a plane-only system converges in one).
+  int max_solver_steps = 20;
+  /// Hierarchy options used to segment the mesh at each iteration.
+  HierarchyOptions hierarchy;
+};
+
+/// Throws InvalidInputError if options are out of range.
+void validate(const DenoiseOptions& options);
+
+/// Chooses the level of a hierarchy to snap onto (by count, tolerance, or any other rule).
+using LevelSelector = std::function<Segmentation(const Hierarchy&)>;
+/// The level with `clusters` clusters (cut_by_count).
+LevelSelector level_by_count(std::uint32_t clusters);
+/// The coarsest level within an RMS `tolerance`, input units (cut_by_tolerance).
+LevelSelector level_by_tolerance(double tolerance);
+
+/// What one snapping pass did.
+struct SnapReport {
+  std::uint32_t clusters = 0;
+  std::uint32_t interior_vertices = 0;  ///< vertices of one cluster only
+  std::uint32_t boundary_vertices = 0;  ///< vertices shared by two or more clusters
+  std::uint32_t moved = 0;              ///< vertices that moved onto their target
+  /// Boundary vertices that were snapped onto fewer primitives than incident ones because the
+  /// full move broke a safeguard.
+  std::uint32_t fallbacks = 0;
+  /// Vertices left where they were: every candidate move was too long or inverted a triangle.
+  std::uint32_t blocked = 0;
+  double mean_move = 0;  ///< over moved vertices, input units
+  double max_move = 0;   ///< input units
+};
+
+/// Step-by-step denoising of one mesh. The vertex and face order never change; only positions do.
+class Denoiser {
+ public:
+  /// Throws InvalidInputError for invalid options or a mesh that fails Mesh::validate().
+  explicit Denoiser(Mesh mesh, DenoiseOptions options = {});
+
+  /// One iteration: builds the hierarchy of the current mesh, cuts it with `level` and snaps.
+  SnapReport iterate(const LevelSelector& level);
+
+  /// Snaps the current positions onto a segmentation of the current mesh. `hierarchy` must have
+  /// been built on a mesh with the same vertices and triangles as mesh(), with these positions or
+  /// others (a smoothed copy); its primitives are refitted on mesh()'s positions unless
+  /// refit_outlier_threshold is 0. Throws InvalidInputError when the connectivity differs.
+  SnapReport snap(const Hierarchy& hierarchy, const Segmentation& segmentation);
+
+  /// The mesh the next iteration segments: mesh(), smoothed when smoothing_steps > 0.
+  std::shared_ptr<const Mesh> segmented_mesh() const;
+
+  /// The current mesh (the input after the iterations so far).
+  const Mesh& mesh() const { return mesh_; }
+
+ private:
+  void refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const;
+
+  Mesh mesh_;
+  DenoiseOptions options_;
+  std::vector<Vec3> input_normals_;        // per triangle, unnormalised: orientation reference
+  std::vector<double> local_edge_length_;  // per vertex, in the input mesh
+  // Triangles around each vertex: those of vertex v are
+  // vertex_triangles_[vertex_triangle_offsets_[v] .. vertex_triangle_offsets_[v + 1]).
+  std::vector<std::uint32_t> vertex_triangle_offsets_;
+  std::vector<std::uint32_t> vertex_triangles_;
+};
+
+/// One-shot: `iterations` times, segment the mesh, cut with `level`, snap. Throws
+/// InvalidInputError for iterations < 1, and as Denoiser.
+Mesh denoise(const Mesh& mesh, const LevelSelector& level, const DenoiseOptions& options = {},
+             int iterations = 1);
+
+}  // namespace primseg

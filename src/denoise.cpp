@@ -1,0 +1,489 @@
+#include "primseg/denoise.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <string>
+
+#include "primseg/error.hpp"
+
+namespace primseg {
+namespace {
+
+Eigen::Vector3d to_eigen(const Vec3& v) {
+  return {v[0], v[1], v[2]};
+}
+Vec3 to_vec3(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+Eigen::Vector3d triangle_normal(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                const Eigen::Vector3d& c) {
+  return (b - a).cross(c - a);
+}
+
+// Unit normal of the primitive's surface at `on_surface` (one of its closest points), or zero
+// where the surface has none (a cone's apex, an axis point of a degenerate fit).
+Eigen::Vector3d surface_normal(const Primitive& primitive, const Eigen::Vector3d& on_surface) {
+  const Eigen::Vector3d origin = to_eigen(primitive.point);
+  const Eigen::Vector3d axis = to_eigen(primitive.axis);
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  switch (primitive.type) {
+    case PrimitiveType::Plane:
+      normal = axis;
+      break;
+    case PrimitiveType::Sphere:
+      normal = on_surface - origin;
+      break;
+    case PrimitiveType::Cylinder: {
+      const Eigen::Vector3d d = on_surface - origin;
+      normal = d - axis * axis.dot(d);
+      break;
+    }
+    case PrimitiveType::Cone: {
+      const Eigen::Vector3d d = on_surface - origin;
+      const Eigen::Vector3d radial = d - axis * axis.dot(d);
+      if (radial.squaredNorm() > 0)
+        normal = radial.normalized() * std::cos(primitive.half_angle) -
+                 axis * std::sin(primitive.half_angle);
+      break;
+    }
+    case PrimitiveType::Torus: {
+      const Eigen::Vector3d d = on_surface - origin;
+      const Eigen::Vector3d radial = d - axis * axis.dot(d);
+      if (radial.squaredNorm() > 0) normal = d - radial.normalized() * primitive.radius;
+      break;
+    }
+  }
+  const double length = normal.norm();
+  return length > 0 && std::isfinite(length) ? Eigen::Vector3d(normal / length)
+                                             : Eigen::Vector3d::Zero();
+}
+
+// The point nearest to x (approximately, for curved primitives) among the minimisers of the sum
+// of squared distances to `primitives`: Gauss–Newton on the tangent planes at the closest points,
+// each step the minimum-norm solution of the truncated normal equations.
+Eigen::Vector3d least_squares_point(const Eigen::Vector3d& x,
+                                    const std::vector<const Primitive*>& primitives,
+                                    double eigenvalue_ratio, int max_steps) {
+  if (primitives.size() == 1) return to_eigen(primitives[0]->closest_point(to_vec3(x)));
+  Eigen::Vector3d y = x;
+  for (int step = 0; step < max_steps; ++step) {
+    Eigen::Matrix3d normal_matrix = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d right_side = Eigen::Vector3d::Zero();
+    for (const Primitive* primitive : primitives) {
+      const Eigen::Vector3d closest = to_eigen(primitive->closest_point(to_vec3(y)));
+      const Eigen::Vector3d n = surface_normal(*primitive, closest);
+      normal_matrix += n * n.transpose();
+      right_side -= n * n.dot(y - closest);
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal_matrix);
+    const Eigen::Vector3d values = eigen.eigenvalues();  // increasing
+    const double largest = values(2);
+    if (!(largest > 0)) break;
+    Eigen::Vector3d delta = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k)
+      if (values(k) > largest * eigenvalue_ratio) {
+        const Eigen::Vector3d u = eigen.eigenvectors().col(k);
+        delta += u * (u.dot(right_side) / values(k));
+      }
+    y += delta;
+    if (!(delta.norm() > 1e-14 * (1 + y.norm()))) break;
+  }
+  return y;
+}
+
+// Weighted least-squares plane through points (PCA), its normal on the side of `reference`;
+// nullopt when the points do not span a plane.
+std::optional<Primitive> fit_plane(const std::vector<Eigen::Vector3d>& points,
+                                   const std::vector<double>& weights,
+                                   const Eigen::Vector3d& reference) {
+  double total = 0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    total += weights[i];
+    centroid += weights[i] * points[i];
+  }
+  if (points.size() < 3 || !(total > 0)) return std::nullopt;
+  centroid /= total;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d d = points[i] - centroid;
+    scatter += weights[i] * d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+  // The two in-plane spreads must be real, or the points are (nearly) on a line.
+  if (!(eigen.eigenvalues()(1) > 1e-6 * eigen.eigenvalues()(2))) return std::nullopt;
+  Eigen::Vector3d normal = eigen.eigenvectors().col(0);
+  if (normal.dot(reference) < 0) normal = -normal;
+  Primitive plane;
+  plane.type = PrimitiveType::Plane;
+  plane.point = to_vec3(centroid);
+  plane.axis = to_vec3(normal);
+  return plane;
+}
+
+// Signed distance of x to a sphere or cylinder given by a parameter vector: sphere (centre,
+// radius), cylinder (point, axis of any length, radius).
+double signed_distance(PrimitiveType type, const Eigen::VectorXd& q, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d d = x - q.head<3>();
+  if (type == PrimitiveType::Sphere) return d.norm() - q(3);
+  const Eigen::Vector3d axis = q.segment<3>(3).normalized();
+  return (d - axis * axis.dot(d)).norm() - q(6);
+}
+
+// Gauss-Newton refinement of a sphere or cylinder on weighted points (geometric distances), each
+// step the minimum-norm least-squares solution (the parametrisation has free directions: a
+// cylinder's point along its axis, its axis length). nullopt when it does not lower the error.
+std::optional<Primitive> refine_curved(const Primitive& start,
+                                       const std::vector<Eigen::Vector3d>& points,
+                                       const std::vector<double>& weights) {
+  const bool sphere = start.type == PrimitiveType::Sphere;
+  const Eigen::Index k = sphere ? 4 : 7;
+  const auto m = static_cast<Eigen::Index>(points.size());
+  if (m < 2 * k || !(start.radius > 0)) return std::nullopt;
+  Eigen::VectorXd q(k);
+  q.head<3>() = to_eigen(start.point);
+  if (sphere) {
+    q(3) = start.radius;
+  } else {
+    q.segment<3>(3) = to_eigen(start.axis);
+    q(6) = start.radius;
+  }
+  auto residuals = [&](const Eigen::VectorXd& params) {
+    Eigen::VectorXd r(m);
+    for (Eigen::Index i = 0; i < m; ++i)
+      r(i) = std::sqrt(weights[i]) * signed_distance(start.type, params, points[i]);
+    return r;
+  };
+  Eigen::VectorXd r = residuals(q);
+  const double initial = r.squaredNorm();
+  double error = initial;
+  const double step = 1e-7 * start.radius;
+  for (int iteration = 0; iteration < 15; ++iteration) {
+    Eigen::MatrixXd jacobian(m, k);
+    for (Eigen::Index j = 0; j < k; ++j) {
+      Eigen::VectorXd plus = q, minus = q;
+      plus(j) += step;
+      minus(j) -= step;
+      jacobian.col(j) = (residuals(plus) - residuals(minus)) / (2 * step);
+    }
+    // Singular values below 1e-9 of the largest are the free directions: no step along them.
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    svd.setThreshold(1e-9);
+    Eigen::VectorXd delta = svd.solve(-r);
+    bool improved = false;
+    for (int halving = 0; halving < 8 && !improved; ++halving, delta /= 2) {
+      const Eigen::VectorXd candidate = q + delta;
+      const Eigen::VectorXd candidate_r = residuals(candidate);
+      if (candidate_r.allFinite() && candidate_r.squaredNorm() < error) {
+        q = candidate;
+        r = candidate_r;
+        error = r.squaredNorm();
+        improved = true;
+      }
+    }
+    if (!improved) break;
+  }
+  if (!(error < initial)) return std::nullopt;
+  Primitive refined = start;
+  refined.point = to_vec3(q.head<3>());
+  if (sphere) {
+    refined.radius = q(3);
+  } else {
+    const Eigen::Vector3d axis = q.segment<3>(3).normalized();
+    refined.axis = to_vec3(axis.dot(to_eigen(start.axis)) < 0 ? Eigen::Vector3d(-axis) : axis);
+    refined.radius = q(6);
+  }
+  if (!(refined.radius > 0) || !std::isfinite(refined.radius)) return std::nullopt;
+  return refined;
+}
+
+}  // namespace
+
+void validate(const DenoiseOptions& options) {
+  if (!(options.max_move_edge_lengths > 0))
+    throw InvalidInputError("denoise: the largest move must be a positive number of edge lengths");
+  if (!(options.min_crease_angle_degrees >= 0 && options.min_crease_angle_degrees < 90))
+    throw InvalidInputError("denoise: the smallest crease angle must be in [0, 90) degrees");
+  if (!(options.refit_outlier_threshold >= 0) || !std::isfinite(options.refit_outlier_threshold))
+    throw InvalidInputError("denoise: the refit outlier threshold must be a non-negative number");
+  if (options.smoothing_steps < 0)
+    throw InvalidInputError("denoise: the smoothing steps must be a non-negative count");
+  if (options.max_solver_steps < 1)
+    throw InvalidInputError("denoise: the solver needs at least one step");
+  validate(options.hierarchy);
+}
+
+LevelSelector level_by_count(std::uint32_t clusters) {
+  return [clusters](const Hierarchy& hierarchy) { return cut_by_count(hierarchy, clusters); };
+}
+
+LevelSelector level_by_tolerance(double tolerance) {
+  return [tolerance](const Hierarchy& hierarchy) { return cut_by_tolerance(hierarchy, tolerance); };
+}
+
+Denoiser::Denoiser(Mesh mesh, DenoiseOptions options)
+    : mesh_(std::move(mesh)), options_(std::move(options)) {
+  validate(options_);
+  mesh_.validate();
+  const std::uint32_t n = mesh_.vertex_count();
+  input_normals_.reserve(mesh_.triangles.size());
+  std::vector<double> edge_sum(n, 0);
+  std::vector<std::uint32_t> edge_count(n, 0);
+  vertex_triangle_offsets_.assign(n + 1, 0);
+  for (const Triangle& t : mesh_.triangles) {
+    const Eigen::Vector3d a = to_eigen(mesh_.positions[t[0]]), b = to_eigen(mesh_.positions[t[1]]),
+                          c = to_eigen(mesh_.positions[t[2]]);
+    const Vec3 normal = to_vec3(triangle_normal(a, b, c));
+    input_normals_.push_back(normal);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = t[k], v = t[(k + 1) % 3];
+      const double length = (to_eigen(mesh_.positions[u]) - to_eigen(mesh_.positions[v])).norm();
+      edge_sum[u] += length;
+      edge_sum[v] += length;
+      ++edge_count[u];
+      ++edge_count[v];
+      ++vertex_triangle_offsets_[u + 1];
+    }
+  }
+  for (std::uint32_t v = 0; v < n; ++v)
+    vertex_triangle_offsets_[v + 1] += vertex_triangle_offsets_[v];
+  vertex_triangles_.resize(vertex_triangle_offsets_[n]);
+  std::vector<std::uint32_t> fill(vertex_triangle_offsets_.begin(),
+                                  vertex_triangle_offsets_.end() - 1);
+  for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t)
+    for (const std::uint32_t v : mesh_.triangles[t]) vertex_triangles_[fill[v]++] = t;
+  local_edge_length_.resize(n);
+  for (std::uint32_t v = 0; v < n; ++v)
+    local_edge_length_[v] = edge_count[v] ? edge_sum[v] / edge_count[v] : 0;
+}
+
+std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
+  // Taubin's λ|μ smoothing with uniform weights over the edge neighbours: shrinks noise, not the
+  // shape. Neighbours come from the triangles around each vertex (each edge seen twice: same
+  // weights for all, so the average is unchanged).
+  constexpr double kLambda = 0.5, kMu = -0.53;
+  auto segmented = std::make_shared<Mesh>(mesh_);
+  std::vector<Vec3>& positions = segmented->positions;
+  std::vector<Vec3> next(positions.size());
+  for (int step = 0; step < 2 * options_.smoothing_steps; ++step) {
+    const double factor = step % 2 == 0 ? kLambda : kMu;
+    for (std::uint32_t v = 0; v < mesh_.vertex_count(); ++v) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int count = 0;
+      for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i)
+        for (const std::uint32_t u : mesh_.triangles[vertex_triangles_[i]])
+          if (u != v) {
+            sum += to_eigen(positions[u]);
+            ++count;
+          }
+      const Eigen::Vector3d x = to_eigen(positions[v]);
+      next[v] = count ? to_vec3(x + factor * (sum / count - x)) : positions[v];
+    }
+    positions.swap(next);
+  }
+  return segmented;
+}
+
+SnapReport Denoiser::iterate(const LevelSelector& level) {
+  const Hierarchy hierarchy = build_hierarchy(segmented_mesh(), options_.hierarchy);
+  return snap(hierarchy, level(hierarchy));
+}
+
+void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const {
+  // Every vertex of a cluster's faces, weighted by the area of its triangles in the cluster.
+  std::vector<std::vector<Eigen::Vector3d>> points(primitives.size());
+  std::vector<std::vector<double>> weights(primitives.size());
+  std::vector<std::pair<std::uint32_t, double>> area_by_cluster;
+  for (std::uint32_t v = 0; v < mesh_.vertex_count(); ++v) {
+    area_by_cluster.clear();
+    for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i) {
+      const std::uint32_t t = vertex_triangles_[i];
+      const std::uint32_t c = segmentation.labels[mesh_.face_of_triangle[t]];
+      const Triangle& corners = mesh_.triangles[t];
+      const double area = triangle_normal(to_eigen(mesh_.positions[corners[0]]),
+                                          to_eigen(mesh_.positions[corners[1]]),
+                                          to_eigen(mesh_.positions[corners[2]]))
+                              .norm();
+      auto found = std::find_if(area_by_cluster.begin(), area_by_cluster.end(),
+                                [&](const auto& entry) { return entry.first == c; });
+      if (found == area_by_cluster.end())
+        area_by_cluster.emplace_back(c, area);
+      else
+        found->second += area;
+    }
+    for (const auto& [c, area] : area_by_cluster) {
+      points[c].push_back(to_eigen(mesh_.positions[v]));
+      weights[c].push_back(area);
+    }
+  }
+  const double floor = 1e-12 * bounding_box_diagonal(mesh_);
+  std::vector<double> residuals;
+  for (std::size_t c = 0; c < primitives.size(); ++c) {
+    const PrimitiveType type = primitives[c].type;
+    if (type != PrimitiveType::Plane && type != PrimitiveType::Sphere &&
+        type != PrimitiveType::Cylinder)
+      continue;
+    Primitive current = primitives[c];
+    std::vector<Eigen::Vector3d> kept_points = points[c];
+    std::vector<double> kept_weights = weights[c];
+    constexpr int kRounds = 3;
+    for (int round = 0; round < kRounds; ++round) {
+      // Inliers: residual within the threshold times the robust deviation (1.4826 MAD) of all
+      // the cluster's vertices from the current fit.
+      residuals.clear();
+      for (const Eigen::Vector3d& p : points[c]) residuals.push_back(current.distance(to_vec3(p)));
+      std::vector<double> sorted = residuals;
+      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      const double limit =
+          std::max(options_.refit_outlier_threshold * 1.4826 * sorted[sorted.size() / 2], floor);
+      kept_points.clear();
+      kept_weights.clear();
+      for (std::size_t i = 0; i < points[c].size(); ++i)
+        if (residuals[i] <= limit) {
+          kept_points.push_back(points[c][i]);
+          kept_weights.push_back(weights[c][i]);
+        }
+      const std::optional<Primitive> refit =
+          type == PrimitiveType::Plane
+              ? fit_plane(kept_points, kept_weights, to_eigen(current.axis))
+              : refine_curved(current, kept_points, kept_weights);
+      if (!refit) break;
+      current = *refit;
+    }
+    primitives[c] = current;
+  }
+}
+
+SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmentation) {
+  const Mesh& segmented = hierarchy.mesh();
+  if (segmented.vertex_count() != mesh_.vertex_count() || segmented.triangles != mesh_.triangles ||
+      segmented.face_of_triangle != mesh_.face_of_triangle)
+    throw InvalidInputError("denoise: the hierarchy was not built on the mesh being denoised");
+  if (segmentation.labels.size() != mesh_.face_count())
+    throw InvalidInputError("denoise: the segmentation has " +
+                            std::to_string(segmentation.labels.size()) + " labels for " +
+                            std::to_string(mesh_.face_count()) + " faces");
+  std::vector<Primitive> primitives;
+  for (const ClusterReport& cluster : describe_clusters(hierarchy, segmentation))
+    primitives.push_back(cluster.primitive);
+  if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
+
+  SnapReport report;
+  report.clusters = segmentation.cluster_count();
+  const double eigenvalue_ratio =
+      std::pow(std::tan(options_.min_crease_angle_degrees * std::numbers::pi / 360), 2);
+  const bool bounded =
+      options_.mode == SnapMode::AllIncident && std::isfinite(options_.max_move_edge_lengths);
+  const std::vector<Vec3> start = mesh_.positions;
+
+  // Candidate targets of a vertex, most preferred first: all incident primitives, then without
+  // the farthest one, and so on down to the nearest alone.
+  auto candidates = [&](std::uint32_t v, std::vector<std::uint32_t>& clusters) {
+    clusters.clear();
+    for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i)
+      clusters.push_back(segmentation.labels[mesh_.face_of_triangle[vertex_triangles_[i]]]);
+    std::sort(clusters.begin(), clusters.end());
+    clusters.erase(std::unique(clusters.begin(), clusters.end()), clusters.end());
+    std::vector<std::pair<double, std::uint32_t>> by_distance;
+    for (const std::uint32_t c : clusters)
+      by_distance.emplace_back(primitives[c].distance(start[v]), c);
+    std::sort(by_distance.begin(), by_distance.end());
+    for (std::size_t i = 0; i < by_distance.size(); ++i) clusters[i] = by_distance[i].second;
+  };
+
+  // True when moving v to `target` inverts none of its triangles (against the input's
+  // orientation; a triangle flattened to zero area is allowed).
+  auto keeps_orientation = [&](std::uint32_t v, const Eigen::Vector3d& target) {
+    for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i) {
+      const std::uint32_t t = vertex_triangles_[i];
+      std::array<Eigen::Vector3d, 3> corner;
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t u = mesh_.triangles[t][k];
+        corner[k] = u == v ? target : to_eigen(mesh_.positions[u]);
+      }
+      if (triangle_normal(corner[0], corner[1], corner[2]).dot(to_eigen(input_normals_[t])) < 0)
+        return false;
+    }
+    return true;
+  };
+
+  const std::uint32_t n = mesh_.vertex_count();
+  // 0: not yet settled, 1: moved, 2: has no triangle.
+  std::vector<char> settled(n, 0);
+  std::vector<std::uint32_t> used_primitive_count(n, 0), incident_count(n, 0);
+  std::vector<std::uint32_t> clusters;
+  std::vector<const Primitive*> chosen;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (vertex_triangle_offsets_[v] == vertex_triangle_offsets_[v + 1]) {
+      settled[v] = 2;
+      continue;
+    }
+    candidates(v, clusters);
+    incident_count[v] = static_cast<std::uint32_t>(clusters.size());
+    (clusters.size() == 1 ? report.interior_vertices : report.boundary_vertices)++;
+  }
+  // A move blocked by a neighbour may pass once that neighbour has moved: the first sweeps try
+  // only the full snap, the last one falls back to fewer primitives. Vertex order throughout.
+  constexpr int kSweeps = 4;
+  for (int sweep = 0; sweep < kSweeps; ++sweep) {
+    const bool last_sweep = sweep == kSweeps - 1;
+    bool changed = false;
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (settled[v]) continue;
+      candidates(v, clusters);
+      const std::size_t most = options_.mode == SnapMode::AllIncident ? clusters.size() : 1;
+      const Eigen::Vector3d x = to_eigen(start[v]);
+      const double bound = options_.max_move_edge_lengths * local_edge_length_[v];
+      const std::size_t fewest = last_sweep ? 1 : most;
+      for (std::size_t count = most; count >= fewest; --count) {
+        chosen.clear();
+        for (std::size_t i = 0; i < count; ++i) chosen.push_back(&primitives[clusters[i]]);
+        const Eigen::Vector3d target =
+            least_squares_point(x, chosen, eigenvalue_ratio, options_.max_solver_steps);
+        if (!target.allFinite() || (bounded && (target - x).norm() > bound) ||
+            !keeps_orientation(v, target))
+          continue;
+        mesh_.positions[v] = to_vec3(target);
+        settled[v] = 1;
+        used_primitive_count[v] = static_cast<std::uint32_t>(count);
+        changed = true;
+        break;
+      }
+    }
+    if (!changed && !last_sweep) sweep = kSweeps - 2;  // nothing more to gain: fall back now
+  }
+
+  double move_sum = 0;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (settled[v] == 2) continue;
+    if (!settled[v]) {
+      ++report.blocked;
+      continue;
+    }
+    ++report.moved;
+    if (used_primitive_count[v] < incident_count[v] && options_.mode == SnapMode::AllIncident)
+      ++report.fallbacks;
+    const double move = (to_eigen(mesh_.positions[v]) - to_eigen(start[v])).norm();
+    move_sum += move;
+    report.max_move = std::max(report.max_move, move);
+  }
+  report.mean_move = report.moved ? move_sum / report.moved : 0;
+  return report;
+}
+
+Mesh denoise(const Mesh& mesh, const LevelSelector& level, const DenoiseOptions& options,
+             int iterations) {
+  if (iterations < 1) throw InvalidInputError("denoise: iterations must be at least 1");
+  Denoiser denoiser(mesh, options);
+  for (int i = 0; i < iterations; ++i) denoiser.iterate(level);
+  return denoiser.mesh();
+}
+
+}  // namespace primseg

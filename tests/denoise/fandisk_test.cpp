@@ -1,0 +1,85 @@
+// The paper's section 7 experiment on a real CAD mesh: fandisk with Gaussian noise of 0.3% of its
+// bounding-box diagonal along the vertex normals, denoised at several levels and measured against
+// the clean mesh (Metro-style). Prints the table the README quotes. With PRIMSEG_FIGURES_DIR set,
+// also writes the README's before/after pictures there.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "denoise_test_support.hpp"
+#include "primseg/denoise.hpp"
+#include "primseg/mesh_distance.hpp"
+#include "primseg/mesh_io.hpp"
+#include "primseg/render.hpp"
+#include "support/test_support.hpp"
+
+namespace primseg {
+namespace {
+
+TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
+  const Mesh clean = read_mesh(testing::cgal_mesh("fandisk.off"));
+  const double sigma = 0.003 * bounding_box_diagonal(clean);
+  const Mesh noisy = testing::with_normal_noise(clean, sigma, 2006);
+  DistanceOptions measure;
+  measure.samples = 200000;
+  const MeshDistance before = mesh_distance(noisy, clean, measure);
+  std::printf("fandisk: diagonal %.5g, sigma %.4g\n", before.diagonal, sigma);
+  std::printf("%8s %12s %12s %8s %12s %8s\n", "K", "rms", "hausdorff", "rms /", "smoothing",
+              "haus /");
+  std::printf("%8s %12.4g %12.4g\n", "noisy", before.rms, before.hausdorff);
+  double best_ratio = 0;
+  std::uint32_t best_k = 0;
+  Mesh best;
+  for (const int smoothing : {0, 5})
+    for (const std::uint32_t k : {20u, 30u, 40u, 60u}) {
+      DenoiseOptions options;
+      options.smoothing_steps = smoothing;
+      Denoiser denoiser(noisy, options);
+      const SnapReport report = denoiser.iterate(level_by_count(k));
+      const MeshDistance after = mesh_distance(denoiser.mesh(), clean, measure);
+      std::printf("%8u %12.4g %12.4g %8.2f %12d %8.2f   (%u fallbacks, %u blocked)\n", k, after.rms,
+                  after.hausdorff, before.rms / after.rms, smoothing,
+                  before.hausdorff / after.hausdorff, report.fallbacks, report.blocked);
+      EXPECT_EQ(testing::inverted_triangles(noisy, denoiser.mesh()), 0u);
+      if (smoothing > 0 && k >= 30) {
+        EXPECT_LT(after.rms * 2, before.rms);
+      }
+      if (before.rms / after.rms > best_ratio) {
+        best_ratio = before.rms / after.rms;
+        best_k = k;
+        best = denoiser.mesh();
+      }
+    }
+  std::printf("best K %u: RMS %.2fx lower\n", best_k, best_ratio);
+  // The target is 5x. Measured: 2.8x (smoothing 5, K = 60); without smoothing, noise
+  // fragments the segmentation into small planes and the gain is at most 1.6x. This guards what
+  // is reached; the gap is the engine's segmentation of noisy curved parts (see README).
+  EXPECT_GE(best_ratio, 2.5);
+
+  if (const char* figures = std::getenv("PRIMSEG_FIGURES_DIR")) {
+    const std::filesystem::path dir(figures);
+    RenderOptions view;
+    view.width = 600;
+    view.height = 450;
+    view.view_direction = {-1.0, -0.6, -0.9};
+    Vec3 low = clean.positions[0], high = clean.positions[0];
+    for (const Vec3& p : clean.positions)
+      for (int d = 0; d < 3; ++d) {
+        low[d] = std::min(low[d], p[d]);
+        high[d] = std::max(high[d], p[d]);
+      }
+    view.frame_box = {{low, high}};
+    for (const auto& [name, mesh] :
+         {std::pair<const char*, const Mesh*>{"fandisk-clean.png", &clean},
+          {"fandisk-noisy.png", &noisy},
+          {"fandisk-denoised.png", &best}})
+      write_png(dir / name, *mesh, {}, view);
+  }
+}
+
+}  // namespace
+}  // namespace primseg
