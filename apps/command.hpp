@@ -22,6 +22,8 @@ struct Command {
 Command add_segment_command(CLI::App& app);
 Command add_cut_command(CLI::App& app);
 Command add_info_command(CLI::App& app);
+Command add_skeleton_command(CLI::App& app);
+Command add_deform_command(CLI::App& app);
 
 // Helpers shared by the commands.
 

@@ -23,9 +23,8 @@ int run(int argc, char** argv) {
   app.set_version_flag("--version", "primseg 0.1.0");
 
   const std::vector<Command> commands = {
-      add_segment_command(app),
-      add_cut_command(app),
-      add_info_command(app),
+      add_segment_command(app),  add_cut_command(app),    add_info_command(app),
+      add_skeleton_command(app), add_deform_command(app),
   };
 
   // Name an unknown command instead of CLI11's "A subcommand is required".
