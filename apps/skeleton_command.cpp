@@ -1,3 +1,4 @@
+#include <array>
 #include <cstdio>
 #include <memory>
 
@@ -16,6 +17,7 @@ Command add_skeleton_command(CLI::App& app) {
   struct Options {
     std::string mesh_path, output, primitives = "cylinder";
     std::optional<std::string> skin_weights, png;
+    std::array<double, 3> view = RenderOptions{}.view_direction, up = RenderOptions{}.up;
     LevelChoice level;
     double band = SkinningOptions{}.band;
     unsigned threads = 0;
@@ -39,6 +41,12 @@ Command add_skeleton_command(CLI::App& app) {
                    "Skinning blend half-width on each side of a boundary, in bone radii")
       ->capture_default_str();
   command->add_option("--png", o->png, "Render the skeleton over the clusters (800x600)");
+  command->add_option("--view", o->view, "--png: direction from the eye to the model")
+      ->delimiter(',')
+      ->capture_default_str();
+  command->add_option("--up", o->up, "--png: direction that points up in the picture")
+      ->delimiter(',')
+      ->capture_default_str();
   command->add_option("--threads", o->threads, "Threads (0: all cores)")->capture_default_str();
   command->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
 
@@ -76,7 +84,12 @@ Command add_skeleton_command(CLI::App& app) {
             detail::write_file_atomically(
                 o->output,
                 json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
-            if (o->png) write_skeleton_png(*o->png, *mesh, skeleton);
+            if (o->png) {
+              RenderOptions picture;
+              picture.view_direction = o->view;
+              picture.up = o->up;
+              write_skeleton_png(*o->png, *mesh, skeleton, picture);
+            }
             if (!o->quiet) {
               std::size_t counts[3] = {0, 0, 0};
               for (const Joint& joint : skeleton.joints) ++counts[static_cast<int>(joint.kind)];
