@@ -5,7 +5,7 @@
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/skinning.hpp"
-#include "skeleton_json.hpp"
+#include "skeleton_io.hpp"
 
 namespace primseg::cli {
 
@@ -13,6 +13,7 @@ Command add_deform_command(CLI::App& app) {
   struct Options {
     std::string mesh_path, skeleton_path, pose_path, output;
     double band = SkinningOptions{}.band;
+    SkeletonPicture picture;
     bool quiet = false;
   };
   auto o = std::make_shared<Options>();
@@ -32,6 +33,7 @@ Command add_deform_command(CLI::App& app) {
       ->add_option("--band", o->band,
                    "Skinning blend half-width on each side of a boundary, in bone radii")
       ->capture_default_str();
+  o->picture.add_options(*command, "the posed mesh and skeleton");
   command->add_flag("--quiet,-q", o->quiet, "No summary output");
 
   return {command, [o] {
@@ -47,8 +49,17 @@ Command add_deform_command(CLI::App& app) {
                                       o->mesh_path + "' has " + std::to_string(mesh.face_count()));
             SkinningOptions skinning;
             skinning.band = o->band;
-            const Mesh posed = deform(mesh, skeleton, pose, skinning);
+            const SkinWeights weights = compute_skin_weights(mesh, skeleton, skinning);
+            const std::vector<RigidTransform> bones = pose_bones(skeleton, pose);
+            Mesh posed = mesh;
+            posed.positions = skin_positions(mesh.positions, weights, bones);
             write_mesh(o->output, posed);
+            if (o->picture.png) {
+              Skeleton posed_skeleton = skeleton;
+              const std::vector<Vec3> joints = posed_joint_positions(skeleton, bones);
+              for (Joint& joint : posed_skeleton.joints) joint.position = joints[joint.id];
+              o->picture.write(posed, posed_skeleton);
+            }
             if (!o->quiet)
               std::printf("%s: %zu joint rotations applied, %u vertices\n", o->output.c_str(),
                           pose.size(), posed.vertex_count());

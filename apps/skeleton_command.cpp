@@ -7,17 +7,16 @@
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/skeleton.hpp"
-#include "primseg/skeleton_render.hpp"
 #include "primseg/skinning.hpp"
-#include "skeleton_json.hpp"
+#include "skeleton_io.hpp"
 
 namespace primseg::cli {
 
 Command add_skeleton_command(CLI::App& app) {
   struct Options {
     std::string mesh_path, output, primitives = "cylinder";
-    std::optional<std::string> skin_weights, png;
-    std::array<double, 3> view = RenderOptions{}.view_direction, up = RenderOptions{}.up;
+    std::optional<std::string> skin_weights;
+    SkeletonPicture picture;
     LevelChoice level;
     double band = SkinningOptions{}.band;
     unsigned threads = 0;
@@ -40,13 +39,7 @@ Command add_skeleton_command(CLI::App& app) {
       ->add_option("--band", o->band,
                    "Skinning blend half-width on each side of a boundary, in bone radii")
       ->capture_default_str();
-  command->add_option("--png", o->png, "Render the skeleton over the clusters (800x600)");
-  command->add_option("--view", o->view, "--png: direction from the eye to the model")
-      ->delimiter(',')
-      ->capture_default_str();
-  command->add_option("--up", o->up, "--png: direction that points up in the picture")
-      ->delimiter(',')
-      ->capture_default_str();
+  o->picture.add_options(*command, "the skeleton over the clusters");
   command->add_option("--threads", o->threads, "Threads (0: all cores)")->capture_default_str();
   command->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
 
@@ -84,12 +77,7 @@ Command add_skeleton_command(CLI::App& app) {
             detail::write_file_atomically(
                 o->output,
                 json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
-            if (o->png) {
-              RenderOptions picture;
-              picture.view_direction = o->view;
-              picture.up = o->up;
-              write_skeleton_png(*o->png, *mesh, skeleton, picture);
-            }
+            o->picture.write(*mesh, skeleton);
             if (!o->quiet) {
               std::size_t counts[3] = {0, 0, 0};
               for (const Joint& joint : skeleton.joints) ++counts[static_cast<int>(joint.kind)];

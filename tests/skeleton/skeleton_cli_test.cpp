@@ -128,10 +128,11 @@ TEST_F(SkeletonCli, DeformRotatesTheForearmAndLeavesTheRestInPlace) {
   }
   std::string output;
   ASSERT_EQ(run("deform " + path("figure.off") + " " + path("skeleton.json") + " " +
-                    path("pose.json") + " -o " + path("posed.ply"),
+                    path("pose.json") + " -o " + path("posed.ply") + " --png " + path("posed.png"),
                 &output),
             0)
       << output;
+  EXPECT_EQ(slurp(path("posed.png")).substr(0, 4), "\x89PNG");
   const Mesh posed = read_mesh(path("posed.ply"));
   ASSERT_EQ(posed.vertex_count(), figure_.mesh.vertex_count());
   double moved = 0;

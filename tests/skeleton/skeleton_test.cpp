@@ -10,6 +10,7 @@
 #include <map>
 #include <numbers>
 #include <set>
+#include <sstream>
 
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
@@ -273,7 +274,9 @@ TEST(Skinning, ElbowRotationMovesTheForearmRigidlyAndLeavesTheTorsoStill) {
       worst = std::max(worst, std::abs(after - before) / before);
     }
   }
-  RecordProperty("forearm_distance_relative_error", std::to_string(worst));
+  std::ostringstream measured;
+  measured << worst;
+  RecordProperty("forearm_distance_relative_error", measured.str());
   EXPECT_LT(worst, 1e-9);
   EXPECT_GT(largest_move, 0.5) << "the forearm did not move";
   // The forearm's free end turned by 90 degrees about the elbow.

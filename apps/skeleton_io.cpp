@@ -1,4 +1,4 @@
-#include "skeleton_json.hpp"
+#include "skeleton_io.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,6 +8,7 @@
 
 #include "../src/file_io.hpp"
 #include "primseg/error.hpp"
+#include "primseg/skeleton_render.hpp"
 
 namespace primseg::cli {
 namespace {
@@ -188,6 +189,24 @@ std::string skin_weights_text(const SkinWeights& weights) {
     text += '\n';
   }
   return text;
+}
+
+void SkeletonPicture::add_options(CLI::App& command, const std::string& what) {
+  command.add_option("--png", png, "Render " + what + " (800x600 PNG)");
+  command.add_option("--view", view, "--png: direction from the eye to the model")
+      ->delimiter(',')
+      ->capture_default_str();
+  command.add_option("--up", up, "--png: direction that points up in the picture")
+      ->delimiter(',')
+      ->capture_default_str();
+}
+
+void SkeletonPicture::write(const Mesh& mesh, const Skeleton& skeleton) const {
+  if (!png) return;
+  RenderOptions options;
+  options.view_direction = view;
+  options.up = up;
+  write_skeleton_png(*png, mesh, skeleton, options);
 }
 
 }  // namespace primseg::cli
