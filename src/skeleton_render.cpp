@@ -55,7 +55,9 @@ class Canvas {
  private:
   template <typename Inside>
   void fill_box(double x0, double x1, double y0, double y1, const Rgb& color, Inside inside) {
-    // Far-off points (a joint outside a frame_box) are clipped to the picture.
+    // Far-off points (a joint outside a frame_box) are clipped to the picture; a position that
+    // overflowed to NaN (coordinates near the double range) is not drawn.
+    if (std::isnan(x0) || std::isnan(x1) || std::isnan(y0) || std::isnan(y1)) return;
     const int i0 = static_cast<int>(std::clamp(std::floor(x0), 0.0, double(width_)));
     const int i1 = static_cast<int>(std::clamp(std::ceil(x1), 0.0, double(width_)));
     const int j0 = static_cast<int>(std::clamp(std::floor(y0), 0.0, double(height_)));
