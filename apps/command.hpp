@@ -26,6 +26,8 @@ Command add_eval_command(CLI::App& app);
 Command add_batch_command(CLI::App& app);
 Command add_denoise_command(CLI::App& app);
 Command add_distance_command(CLI::App& app);
+Command add_skeleton_command(CLI::App& app);
+Command add_deform_command(CLI::App& app);
 
 // Helpers shared by the commands.
 

@@ -22,6 +22,8 @@ int run(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "primseg 0.1.0");
 
+  // One command per line, so that adding one is a one-line change.
+  // clang-format off
   const std::vector<Command> commands = {
       add_segment_command(app),
       add_cut_command(app),
@@ -30,7 +32,10 @@ int run(int argc, char** argv) {
       add_batch_command(app),
       add_denoise_command(app),
       add_distance_command(app),
+      add_skeleton_command(app),
+      add_deform_command(app),
   };
+  // clang-format on
 
   // Name an unknown command instead of CLI11's "A subcommand is required".
   if (argc > 1 && argv[1][0] != '-') {

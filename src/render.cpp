@@ -676,6 +676,21 @@ std::vector<std::uint8_t> filter_scanlines(std::span<const std::uint8_t> rgb, in
   return filtered;
 }
 
+// The camera of a picture of the mesh (supersampled); false, leaving `camera` as it is, when
+// there is no triangle to frame.
+bool picture_camera(const Mesh& mesh, const RenderOptions& options, Camera& camera) {
+  Vec3 low;
+  Vec3 high;
+  if (!bounding_box_of_triangles(mesh, low, high)) return false;
+  if (options.frame_box) {
+    low = (*options.frame_box)[0];
+    high = (*options.frame_box)[1];
+  }
+  camera = make_camera(low, high, options, options.width * options.supersample,
+                       options.height * options.supersample);
+  return true;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> render_mesh(const Mesh& mesh,
@@ -690,15 +705,8 @@ std::vector<std::uint8_t> render_mesh(const Mesh& mesh,
   const int sample_height = options.height * options.supersample;
   SampleBuffer buffer(sample_width, sample_height);
 
-  Vec3 low;
-  Vec3 high;
   Camera camera;
-  if (bounding_box_of_triangles(mesh, low, high)) {
-    if (options.frame_box) {
-      low = (*options.frame_box)[0];
-      high = (*options.frame_box)[1];
-    }
-    camera = make_camera(low, high, options, sample_width, sample_height);
+  if (picture_camera(mesh, options, camera)) {
     const std::vector<ProjectedVertex> projected = project_vertices(mesh, camera);
     const double edge_half_width_subpixels =
         options.edges ? kEdgeHalfWidthPixels * options.supersample * kSubpixel : 0.0;
@@ -710,6 +718,23 @@ std::vector<std::uint8_t> render_mesh(const Mesh& mesh,
     }
   }
   return resolve(buffer, mesh, face_colors, camera, options);
+}
+
+std::vector<std::array<double, 2>> project_to_picture(const Mesh& mesh,
+                                                      std::span<const Vec3> points,
+                                                      const RenderOptions& options) {
+  validate_options(options);
+  Camera camera;
+  picture_camera(mesh, options, camera);
+  std::vector<std::array<double, 2>> result(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3 offset = subtract(points[i], camera.centre);
+    result[i] = {(camera.half_width + dot(offset, camera.right) * camera.samples_per_unit) /
+                     options.supersample,
+                 (camera.half_height - dot(offset, camera.up) * camera.samples_per_unit) /
+                     options.supersample};
+  }
+  return result;
 }
 
 std::string encode_png(std::span<const std::uint8_t> rgb, int width, int height) {

@@ -61,6 +61,13 @@ std::vector<std::uint8_t> render_mesh(const Mesh& mesh,
                                       std::span<const std::array<std::uint8_t, 3>> face_colors,
                                       const RenderOptions& options = {});
 
+/// Where render_mesh(mesh, ..., options) draws each model-space point: pixel coordinates (x to the
+/// right, y down, the centre of pixel (i, j) at (i + 0.5, j + 0.5)), shape (n). For drawing
+/// overlays (skeletons, markers) on a rendered picture. Same checks as render_mesh.
+std::vector<std::array<double, 2>> project_to_picture(const Mesh& mesh,
+                                                      std::span<const Vec3> points,
+                                                      const RenderOptions& options = {});
+
 /// Encodes RGB8 pixels (width * height * 3 bytes, row-major, top row first) as a PNG file image:
 /// 8-bit truecolour, per-row adaptive filters, zlib stream compressed with fixed-Huffman
 /// deflate (stored blocks when that would be smaller). Throws InvalidInputError when the sizes do

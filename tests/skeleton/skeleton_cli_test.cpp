@@ -1,0 +1,199 @@
+// `primseg skeleton` and `primseg deform`, run as a user would, on the stick figure written to a
+// file.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "primseg/mesh_io.hpp"
+#include "support/stick_figure.hpp"
+#include "support/test_support.hpp"
+
+namespace primseg {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A temp directory holding the stick figure as figure.off (its paths need no shell quoting).
+class SkeletonCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::temp_directory("skeleton-cli");
+    figure_ = testing::make_stick_figure();
+    write_mesh(path("figure.off"), figure_.mesh);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  int run(const std::string& args, std::string* output = nullptr) const {
+    return testing::run_command(testing::cli_path().string() + " " + args, output);
+  }
+  // The figure's skeleton at K = 8 with cylinders and spheres, as skeleton.json.
+  json skeleton(const std::string& extra = "") const {
+    std::string output;
+    EXPECT_EQ(
+        run("skeleton " + path("figure.off") + " --clusters 8 --primitives cylinder,sphere -o " +
+                path("skeleton.json") + " " + extra,
+            &output),
+        0)
+        << output;
+    return json::parse(slurp(path("skeleton.json")));
+  }
+  // The joint nearest a point.
+  static std::uint32_t nearest_joint(const json& skeleton, const Vec3& p) {
+    std::uint32_t best = 0;
+    double best_distance = INFINITY;
+    for (const json& joint : skeleton["joints"]) {
+      const auto q = joint["position"].get<std::vector<double>>();
+      const double d = std::hypot(q[0] - p[0], q[1] - p[1], q[2] - p[2]);
+      if (d < best_distance) {
+        best_distance = d;
+        best = joint["id"].get<std::uint32_t>();
+      }
+    }
+    return best;
+  }
+
+  fs::path dir_;
+  testing::StickFigure figure_;
+};
+
+TEST_F(SkeletonCli, WritesTheSkeletonAndSkinWeights) {
+  const json s = skeleton("--skin-weights " + path("weights.txt"));
+  EXPECT_EQ(s["cluster_count"], 8);
+  EXPECT_EQ(s["primitives"], "cylinder,sphere");
+  ASSERT_EQ(s["bones"].size(), 8u);
+  EXPECT_EQ(s["face_labels"].size(), figure_.mesh.face_count());
+  std::size_t sensitive = 0, virtual_joints = 0;
+  for (const json& joint : s["joints"]) {
+    for (const char* key : {"id", "position", "kind", "visible", "bones"})
+      EXPECT_TRUE(joint.contains(key)) << key;
+    sensitive += joint["kind"] == "sensitive";
+    virtual_joints += joint["kind"] == "virtual";
+  }
+  EXPECT_EQ(sensitive, 7u);       // head, 2 shoulders, 2 hips, 2 elbows
+  EXPECT_EQ(virtual_joints, 5u);  // head top, 2 hands, 2 feet
+  for (const json& bone : s["bones"])
+    for (const char* key : {"id", "cluster", "joints", "visible", "axis", "radius"})
+      EXPECT_TRUE(bone.contains(key)) << key;
+
+  // One line per vertex: "bone weight" pairs summing to 1.
+  std::istringstream lines(slurp(path("weights.txt")));
+  std::string line;
+  std::uint32_t rows = 0;
+  while (std::getline(lines, line)) {
+    std::istringstream fields(line);
+    std::uint32_t bone = 0;
+    double weight = 0, sum = 0;
+    while (fields >> bone >> weight) {
+      EXPECT_LT(bone, 8u);
+      sum += weight;
+    }
+    EXPECT_NEAR(sum, 1, 1e-12) << "line " << rows + 1;
+    ++rows;
+  }
+  EXPECT_EQ(rows, figure_.mesh.vertex_count());
+}
+
+TEST_F(SkeletonCli, DefaultPrimitivesAreCylindersOnly) {
+  std::string output;
+  ASSERT_EQ(
+      run("skeleton " + path("figure.off") + " --clusters 12 -q -o " + path("s.json"), &output), 0)
+      << output;
+  const json s = json::parse(slurp(path("s.json")));
+  EXPECT_EQ(s["primitives"], "cylinder");
+  EXPECT_EQ(s["bones"].size(), 12u);
+}
+
+TEST_F(SkeletonCli, DeformRotatesTheForearmAndLeavesTheRestInPlace) {
+  const json s = skeleton();
+  const std::uint32_t elbow = nearest_joint(s, figure_.elbow[1]);
+  {
+    std::ofstream pose(path("pose.json"));
+    pose << R"({"rotations": [{"joint": )" << elbow << R"(, "axis": [0, 1, 0], "degrees": 90}]})";
+  }
+  std::string output;
+  ASSERT_EQ(run("deform " + path("figure.off") + " " + path("skeleton.json") + " " +
+                    path("pose.json") + " -o " + path("posed.ply") + " --png " + path("posed.png"),
+                &output),
+            0)
+      << output;
+  EXPECT_EQ(slurp(path("posed.png")).substr(0, 4), "\x89PNG");
+  const Mesh posed = read_mesh(path("posed.ply"));
+  ASSERT_EQ(posed.vertex_count(), figure_.mesh.vertex_count());
+  double moved = 0;
+  for (std::uint32_t v = 0; v < posed.vertex_count(); ++v) {
+    const Vec3& before = figure_.mesh.positions[v];
+    // Away from the right arm's elbow, nothing moves at all.
+    if (before[0] < 1.5) {
+      ASSERT_EQ(posed.positions[v], before) << "vertex " << v;
+    }
+    moved = std::max(
+        moved, std::hypot(posed.positions[v][0] - before[0], posed.positions[v][1] - before[1],
+                          posed.positions[v][2] - before[2]));
+  }
+  EXPECT_GT(moved, 1.0);
+}
+
+TEST_F(SkeletonCli, BadInputGivesAClearError) {
+  const json s = skeleton();
+  std::uint32_t virtual_joint = 0;
+  for (const json& joint : s["joints"])
+    if (joint["kind"] == "virtual") virtual_joint = joint["id"];
+  const auto deform_with = [&](const std::string& pose_text, std::string* output,
+                               const std::string& mesh = "figure.off") {
+    std::ofstream(path("pose.json")) << pose_text;
+    return run("deform " + path(mesh) + " " + path("skeleton.json") + " " + path("pose.json") +
+                   " -o " + path("out.off"),
+               output);
+  };
+  std::string output;
+  EXPECT_EQ(deform_with(R"({"rotations": [{"joint": )" + std::to_string(virtual_joint) +
+                            R"(, "axis": [0, 0, 1], "degrees": 30}]})",
+                        &output),
+            1);
+  EXPECT_NE(output.find("only sensitive joints rotate"), std::string::npos) << output;
+  EXPECT_EQ(deform_with(R"({"rotations": [{"joint": 0, "axis": [0, 0], "degrees": 30}]})", &output),
+            1);
+  EXPECT_NE(output.find("axis must be an array of 3 numbers"), std::string::npos) << output;
+  EXPECT_EQ(deform_with(R"({"rotations": [)", &output), 1);
+  EXPECT_NE(output.find("not valid JSON"), std::string::npos) << output;
+
+  // A skeleton made from another mesh.
+  const Mesh other = testing::grid_mesh(3, 3, [](double u, double v) { return Vec3{u, v, 0}; });
+  write_mesh(path("other.off"), other);
+  EXPECT_EQ(deform_with(R"({"rotations": []})", &output, "other.off"), 1);
+  EXPECT_NE(output.find("was made from a mesh of"), std::string::npos) << output;
+
+  // A truncated skeleton file.
+  const std::string text = slurp(path("skeleton.json"));
+  std::ofstream(path("skeleton.json")) << text.substr(0, text.size() / 2);
+  EXPECT_EQ(deform_with(R"({"rotations": []})", &output), 1);
+  EXPECT_NE(output.find("not valid JSON"), std::string::npos) << output;
+
+  // skeleton: a level is required; a bad band is refused.
+  EXPECT_EQ(run("skeleton " + path("figure.off") + " -o " + path("x.json"), &output), 1);
+  EXPECT_NE(output.find("--clusters"), std::string::npos) << output;
+  EXPECT_EQ(run("skeleton " + path("figure.off") + " --clusters 8 --band -1 -o " + path("x.json"),
+                &output),
+            1);
+  EXPECT_NE(output.find("--band"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(path("x.json")));
+}
+
+}  // namespace
+}  // namespace primseg
