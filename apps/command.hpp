@@ -22,6 +22,7 @@ struct Command {
 Command add_segment_command(CLI::App& app);
 Command add_cut_command(CLI::App& app);
 Command add_info_command(CLI::App& app);
+Command add_view_command(CLI::App& app);
 
 // Helpers shared by the commands.
 

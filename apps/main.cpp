@@ -26,6 +26,7 @@ int run(int argc, char** argv) {
       add_segment_command(app),
       add_cut_command(app),
       add_info_command(app),
+      add_view_command(app),
   };
 
   // Name an unknown command instead of CLI11's "A subcommand is required".
