@@ -28,8 +28,12 @@ add_custom_command(OUTPUT ${viewer_source}
   COMMENT "Embedding the web viewer page")
 target_sources(primseg_cli PRIVATE ${viewer_source})
 target_include_directories(primseg_cli PRIVATE ${PROJECT_SOURCE_DIR}/apps)
-if(viewer_page)
-  set(PRIMSEG_VIEWER_AVAILABLE ON)
-else()
-  set(PRIMSEG_VIEWER_AVAILABLE OFF)
-endif()
+
+# The browser tests (web/test/) in CTest, when the npm dependencies are installed.
+function(primseg_add_viewer_tests)
+  if(PRIMSEG_NODE AND EXISTS ${PRIMSEG_WEB_DIR}/node_modules/playwright-core)
+    add_test(NAME web.viewer COMMAND ${PRIMSEG_NODE} --test ${PRIMSEG_WEB_DIR}/test/)
+    set_tests_properties(web.viewer PROPERTIES RUN_SERIAL ON TIMEOUT 900
+      ENVIRONMENT "PRIMSEG=$<TARGET_FILE:primseg_cli>;PRIMSEG_WEB_ARTIFACTS=${PROJECT_BINARY_DIR}/web-artifacts")
+  endif()
+endfunction()

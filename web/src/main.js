@@ -42,7 +42,7 @@ function clusterColor(seed) {
   return hslToRgb(hue, saturation, lightness);
 }
 
-const format = (x) => (Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(4) : x.toPrecision(6));
+const format = (x) => x === 0 ? '0' : (Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(4) : x.toPrecision(6));
 const formatVector = (v) => '(' + v.map(format).join(', ') + ')';
 
 class Viewer {
@@ -69,7 +69,8 @@ class Viewer {
     // Colours are written as they should appear: no colour-space conversion (and, in test mode,
     // pixels equal to the cluster codes).
     this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
-    this.renderer.setClearColor(testMode ? 0x000000 : 0x1d2026);
+    this.renderer.setClearColor(testMode ? new THREE.Color(0, 0, 0)
+      : new THREE.Color().setRGB(0x1d / 255, 0x20 / 255, 0x26 / 255, THREE.LinearSRGBColorSpace));
     this.scene = new THREE.Scene();
 
     const { positions, triangles } = this.data;
@@ -342,7 +343,15 @@ class Viewer {
         const v = 3 * meshTriangles[3 * t + (k % 3)];
         points.push([positions[v], positions[v + 1], positions[v + 2]]);
       }
-      const surface = primitiveSurface(primitive, points);
+      let patch = null;
+      if (primitive.type === 0) {
+        patch = new Float32Array(9 * count);
+        for (let k = 0; k < 3 * count; ++k) {
+          const v = 3 * meshTriangles[3 * triangles[offsets[c] + Math.floor(k / 3)] + (k % 3)];
+          patch.set(positions.subarray(v, v + 3), 3 * k);
+        }
+      }
+      const surface = primitiveSurface(primitive, points, patch);
       if (!surface) continue;
       const base = vertices.length / 3;
       const rgb = Array.from(this.currentColors.subarray(3 * c, 3 * c + 3)).map((x) => Math.min(255, x + 60) / 255);

@@ -70,7 +70,9 @@ export class ErrorPlot {
     g.font = '10px system-ui, sans-serif';
     g.textAlign = 'center';
     for (let K = 1; K <= this.faces; K *= 10) g.fillText(String(K), this.x(K), h - 8);
-    g.fillText('clusters', m.left + this.width() / 2 + 40, h - 8);
+    g.textAlign = 'right';
+    g.fillText('clusters (log)', m.left + this.width() - 4, m.top + 12);
+    g.textAlign = 'center';
     g.textAlign = 'right';
     g.fillText(top.toPrecision(2), m.left - 3, m.top + 8);
     g.fillText('0', m.left - 3, m.top + plotH);

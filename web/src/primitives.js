@@ -137,21 +137,32 @@ function convexHull(points) {
 
 /**
  * A surface of the primitive covering the given points (an array of [x, y, z]): a plane patch
- * (their convex hull), a sphere cap, a cylinder or cone segment, a piece of torus. Returns
+ * (the given triangle corners `patch`, flat xyz, projected on it; else the points' convex
+ * hull), a sphere cap, a cylinder or cone segment, a piece of torus. Returns
  * {vertices: flat xyz, indices} or null when it cannot be drawn.
  */
-export function primitiveSurface(p, points) {
+export function primitiveSurface(p, points, patch = null) {
   if (points.length < 3) return null;
   const a = normalized(p.axis);
   const [u, v] = basis(a);
   const o = p.point;
   switch (p.type) {
     case 0: {
+      // The cluster's own triangles projected on the plane: a patch with the cluster's exact
+      // outline, holes and concave sides included.
+      if (patch) {
+        const vertices = [];
+        for (let k = 0; k < patch.length; k += 3) {
+          const x = [patch[k], patch[k + 1], patch[k + 2]];
+          vertices.push(...sub(x, scale(a, dot(a, sub(x, o)))));
+        }
+        return { vertices, indices: Array.from({ length: patch.length / 3 }, (_, k) => k) };
+      }
       const hull = convexHull(points.map((x) => [dot(sub(x, o), u), dot(sub(x, o), v)]));
       if (hull.length < 3) return null;
       const vertices = [], indices = [];
       for (const [s, t] of hull) vertices.push(...add(o, add(scale(u, s), scale(v, t))));
-      for (let i = 1; i + 1 < hull.length; ++i) indices.push(0, i, i + 1);
+      for (let k = 1; k + 1 < hull.length; ++k) indices.push(0, k, k + 1);
       return { vertices, indices };
     }
     case 1: {

@@ -1,0 +1,54 @@
+// Figures of `primseg view` pages (printed, not asserted: the machine is shared and noisy):
+// page size, load time in headless chromium (median of 3 loads) and slider step time (median of
+// 20 steps between log-spaced levels, each step a cut, a recolouring and a render).
+//
+// Usage: PRIMSEG=path/to/primseg node bench/viewer-bench.mjs MESH...
+//        (a mesh named "torus1m" is generated: 1,000,000 triangles)
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, statSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { basename, join, resolve } from 'node:path';
+import { launchBrowser, openViewer } from '../test/browser.mjs';
+import { writeWavyTorus } from '../test/meshes.mjs';
+
+const cli = resolve(process.env.PRIMSEG ?? '../build/primseg');
+const work = mkdtempSync(join(tmpdir(), 'primseg-web-bench-'));
+const median = (values) => [...values].sort((a, b) => a - b)[Math.floor(values.length / 2)];
+
+const browser = await launchBrowser();
+for (let mesh of process.argv.slice(2)) {
+  if (mesh === 'torus1m') {
+    mesh = join(work, 'torus1m.off');
+    writeWavyTorus(mesh, 1000, 500);
+  }
+  const html = join(work, basename(mesh) + '.html');
+  const start = Date.now();
+  execFileSync(cli, ['view', mesh, '-o', html, '--quiet']);
+  const viewSeconds = (Date.now() - start) / 1000;
+  const loads = [];
+  let steps = [];
+  for (let run = 0; run < 3; ++run) {
+    const { page, errors, loadMs, wallMs } = await openViewer(browser, html);
+    if (errors.length) throw new Error(`${mesh}: console errors: ${errors.join('; ')}`);
+    loads.push({ loadMs, wallMs });
+    if (run === 0)
+      steps = await page.evaluate(async () => {
+        const viewer = await window.primseg.ready;
+        const F = viewer.tree.faceCount, times = [];
+        for (let i = 0; i < 20; ++i) {
+          const K = Math.round(Math.exp(((i % 10) / 10) * Math.log(F))) + (i >= 10 ? 1 : 0);
+          const start = performance.now();
+          viewer.setClusters(K);
+          viewer.renderer.getContext().finish(); // the frame is drawn, not only queued
+          times.push(performance.now() - start);
+        }
+        return times;
+      });
+    await page.close();
+  }
+  console.log(`${basename(mesh)}: page ${(statSync(html).size / 1e6).toFixed(1)} MB (primseg view ${viewSeconds.toFixed(1)} s), ` +
+    `load ${(median(loads.map((l) => l.loadMs)) / 1000).toFixed(2)} s in the page ` +
+    `(${(median(loads.map((l) => l.wallMs)) / 1000).toFixed(2)} s from navigation), ` +
+    `slider step median ${median(steps).toFixed(1)} ms (max ${Math.max(...steps).toFixed(1)} ms)`);
+}
+await browser.close();
