@@ -1,7 +1,7 @@
 // primseg view: one self-contained HTML page to browse the whole hierarchy in a browser.
 //
-// The page gets the mesh and the merge tree as little-endian typed arrays in base64 (see
-// web/src/data.ts for the reader and docs/viewer.md for the layout), and cuts levels itself.
+// The page gets the mesh and the merge tree as little-endian typed arrays in base64 (the layout
+// is documented by their reader, web/src/data.js), and cuts levels itself.
 
 #include <algorithm>
 #include <bit>
