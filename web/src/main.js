@@ -482,7 +482,6 @@ const ready = (async () => {
   const decoded = performance.now();
   const viewer = new Viewer(data);
   viewer.render();
-  viewer.renderer.getContext().finish();
   viewer.loadMs = performance.now() - start;
   viewer.loadTimes = { decodeMs: decoded - start, viewerMs: performance.now() - decoded };
   return viewer;
