@@ -28,6 +28,7 @@ Command add_denoise_command(CLI::App& app);
 Command add_distance_command(CLI::App& app);
 Command add_skeleton_command(CLI::App& app);
 Command add_deform_command(CLI::App& app);
+Command add_view_command(CLI::App& app);
 
 // Helpers shared by the commands.
 

@@ -34,6 +34,7 @@ int run(int argc, char** argv) {
       add_distance_command(app),
       add_skeleton_command(app),
       add_deform_command(app),
+      add_view_command(app),
   };
   // clang-format on
 

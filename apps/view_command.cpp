@@ -1,0 +1,232 @@
+// primseg view: one self-contained HTML page to browse the whole hierarchy in a browser.
+//
+// The page gets the mesh and the merge tree as little-endian typed arrays in base64 (the layout
+// is documented by their reader, web/src/data.js), and cuts levels itself.
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "../src/file_io.hpp"
+#include "command.hpp"
+#include "primseg/error.hpp"
+#include "primseg/mesh_io.hpp"
+#include "primseg/tree_io.hpp"
+#include "viewer_bundle.hpp"
+
+namespace primseg::cli {
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "the page reads the arrays as little-endian typed arrays");
+
+/// Merges whose primitive parameters go into the page: the last ones, that is every cluster of
+/// every level with at most this many + 1 clusters. Finer levels show their clusters' type and
+/// RMS estimate only (a 1M-face page would otherwise carry 72 MB of parameters).
+constexpr std::uint32_t kMergesWithParameters = 32768;
+
+std::string base64(const void* data, std::size_t size) {
+  static constexpr char kAlphabet[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  std::string out;
+  out.reserve((size + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 3 <= size; i += 3) {
+    const unsigned v = bytes[i] << 16 | bytes[i + 1] << 8 | bytes[i + 2];
+    out += kAlphabet[v >> 18];
+    out += kAlphabet[v >> 12 & 63];
+    out += kAlphabet[v >> 6 & 63];
+    out += kAlphabet[v & 63];
+  }
+  if (i < size) {
+    const unsigned v = bytes[i] << 16 | (i + 1 < size ? bytes[i + 1] << 8 : 0);
+    out += kAlphabet[v >> 18];
+    out += kAlphabet[v >> 12 & 63];
+    out += i + 1 < size ? kAlphabet[v >> 6 & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+/// Appends `<script type="application/octet-stream" id="primseg-NAME">BASE64</script>`.
+template <typename T>
+void append_array(std::string& html, const char* name, const std::vector<T>& values) {
+  html += "<script type=\"application/octet-stream\" id=\"primseg-";
+  html += name;
+  html += "\">";
+  html += base64(values.data(), values.size() * sizeof(T));
+  html += "</script>\n";
+}
+
+/// JSON that can sit inside a <script> element: no "</script" can appear.
+std::string script_safe(const nlohmann::json& json) {
+  const std::string text = json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    if (c == '<')
+      out += "\\u003c";  // '<' only occurs inside JSON strings, where the escape is valid
+    else
+      out += c;
+  }
+  return out;
+}
+
+std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
+                      std::uint32_t initial_clusters) {
+  const Mesh& mesh = hierarchy.mesh();
+  const std::uint32_t f = hierarchy.face_count();
+  const auto merges = hierarchy.merges();
+
+  // Positions relative to the bounding-box centre, so that float32 keeps the shape's detail
+  // even far from the origin.
+  Vec3 low = mesh.positions.empty() ? Vec3{0, 0, 0} : mesh.positions[0], high = low;
+  for (const Vec3& p : mesh.positions)
+    for (int a = 0; a < 3; ++a) {
+      low[a] = std::min(low[a], p[a]);
+      high[a] = std::max(high[a], p[a]);
+    }
+  const Vec3 center{(low[0] + high[0]) / 2, (low[1] + high[1]) / 2, (low[2] + high[2]) / 2};
+  std::vector<float> positions(mesh.positions.size() * 3);
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+    for (int a = 0; a < 3; ++a)
+      positions[3 * v + a] = static_cast<float>(mesh.positions[v][a] - center[a]);
+  std::vector<std::uint32_t> triangles(mesh.triangles.size() * 3);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    std::copy(mesh.triangles[t].begin(), mesh.triangles[t].end(), triangles.begin() + 3 * t);
+
+  std::vector<std::uint32_t> children(merges.size() * 2);
+  std::vector<double> rms(merges.size());
+  std::vector<std::uint8_t> types(merges.size());
+  for (std::size_t i = 0; i < merges.size(); ++i) {
+    children[2 * i] = merges[i].first;
+    children[2 * i + 1] = merges[i].second;
+    rms[i] = hierarchy.rms_estimate(static_cast<std::uint32_t>(f + i));
+    types[i] = static_cast<std::uint8_t>(merges[i].primitive.type);
+  }
+  // Parameters of the last merges, relative to the same centre as the positions.
+  const std::uint32_t real = f - hierarchy.component_count();
+  const std::uint32_t with_parameters = std::min(real, kMergesWithParameters);
+  std::vector<double> parameters;
+  parameters.reserve(with_parameters * 9);
+  for (std::uint32_t i = real - with_parameters; i < real; ++i) {
+    const Primitive& p = merges[i].primitive;
+    for (int a = 0; a < 3; ++a) parameters.push_back(p.point[a] - center[a]);
+    for (int a = 0; a < 3; ++a) parameters.push_back(p.axis[a]);
+    parameters.push_back(p.radius);
+    parameters.push_back(p.minor_radius);
+    parameters.push_back(p.half_angle);
+  }
+
+  nlohmann::json header = {
+      {"format", 1},
+      {"name", mesh_name},
+      {"faces", f},
+      {"vertices", mesh.vertex_count()},
+      {"triangles", mesh.triangle_count()},
+      {"components", hierarchy.component_count()},
+      {"center", center},
+      {"bboxDiagonal", bounding_box_diagonal(mesh)},
+      {"weights", hierarchy.options().weights == VertexWeights::Uniform ? "uniform" : "area"},
+      {"firstMergeWithParameters", real - with_parameters},
+      {"initialClusters", initial_clusters},
+      // Later: automatic levels ("levels": [K...]) and the skeleton ("skeleton": {...}); the
+      // page draws them when present (web/src/hooks.ts).
+  };
+  std::string html = "<script type=\"application/json\" id=\"primseg-header\">";
+  html += script_safe(header);
+  html += "</script>\n";
+  append_array(html, "positions", positions);
+  append_array(html, "triangles", triangles);
+  // Input faces of the triangles: only needed for polygon meshes (else the identity).
+  if (mesh.triangle_count() != f) append_array(html, "face-of-triangle", mesh.face_of_triangle);
+  append_array(html, "children", children);
+  append_array(html, "rms", rms);
+  append_array(html, "types", types);
+  append_array(html, "parameters", parameters);
+  // A polygon face may be non-planar: its own RMS is then not zero.
+  if (mesh.triangle_count() != f) {
+    std::vector<double> leaf_rms(f);
+    for (std::uint32_t face = 0; face < f; ++face) leaf_rms[face] = hierarchy.rms_estimate(face);
+    append_array(html, "leaf-rms", leaf_rms);
+  }
+  return html;
+}
+
+bool same_mesh(const Mesh& a, const Mesh& b) {
+  return a.positions == b.positions && a.polygon_offsets == b.polygon_offsets &&
+         a.polygon_vertices == b.polygon_vertices;
+}
+
+}  // namespace
+
+Command add_view_command(CLI::App& app) {
+  struct Options {
+    std::string mesh_path, output, primitives = "plane,cylinder,sphere";
+    std::optional<std::string> tree_path;
+    std::optional<std::uint32_t> clusters;
+    unsigned threads = 0;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* view = app.add_subcommand(
+      "view", "Write a self-contained HTML page to browse the whole hierarchy in a browser");
+  view->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl)")->required();
+  view->add_option("--tree", o->tree_path,
+                   "Hierarchy written by segment --tree for this mesh (else it is built)");
+  view->add_option("--clusters", o->clusters,
+                   std::string("Level shown when the page opens (default: the --tolerance ") +
+                       kDefaultTolerance + " level)");
+  view->add_option("-o,--output", o->output, "The HTML page to write")->required();
+  view->add_option("--primitives", o->primitives,
+                   "Primitive types when the hierarchy is built, comma-separated")
+      ->capture_default_str();
+  view->add_option("--threads", o->threads, "Threads when the hierarchy is built (0: all cores)")
+      ->capture_default_str();
+  view->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
+
+  return {
+      view, [o] {
+        const std::string_view page = viewer_template();
+        const std::size_t marker = page.find(kViewerDataMarker);
+        if (page.empty() || marker == std::string_view::npos)
+          throw InvalidInputError(
+              "view: this primseg was built without the web viewer (npm was not available). "
+              "To enable it: cd web && npm ci, then configure and build primseg again "
+              "(CMake bundles web/ with esbuild and embeds the page)");
+        HierarchyOptions options;
+        options.primitives = parse_primitives(o->primitives);
+        options.threads = o->threads;
+        validate(options);
+        auto mesh = std::make_shared<const Mesh>(read_mesh(o->mesh_path));
+        if (o->clusters) validate_level({o->clusters, std::nullopt}, mesh->face_count());
+        const auto build_start = Clock::now();
+        const Hierarchy hierarchy = [&] {
+          if (!o->tree_path)
+            return HierarchyBuilder(mesh, options).finish(Progress("hierarchy", o->quiet));
+          Hierarchy tree = read_tree(*o->tree_path);
+          if (!same_mesh(tree.mesh(), *mesh))
+            throw InvalidInputError("view: the tree '" + *o->tree_path + "' was not built from '" +
+                                    o->mesh_path + "'");
+          return tree;
+        }();
+        const double build_seconds = seconds_since(build_start);
+        const std::uint32_t initial = cut(hierarchy, {o->clusters, std::nullopt}).cluster_count();
+        std::string html(page.substr(0, marker));
+        html +=
+            page_data(hierarchy, std::filesystem::path(o->mesh_path).filename().string(), initial);
+        html += page.substr(marker + kViewerDataMarker.size());
+        detail::write_file_atomically(o->output, html);
+        if (!o->quiet)
+          std::printf("%s: %u faces, hierarchy %s in %.3f s; %s: %.1f MB, opens at %u clusters\n",
+                      o->mesh_path.c_str(), mesh->face_count(), o->tree_path ? "read" : "built",
+                      build_seconds, o->output.c_str(), static_cast<double>(html.size()) / 1e6,
+                      initial);
+      }};
+}
+
+}  // namespace primseg::cli

@@ -1,0 +1,30 @@
+// Extension points for what other issues add to the page.
+//
+// - Automatic levels: when `primseg view` writes `"levels": [K, ...]` in the page header, they
+//   are ticked on the error plot and offered as buttons (main.js: showLevels). Nothing else is
+//   needed on the page side.
+// - Skeleton overlay: an overlay is an object {update(cut), dispose()} made by a factory
+//   registered here with a header key; the viewer calls the factory when the page header has that
+//   key (e.g. "skeleton"), with the context below, and calls update() after every change of
+//   level. Dragging joints is the overlay's own business (it gets the camera, the canvas and the
+//   mesh geometry, whose positions it may deform, then call requestRender()).
+
+const factories = new Map();
+
+/**
+ * Registers an overlay for pages whose header has `key`.
+ * @param key header key, e.g. 'skeleton'
+ * @param factory (context) => {update(cut), dispose()}; context: {header, value (header[key]),
+ *   data, tree, scene, camera, canvas, geometry, requestRender}
+ */
+export function registerOverlay(key, factory) {
+  factories.set(key, factory);
+}
+
+/** The overlays a page's header asks for. */
+export function createOverlays(context) {
+  const overlays = [];
+  for (const [key, factory] of factories)
+    if (context.header[key] !== undefined) overlays.push(factory({ ...context, value: context.header[key] }));
+  return overlays;
+}

@@ -1,0 +1,494 @@
+// The page of `primseg view`: the mesh coloured by the clusters of a level, sliders over the
+// number of clusters and the tolerance (cuts made here, in linear time), the fitted primitives,
+// the error curve, and the details of a clicked cluster.
+//
+// `?test` in the URL selects the test mode: unlit, no antialiasing, each cluster drawn in the
+// colour (i + 1) as 24-bit RGB, i its index in the cut, so that a test can count clusters in
+// the pixels. window.primseg is the page's programmatic interface (tests, other tools).
+
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { readPageData } from './data.js';
+import { Tree, TYPE_NAMES } from './hierarchy.js';
+import { clusterErrors, facePlane, primitiveSurface } from './primitives.js';
+import { ErrorPlot } from './plot.js';
+import { createOverlays } from './hooks.js';
+
+const testMode = new URLSearchParams(location.search).has('test');
+const $ = (id) => document.getElementById(id);
+
+// Types drawn in "colour by type" mode, indexed as include/primseg/primitive.hpp.
+const TYPE_COLORS = [[120, 150, 200], [235, 150, 60], [90, 190, 110], [190, 110, 210], [220, 80, 90]];
+// Beyond this many clusters the primitives are not drawn (too many to read anyway).
+const MAX_DRAWN_PRIMITIVES = 2000;
+// Points per cluster used to shape a drawn primitive (extents, hull).
+const MAX_SHAPE_POINTS = 20000;
+
+function hslToRgb(h, s, l) {
+  const k = (n) => (n + h * 12) % 12;
+  const a = s * Math.min(l, 1 - l);
+  const f = (n) => l - a * Math.max(-1, Math.min(k(n) - 3, 9 - k(n), 1));
+  return [Math.round(f(0) * 255), Math.round(f(8) * 255), Math.round(f(4) * 255)];
+}
+
+/** A colour for a cluster from its representative face, stable across levels. */
+function clusterColor(seed) {
+  let h = Math.imul(seed ^ 0x9e3779b9, 0x85ebca6b);
+  h = Math.imul(h ^ (h >>> 13), 0xc2b2ae35);
+  h ^= h >>> 16;
+  const hue = (h & 0xffff) / 65536;
+  const saturation = 0.55 + ((h >>> 16) & 0xff) / 255 * 0.35;
+  const lightness = 0.45 + ((h >>> 24) & 0xff) / 255 * 0.2;
+  return hslToRgb(hue, saturation, lightness);
+}
+
+const format = (x) => x === 0 ? '0' : (Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(4) : x.toPrecision(6));
+const formatVector = (v) => '(' + v.map(format).join(', ') + ')';
+
+class Viewer {
+  constructor(data) {
+    this.data = data;
+    this.header = data.header;
+    this.tree = new Tree(data);
+    this.colorMode = 'cluster';
+    this.selected = -1;
+    this.stepTimes = [];
+    this.setUpScene();
+    this.setUpControls();
+    this.overlays = createOverlays({
+      header: this.header, data, tree: this.tree, scene: this.scene, camera: this.camera,
+      canvas: this.renderer.domElement, geometry: this.geometry, requestRender: () => this.render(),
+    });
+    this.setClusters(this.header.initialClusters);
+  }
+
+  setUpScene() {
+    const canvas = $('view');
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !testMode, preserveDrawingBuffer: testMode });
+    this.renderer.setPixelRatio(testMode ? 1 : window.devicePixelRatio);
+    // Colours are written as they should appear: no colour-space conversion (and, in test mode,
+    // pixels equal to the cluster codes).
+    this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
+    this.renderer.setClearColor(testMode ? new THREE.Color(0, 0, 0)
+      : new THREE.Color().setRGB(0x1d / 255, 0x20 / 255, 0x26 / 255, THREE.LinearSRGBColorSpace));
+    this.scene = new THREE.Scene();
+
+    const { positions, triangles } = this.data;
+    const T = triangles.length / 3;
+    // Unshared corners: each triangle has its own colour (flat per-cluster colouring).
+    const corners = new Float32Array(T * 9);
+    for (let i = 0; i < T * 3; ++i) {
+      const v = 3 * triangles[i];
+      corners[3 * i] = positions[v];
+      corners[3 * i + 1] = positions[v + 1];
+      corners[3 * i + 2] = positions[v + 2];
+    }
+    this.geometry = new THREE.BufferGeometry();
+    this.geometry.setAttribute('position', new THREE.BufferAttribute(corners, 3));
+    this.colors = new Uint8Array(T * 9);
+    this.colorAttribute = new THREE.BufferAttribute(this.colors, 3, true);
+    this.colorAttribute.setUsage(THREE.DynamicDrawUsage);
+    this.geometry.setAttribute('color', this.colorAttribute);
+    this.geometry.computeBoundingSphere();
+    const material = testMode
+      ? new THREE.MeshBasicMaterial({ vertexColors: true, side: THREE.DoubleSide })
+      : new THREE.MeshLambertMaterial({ vertexColors: true, flatShading: true, side: THREE.DoubleSide,
+        polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
+    this.mesh = new THREE.Mesh(this.geometry, material);
+    this.scene.add(this.mesh);
+    this.wireframe = new THREE.Mesh(this.geometry,
+      new THREE.MeshBasicMaterial({ color: 0x000000, wireframe: true, transparent: true, opacity: 0.35 }));
+    this.wireframe.visible = false;
+    this.scene.add(this.wireframe);
+
+    const sphere = this.geometry.boundingSphere;
+    this.radius = sphere.radius > 0 ? sphere.radius : 1;
+    this.camera = new THREE.PerspectiveCamera(35, 1, this.radius / 100, this.radius * 100);
+    this.scene.add(this.camera);
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 1.2));
+    const light = new THREE.DirectionalLight(0xffffff, 1.6);
+    light.position.set(0.5, 1, 2);
+    this.camera.add(light);
+    this.controls = new OrbitControls(this.camera, canvas);
+    this.controls.addEventListener('change', () => this.render());
+    this.setView([1, 0.8, 1.4]);
+    window.addEventListener('resize', () => this.resize());
+    this.resize();
+  }
+
+  /** Looks at the whole mesh from `direction` (from the centre towards the camera). */
+  setView(direction) {
+    const d = new THREE.Vector3(...direction).normalize();
+    const center = this.geometry.boundingSphere.center;
+    const distance = this.radius / Math.sin(THREE.MathUtils.degToRad(35 / 2)) * 1.05;
+    this.camera.position.copy(center).addScaledVector(d, distance);
+    this.camera.up.set(Math.abs(d.y) > 0.99 ? 1 : 0, Math.abs(d.y) > 0.99 ? 0 : 1, 0);
+    this.controls.target.copy(center);
+    this.controls.update();
+    this.render();
+  }
+
+  resize() {
+    const canvas = this.renderer.domElement;
+    this.renderer.setSize(canvas.clientWidth, canvas.clientHeight, false);
+    this.camera.aspect = canvas.clientWidth / Math.max(1, canvas.clientHeight);
+    this.camera.updateProjectionMatrix();
+    this.render();
+  }
+
+  render() {
+    if (this.renderer && !this.deferRender) this.renderer.render(this.scene, this.camera);
+  }
+
+  setUpControls() {
+    const F = this.tree.faceCount;
+    $('title').textContent = `${this.header.name}: ${F.toLocaleString('en')} faces`;
+    document.title = `${this.header.name} - primseg`;
+    const slider = $('clusters-slider'), input = $('clusters-input');
+    input.max = String(F);
+    // The slider is logarithmic in K: a step means the same relative change at every level.
+    const logF = Math.log(Math.max(2, F));
+    slider.addEventListener('input', () =>
+      this.setClusters(Math.round(Math.exp((slider.valueAsNumber / 1000) * logF))));
+    input.addEventListener('change', () => this.setClusters(input.valueAsNumber));
+    this.sliderOf = (K) => Math.round((Math.log(K) / logF) * 1000);
+
+    // Tolerance: logarithmic between the smallest and the largest positive RMS estimate; 0 at
+    // the left end.
+    let low = Infinity, high = 0;
+    for (const r of this.data.rms)
+      if (r > 0) {
+        low = Math.min(low, r);
+        high = Math.max(high, r);
+      }
+    if (!(high > 0)) [low, high] = [1e-9, 1];
+    this.toleranceRange = [Math.log(low), Math.log(high * 1.001)];
+    const tolerance = $('tolerance-slider');
+    tolerance.addEventListener('input', () => {
+      const s = tolerance.valueAsNumber / 1000;
+      const [a, b] = this.toleranceRange;
+      this.setTolerance(s === 0 ? 0 : Math.exp(a + s * (b - a)));
+    });
+
+    $('color-mode').addEventListener('change', (event) => {
+      this.colorMode = event.target.value;
+      this.recolor();
+    });
+    $('show-primitives').addEventListener('change', () => this.updatePrimitives());
+    $('show-wireframe').addEventListener('change', (event) => {
+      this.wireframe.visible = event.target.checked;
+      this.render();
+    });
+
+    this.plot = new ErrorPlot($('plot'), this.tree.errorCurve, this.tree.minClusters, (K) => this.setClusters(K));
+    if (Array.isArray(this.header.levels)) this.showLevels(this.header.levels);
+
+    // A click (not a drag) selects the cluster under the pointer.
+    const canvas = this.renderer.domElement;
+    let down = null;
+    canvas.addEventListener('pointerdown', (event) => (down = [event.clientX, event.clientY]));
+    canvas.addEventListener('pointerup', (event) => {
+      if (down && Math.hypot(event.clientX - down[0], event.clientY - down[1]) < 4)
+        this.pick(event.clientX, event.clientY);
+      down = null;
+    });
+  }
+
+  /** Ticks automatic levels on the plot and offers them as buttons. */
+  showLevels(levels) {
+    this.plot.setLevels(levels);
+    const box = $('levels');
+    box.textContent = '';
+    for (const K of levels) {
+      const button = document.createElement('button');
+      button.textContent = String(K);
+      button.addEventListener('click', () => this.setClusters(K));
+      box.appendChild(button);
+    }
+    $('levels-row').style.display = levels.length ? '' : 'none';
+  }
+
+  setClusters(K) {
+    if (!Number.isFinite(K)) return;
+    const start = performance.now();
+    this.tolerance = null;
+    this.apply(this.tree.cutByCount(K), start);
+  }
+
+  setTolerance(tolerance) {
+    const start = performance.now();
+    this.tolerance = tolerance;
+    this.apply(this.tree.cutByTolerance(tolerance), start);
+  }
+
+  // A step: the cut (already made since `start`), the colours and panels, then one frame. The
+  // page's own work is timed apart from the frame, which the GPU draws.
+  apply(cut, start) {
+    this.deferRender = true;
+    this.cut = cut;
+    this.selected = -1;
+    $('info').style.display = 'none';
+    this.recolor();
+    this.updatePrimitives();
+    for (const overlay of this.overlays) overlay.update(cut);
+    const K = cut.size;
+    $('clusters-slider').value = String(this.sliderOf(K));
+    $('clusters-input').value = String(K);
+    const largest = this.tree.largestRms(cut);
+    const shown = this.tolerance ?? largest;
+    const [a, b] = this.toleranceRange;
+    $('tolerance-slider').value = String(shown > 0 ? Math.round(((Math.log(shown) - a) / (b - a)) * 1000) : 0);
+    $('tolerance-value').textContent = `${format(shown)} (${format((100 * shown) / this.header.bboxDiagonal)}%)`;
+    this.plot.setCurrent(K);
+    const ms = performance.now() - start;
+    this.stepTimes.push(ms);
+    this.deferRender = false;
+    this.render();
+    $('status').textContent = `${K.toLocaleString('en')} clusters, largest RMS ${format(largest)}; step ${ms.toFixed(1)} ms`;
+  }
+
+  // Colour of each cluster of the current cut, RGB bytes.
+  clusterColors() {
+    const cut = this.cut, tree = this.tree, K = cut.size;
+    const colors = new Uint8Array(3 * K);
+    for (let c = 0; c < K; ++c) {
+      let rgb;
+      if (testMode) rgb = [(c + 1) & 255, ((c + 1) >> 8) & 255, ((c + 1) >> 16) & 255];
+      else if (this.colorMode === 'type') rgb = TYPE_COLORS[tree.type(cut.nodes[c])] ?? [128, 128, 128];
+      else rgb = clusterColor(tree.representative[cut.nodes[c]]);
+      if (c === this.selected && !testMode) rgb = rgb.map((x) => Math.round(x + (255 - x) * 0.55));
+      colors.set(rgb, 3 * c);
+    }
+    return colors;
+  }
+
+  recolor() {
+    const colors = this.clusterColors();
+    this.currentColors = colors;
+    const faceCluster = this.cut.faceCluster, faceOfTriangle = this.data.faceOfTriangle;
+    const out = this.colors, T = out.length / 9;
+    for (let t = 0; t < T; ++t) {
+      const c = 3 * faceCluster[faceOfTriangle ? faceOfTriangle[t] : t];
+      const r = colors[c], g = colors[c + 1], b = colors[c + 2];
+      for (let k = 9 * t, end = k + 9; k < end; k += 3) {
+        out[k] = r;
+        out[k + 1] = g;
+        out[k + 2] = b;
+      }
+    }
+    this.colorAttribute.needsUpdate = true;
+    this.updateLegend();
+    this.render();
+  }
+
+  updateLegend() {
+    const cut = this.cut, tree = this.tree, legend = $('legend');
+    const rows = [];
+    const swatch = (rgb) => `<span class="swatch" style="background:rgb(${rgb.join(',')})"></span>`;
+    if (this.colorMode === 'type') {
+      const count = new Array(TYPE_NAMES.length).fill(0), area = new Array(TYPE_NAMES.length).fill(0);
+      for (const node of cut.nodes) {
+        ++count[tree.type(node)];
+        area[tree.type(node)] += tree.area[node];
+      }
+      const total = area.reduce((x, y) => x + y, 0) || 1;
+      rows.push('<tr><td></td><td>type</td><td>clusters</td><td>area</td></tr>');
+      TYPE_NAMES.forEach((name, t) => {
+        if (count[t]) rows.push(`<tr><td>${swatch(TYPE_COLORS[t])}</td><td>${name}</td><td>${count[t]}</td><td>${(100 * area[t] / total).toFixed(1)}%</td></tr>`);
+      });
+    } else {
+      const largest = tree.largestClusters(cut, 12);
+      rows.push('<tr><td></td><td>id</td><td>type</td><td>faces</td></tr>');
+      largest.forEach((c, rank) => {
+        const node = cut.nodes[c];
+        rows.push(`<tr><td>${swatch(Array.from(this.currentColors.subarray(3 * c, 3 * c + 3)))}</td><td>${rank}</td><td>${TYPE_NAMES[tree.type(node)]}</td><td>${tree.faces[node]}</td></tr>`);
+      });
+      if (cut.size > largest.length) rows.push(`<tr><td></td><td colspan="3">... ${cut.size - largest.length} more</td></tr>`);
+    }
+    legend.innerHTML = `<table>${rows.join('')}</table>`;
+  }
+
+  // Triangles of each cluster of the current cut (counting sort): {offsets, triangles}.
+  trianglesByCluster() {
+    const faceCluster = this.cut.faceCluster, faceOfTriangle = this.data.faceOfTriangle;
+    const T = this.data.triangles.length / 3, K = this.cut.size;
+    const offsets = new Uint32Array(K + 1);
+    const clusterOf = (t) => faceCluster[faceOfTriangle ? faceOfTriangle[t] : t];
+    for (let t = 0; t < T; ++t) ++offsets[clusterOf(t) + 1];
+    for (let c = 0; c < K; ++c) offsets[c + 1] += offsets[c];
+    const fill = offsets.slice(0, K), triangles = new Uint32Array(T);
+    for (let t = 0; t < T; ++t) triangles[fill[clusterOf(t)]++] = t;
+    return { offsets, triangles };
+  }
+
+  updatePrimitives() {
+    if (this.primitiveMesh) {
+      this.scene.remove(this.primitiveMesh);
+      this.primitiveMesh.geometry.dispose();
+      this.primitiveMesh = null;
+    }
+    if (!$('show-primitives').checked) return this.render();
+    const cut = this.cut;
+    if (cut.size > MAX_DRAWN_PRIMITIVES) {
+      $('status').textContent = `primitives are drawn up to ${MAX_DRAWN_PRIMITIVES} clusters`;
+      return this.render();
+    }
+    const { offsets, triangles } = this.trianglesByCluster();
+    const positions = this.data.positions, meshTriangles = this.data.triangles;
+    const vertices = [], colors = [], indices = [];
+    for (let c = 0; c < cut.size; ++c) {
+      const primitive = this.tree.primitive(cut.nodes[c]);
+      if (!primitive) continue;
+      const count = offsets[c + 1] - offsets[c];
+      const stride = Math.max(1, Math.floor((3 * count) / MAX_SHAPE_POINTS));
+      const points = [];
+      for (let k = 0; k < 3 * count; k += stride) {
+        const t = triangles[offsets[c] + Math.floor(k / 3)];
+        const v = 3 * meshTriangles[3 * t + (k % 3)];
+        points.push([positions[v], positions[v + 1], positions[v + 2]]);
+      }
+      let patch = null;
+      if (primitive.type === 0) {
+        patch = new Float32Array(9 * count);
+        for (let k = 0; k < 3 * count; ++k) {
+          const v = 3 * meshTriangles[3 * triangles[offsets[c] + Math.floor(k / 3)] + (k % 3)];
+          patch.set(positions.subarray(v, v + 3), 3 * k);
+        }
+      }
+      const surface = primitiveSurface(primitive, points, patch);
+      if (!surface) continue;
+      const base = vertices.length / 3;
+      const rgb = Array.from(this.currentColors.subarray(3 * c, 3 * c + 3)).map((x) => Math.min(255, x + 60) / 255);
+      for (let i = 0; i < surface.vertices.length; i += 3) {
+        vertices.push(surface.vertices[i], surface.vertices[i + 1], surface.vertices[i + 2]);
+        colors.push(...rgb);
+      }
+      for (const i of surface.indices) indices.push(base + i);
+    }
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.Float32BufferAttribute(vertices, 3));
+    geometry.setAttribute('color', new THREE.Float32BufferAttribute(colors, 3));
+    geometry.setIndex(indices);
+    const material = new THREE.MeshBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.45,
+      side: THREE.DoubleSide, depthWrite: false });
+    this.primitiveMesh = new THREE.Mesh(geometry, material);
+    this.primitiveMesh.renderOrder = 1;
+    this.scene.add(this.primitiveMesh);
+    this.render();
+  }
+
+  /** The cluster under a point of the window (client coordinates), or -1. */
+  clusterAt(x, y) {
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    const pointer = new THREE.Vector2(((x - rect.left) / rect.width) * 2 - 1, -((y - rect.top) / rect.height) * 2 + 1);
+    const raycaster = new THREE.Raycaster();
+    raycaster.setFromCamera(pointer, this.camera);
+    const hit = raycaster.intersectObject(this.mesh, false)[0];
+    if (!hit) return { cluster: -1 };
+    const face = this.data.faceOfTriangle ? this.data.faceOfTriangle[hit.faceIndex] : hit.faceIndex;
+    return { cluster: this.cut.faceCluster[face], face };
+  }
+
+  /** Selects the cluster under a window point and shows its details; returns them. */
+  pick(x, y) {
+    const { cluster, face } = this.clusterAt(x, y);
+    this.selected = cluster;
+    this.recolor();
+    if (cluster < 0) {
+      $('info').style.display = 'none';
+      this.info = null;
+      return null;
+    }
+    this.info = this.describe(cluster, face);
+    this.showInfo(this.info);
+    return this.info;
+  }
+
+  /** What a user wants to know about a cluster of the current cut. */
+  describe(c, face) {
+    const tree = this.tree, node = this.cut.nodes[c], header = this.header;
+    const { offsets, triangles } = this.trianglesByCluster();
+    const ids = triangles.subarray(offsets[c], offsets[c + 1]);
+    const primitive = tree.primitive(node) ?? (tree.isLeaf(node) ? facePlane(this.data.positions, this.data.triangles, ids) : null);
+    const info = {
+      id: tree.clusterId(this.cut, c), clusters: this.cut.size, node, face,
+      type: TYPE_NAMES[tree.type(node)], faces: tree.faces[node], area: tree.area[node],
+      rmsEstimate: tree.rms(node),
+    };
+    if (primitive) {
+      const { rms, max } = clusterErrors(primitive, this.data.positions, this.data.triangles, ids, this.cornerWeight());
+      info.rms = rms;
+      info.max = max;
+      const center = header.center;
+      const point = primitive.point.map((x, a) => x + center[a]);
+      const p = { plane: { normal: primitive.axis, point }, cylinder: { axis: primitive.axis, point, radius: primitive.radius },
+        sphere: { center: point, radius: primitive.radius }, cone: { apex: point, axis: primitive.axis, half_angle: primitive.halfAngle },
+        torus: { center: point, axis: primitive.axis, major_radius: primitive.radius, minor_radius: primitive.minorRadius } };
+      info.params = p[TYPE_NAMES[primitive.type]];
+    }
+    return info;
+  }
+
+  // Corner weights as primseg's: area / 3, or 1 / (triangles at the vertex) for uniform weights.
+  cornerWeight() {
+    if (this.header.weights !== 'uniform') return (t) => this.tree.triangleArea[t] / 3;
+    if (!this.valence) {
+      this.valence = new Uint32Array(this.header.vertices);
+      for (const v of this.data.triangles) ++this.valence[v];
+    }
+    return (t, v) => 1 / this.valence[v];
+  }
+
+  showInfo(info) {
+    const rows = [['type', info.type], ['faces', info.faces.toLocaleString('en')], ['area', format(info.area)]];
+    if (info.params) for (const [key, value] of Object.entries(info.params)) rows.push([key, Array.isArray(value) ? formatVector(value) : format(value)]);
+    else rows.push(['parameters', 'not in the page at this level (too fine)']);
+    if (info.rms !== undefined) rows.push(['RMS', format(info.rms)], ['max error', format(info.max)]);
+    rows.push(['RMS estimate', format(info.rmsEstimate)]);
+    const panel = $('info');
+    panel.innerHTML = `<h2>cluster ${info.id} of ${info.clusters}</h2><table>${rows.map(([k, v]) => `<tr><td>${k}</td><td>${v}</td></tr>`).join('')}</table>`;
+    panel.style.display = 'block';
+  }
+
+  /** The labels of every input face, numbered as primseg numbers them (by decreasing area). */
+  labels() {
+    const ids = this.tree.clusterIds(this.cut);
+    return Array.from(this.cut.faceCluster, (c) => ids[c]);
+  }
+
+  /** The canvas's pixels after a render, RGBA rows bottom-up, as base64. */
+  readPixels() {
+    this.render();
+    const gl = this.renderer.getContext();
+    const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
+    const pixels = new Uint8Array(w * h * 4);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
+    let binary = '';
+    for (let i = 0; i < pixels.length; i += 0x8000) binary += String.fromCharCode.apply(null, pixels.subarray(i, i + 0x8000));
+    return { width: w, height: h, rgba: btoa(binary) };
+  }
+}
+
+function showError(error) {
+  const box = $('error');
+  box.textContent = 'primseg viewer: ' + (error && error.message ? error.message : String(error));
+  box.style.display = 'block';
+  console.error(error);
+}
+
+const ready = (async () => {
+  const start = performance.now();
+  const data = await readPageData(document);
+  const decoded = performance.now();
+  const viewer = new Viewer(data);
+  viewer.render();
+  viewer.loadMs = performance.now() - start;
+  viewer.loadTimes = { decodeMs: decoded - start, viewerMs: performance.now() - decoded };
+  return viewer;
+})();
+ready.catch(showError);
+
+window.primseg = {
+  ready,
+  testMode,
+};

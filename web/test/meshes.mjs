@@ -1,0 +1,61 @@
+// Test meshes written as OFF files: generated here, so that the tests need no data download.
+import { writeFileSync } from 'node:fs';
+
+function writeOff(path, vertices, triangles) {
+  const lines = ['OFF', `${vertices.length} ${triangles.length} 0`];
+  for (const v of vertices) lines.push(v.join(' '));
+  for (const t of triangles) lines.push('3 ' + t.join(' '));
+  writeFileSync(path, lines.join('\n') + '\n');
+}
+
+/** A box of size 2 x 1.5 x 1 with every side an n x n grid: 6 planes, 12 n^2 triangles. */
+export function writeGridBox(path, n) {
+  const vertices = [], triangles = [], index = new Map();
+  const vertex = (p) => {
+    const key = p.join(',');
+    if (!index.has(key)) {
+      index.set(key, vertices.length);
+      vertices.push(p);
+    }
+    return index.get(key);
+  };
+  const size = [2, 1.5, 1];
+  for (let axis = 0; axis < 3; ++axis)
+    for (const side of [0, 1]) {
+      const [u, v] = [(axis + 1) % 3, (axis + 2) % 3];
+      const point = (i, j) => {
+        const p = [0, 0, 0];
+        p[axis] = side * size[axis];
+        p[u] = (i / n) * size[u];
+        p[v] = (j / n) * size[v];
+        return vertex(p);
+      };
+      for (let i = 0; i < n; ++i)
+        for (let j = 0; j < n; ++j) {
+          const [a, b, c, d] = [point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)];
+          // Outward orientation: flip on the low side.
+          if (side) triangles.push([a, b, c], [a, c, d]);
+          else triangles.push([a, c, b], [a, d, c]);
+        }
+    }
+  writeOff(path, vertices, triangles);
+  return triangles.length;
+}
+
+/** A wavy torus of 2 * rows * columns triangles (a big, curved test surface). */
+export function writeWavyTorus(path, rows, columns) {
+  const vertices = [], triangles = [];
+  for (let i = 0; i < rows; ++i)
+    for (let j = 0; j < columns; ++j) {
+      const phi = (2 * Math.PI * i) / rows, psi = (2 * Math.PI * j) / columns;
+      const r = 1 + 0.05 * Math.sin(7 * phi) * Math.cos(3 * psi);
+      const ring = 3 + r * Math.cos(psi);
+      vertices.push([(ring * Math.cos(phi)).toFixed(6), (ring * Math.sin(phi)).toFixed(6), (r * Math.sin(psi)).toFixed(6)]);
+    }
+  const at = (i, j) => (i % rows) * columns + (j % columns);
+  for (let i = 0; i < rows; ++i)
+    for (let j = 0; j < columns; ++j)
+      triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+  writeOff(path, vertices, triangles);
+  return triangles.length;
+}

@@ -1,0 +1,203 @@
+// End-to-end tests of `primseg view` in a real browser (Debian's chromium, headless).
+// PRIMSEG: the CLI (default ../build/primseg); PRIMSEG_WEB_ARTIFACTS: where screenshots go.
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync, spawnSync } from 'node:child_process';
+import { mkdirSync, mkdtempSync, readFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { launchBrowser, openViewer } from './browser.mjs';
+import { writeGridBox } from './meshes.mjs';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const cli = resolve(process.env.PRIMSEG ?? join(here, '../../build/primseg'));
+const artifacts = resolve(process.env.PRIMSEG_WEB_ARTIFACTS ?? join(tmpdir(), 'primseg-web-artifacts'));
+const work = mkdtempSync(join(tmpdir(), 'primseg-web-'));
+mkdirSync(artifacts, { recursive: true });
+
+function primseg(...args) {
+  return execFileSync(cli, args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
+}
+const readLabels = (file) => readFileSync(file, 'utf8').trim().split('\n').map(Number);
+
+let browser, fandisk;
+before(async () => {
+  browser = await launchBrowser();
+  execFileSync('tar', ['xzf', '/usr/share/doc/libcgal-dev/data.tar.gz', '-C', work, 'data/meshes/fandisk.off']);
+  fandisk = join(work, 'data/meshes/fandisk.off');
+  primseg('segment', fandisk, '--tree', join(work, 'fandisk.tree'), '--quiet');
+  primseg('view', fandisk, '--tree', join(work, 'fandisk.tree'), '--clusters', '27', '-o', join(work, 'fandisk.html'), '--quiet');
+});
+after(async () => browser?.close());
+
+/** Distinct non-background colours drawn from six axis views, as cluster indices (code - 1). */
+async function drawnClusters(page) {
+  const codes = new Set();
+  for (const direction of [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]) {
+    const { rgba } = await page.evaluate(async (d) => {
+      const viewer = await window.primseg.ready;
+      viewer.setView(d);
+      return viewer.readPixels();
+    }, direction);
+    const pixels = Buffer.from(rgba, 'base64');
+    for (let i = 0; i < pixels.length; i += 4) {
+      const code = pixels[i] | (pixels[i + 1] << 8) | (pixels[i + 2] << 16);
+      if (code) codes.add(code - 1);
+    }
+  }
+  return codes;
+}
+
+test('a generated box: no console error, no network, exactly K cluster colours drawn', async () => {
+  const mesh = join(work, 'box.off'), html = join(work, 'box.html');
+  const triangles = writeGridBox(mesh, 8);
+  primseg('view', mesh, '-o', html, '--quiet');
+  const { page, errors, requests } = await openViewer(browser, html, { test: true, width: 640, height: 480 });
+  for (const K of [1, 3, 6, 20, 100, triangles]) {
+    const size = await page.evaluate(async (k) => {
+      const viewer = await window.primseg.ready;
+      viewer.setClusters(k);
+      return viewer.cut.size;
+    }, K);
+    assert.equal(size, K);
+    const drawn = await drawnClusters(page);
+    assert.equal(drawn.size, K, `K = ${K}: ${drawn.size} colours drawn`);
+    assert.ok(Math.max(...drawn) < K, 'every colour is a cluster code');
+  }
+  await page.screenshot({ path: join(artifacts, 'box-test-mode.png') });
+  assert.deepEqual(errors, []);
+  assert.deepEqual(requests, []);
+  await page.close();
+});
+
+test('fandisk: the page cuts the same levels as primseg cut, by count and by tolerance', async () => {
+  const { page, errors } = await openViewer(browser, join(work, 'fandisk.html'));
+  const tree = join(work, 'fandisk.tree'), labelsFile = join(work, 'cut.labels');
+  const levels = [['--clusters', '1'], ['--clusters', '5'], ['--clusters', '27'], ['--clusters', '300'],
+    ['--clusters', '5000'], ['--clusters', '12946'], ['--tolerance', '0.1%'], ['--tolerance', '1%'], ['--tolerance', '0']];
+  const diagonal = await page.evaluate(async () => (await window.primseg.ready).header.bboxDiagonal);
+  for (const [option, value] of levels) {
+    const jsonFile = join(work, 'cut.json');
+    primseg('cut', tree, option, value, '--labels', labelsFile, '--json', jsonFile, '--quiet');
+    const expected = readLabels(labelsFile);
+    const area = JSON.parse(readFileSync(jsonFile, 'utf8')).clusters.map((c) => c.area);
+    const tolerance = value.endsWith('%') ? (Number(value.slice(0, -1)) / 100) * diagonal : Number(value);
+    const labels = await page.evaluate(async ([byCount, x]) => {
+      const viewer = await window.primseg.ready;
+      if (byCount) viewer.setClusters(x);
+      else viewer.setTolerance(x);
+      return viewer.labels();
+    }, [option === '--clusters', option === '--clusters' ? Number(value) : tolerance]);
+    assert.equal(labels.length, expected.length);
+    // The same clusters: page label p is CLI label cliOf[p], one to one.
+    const cliOf = new Map(), pageOf = new Map();
+    labels.forEach((p, f) => {
+      if (!cliOf.has(p)) cliOf.set(p, expected[f]);
+      if (!pageOf.has(expected[f])) pageOf.set(expected[f], p);
+      assert.equal(cliOf.get(p), expected[f], `${option} ${value}: face ${f} is not in the CLI's cluster`);
+      assert.equal(pageOf.get(expected[f]), p, `${option} ${value}: face ${f} is not in the page's cluster`);
+    });
+    assert.equal(cliOf.size, area.length);
+    // The same numbering (by decreasing area), but for clusters whose areas are equal up to the
+    // precision of the page's float32 positions.
+    let renumbered = 0;
+    for (const [p, q] of cliOf)
+      if (p !== q) {
+        ++renumbered;
+        assert.ok(Math.abs(area[p] - area[q]) <= 1e-4 * area[q] + 1e-10 * diagonal ** 2, `${option} ${value}: cluster ${q} numbered ${p}`);
+      }
+    if (renumbered) console.log(`# ${option} ${value}: ${renumbered} of ${area.length} clusters of near-equal area numbered in another order`);
+  }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('fandisk: a click reports the cluster under the pointer, as primseg reports it', async () => {
+  const K = 27;
+  primseg('cut', join(work, 'fandisk.tree'), '--clusters', String(K), '--labels', join(work, 'k.labels'),
+    '--json', join(work, 'k.json'), '--quiet');
+  const labels = readLabels(join(work, 'k.labels'));
+  const clusters = JSON.parse(readFileSync(join(work, 'k.json'), 'utf8')).clusters;
+  const { page, errors } = await openViewer(browser, join(work, 'fandisk.html'), { test: true, width: 800, height: 600 });
+  const { width, height, rgba } = await page.evaluate(async () => (await window.primseg.ready).readPixels());
+  const pixels = Buffer.from(rgba, 'base64');
+  // A pixel well inside each of a few clusters: one whose neighbours all have its colour.
+  const code = (x, y) => { const i = 4 * (y * width + x); return pixels[i] | (pixels[i + 1] << 8) | (pixels[i + 2] << 16); };
+  const targets = new Map();
+  for (let y = 10; y < height - 10 && targets.size < 6; y += 7)
+    for (let x = 10; x < width - 10; x += 7) {
+      const c = code(x, y);
+      if (!c || targets.has(c) || ![[-4, 0], [4, 0], [0, -4], [0, 4]].every(([dx, dy]) => code(x + dx, y + dy) === c))
+        continue;
+      // Not under one of the page's panels (the info panel appears after the first click).
+      const onCanvas = await page.evaluate(([px, py]) => {
+        const below = document.elementsFromPoint(px, py);
+        return below[0]?.id === 'view' && !below.some((e) => e.classList.contains('panel'));
+      }, [x, height - 1 - y]);
+      const clear = onCanvas && !(x < 420 && height - 1 - y > height - 320);
+      if (clear) targets.set(c, [x, y]);
+    }
+  assert.ok(targets.size >= 3, 'several clusters are visible');
+  for (const [c, [x, y]] of targets) {
+    await page.evaluate(async () => ((await window.primseg.ready).info = null));
+    await page.mouse.click(x, height - 1 - y); // readPixels rows go bottom-up
+    const info = await page.evaluate(async () => (await window.primseg.ready).info);
+    assert.ok(info, `a click at (${x}, ${y}) selects a cluster`);
+    const cutIndex = await page.evaluate(async (face) => (await window.primseg.ready).cut.faceCluster[face], info.face);
+    assert.equal(cutIndex, c - 1, 'the clicked face is in the cluster drawn there');
+    const expected = clusters[labels[info.face]];
+    assert.equal(info.id, expected.id);
+    assert.equal(info.clusters, K);
+    assert.equal(info.type, expected.type);
+    assert.equal(info.faces, expected.faces);
+    const panel = await page.textContent('#info');
+    assert.match(panel, new RegExp(`cluster ${expected.id} of ${K}`));
+    // float32 positions in the page: agreement to a millionth of the part's size.
+    const diagonal = 1.2;
+    assert.ok(Math.abs(info.rms - expected.rms) < 1e-6 * diagonal, `rms ${info.rms} vs ${expected.rms}`);
+    assert.ok(Math.abs(info.max - expected.max) < 1e-6 * diagonal, `max ${info.max} vs ${expected.max}`);
+    assert.ok(Math.abs(info.area - expected.area) < 1e-5 * expected.area, `area ${info.area} vs ${expected.area}`);
+    if (expected.type === 'cylinder' || expected.type === 'sphere')
+      assert.ok(Math.abs(info.params.radius - expected.params.radius) < 1e-9 * diagonal);
+  }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('fandisk: screenshot with the fitted primitives drawn', async () => {
+  const { page, errors } = await openViewer(browser, join(work, 'fandisk.html'), { width: 1100, height: 700 });
+  await page.check('#show-primitives');
+  const drawn = await page.evaluate(async () => {
+    const viewer = await window.primseg.ready;
+    return viewer.primitiveMesh ? viewer.primitiveMesh.geometry.index.count / 3 : 0;
+  });
+  assert.ok(drawn > 0, 'primitive surfaces are drawn');
+  await page.uncheck('#show-primitives');
+  await page.selectOption('#color-mode', 'type');
+  await page.screenshot({ path: join(artifacts, 'fandisk-types.png') });
+  await page.selectOption('#color-mode', 'cluster');
+  await page.screenshot({ path: join(artifacts, 'fandisk.png') });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('the page is the same bytes from the mesh alone or with its tree', () => {
+  const html = join(work, 'again.html');
+  primseg('view', fandisk, '--clusters', '27', '-o', html, '--quiet');
+  assert.ok(readFileSync(html).equals(readFileSync(join(work, 'fandisk.html'))));
+});
+
+test('bad input: a clear error and exit status 1', () => {
+  const cases = [
+    [['view', join(work, 'missing.off'), '-o', join(work, 'x.html')], /cannot|missing/],
+    [['view', fandisk, '--clusters', '0', '-o', join(work, 'x.html')], /--clusters/],
+    [['view', join(work, 'box.off'), '--tree', join(work, 'fandisk.tree'), '-o', join(work, 'x.html')], /was not built from/],
+    [['view', fandisk], /output/i],
+  ];
+  for (const [args, message] of cases) {
+    const run = spawnSync(cli, args, { encoding: 'utf8' });
+    assert.equal(run.status, 1, args.join(' ') + ': ' + run.stderr);
+    assert.match(run.stderr, message);
+  }
+});
