@@ -127,7 +127,7 @@ std::string csv_field(const std::string& text) {
 std::string options_signature(const BatchOptions& o) {
   return "primitives=" + o.primitives + " weights=" + o.weights +
          " exact_costs=" + (o.exact_costs ? "1" : "0") +
-         " clusters=" + (o.level.clusters ? std::to_string(*o.level.clusters) : "-") +
+         " clusters=" + o.level.clusters.value_or("-") +
          " tolerance=" + o.level.tolerance.value_or(kDefaultTolerance);
 }
 

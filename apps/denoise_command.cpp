@@ -76,7 +76,8 @@ Command add_denoise_command(CLI::App& app) {
             for (int i = 0; i < o->iterations; ++i) {
               hierarchy = std::make_unique<Hierarchy>(
                   build_hierarchy(denoiser.segmented_mesh(), options.hierarchy));
-              const SnapReport r = denoiser.snap(*hierarchy, cut(*hierarchy, o->level.level));
+              const SnapReport r =
+                  denoiser.snap(*hierarchy, cut(*hierarchy, o->level.level).segmentation);
               rounds.push_back({{"clusters", r.clusters},
                                 {"boundary_vertices", r.boundary_vertices},
                                 {"moved", r.moved},

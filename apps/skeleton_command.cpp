@@ -26,7 +26,8 @@ Command add_skeleton_command(CLI::App& app) {
   auto* command = app.add_subcommand(
       "skeleton", "Extract a deformation skeleton (one bone per cluster) from a level");
   command->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl)")->required();
-  command->add_option("--clusters", o->level.clusters, "Number of clusters K (1..F): of bones")
+  command
+      ->add_option("--clusters", o->level.clusters, "Number of clusters K (1..F) or auto: of bones")
       ->required();
   command
       ->add_option("--primitives", o->primitives,
@@ -57,13 +58,18 @@ Command add_skeleton_command(CLI::App& app) {
             const Hierarchy hierarchy = builder.finish(Progress("hierarchy", o->quiet));
             const double build_seconds = seconds_since(build_start);
             const auto skeleton_start = Clock::now();
-            const Skeleton skeleton = extract_skeleton(hierarchy, cut(hierarchy, o->level));
+            const Skeleton skeleton =
+                extract_skeleton(hierarchy, cut(hierarchy, o->level).segmentation);
             const double skeleton_seconds = seconds_since(skeleton_start);
 
             nlohmann::json json = skeleton_to_json(skeleton);
             json["mesh"] = mesh_summary(o->mesh_path, hierarchy);
             json["primitives"] = o->primitives;
-            json["requested_clusters"] = *o->level.clusters;
+            const std::optional<std::uint32_t> requested = parse_cluster_count(*o->level.clusters);
+            if (requested)
+              json["requested_clusters"] = *requested;
+            else
+              json["requested_clusters"] = "auto";
             json["timing"] = {{"hierarchy_seconds", build_seconds},
                               {"skeleton_seconds", skeleton_seconds}};
             if (o->skin_weights) {

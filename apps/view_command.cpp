@@ -168,7 +168,7 @@ Command add_view_command(CLI::App& app) {
   struct Options {
     std::string mesh_path, output, primitives = "plane,cylinder,sphere";
     std::optional<std::string> tree_path;
-    std::optional<std::uint32_t> clusters;
+    std::optional<std::string> clusters;  // K or auto
     unsigned threads = 0;
     bool quiet = false;
   };
@@ -215,7 +215,8 @@ Command add_view_command(CLI::App& app) {
           return tree;
         }();
         const double build_seconds = seconds_since(build_start);
-        const std::uint32_t initial = cut(hierarchy, {o->clusters, std::nullopt}).cluster_count();
+        const std::uint32_t initial =
+            cut(hierarchy, {o->clusters, std::nullopt}).segmentation.cluster_count();
         std::string html(page.substr(0, marker));
         html +=
             page_data(hierarchy, std::filesystem::path(o->mesh_path).filename().string(), initial);
