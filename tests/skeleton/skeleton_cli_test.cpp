@@ -119,6 +119,25 @@ TEST_F(SkeletonCli, DefaultPrimitivesAreCylindersOnly) {
   EXPECT_EQ(s["bones"].size(), 12u);
 }
 
+TEST_F(SkeletonCli, AutomaticLevelIsTheOneSegmentChooses) {
+  std::string output;
+  ASSERT_EQ(run("segment " + path("figure.off") +
+                    " --clusters auto --primitives cylinder,sphere -q --json " + path("seg.json"),
+                &output),
+            0)
+      << output;
+  const json segmented = json::parse(slurp(path("seg.json")));
+  ASSERT_EQ(run("skeleton " + path("figure.off") +
+                    " --clusters auto --primitives cylinder,sphere -q -o " + path("auto.json"),
+                &output),
+            0)
+      << output;
+  const json s = json::parse(slurp(path("auto.json")));
+  EXPECT_EQ(s["requested_clusters"], "auto");
+  EXPECT_EQ(s["cluster_count"], segmented["level"]["clusters"]);
+  EXPECT_EQ(s["bones"].size(), s["cluster_count"].get<std::size_t>());
+}
+
 TEST_F(SkeletonCli, DeformRotatesTheForearmAndLeavesTheRestInPlace) {
   const json s = skeleton();
   const std::uint32_t elbow = nearest_joint(s, figure_.elbow[1]);
