@@ -112,7 +112,7 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
   const std::uint32_t real = f - hierarchy.component_count();
   const std::uint32_t with_parameters = std::min(real, kMergesWithParameters);
   std::vector<double> parameters;
-  parameters.reserve(with_parameters * 9);
+  parameters.reserve(std::size_t{with_parameters} * 9);
   for (std::uint32_t i = real - with_parameters; i < real; ++i) {
     const Primitive& p = merges[i].primitive;
     for (int a = 0; a < 3; ++a) parameters.push_back(p.point[a] - center[a]);
