@@ -15,6 +15,7 @@ Command add_denoise_command(CLI::App& app) {
     int iterations = 1;
     int smoothing_steps = DenoiseOptions{}.smoothing_steps;
     bool stylize = false;
+    bool bilateral = false;
     double max_move = DenoiseOptions{}.max_move_edge_lengths;
     double min_crease_angle = DenoiseOptions{}.min_crease_angle_degrees;
     unsigned threads = 0;
@@ -39,6 +40,11 @@ Command add_denoise_command(CLI::App& app) {
                    "snapped from their own positions)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
+  denoise
+      ->add_flag("--bilateral", o->bilateral,
+                 "Segment a copy smoothed by bilateral normal filtering (keeps edges sharp; "
+                 "for noisy CAD parts)")
+      ->excludes("--smooth");
   denoise->add_flag("--stylize", o->stylize,
                     "Snap each vertex onto its own cluster's primitive only (a boundary vertex "
                     "onto the nearest incident one), for few clusters");
@@ -61,6 +67,7 @@ Command add_denoise_command(CLI::App& app) {
             options.mode = o->stylize ? SnapMode::NearestIncident : SnapMode::AllIncident;
             options.max_move_edge_lengths = o->max_move;
             options.smoothing_steps = o->smoothing_steps;
+            if (o->bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
             options.min_crease_angle_degrees = o->min_crease_angle;
             options.hierarchy.primitives = parse_primitives(o->primitives);
             options.hierarchy.threads = o->threads;
@@ -97,6 +104,9 @@ Command add_denoise_command(CLI::App& app) {
             summary["mesh"] = mesh_summary(o->mesh_path, *hierarchy);
             summary["denoise"] = {{"output", o->output_path},
                                   {"mode", o->stylize ? "stylize" : "denoise"},
+                                  {"segmented_copy", o->bilateral             ? "bilateral"
+                                                     : o->smoothing_steps > 0 ? "taubin"
+                                                                              : "input"},
                                   {"rounds", rounds}};
             summary["timing"] = {{"denoise_seconds", seconds_since(start)}};
             // The per-level outputs describe the segmentation the last round snapped onto.

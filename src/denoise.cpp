@@ -215,6 +215,11 @@ void validate(const DenoiseOptions& options) {
     throw InvalidInputError("denoise: the refit outlier threshold must be a non-negative number");
   if (options.smoothing_steps < 0)
     throw InvalidInputError("denoise: the smoothing steps must be a non-negative count");
+  if (options.bilateral_smoothing) {
+    validate(*options.bilateral_smoothing);
+    if (options.smoothing_steps > 0)
+      throw InvalidInputError("denoise: choose Taubin or bilateral smoothing, not both");
+  }
   if (options.max_solver_steps < 1)
     throw InvalidInputError("denoise: the solver needs at least one step");
   validate(options.hierarchy);
@@ -268,6 +273,8 @@ std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
   // Taubin's λ|μ smoothing with uniform weights over the edge neighbours: shrinks noise, not the
   // shape. Neighbours come from the triangles around each vertex (each edge seen twice: same
   // weights for all, so the average is unchanged).
+  if (options_.bilateral_smoothing)
+    return std::make_shared<Mesh>(bilateral_smooth(mesh_, *options_.bilateral_smoothing));
   constexpr double kLambda = 0.5, kMu = -0.53;
   auto segmented = std::make_shared<Mesh>(mesh_);
   std::vector<Vec3>& positions = segmented->positions;

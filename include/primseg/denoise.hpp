@@ -15,8 +15,10 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
+#include "primseg/bilateral_smoothing.hpp"
 #include "primseg/cut.hpp"
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh.hpp"
@@ -60,6 +62,11 @@ struct DenoiseOptions {
   /// into small planes; the primitives are then refitted, and the vertices snapped, on the
   /// unsmoothed positions. 0 segments the mesh as it is.
   int smoothing_steps = 0;
+  /// When set, the copy that is segmented is smoothed by bilateral normal filtering with these
+  /// options (bilateral_smoothing.hpp) instead of Taubin steps (smoothing_steps must then be 0):
+  /// noise is averaged on smooth parts while edges stay sharp, which segments noisy CAD parts
+  /// better (fandisk with 0.3% noise: RMS 3.3x lower at K = 40 against 2.6x with 5 Taubin steps).
+  std::optional<BilateralSmoothingOptions> bilateral_smoothing;
   /// Gauss–Newton steps for curved primitives (a plane-only system converges in one).
   int max_solver_steps = 20;
   /// Hierarchy options used to segment the mesh at each iteration.
@@ -106,7 +113,8 @@ class Denoiser {
   /// refit_outlier_threshold is 0. Throws InvalidInputError when the connectivity differs.
   SnapReport snap(const Hierarchy& hierarchy, const Segmentation& segmentation);
 
-  /// The mesh the next iteration segments: mesh(), smoothed when smoothing_steps > 0.
+  /// The mesh the next iteration segments: mesh(), smoothed when smoothing_steps > 0 or
+  /// bilateral_smoothing is set.
   std::shared_ptr<const Mesh> segmented_mesh() const;
 
   /// The current mesh (the input after the iterations so far).

@@ -96,6 +96,27 @@ TEST(CliDenoise, StylizeToleranceIterationsAndLevelOutputs) {
   EXPECT_TRUE(fs::exists(f.dir / "s.off"));
 }
 
+TEST(CliDenoise, BilateralSmoothingOfTheSegmentedCopy) {
+  const Files f = noisy_box();
+  const fs::path out = f.dir / "bilateral.ply";
+  std::string output;
+  ASSERT_EQ(primseg({"denoise", q(f.noisy), "--clusters 6 --bilateral -o", q(out), "--json",
+                     q(f.dir / "b.json")},
+                    &output),
+            0)
+      << output;
+  std::ifstream json_file(f.dir / "b.json");
+  EXPECT_EQ(nlohmann::json::parse(json_file)["denoise"]["segmented_copy"], "bilateral");
+  const nlohmann::json before = distance_json(f.noisy, f.clean);
+  const nlohmann::json after = distance_json(out, f.clean);
+  EXPECT_LE(after["symmetric"]["rms"].get<double>() * 3, before["symmetric"]["rms"].get<double>());
+  // One smoothing of the segmented copy at a time.
+  EXPECT_EQ(
+      primseg({"denoise", q(f.noisy), "--clusters 6 --bilateral --smooth 5 -o", q(out)}, &output),
+      1);
+  EXPECT_NE(output.find("--bilateral"), std::string::npos) << output;
+}
+
 TEST(CliDenoise, BadUsageFailsWithAMessage) {
   const Files f = noisy_box();
   std::string output;

@@ -34,19 +34,27 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
   double best_ratio = 0;
   std::uint32_t best_k = 0;
   Mesh best;
-  for (const int smoothing : {0, 5})
+  // Smoothing of the segmented copy: none, 5 Taubin steps (-5 in the table), bilateral (1).
+  for (const int smoothing : {0, -5, 1})
     for (const std::uint32_t k : {20u, 30u, 40u, 60u}) {
       DenoiseOptions options;
-      options.smoothing_steps = smoothing;
+      if (smoothing < 0) options.smoothing_steps = -smoothing;
+      if (smoothing == 1) options.bilateral_smoothing = BilateralSmoothingOptions{};
       Denoiser denoiser(noisy, options);
       const SnapReport report = denoiser.iterate(level_by_count(k));
       const MeshDistance after = mesh_distance(denoiser.mesh(), clean, measure);
-      std::printf("%8u %12.4g %12.4g %8.2f %12d %8.2f   (%u fallbacks, %u blocked)\n", k, after.rms,
-                  after.hausdorff, before.rms / after.rms, smoothing,
+      std::printf("%8u %12.4g %12.4g %8.2f %12s %8.2f   (%u fallbacks, %u blocked)\n", k, after.rms,
+                  after.hausdorff, before.rms / after.rms,
+                  smoothing == 0  ? "none"
+                  : smoothing < 0 ? "taubin 5"
+                                  : "bilateral",
                   before.hausdorff / after.hausdorff, report.fallbacks, report.blocked);
       EXPECT_EQ(testing::inverted_triangles(noisy, denoiser.mesh()), 0u);
-      if (smoothing > 0 && k >= 30) {
+      if (smoothing != 0 && k >= 30) {
         EXPECT_LT(after.rms * 2, before.rms);
+      }
+      if (smoothing == 1 && k >= 40) {
+        EXPECT_LT(after.rms * 3, before.rms);
       }
       if (before.rms / after.rms > best_ratio) {
         best_ratio = before.rms / after.rms;
@@ -55,10 +63,11 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
       }
     }
   std::printf("best K %u: RMS %.2fx lower\n", best_k, best_ratio);
-  // The target is 5x. Measured: 2.8x (smoothing 5, K = 60); without smoothing, noise
-  // fragments the segmentation into small planes and the gain is at most 1.6x. This guards what
-  // is reached; the gap is the engine's segmentation of noisy curved parts (see README).
-  EXPECT_GE(best_ratio, 2.5);
+  // The target is 5x. Measured: 3.3x (bilateral smoothing, K = 40), 2.8x (5 Taubin
+  // steps, K = 60); without smoothing, noise fragments the segmentation into small planes and the
+  // gain is at most 1.6x. Snapping the same noisy vertices onto the clean mesh's segmentation
+  // gives 5.9x at K = 30: the gap is the segmentation of the noisy curved parts (see README).
+  EXPECT_GE(best_ratio, 3.0);
 
   if (const char* figures = std::getenv("PRIMSEG_FIGURES_DIR")) {
     const std::filesystem::path dir(figures);
