@@ -15,6 +15,8 @@ import re
 import sys
 
 IDENTIFIER = r"[A-Za-z_][A-Za-z0-9_]*"
+OPERATOR_NAMES = {"*": "mul", "+": "add", "-": "sub", "/": "div", "==": "eq", "!=": "ne", "<": "lt",
+                  "<=>": "compare", "=": "assign", "[]": "index", "()": "call"}
 
 
 def declared_name(line):
@@ -23,11 +25,19 @@ def declared_name(line):
     match = re.match(r"(?:struct|class|enum class|enum)\s+(" + IDENTIFIER + ")", line)
     if match:
         return match.group(1)
+    match = re.match(r"using\s+(" + IDENTIFIER + r")\s*=", line)
+    if match:  # a type alias, whatever its definition contains
+        return match.group(1)
     if line.startswith(("#", "}", "public:", "private:", "friend")):
         return None
     code = line.split("//")[0]
+    while re.search(r"<[^<>]*>", code):  # template arguments name types, not the declaration
+        code = re.sub(r"<[^<>]*>", "", code)
     if "(" in code:  # a function: the identifier just before the first parenthesis
         match = re.search(r"(~?" + IDENTIFIER + r"|operator\S*)\s*\($", code[: code.index("(") + 1])
+        if match and match.group(1).startswith("operator"):  # operator* -> operator_mul: a C++ name
+            symbol = match.group(1)[len("operator"):]
+            return "operator_" + OPERATOR_NAMES.get(symbol, "call" if symbol == "" else "other")
         return match.group(1) if match else None
     match = re.search(r"(" + IDENTIFIER + r")\s*(?:\[[^\]]*\])?\s*(?:=|;|\{|,)", code)
     return match.group(1) if match else None

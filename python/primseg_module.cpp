@@ -6,22 +6,30 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "doxygen_docstrings.hpp"
+#include "primseg/auto_level.hpp"
 #include "primseg/cut.hpp"
+#include "primseg/denoise.hpp"
 #include "primseg/error.hpp"
 #include "primseg/hierarchy.hpp"
+#include "primseg/mesh_distance.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
+#include "primseg/skeleton.hpp"
+#include "primseg/skinning.hpp"
 #include "primseg/tree_io.hpp"
 
 namespace py = pybind11;
@@ -241,24 +249,48 @@ PyHierarchy segment_mesh(std::shared_ptr<const Mesh> mesh, const HierarchyOption
 // The CLI's default level (--tolerance 0.1%): as a fraction of the bounding-box diagonal.
 constexpr double kDefaultRelativeTolerance = 0.1 / 100;
 
-Segmentation cut_level(const Hierarchy& hierarchy, const std::optional<std::int64_t>& clusters,
-                       const std::optional<double>& tolerance,
-                       const std::optional<double>& relative_tolerance) {
-  if (int(clusters.has_value()) + int(tolerance.has_value()) + int(relative_tolerance.has_value()) >
+// A level as Python gives it: k (a count or "auto"), tolerance or relative_tolerance.
+using ClusterCount = std::optional<std::variant<std::int64_t, std::string>>;
+struct LevelArguments {
+  ClusterCount k;
+  std::optional<double> tolerance, relative_tolerance;
+};
+
+// Throws InvalidInputError unless the level can be cut from a mesh of `face_count` faces:
+// checked before any hierarchy is built.
+void validate_level(const LevelArguments& level, std::uint32_t face_count) {
+  if (int(level.k.has_value()) + int(level.tolerance.has_value()) +
+          int(level.relative_tolerance.has_value()) >
       1)
     throw InvalidInputError("give at most one of k, tolerance and relative_tolerance");
-  if (clusters) {
-    if (*clusters < 1 || *clusters > hierarchy.face_count())
+  if (level.k) {
+    if (const auto* name = std::get_if<std::string>(&*level.k)) {
+      if (*name != "auto")
+        throw InvalidInputError("k must be a number of clusters or 'auto', not '" + *name + "'");
+    } else if (const std::int64_t k = std::get<std::int64_t>(*level.k); k < 1 || k > face_count) {
       throw InvalidInputError("k must be between 1 and the number of faces (" +
-                              std::to_string(hierarchy.face_count()) + "), not " +
-                              std::to_string(*clusters));
-    return cut_by_count(hierarchy, static_cast<std::uint32_t>(*clusters));
+                              std::to_string(face_count) + "), not " + std::to_string(k));
+    }
   }
-  if (tolerance) return cut_by_tolerance(hierarchy, *tolerance);
-  const double fraction = relative_tolerance.value_or(kDefaultRelativeTolerance);
-  if (!std::isfinite(fraction) || fraction < 0)
+  if (level.tolerance && !(std::isfinite(*level.tolerance) && *level.tolerance >= 0))
+    throw InvalidInputError("tolerance must be a non-negative number, not " +
+                            std::to_string(*level.tolerance));
+  if (level.relative_tolerance &&
+      !(std::isfinite(*level.relative_tolerance) && *level.relative_tolerance >= 0))
     throw InvalidInputError("relative_tolerance must be a non-negative number, not " +
-                            std::to_string(fraction));
+                            std::to_string(*level.relative_tolerance));
+}
+
+// The segmentation of a level, as the CLI's --clusters K|auto and --tolerance T|T% cut it.
+Segmentation cut_level(const Hierarchy& hierarchy, const LevelArguments& level) {
+  validate_level(level, hierarchy.face_count());
+  if (level.k) {
+    if (std::holds_alternative<std::string>(*level.k))
+      return cut_by_count(hierarchy, choose_level(hierarchy).clusters);
+    return cut_by_count(hierarchy, static_cast<std::uint32_t>(std::get<std::int64_t>(*level.k)));
+  }
+  if (level.tolerance) return cut_by_tolerance(hierarchy, *level.tolerance);
+  const double fraction = level.relative_tolerance.value_or(kDefaultRelativeTolerance);
   return cut_by_tolerance(hierarchy, fraction * bounding_box_diagonal(hierarchy.mesh()));
 }
 
@@ -282,6 +314,240 @@ py::dict cluster_dict(const ClusterReport& report) {
   cluster["max"] = report.max;
   cluster["params"] = params;
   return cluster;
+}
+
+// ---------------------------------------------------------------------------------------------
+// denoise, skeleton, distance: the CLI commands of those names.
+
+// The mesh of a `mesh_or_V, F` argument pair: a Mesh (F must be None) or arrays V and F.
+// `function` names the caller in messages.
+std::shared_ptr<const Mesh> mesh_argument(const std::string& function, const py::object& first,
+                                          const py::object& faces) {
+  if (py::isinstance<PyMesh>(first)) {
+    if (!faces.is_none())
+      throw InvalidInputError(function + "(mesh) takes no F" +
+                              (function == "segment" ? "" : " (give the level as k=...)"));
+    return first.cast<const PyMesh&>().mesh;
+  }
+  if (faces.is_none()) throw InvalidInputError(function + "(V, F): F is missing");
+  return mesh_from_python(first, faces);
+}
+
+// One mesh of distance(a, b): a Mesh, a Hierarchy (its mesh) or a (V, F) pair.
+std::shared_ptr<const Mesh> mesh_operand(const py::handle& operand, const char* name) {
+  if (py::isinstance<PyMesh>(operand)) return operand.cast<const PyMesh&>().mesh;
+  if (py::isinstance<PyHierarchy>(operand))
+    return operand.cast<const PyHierarchy&>().hierarchy->shared_mesh();
+  if ((py::isinstance<py::tuple>(operand) || py::isinstance<py::list>(operand)) &&
+      py::len(operand) == 2) {
+    const py::sequence pair = py::reinterpret_borrow<py::sequence>(operand);
+    return mesh_from_python(pair[0], pair[1]);
+  }
+  throw InvalidInputError(std::string(name) +
+                          " must be a Mesh, a Hierarchy or a (V, F) pair, not " +
+                          py::repr(py::type::of(operand)).cast<std::string>());
+}
+
+// A Python number as a double, or InvalidInputError naming `what`.
+double number_argument(const py::handle& value, const std::string& what) {
+  if (py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value))
+    throw InvalidInputError(what + " must be a number, not " + py::repr(value).cast<std::string>());
+  try {
+    return value.cast<double>();
+  } catch (const py::cast_error&) {
+    throw InvalidInputError(what + " must be a number, not " + py::repr(value).cast<std::string>());
+  }
+}
+
+// A Python integer in [0, limit], or InvalidInputError naming `what`.
+std::uint64_t unsigned_argument(const py::handle& value, const std::string& what,
+                                std::uint64_t limit = std::numeric_limits<std::uint64_t>::max()) {
+  const std::string bad = what + " must be an integer in 0.." + std::to_string(limit) + ", not " +
+                          py::repr(value).cast<std::string>();
+  if (py::isinstance<py::bool_>(value) || !PyIndex_Check(value.ptr())) throw InvalidInputError(bad);
+  const py::int_ integer = py::reinterpret_steal<py::int_>(PyNumber_Index(value.ptr()));
+  if (!integer) throw py::error_already_set();
+  const unsigned long long result = PyLong_AsUnsignedLongLong(integer.ptr());
+  if (PyErr_Occurred()) {  // negative, or beyond 64 bits
+    PyErr_Clear();
+    throw InvalidInputError(bad);
+  }
+  if (result > limit) throw InvalidInputError(bad);
+  return result;
+}
+
+// A pose: rotations as the CLI's pose file gives them ({"rotations": [...]}, or the list alone),
+// each a dict {"joint": J, "axis": [x, y, z], "degrees": A} or a (joint, axis, degrees) tuple.
+std::vector<JointRotation> pose_argument(const py::handle& pose) {
+  py::object rotations = py::reinterpret_borrow<py::object>(pose);
+  if (py::isinstance<py::dict>(pose)) {
+    const py::dict file = py::reinterpret_borrow<py::dict>(pose);
+    if (!file.contains("rotations"))
+      throw InvalidInputError("pose: a dict must have \"rotations\" (as a pose file)");
+    rotations = file["rotations"];
+  }
+  if (!py::isinstance<py::sequence>(rotations) || py::isinstance<py::str>(rotations))
+    throw InvalidInputError("pose must be a list of rotations, not " +
+                            py::repr(py::type::of(rotations)).cast<std::string>());
+  std::vector<JointRotation> result;
+  const py::sequence list = py::reinterpret_borrow<py::sequence>(rotations);
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where = "pose rotation " + std::to_string(i);
+    py::object joint, axis, degrees;
+    const py::object item = list[i];
+    if (py::isinstance<py::dict>(item)) {
+      const py::dict rotation = py::reinterpret_borrow<py::dict>(item);
+      for (const char* key : {"joint", "axis", "degrees"})
+        if (!rotation.contains(key)) throw InvalidInputError(where + ": missing \"" + key + "\"");
+      joint = rotation["joint"], axis = rotation["axis"], degrees = rotation["degrees"];
+    } else if (py::isinstance<py::sequence>(item) && !py::isinstance<py::str>(item) &&
+               py::len(item) == 3) {
+      const py::sequence triple = py::reinterpret_borrow<py::sequence>(item);
+      joint = triple[0], axis = triple[1], degrees = triple[2];
+    } else {
+      throw InvalidInputError(where + " must be a dict {\"joint\", \"axis\", \"degrees\"} or a " +
+                              "(joint, axis, degrees) tuple, not " +
+                              py::repr(item).cast<std::string>());
+    }
+    JointRotation rotation;
+    rotation.joint = static_cast<std::uint32_t>(
+        unsigned_argument(joint, where + ": joint", std::numeric_limits<std::uint32_t>::max() - 1));
+    if (!py::isinstance<py::sequence>(axis) || py::isinstance<py::str>(axis) || py::len(axis) != 3)
+      throw InvalidInputError(where + ": axis must be 3 numbers");
+    const py::sequence components = py::reinterpret_borrow<py::sequence>(axis);
+    for (std::size_t c = 0; c < 3; ++c) {
+      rotation.axis[c] = number_argument(components[c], where + ": axis");
+      if (!std::isfinite(rotation.axis[c]))
+        throw InvalidInputError(where + ": axis must be finite");
+    }
+    const double angle_degrees = number_argument(degrees, where + ": degrees");
+    if (!std::isfinite(angle_degrees))
+      throw InvalidInputError(where + ": degrees must be a finite number");
+    rotation.angle = angle_degrees * std::numbers::pi / 180;  // as the CLI's pose file
+    result.push_back(rotation);
+  }
+  return result;
+}
+
+py::list index_list(const std::vector<std::uint32_t>& ids) {
+  py::list list;
+  for (const std::uint32_t id : ids) list.append(id);
+  return list;
+}
+
+// The skeleton of a level, with the mesh it was made from and its skin weights once asked for.
+struct PySkeleton {
+  std::shared_ptr<const Mesh> mesh;
+  std::shared_ptr<const Skeleton> skeleton;
+  // The weights of the last band asked for: a pose then costs one pass over the vertices.
+  std::shared_ptr<const SkinWeights> weights;
+  double weights_band = 0;
+
+  // Computed without the GIL; cached with it (the caller holds it when this returns).
+  std::shared_ptr<const SkinWeights> skin_weights(double band) {
+    if (!(std::isfinite(band) && band >= 0))
+      throw InvalidInputError("band must be a finite number >= 0, not " + std::to_string(band));
+    if (weights && weights_band == band) return weights;
+    std::shared_ptr<const SkinWeights> computed;
+    {
+      py::gil_scoped_release release;
+      SkinningOptions options;
+      options.band = band;
+      computed =
+          std::make_shared<const SkinWeights>(compute_skin_weights(*mesh, *skeleton, options));
+    }
+    weights = computed;
+    weights_band = band;
+    return computed;
+  }
+};
+
+// The joints and bones as the CLI's skeleton file lists them.
+py::dict joint_dict(const Joint& joint) {
+  py::dict dict;
+  dict["id"] = joint.id;
+  dict["position"] = vector_list(joint.position);
+  dict["kind"] = std::string(to_string(joint.kind));
+  dict["visible"] = joint.visible;
+  dict["bones"] = index_list(joint.bones);
+  return dict;
+}
+
+py::dict bone_dict(const Bone& bone) {
+  py::dict dict;
+  dict["id"] = bone.id;
+  dict["cluster"] = bone.cluster;
+  dict["joints"] = index_list(bone.joints);
+  dict["visible"] = bone.visible;
+  dict["axis"] = vector_list(bone.axis);
+  dict["point"] = vector_list(bone.point);
+  dict["radius"] = bone.radius;
+  dict["area"] = bone.area;
+  return dict;
+}
+
+py::list joint_list(const Skeleton& skeleton) {
+  py::list list;
+  for (const Joint& joint : skeleton.joints) list.append(joint_dict(joint));
+  return list;
+}
+
+py::list bone_list(const Skeleton& skeleton) {
+  py::list list;
+  for (const Bone& bone : skeleton.bones) list.append(bone_dict(bone));
+  return list;
+}
+
+py::array positions_array(std::vector<Vec3>&& positions) {
+  const py::ssize_t rows = static_cast<py::ssize_t>(positions.size());
+  return adopt<double>(std::move(positions), {rows, 3});
+}
+
+// One side of `primseg distance --json`: the figures in input units and in percent of the
+// bounding-box diagonal, computed as the CLI computes them (the same doubles).
+py::dict distance_side(const OneSidedDistance& d, double diagonal) {
+  const double percent = diagonal > 0 ? 100 / diagonal : 0;
+  py::dict side;
+  side["mean"] = d.mean;
+  side["rms"] = d.rms;
+  side["max"] = d.max;
+  side["samples"] = d.samples;
+  side["mean_percent"] = d.mean * percent;
+  side["rms_percent"] = d.rms * percent;
+  side["max_percent"] = d.max * percent;
+  return side;
+}
+
+py::dict snap_report_dict(const SnapReport& r) {
+  py::dict round;
+  round["clusters"] = r.clusters;
+  round["boundary_vertices"] = r.boundary_vertices;
+  round["moved"] = r.moved;
+  round["fallbacks"] = r.fallbacks;
+  round["blocked"] = r.blocked;
+  round["mean_move"] = r.mean_move;
+  round["max_move"] = r.max_move;
+  return round;
+}
+
+// The hierarchy options of denoise and skeleton: those of a given Hierarchy (primitives and
+// weights must then be None), else the arguments with `default_primitives`.
+HierarchyOptions tool_hierarchy_options(const std::string& function, const PyHierarchy* given,
+                                        const py::object& primitives, const py::object& weights,
+                                        unsigned threads, const py::object& default_primitives) {
+  if (given) {
+    if (!primitives.is_none() || !weights.is_none())
+      throw InvalidInputError(function + "(hierarchy): primitives and weights are the hierarchy's");
+    HierarchyOptions options = given->hierarchy->options();
+    options.threads = threads;
+    return options;
+  }
+  if (!weights.is_none() && !py::isinstance<py::str>(weights))
+    throw InvalidInputError("weights: must be 'area' or 'uniform', not " +
+                            py::repr(weights).cast<std::string>());
+  return hierarchy_options(primitives.is_none() ? default_primitives : primitives,
+                           weights.is_none() ? std::string("area") : weights.cast<std::string>(),
+                           threads, false, false);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -329,11 +595,13 @@ void register_exceptions(py::module_& m) {
 const char* kLevelArguments =
     R"(Exactly one level, or none for the CLI's default (relative_tolerance=0.001, i.e.
 `--tolerance 0.1%`):
-  k: number of clusters, 1..F (below the number of connected components C you get C);
+  k: number of clusters, 1..F (below the number of connected components C you get C), or
+    "auto": the most significant level of the error curve (the CLI's --clusters auto);
   tolerance: the coarsest level whose clusters each have an RMS distance estimate of at
     most `tolerance` to their primitive, input units;
   relative_tolerance: the same as a fraction of the bounding-box diagonal (0.001 = 0.1%).
-Raises InvalidInputError (a ValueError) for k outside 1..F or a negative or NaN tolerance.)";
+Raises InvalidInputError (a ValueError) for k outside 1..F, a string other than "auto", or a
+negative or NaN tolerance.)";
 
 }  // namespace
 }  // namespace primseg::python
@@ -350,8 +618,9 @@ PYBIND11_MODULE(primseg, m) {
     for c in h.clusters(12):                       # like the CLI's --json clusters
         print(c["type"], c["faces"], c["rms"], c["params"])
     Z = h.linkage()                                # scipy.cluster.hierarchy linkage matrix
-
-denoise, skeleton and distance will mirror the CLI commands once those exist.)"});
+    V2 = primseg.denoise(mesh, k=30)               # primseg denoise: new positions (n, 3)
+    s = primseg.skeleton(mesh, k=12)               # primseg skeleton: joints, bones, deform(pose)
+    d = primseg.distance(mesh, (V2, mesh.F))       # primseg distance --json, as a dict)"});
   m.attr("__version__") = "0.1.0";
   // Every docstring starts with its own Python signature (pybind11's would show C++ types).
   py::options docstring_options;
@@ -460,12 +729,7 @@ coordinates, index out of range, no faces) or bad options.)";
          const std::string& weights, unsigned threads, bool exact_costs, bool eager) {
         const HierarchyOptions options =
             hierarchy_options(primitives, weights, threads, exact_costs, eager);
-        if (py::isinstance<PyMesh>(first)) {
-          if (!faces.is_none()) throw InvalidInputError("segment(mesh) takes no F");
-          return segment_mesh(first.cast<const PyMesh&>().mesh, options);
-        }
-        if (faces.is_none()) throw InvalidInputError("segment(V, F): F is missing");
-        return segment_mesh(mesh_from_python(first, faces), options);
+        return segment_mesh(mesh_argument("segment", first, faces), options);
       },
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(),
       py::arg("primitives") = py::make_tuple("plane", "cylinder", "sphere"),
@@ -495,15 +759,16 @@ coordinates, index out of range, no faces) or bad options.)";
   hierarchy_class
       .def(
           "cut",
-          [](const PyHierarchy& self, std::optional<std::int64_t> k,
-             std::optional<double> tolerance, std::optional<double> relative_tolerance) {
-            Segmentation level;
+          [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
+             std::optional<double> relative_tolerance) {
+            const LevelArguments level{std::move(k), tolerance, relative_tolerance};
+            Segmentation segmentation;
             {
               py::gil_scoped_release release;
-              level = cut_level(*self.hierarchy, k, tolerance, relative_tolerance);
+              segmentation = cut_level(*self.hierarchy, level);
             }
-            const py::ssize_t faces = static_cast<py::ssize_t>(level.labels.size());
-            return adopt<std::int32_t>(std::move(level.labels), {faces});
+            const py::ssize_t faces = static_cast<py::ssize_t>(segmentation.labels.size());
+            return adopt<std::int32_t>(std::move(segmentation.labels), {faces});
           },
           py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
           py::arg("relative_tolerance") = py::none(),
@@ -516,13 +781,13 @@ labels as the CLI's --labels.)",
               .c_str())
       .def(
           "clusters",
-          [](const PyHierarchy& self, std::optional<std::int64_t> k,
-             std::optional<double> tolerance, std::optional<double> relative_tolerance) {
+          [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
+             std::optional<double> relative_tolerance) {
+            const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterReport> reports;
             {
               py::gil_scoped_release release;
-              reports = describe_clusters(
-                  *self.hierarchy, cut_level(*self.hierarchy, k, tolerance, relative_tolerance));
+              reports = describe_clusters(*self.hierarchy, cut_level(*self.hierarchy, level));
             }
             py::list clusters;
             for (const ClusterReport& report : reports) clusters.append(cluster_dict(report));
@@ -595,4 +860,338 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
         return "<primseg.Hierarchy: " + std::to_string(self.hierarchy->face_count()) + " faces, " +
                std::to_string(self.hierarchy->component_count()) + " components>";
       });
+
+  // ------------------------------------------------------------------------------------------
+  // denoise, skeleton, distance.
+
+  const char* denoise_doc =
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, stylize=False, max_move=4.0, min_crease_angle=10.0, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
+denoise(V, F, *, ...) -> numpy.ndarray
+denoise(hierarchy, *, ...) -> numpy.ndarray
+
+`primseg denoise`: snaps every vertex onto the primitives of a level, `iterations` times (each
+round segments the previous round's result), and returns the new positions, float64 (n, 3), in
+the input's vertex order (the faces do not change): the CLI's output mesh, bit for bit. With
+return_rounds=True it returns (V, rounds), rounds a list of dicts like the CLI's --json
+"denoise" "rounds" (clusters, boundary_vertices, moved, fallbacks, blocked, mean_move,
+max_move).
+The input is a Mesh, arrays V and F (as segment takes them), or a Hierarchy: its first round
+then snaps onto that tree's level without building it again (smoothing_steps must be 0, and the
+later rounds use its primitives and weights).
+Level: k (count or "auto"), tolerance or relative_tolerance as in Hierarchy.cut, the CLI's
+--clusters and --tolerance; none: 0.1% of the diagonal.
+stylize: --stylize (each vertex onto its own cluster's primitive); max_move: --max-move (in mean
+incident edge lengths); min_crease_angle: --min-crease-angle (degrees); smoothing_steps:
+--smooth; primitives (default plane, cylinder, sphere) and weights (default "area"): as in
+segment. The GIL is released while it works.
+Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)";
+  m.def(
+      "denoise",
+      [](const py::object& first, const py::object& faces, ClusterCount k,
+         std::optional<double> tolerance, std::optional<double> relative_tolerance, int iterations,
+         int smoothing_steps, bool stylize, double max_move, double min_crease_angle,
+         const py::object& primitives, const py::object& weights, unsigned threads,
+         bool return_rounds) -> py::object {
+        const LevelArguments level{std::move(k), tolerance, relative_tolerance};
+        const PyHierarchy* given =
+            py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
+        if (given && !faces.is_none())
+          throw InvalidInputError("denoise(hierarchy) takes no F (give the level as k=...)");
+        DenoiseOptions options;
+        options.mode = stylize ? SnapMode::NearestIncident : SnapMode::AllIncident;
+        options.max_move_edge_lengths = max_move;
+        options.min_crease_angle_degrees = min_crease_angle;
+        options.smoothing_steps = smoothing_steps;
+        options.hierarchy = tool_hierarchy_options("denoise", given, primitives, weights, threads,
+                                                   py::make_tuple("plane", "cylinder", "sphere"));
+        validate(options);
+        if (iterations < 1 || iterations > 100)
+          throw InvalidInputError("iterations must be between 1 and 100 (the CLI's range), not " +
+                                  std::to_string(iterations));
+        if (smoothing_steps < 0 || smoothing_steps > 1000)
+          throw InvalidInputError(
+              "smoothing_steps must be between 0 and 1000 (the CLI's range), not " +
+              std::to_string(smoothing_steps));
+        if (given && smoothing_steps > 0)
+          throw InvalidInputError(
+              "denoise(hierarchy): smoothing_steps must be 0 (the tree was built on the mesh as "
+              "it is); give the mesh to segment a smoothed copy");
+        const std::shared_ptr<const Mesh> mesh =
+            given ? given->hierarchy->shared_mesh() : mesh_argument("denoise", first, faces);
+        validate_level(level, mesh->face_count());
+        std::vector<SnapReport> reports;
+        std::vector<Vec3> positions;
+        {
+          py::gil_scoped_release release;
+          Denoiser denoiser(*mesh, options);
+          for (int round = 0; round < iterations; ++round) {
+            // As `primseg denoise`: each round segments the previous round's result.
+            const std::shared_ptr<const Hierarchy> hierarchy =
+                round == 0 && given ? given->hierarchy
+                                    : std::make_shared<const Hierarchy>(build_hierarchy(
+                                          denoiser.segmented_mesh(), options.hierarchy));
+            reports.push_back(denoiser.snap(*hierarchy, cut_level(*hierarchy, level)));
+          }
+          positions = denoiser.mesh().positions;
+        }
+        py::array V = positions_array(std::move(positions));
+        if (!return_rounds) return V;
+        py::list rounds;
+        for (const SnapReport& report : reports) rounds.append(snap_report_dict(report));
+        return py::make_tuple(V, rounds);
+      },
+      py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(), py::arg("k") = py::none(),
+      py::arg("tolerance") = py::none(), py::arg("relative_tolerance") = py::none(),
+      py::arg("iterations") = 1, py::arg("smoothing_steps") = DenoiseOptions{}.smoothing_steps,
+      py::arg("stylize") = false, py::arg("max_move") = DenoiseOptions{}.max_move_edge_lengths,
+      py::arg("min_crease_angle") = DenoiseOptions{}.min_crease_angle_degrees,
+      py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
+      py::arg("return_rounds") = false,
+      join_docs({denoise_doc, cpp_doc("denoise.hpp", doc::denoise__file),
+                 cpp_doc("DenoiseOptions::max_move_edge_lengths",
+                         doc::denoise__DenoiseOptions__max_move_edge_lengths),
+                 cpp_doc("DenoiseOptions::min_crease_angle_degrees",
+                         doc::denoise__DenoiseOptions__min_crease_angle_degrees),
+                 cpp_doc("DenoiseOptions::smoothing_steps",
+                         doc::denoise__DenoiseOptions__smoothing_steps),
+                 cpp_doc("SnapMode", doc::denoise__SnapMode),
+                 cpp_doc("SnapReport", doc::denoise__SnapReport)})
+          .c_str());
+
+  py::class_<PySkeleton>(
+      m, "Skeleton",
+      join_docs({R"(A deformation skeleton (from primseg.skeleton): one bone per cluster of a level,
+joints where clusters meet, the mesh it was made from, its skin weights and poses.
+
+joints and bones are lists of dicts with the keys and values of the CLI's skeleton file;
+to_dict() is that file without its "mesh", "primitives", "requested_clusters" and "timing".)",
+                 cpp_doc("Skeleton", doc::skeleton__Skeleton),
+                 cpp_doc("extract_skeleton", doc::skeleton__extract_skeleton)})
+          .c_str())
+      .def_property_readonly(
+          "joints", [](const PySkeleton& self) { return joint_list(*self.skeleton); },
+          R"(List of dicts: id, position [x, y, z] (input units), kind ("sensitive", "locked" or
+"virtual"), visible, bones (incident bone ids).)")
+      .def_property_readonly(
+          "bones", [](const PySkeleton& self) { return bone_list(*self.skeleton); },
+          R"(List of dicts, bone i is cluster i: id, cluster, joints, visible, axis (unit), point,
+radius, area (input units).)")
+      .def_property_readonly(
+          "joint_positions",
+          [](const PySkeleton& self) {
+            std::vector<Vec3> positions;
+            for (const Joint& joint : self.skeleton->joints) positions.push_back(joint.position);
+            return positions_array(std::move(positions));
+          },
+          "(J, 3) float64: the rest positions of the joints.")
+      .def_property_readonly(
+          "face_labels",
+          [](const PySkeleton& self) {
+            std::vector<std::uint32_t> labels = self.skeleton->face_labels;
+            const py::ssize_t faces = static_cast<py::ssize_t>(labels.size());
+            return adopt<std::int32_t>(std::move(labels), {faces});
+          },
+          doc::skeleton__Skeleton__face_labels)
+      .def_property_readonly(
+          "cluster_count", [](const PySkeleton& self) { return self.skeleton->cluster_count(); },
+          "K, the number of bones (one per cluster).")
+      .def_property_readonly(
+          "root_bone", [](const PySkeleton& self) { return self.skeleton->root_bone(); },
+          doc::skeleton__Skeleton__root_bone)
+      .def_property_readonly(
+          "mesh", [](const PySkeleton& self) { return PyMesh{self.mesh}; },
+          "The mesh the skeleton was made from (shared, no copy).")
+      .def(
+          "to_dict",
+          [](const PySkeleton& self) {
+            py::dict dict;
+            dict["cluster_count"] = self.skeleton->cluster_count();
+            dict["root_bone"] = self.skeleton->root_bone();
+            dict["joints"] = joint_list(*self.skeleton);
+            dict["bones"] = bone_list(*self.skeleton);
+            dict["face_labels"] = index_list(self.skeleton->face_labels);
+            return dict;
+          },
+          R"(to_dict() -> dict
+
+cluster_count, root_bone, joints, bones and face_labels (a list): the CLI's skeleton file
+(`primseg skeleton -o`) without its summary entries; json.dumps() takes it as it is.)")
+      .def(
+          "skin_weights",
+          [](PySkeleton& self, double band, bool sparse) -> py::object {
+            const std::shared_ptr<const SkinWeights> weights = self.skin_weights(band);
+            const py::ssize_t n = weights->vertex_count();
+            if (sparse) {
+              std::vector<double> values = weights->weights;
+              std::vector<std::uint32_t> bones = weights->bones, offsets = weights->offsets;
+              const py::ssize_t entries = static_cast<py::ssize_t>(values.size());
+              return py::make_tuple(adopt<double>(std::move(values), {entries}),
+                                    adopt<std::int32_t>(std::move(bones), {entries}),
+                                    adopt<std::int32_t>(std::move(offsets), {n + 1}));
+            }
+            const py::ssize_t k = self.skeleton->cluster_count();
+            py::array_t<double> dense({n, k});
+            double* out = dense.mutable_data();
+            std::fill(out, out + n * k, 0.0);
+            for (std::uint32_t v = 0; v < weights->vertex_count(); ++v) {
+              const auto bones = weights->bones_of(v);
+              const auto values = weights->weights_of(v);
+              for (std::size_t i = 0; i < bones.size(); ++i) out[v * k + bones[i]] = values[i];
+            }
+            return dense;
+          },
+          py::arg("band") = SkinningOptions{}.band, py::arg("sparse") = false,
+          join_docs({R"(skin_weights(band=0.5, sparse=False) -> numpy.ndarray or tuple
+
+The weight of each bone for each vertex: float64 (n, K), rows summing to 1 (an unused vertex:
+a row of zeros). sparse=True gives the compressed rows instead, (data float64, indices int32,
+indptr int32), for scipy.sparse.csr_matrix((data, indices, indptr), shape=(n, K)): the CLI's
+--skin-weights file. band: the CLI's --band (blend half-width in bone radii). Computed once per
+band and kept for deform().)",
+                     cpp_doc("skinning.hpp", doc::skinning__file),
+                     cpp_doc("SkinningOptions::band", doc::skinning__SkinningOptions__band)})
+              .c_str())
+      .def(
+          "deform",
+          [](PySkeleton& self, const py::object& pose, double band) {
+            const std::vector<JointRotation> rotations = pose_argument(pose);
+            const std::shared_ptr<const SkinWeights> weights = self.skin_weights(band);
+            std::vector<Vec3> positions;
+            {
+              py::gil_scoped_release release;
+              const std::vector<RigidTransform> bones = pose_bones(*self.skeleton, rotations);
+              positions = skin_positions(self.mesh->positions, *weights, bones);
+            }
+            return positions_array(std::move(positions));
+          },
+          py::arg("pose"), py::arg("band") = SkinningOptions{}.band,
+          join_docs({R"(deform(pose, band=0.5) -> numpy.ndarray
+
+`primseg deform`: the vertex positions, float64 (n, 3), of the mesh posed by rotating joints,
+by linear blend skinning; the CLI's output mesh, bit for bit. pose: the CLI's pose file as
+json.load gives it ({"rotations": [...]}), or its list of rotations, each a dict {"joint": J,
+"axis": [x, y, z], "degrees": A} or a tuple (J, axis, degrees). Rotated joints must be
+sensitive. Raises InvalidInputError (a ValueError) for a malformed pose, an unknown, locked or
+repeated joint, or a zero axis.)",
+                     cpp_doc("JointRotation", doc::skinning__JointRotation),
+                     cpp_doc("pose_bones", doc::skinning__pose_bones),
+                     cpp_doc("skin_positions", doc::skinning__skin_positions)})
+              .c_str())
+      .def(
+          "posed_joint_positions",
+          [](const PySkeleton& self, const py::object& pose) {
+            const std::vector<JointRotation> rotations = pose_argument(pose);
+            return positions_array(
+                posed_joint_positions(*self.skeleton, pose_bones(*self.skeleton, rotations)));
+          },
+          py::arg("pose"),
+          join_docs({"posed_joint_positions(pose) -> numpy.ndarray: (J, 3) float64, the joints "
+                     "in a pose (as deform takes it).",
+                     cpp_doc("posed_joint_positions", doc::skinning__posed_joint_positions)})
+              .c_str())
+      .def(
+          "bones_beyond",
+          [](const PySkeleton& self, std::int64_t joint) {
+            if (joint < 0 || joint >= static_cast<std::int64_t>(self.skeleton->joints.size()))
+              throw InvalidInputError("joint must be between 0 and " +
+                                      std::to_string(self.skeleton->joints.size()) + " - 1, not " +
+                                      std::to_string(joint));
+            return index_list(bones_beyond(*self.skeleton, static_cast<std::uint32_t>(joint)));
+          },
+          py::arg("joint"),
+          join_docs({"bones_beyond(joint) -> list: the bones a rotation of `joint` moves.",
+                     cpp_doc("bones_beyond", doc::skinning__bones_beyond)})
+              .c_str())
+      .def("__repr__", [](const PySkeleton& self) {
+        return "<primseg.Skeleton: " + std::to_string(self.skeleton->cluster_count()) + " bones, " +
+               std::to_string(self.skeleton->joints.size()) + " joints>";
+      });
+
+  m.def(
+      "skeleton",
+      [](const py::object& first, const py::object& faces, ClusterCount k,
+         std::optional<double> tolerance, std::optional<double> relative_tolerance,
+         const py::object& primitives, const py::object& weights, unsigned threads) {
+        const LevelArguments level{std::move(k), tolerance, relative_tolerance};
+        const PyHierarchy* given =
+            py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
+        if (given && !faces.is_none())
+          throw InvalidInputError("skeleton(hierarchy) takes no F (give the level as k=...)");
+        const HierarchyOptions options = tool_hierarchy_options(
+            "skeleton", given, primitives, weights, threads, py::make_tuple("cylinder"));
+        const std::shared_ptr<const Mesh> mesh =
+            given ? given->hierarchy->shared_mesh() : mesh_argument("skeleton", first, faces);
+        validate_level(level, mesh->face_count());
+        py::gil_scoped_release release;
+        const std::shared_ptr<const Hierarchy> hierarchy =
+            given ? given->hierarchy
+                  : std::make_shared<const Hierarchy>(build_hierarchy(mesh, options));
+        PySkeleton skeleton;
+        skeleton.mesh = mesh;
+        skeleton.skeleton = std::make_shared<const Skeleton>(
+            extract_skeleton(*hierarchy, cut_level(*hierarchy, level)));
+        return skeleton;
+      },
+      py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(), py::arg("k") = py::none(),
+      py::arg("tolerance") = py::none(), py::arg("relative_tolerance") = py::none(),
+      py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
+      join_docs(
+          {R"(skeleton(mesh, *, k=None, tolerance=None, relative_tolerance=None, primitives=None, weights=None, threads=0) -> Skeleton
+skeleton(V, F, *, ...) -> Skeleton
+skeleton(hierarchy, *, ...) -> Skeleton
+
+`primseg skeleton`: the deformation skeleton of a level, one bone per cluster. The input is a
+Mesh, arrays V and F, or a Hierarchy (its tree, not built again). Level: k (count or "auto"),
+tolerance or relative_tolerance as in Hierarchy.cut (the CLI asks for --clusters K|auto).
+primitives: cylinders only by default, as the CLI (and the paper) do; weights: "area" by
+default. The GIL is released while it works.)",
+           cpp_doc("skeleton.hpp", doc::skeleton__file)})
+          .c_str());
+
+  m.def(
+      "distance",
+      [](const py::object& a, const py::object& b, const py::object& samples,
+         std::optional<double> density, const py::object& seed, unsigned threads) {
+        DistanceOptions options;
+        if (!samples.is_none() && density)
+          throw InvalidInputError("give samples or density, not both");
+        if (!samples.is_none()) options.samples = unsigned_argument(samples, "samples");
+        if (density) options.density = *density;
+        options.seed = unsigned_argument(seed, "seed");
+        options.threads = threads;
+        const std::shared_ptr<const Mesh> first = mesh_operand(a, "a");
+        const std::shared_ptr<const Mesh> second = mesh_operand(b, "b");
+        MeshDistance d;
+        {
+          py::gil_scoped_release release;
+          d = mesh_distance(*first, *second, options);
+        }
+        py::dict result;
+        result["bbox_diagonal"] = d.diagonal;
+        result["a_to_b"] = distance_side(d.a_to_b, d.diagonal);
+        result["b_to_a"] = distance_side(d.b_to_a, d.diagonal);
+        result["symmetric"] = distance_side(
+            {d.mean, d.rms, d.hausdorff, d.a_to_b.samples + d.b_to_a.samples}, d.diagonal);
+        result["seed"] = options.seed;
+        return result;
+      },
+      py::arg("a"), py::arg("b"), py::kw_only(), py::arg("samples") = py::none(),
+      py::arg("density") = py::none(), py::arg("seed") = DistanceOptions{}.seed,
+      py::arg("threads") = 0u,
+      join_docs({R"(distance(a, b, *, samples=None, density=None, seed=1, threads=0) -> dict
+
+`primseg distance --json`: Metro-style distances between two surfaces, each a Mesh, a Hierarchy
+(its mesh) or a (V, F) pair. Returns the CLI's JSON without its file names and timing:
+bbox_diagonal, seed, and a_to_b, b_to_a, symmetric, each {mean, rms, max, samples,
+mean_percent, rms_percent, max_percent} (input units, and percent of the diagonal of both
+meshes' bounding box); symmetric "max" is the Hausdorff distance.
+samples: area-uniform samples on each surface (default 200000); density: samples per unit area
+instead; seed: of the sample positions (the same seed gives the same figures); threads: 0 for all
+cores (the figures do not depend on it). The GIL is released while it works.)",
+                 cpp_doc("mesh_distance", doc::mesh_distance__mesh_distance),
+                 cpp_doc("OneSidedDistance", doc::mesh_distance__OneSidedDistance),
+                 cpp_doc("OneSidedDistance::max", doc::mesh_distance__OneSidedDistance__max),
+                 cpp_doc("MeshDistance::mean", doc::mesh_distance__MeshDistance__mean),
+                 cpp_doc("DistanceOptions::density", doc::mesh_distance__DistanceOptions__density)})
+          .c_str());
 }

@@ -112,3 +112,53 @@ tree.save(tree_path)
 reloaded = primseg.read_tree(tree_path)
 assert np.array_equal(reloaded.cut(30), labels)
 print(f"saved and reloaded {tree_path.name}: {tree_path.stat().st_size / 1e6:.1f} MB")
+
+# %% [markdown]
+# ## Denoising: snap the vertices onto the primitives
+# Noise of 0.1% of the diagonal blurs fandisk's sharp edges. `denoise` segments the noisy mesh,
+# then moves every vertex onto its cluster's primitive (a vertex between clusters onto their
+# intersection, which restores the edges); `distance` measures the result against the clean part
+# as `primseg distance --json` does. The RMS distance drops by about half; the largest distance
+# can grow, where a vertex near a border snapped onto its neighbour's primitive.
+
+# %%
+rng = np.random.default_rng(1)
+noisy_V = mesh.V + rng.normal(scale=1e-3 * mesh.bounding_box_diagonal, size=mesh.V.shape)
+start = time.perf_counter()
+clean_V, rounds = primseg.denoise(noisy_V, mesh.F, k=30, return_rounds=True)
+print(f"denoised in {time.perf_counter() - start:.2f} s:", rounds[0])
+before = primseg.distance(mesh, (noisy_V, mesh.F), samples=50000)
+after = primseg.distance(mesh, (clean_V, mesh.F), samples=50000)
+for name, d in [("noisy", before), ("denoised", after)]:
+    s = d["symmetric"]
+    print(f"{name:9} to the original: rms {s['rms_percent']:.4f}%  hausdorff {s['max_percent']:.4f}%"
+          " of the diagonal")
+assert clean_V.shape == mesh.V.shape and clean_V.dtype == np.float64
+assert after["symmetric"]["rms"] < 0.6 * before["symmetric"]["rms"]
+
+# %% [markdown]
+# ## A skeleton, and a pose
+# On a natural shape, cylinders only, the clusters are limbs and the skeleton follows: one bone
+# per cluster, one joint where clusters meet (here man.off from the same archive). `deform`
+# rotates joints and moves the vertices by linear blend skinning.
+
+# %%
+if len(sys.argv) <= 2:
+    man_path = path.parent / "man.off"
+    with tarfile.open("/usr/share/doc/libcgal-dev/data.tar.gz") as archive:
+        man_path.write_bytes(archive.extractfile("data/meshes/man.off").read())
+else:
+    man_path = pathlib.Path(sys.argv[2])
+man = primseg.read_mesh(man_path)
+skeleton = primseg.skeleton(man, k=20)  # primitives=("cylinder",) by default, as the CLI
+kinds = [j["kind"] for j in skeleton.joints]
+print(skeleton, {kind: kinds.count(kind) for kind in sorted(set(kinds))})
+weights = skeleton.skin_weights()  # (n, K): one weight per bone per vertex, rows summing to 1
+joint = next(j["id"] for j in skeleton.joints
+             if j["kind"] == "sensitive" and len(skeleton.bones_beyond(j["id"])) < 5)
+posed = skeleton.deform([{"joint": joint, "axis": [1, 0, 0], "degrees": 45}])
+moved = np.linalg.norm(posed - man.V, axis=1) > 0
+print(f"rotating joint {joint} by 45 degrees moves {moved.sum()} of {len(man.V)} vertices"
+      f" (bones {skeleton.bones_beyond(joint)})")
+assert np.allclose(weights[np.unique(man.F)].sum(axis=1), 1.0)
+assert 0 < moved.sum() < len(man.V)

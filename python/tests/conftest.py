@@ -3,7 +3,10 @@ small generated solids with known primitives."""
 
 import os
 import pathlib
+import subprocess
 import tarfile
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -69,3 +72,42 @@ def same_partition(a, b):
     a, b = np.asarray(a), np.asarray(b)
     pairs = np.unique(np.stack([a, b]), axis=1)
     return len(pairs[0]) == len(np.unique(a)) == len(np.unique(b))
+
+
+def run_cli(cli, *args):
+    """Runs the primseg executable; returns its standard output."""
+    # Under the sanitizer build the interpreter runs with the ASan runtime preloaded; the CLI
+    # carries its own and must not get a second one.
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+    return subprocess.run([str(cli), *map(str, args)], check=True, capture_output=True, env=env,
+                          text=True).stdout
+
+
+def write_off(path, V, F):
+    """An OFF file whose coordinates read back bit for bit (repr is the shortest round trip)."""
+    lines = ["OFF", f"{len(V)} {len(F)} 0"] + [" ".join(map(repr, v)) for v in np.asarray(V).tolist()]
+    lines += [" ".join(map(str, [len(f), *f])) for f in np.asarray(F).tolist()]
+    pathlib.Path(path).write_text("\n".join(lines) + "\n")
+
+
+def assert_releases_the_gil(call):
+    """Runs call() in a thread while this one ticks: holding the GIL would freeze the ticks for
+    the whole call, one gap as long as the call."""
+    span = {}
+
+    def work():
+        span["start"] = time.perf_counter()
+        call()
+        span["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=work)
+    ticks = []
+    worker.start()
+    while worker.is_alive():
+        ticks.append(time.perf_counter())
+        time.sleep(0.001)
+    worker.join()
+    inside = [t for t in ticks if span["start"] < t < span["end"]]
+    duration = span["end"] - span["start"]
+    gaps = np.diff([span["start"], *inside, span["end"]])
+    assert gaps.max() < duration / 2, (gaps.max(), duration)

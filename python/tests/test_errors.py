@@ -48,13 +48,22 @@ BAD_ARRAYS = {
 }
 
 
+ENTRY_POINTS = {
+    "Mesh": primseg.Mesh,
+    "segment": primseg.segment,
+    "denoise": lambda V, F: primseg.denoise(V, F, k=1),
+    "skeleton": lambda V, F: primseg.skeleton(V, F, k=1),
+    "distance a": lambda V, F: primseg.distance((V, F), (V_OK, F_OK)),
+    "distance b": lambda V, F: primseg.distance([V_OK, F_OK], [V, F]),
+}
+
+
 @pytest.mark.parametrize("name", BAD_ARRAYS)
-@pytest.mark.parametrize("entry_point", ["Mesh", "segment"])
+@pytest.mark.parametrize("entry_point", ENTRY_POINTS)
 def test_bad_arrays_raise_value_error(name, entry_point):
     V, F, message = BAD_ARRAYS[name]
-    call = primseg.Mesh if entry_point == "Mesh" else primseg.segment
     with pytest.raises(ValueError, match=message) as raised:
-        call(V, F)
+        ENTRY_POINTS[entry_point](V, F)
     if name != "ragged list":  # numpy's own ValueError, before primseg sees the data
         assert isinstance(raised.value, primseg.InvalidInputError)
 
@@ -93,8 +102,10 @@ def test_level_errors():
             h.cut(tolerance=bad)
         with pytest.raises(ValueError, match="relative_tolerance must be a non-negative number"):
             h.cut(relative_tolerance=bad)
-    with pytest.raises(TypeError):
+    with pytest.raises(ValueError, match="k must be a number of clusters or 'auto', not '3'"):
         h.cut("3")
+    with pytest.raises(TypeError):
+        h.cut(3.5)
 
 
 def test_file_errors(tmp_path, fandisk):
@@ -128,3 +139,108 @@ def test_file_errors(tmp_path, fandisk):
         primseg.read_tree(missing)
     with pytest.raises(OSError):
         primseg.segment(V_OK, F_OK).save(tmp_path / "no" / "such" / "dir" / "t.tree")
+
+
+def test_denoise_argument_errors():
+    mesh = primseg.Mesh(V_OK, F_OK)
+    with pytest.raises(ValueError, match=r"denoise\(mesh\) takes no F \(give the level as k=...\)"):
+        primseg.denoise(mesh, 1)
+    with pytest.raises(ValueError, match=r"denoise\(V, F\): F is missing"):
+        primseg.denoise(V_OK)
+    with pytest.raises(ValueError, match=r"k must be between 1 and the number of faces \(2\), not 3"):
+        primseg.denoise(mesh, k=3)
+    with pytest.raises(ValueError, match="k must be a number of clusters or 'auto', not 'all'"):
+        primseg.denoise(mesh, k="all")
+    with pytest.raises(ValueError, match="at most one of k, tolerance and relative_tolerance"):
+        primseg.denoise(mesh, k=1, tolerance=0.1)
+    with pytest.raises(ValueError, match="tolerance must be a non-negative number"):
+        primseg.denoise(mesh, tolerance=float("nan"))
+    for bad in (0, -1, 101):
+        with pytest.raises(ValueError, match="iterations must be between 1 and 100"):
+            primseg.denoise(mesh, iterations=bad)
+    for option in ({"max_move": 0.0}, {"max_move": float("nan")}, {"min_crease_angle": 90.0},
+                   {"min_crease_angle": -1.0}, {"smoothing_steps": -1}):
+        with pytest.raises(ValueError):
+            primseg.denoise(mesh, **option)
+    with pytest.raises(ValueError, match="unknown primitive 'cone'"):
+        primseg.denoise(mesh, primitives="cone")
+    with pytest.raises(ValueError, match="weights: must be 'area' or 'uniform', not 3"):
+        primseg.denoise(mesh, weights=3)
+    tree = primseg.segment(mesh)
+    with pytest.raises(ValueError, match=r"denoise\(hierarchy\): smoothing_steps must be 0"):
+        primseg.denoise(tree, smoothing_steps=2)
+    with pytest.raises(ValueError, match="primitives and weights are the hierarchy's"):
+        primseg.denoise(tree, primitives="plane")
+    with pytest.raises(ValueError, match=r"denoise\(hierarchy\) takes no F"):
+        primseg.denoise(tree, F_OK)
+    with pytest.raises(TypeError):
+        primseg.denoise(mesh, k=1.5)
+
+
+def test_skeleton_and_pose_errors(cgal_mesh):
+    mesh = primseg.Mesh(V_OK, F_OK)
+    with pytest.raises(ValueError, match=r"skeleton\(mesh\) takes no F"):
+        primseg.skeleton(mesh, 2)
+    with pytest.raises(ValueError, match=r"k must be between 1 and the number of faces \(2\), not 0"):
+        primseg.skeleton(mesh, k=0)
+    with pytest.raises(ValueError, match="unknown primitive"):
+        primseg.skeleton(mesh, primitives=("cylinder", "torus"))
+    skeleton = primseg.skeleton(primseg.read_mesh(cgal_mesh("man.off")), k=20)
+    locked = [j["id"] for j in skeleton.joints if j["kind"] != "sensitive"]
+    assert locked
+    sensitive = [j["id"] for j in skeleton.joints if j["kind"] == "sensitive"][0]
+    for band in (-0.1, float("inf"), float("nan")):
+        with pytest.raises(ValueError, match="band must be a finite number >= 0"):
+            skeleton.skin_weights(band=band)
+        with pytest.raises(ValueError, match="band"):
+            skeleton.deform([], band=band)
+    bad_poses = {
+        "not a list": (3, "pose must be a list of rotations"),
+        "a string": ("joint 1", "pose must be a list of rotations"),
+        "dict without rotations": ({"pose": []}, "must have \"rotations\""),
+        "missing key": ([{"joint": sensitive, "axis": [0, 0, 1]}], "pose rotation 0: missing \"degrees\""),
+        "short tuple": ([(sensitive, (0, 0, 1))], "pose rotation 0 must be a dict"),
+        "negative joint": ([(-1, (0, 0, 1), 10)], "pose rotation 0: joint must be an integer"),
+        "float joint": ([(1.0, (0, 0, 1), 10)], "joint must be an integer"),
+        "huge joint": ([(2**70, (0, 0, 1), 10)], "joint must be an integer"),
+        "unknown joint": ([(len(skeleton.joints), (0, 0, 1), 10)], "joint"),
+        "two-component axis": ([(sensitive, (0, 1), 10)], "axis must be 3 numbers"),
+        "text axis": ([(sensitive, "xyz", 10)], "axis must be 3 numbers"),
+        "NaN axis": ([(sensitive, (0, float("nan"), 1), 10)], "axis must be finite"),
+        "zero axis": ([(sensitive, (0, 0, 0), 10)], "axis"),
+        "text angle": ([(sensitive, (0, 0, 1), "ten")], "degrees must be a number, not 'ten'"),
+        "infinite angle": ([(sensitive, (0, 0, 1), float("inf"))], "degrees must be a finite number"),
+        "joint twice": ([(sensitive, (0, 0, 1), 10)] * 2, "twice|more than once|repeated|already"),
+    }
+    bad_poses["locked joint"] = ([(locked[0], (0, 0, 1), 10)], "sensitive")
+    for name, (pose, message) in bad_poses.items():
+        with pytest.raises(ValueError, match=message):
+            skeleton.deform(pose)
+        with pytest.raises(ValueError, match=message):
+            skeleton.posed_joint_positions(pose)
+    with pytest.raises(ValueError, match="joint must be between 0 and"):
+        skeleton.bones_beyond(len(skeleton.joints))
+    with pytest.raises(ValueError, match="joint must be between 0 and"):
+        skeleton.bones_beyond(-1)
+
+
+def test_distance_argument_errors():
+    with pytest.raises(ValueError, match="a must be a Mesh, a Hierarchy or a \\(V, F\\) pair, not <class 'numpy.ndarray'>"):
+        primseg.distance(V_OK, (V_OK, F_OK))
+    with pytest.raises(ValueError, match="b must be a Mesh"):
+        primseg.distance((V_OK, F_OK), (V_OK, F_OK, None))
+    with pytest.raises(ValueError, match="give samples or density, not both"):
+        primseg.distance((V_OK, F_OK), (V_OK, F_OK), samples=10, density=1.0)
+    for samples in (-1, 2**64, 1.5, "10", True):
+        with pytest.raises(ValueError, match="samples must be an integer"):
+            primseg.distance((V_OK, F_OK), (V_OK, F_OK), samples=samples)
+    with pytest.raises(ValueError, match="sample"):
+        primseg.distance((V_OK, F_OK), (V_OK, F_OK), samples=0)
+    for density in (-1.0, float("nan"), 1e12):
+        with pytest.raises(ValueError, match="density"):
+            primseg.distance((V_OK, F_OK), (V_OK, F_OK), density=density)
+    with pytest.raises(ValueError, match="seed must be an integer"):
+        primseg.distance((V_OK, F_OK), (V_OK, F_OK), seed=-3)
+    flat = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]])
+    with pytest.raises(ValueError, match="area"):
+        primseg.distance((flat, [[0, 1, 2]]), (V_OK, F_OK))

@@ -1,17 +1,13 @@
 """segment, cut, clusters, save/read_tree: the same results as the CLI, from any array layout."""
 
 import json
-import os
-import subprocess
-import threading
-import time
 import tracemalloc
 
 import numpy as np
 import pytest
 
 import primseg
-from conftest import capped_cylinder, same_partition
+from conftest import assert_releases_the_gil, capped_cylinder, run_cli, same_partition
 
 
 @pytest.fixture(scope="module")
@@ -19,16 +15,10 @@ def fandisk_tree(fandisk):
     return primseg.segment(primseg.read_mesh(fandisk))
 
 
-def run_cli(cli, *args):
-    # Under the sanitizer build the interpreter runs with the ASan runtime preloaded; the CLI
-    # carries its own and must not get a second one.
-    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
-    subprocess.run([str(cli), *map(str, args)], check=True, capture_output=True, env=env)
-
-
 @pytest.mark.parametrize(
     "cli_level, python_level",
     [((), {}), (("--clusters", "30"), {"k": 30}), (("--clusters", "1"), {"k": 1}),
+     (("--clusters", "auto"), {"k": "auto"}),
      (("--tolerance", "0.05%"), {"relative_tolerance": 0.0005}),
      (("--tolerance", "0.002"), {"tolerance": 0.002})])
 def test_labels_and_clusters_match_the_cli(cli, fandisk, fandisk_tree, tmp_path, cli_level, python_level):
@@ -162,25 +152,7 @@ def test_deterministic_for_any_thread_count(fandisk_tree):
 
 def test_segment_releases_the_gil(fandisk_tree):
     mesh = fandisk_tree.mesh
-    span = {}
-
-    def work():
-        span["start"] = time.perf_counter()
-        primseg.segment(mesh, threads=1)
-        span["end"] = time.perf_counter()
-
-    worker = threading.Thread(target=work)
-    ticks = []
-    worker.start()
-    while worker.is_alive():
-        ticks.append(time.perf_counter())
-        time.sleep(0.001)
-    worker.join()
-    inside = [t for t in ticks if span["start"] < t < span["end"]]
-    duration = span["end"] - span["start"]
-    # Holding the GIL would freeze this thread for the whole call: one gap as long as the call.
-    gaps = np.diff([span["start"], *inside, span["end"]])
-    assert gaps.max() < duration / 2, (gaps.max(), duration)
+    assert_releases_the_gil(lambda: primseg.segment(mesh, threads=1))
 
 
 def test_polygon_file_labels_match_the_cli(cli, tmp_path):
