@@ -865,7 +865,7 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
   // denoise, skeleton, distance.
 
   const char* denoise_doc =
-      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, stylize=False, max_move=4.0, min_crease_angle=10.0, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
 denoise(V, F, *, ...) -> numpy.ndarray
 denoise(hierarchy, *, ...) -> numpy.ndarray
 
@@ -882,16 +882,17 @@ Level: k (count or "auto"), tolerance or relative_tolerance as in Hierarchy.cut,
 --clusters and --tolerance; none: 0.1% of the diagonal.
 stylize: --stylize (each vertex onto its own cluster's primitive); max_move: --max-move (in mean
 incident edge lengths); min_crease_angle: --min-crease-angle (degrees); smoothing_steps:
---smooth; primitives (default plane, cylinder, sphere) and weights (default "area"): as in
+--smooth (Taubin steps on the copy that is segmented); bilateral: --bilateral (that copy
+smoothed by bilateral normal filtering instead, which keeps edges sharp); primitives (default plane, cylinder, sphere) and weights (default "area"): as in
 segment. The GIL is released while it works.
 Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)";
   m.def(
       "denoise",
       [](const py::object& first, const py::object& faces, ClusterCount k,
          std::optional<double> tolerance, std::optional<double> relative_tolerance, int iterations,
-         int smoothing_steps, bool stylize, double max_move, double min_crease_angle,
-         const py::object& primitives, const py::object& weights, unsigned threads,
-         bool return_rounds) -> py::object {
+         int smoothing_steps, bool bilateral, bool stylize, double max_move,
+         double min_crease_angle, const py::object& primitives, const py::object& weights,
+         unsigned threads, bool return_rounds) -> py::object {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
@@ -902,6 +903,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         options.max_move_edge_lengths = max_move;
         options.min_crease_angle_degrees = min_crease_angle;
         options.smoothing_steps = smoothing_steps;
+        if (bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
         options.hierarchy = tool_hierarchy_options("denoise", given, primitives, weights, threads,
                                                    py::make_tuple("plane", "cylinder", "sphere"));
         validate(options);
@@ -912,10 +914,10 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
           throw InvalidInputError(
               "smoothing_steps must be between 0 and 1000 (the CLI's range), not " +
               std::to_string(smoothing_steps));
-        if (given && smoothing_steps > 0)
+        if (given && (smoothing_steps > 0 || bilateral))
           throw InvalidInputError(
-              "denoise(hierarchy): smoothing_steps must be 0 (the tree was built on the mesh as "
-              "it is); give the mesh to segment a smoothed copy");
+              "denoise(hierarchy): smoothing_steps must be 0 and bilateral False (the tree was "
+              "built on the mesh as it is); give the mesh to segment a smoothed copy");
         const std::shared_ptr<const Mesh> mesh =
             given ? given->hierarchy->shared_mesh() : mesh_argument("denoise", first, faces);
         validate_level(level, mesh->face_count());
@@ -943,7 +945,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(), py::arg("k") = py::none(),
       py::arg("tolerance") = py::none(), py::arg("relative_tolerance") = py::none(),
       py::arg("iterations") = 1, py::arg("smoothing_steps") = DenoiseOptions{}.smoothing_steps,
-      py::arg("stylize") = false, py::arg("max_move") = DenoiseOptions{}.max_move_edge_lengths,
+      py::arg("bilateral") = false, py::arg("stylize") = false,
+      py::arg("max_move") = DenoiseOptions{}.max_move_edge_lengths,
       py::arg("min_crease_angle") = DenoiseOptions{}.min_crease_angle_degrees,
       py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
       py::arg("return_rounds") = false,
@@ -954,6 +957,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
                          doc::denoise__DenoiseOptions__min_crease_angle_degrees),
                  cpp_doc("DenoiseOptions::smoothing_steps",
                          doc::denoise__DenoiseOptions__smoothing_steps),
+                 cpp_doc("DenoiseOptions::bilateral_smoothing",
+                         doc::denoise__DenoiseOptions__bilateral_smoothing),
                  cpp_doc("SnapMode", doc::denoise__SnapMode),
                  cpp_doc("SnapReport", doc::denoise__SnapReport)})
           .c_str());

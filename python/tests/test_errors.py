@@ -169,6 +169,10 @@ def test_denoise_argument_errors():
     tree = primseg.segment(mesh)
     with pytest.raises(ValueError, match=r"denoise\(hierarchy\): smoothing_steps must be 0"):
         primseg.denoise(tree, smoothing_steps=2)
+    with pytest.raises(ValueError, match=r"denoise\(hierarchy\): smoothing_steps must be 0 and bilateral False"):
+        primseg.denoise(tree, bilateral=True)
+    with pytest.raises(ValueError, match="choose Taubin or bilateral smoothing, not both"):
+        primseg.denoise(mesh, smoothing_steps=2, bilateral=True)
     with pytest.raises(ValueError, match="primitives and weights are the hierarchy's"):
         primseg.denoise(tree, primitives="plane")
     with pytest.raises(ValueError, match=r"denoise\(hierarchy\) takes no F"):

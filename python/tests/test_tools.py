@@ -42,6 +42,7 @@ def man_skeleton(man):
      (("--tolerance", "0.05%"), {"relative_tolerance": 0.0005}),
      (("--clusters", "30", "--iterations", "2", "--smooth", "3"),
       {"k": 30, "iterations": 2, "smoothing_steps": 3}),
+     (("--clusters", "40", "--bilateral"), {"k": 40, "bilateral": True}),
      (("--clusters", "12", "--stylize", "--primitives", "plane"),
       {"k": 12, "stylize": True, "primitives": "plane"}),
      (("--clusters", "30", "--max-move", "1.5", "--min-crease-angle", "25"),
