@@ -12,6 +12,8 @@ the same work called from Python, and prints medians:
 - distance to a noisy copy (200000 samples): seconds against primseg.distance(a, b);
 - denoise --clusters 30: denoise_seconds, which also reads the input and writes the output,
   against read_mesh + primseg.denoise (no output file: Python gets the array).
+Then the work Python adds, which a loaded machine's noise cannot hide: building the C++ mesh
+from numpy arrays, and the cost of a call on a one-triangle mesh (medians of 21 and 201).
 """
 
 import json
@@ -91,6 +93,18 @@ def main():
             median = statistics.median(values)
             print(f"  {label:28s} median {median * 1e3:8.1f} ms  ({(median / reference - 1) * 100:+.1f}%)"
                   f"  min {min(values) * 1e3:8.1f} ms")
+    python_side(mesh, V, F)
+
+
+def python_side(mesh, V, F):
+    def median(call, repeats):
+        return statistics.median(timed(call) for _ in range(repeats))
+
+    tiny = primseg.Mesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    print("Python-side work")
+    print(f"  Mesh(V32, F64 Fortran)        {median(lambda: primseg.Mesh(V, F), 21) * 1e3:8.2f} ms")
+    print(f"  Mesh(mesh.V, mesh.F)          {median(lambda: primseg.Mesh(mesh.V, mesh.F), 21) * 1e3:8.2f} ms")
+    print(f"  segment(one triangle)         {median(lambda: primseg.segment(tiny), 201) * 1e6:8.1f} us")
 
 
 if __name__ == "__main__":
