@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "bench_support.hpp"
+#include "compare_ransac_quality.hpp"
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh.hpp"
 #include "primseg/mesh_io.hpp"
@@ -95,9 +96,9 @@ Converted convert(const primseg::Mesh& input) {
     if (out.mesh.is_isolated(v)) isolated.push_back(v);
   for (const auto v : isolated) out.mesh.remove_vertex(v);
   out.mesh.collect_garbage();
-  out.diagonal = std::sqrt((high[0] - low[0]) * (high[0] - low[0]) +
-                           (high[1] - low[1]) * (high[1] - low[1]) +
-                           (high[2] - low[2]) * (high[2] - low[2]));
+  out.diagonal =
+      std::sqrt((high[0] - low[0]) * (high[0] - low[0]) + (high[1] - low[1]) * (high[1] - low[1]) +
+                (high[2] - low[2]) * (high[2] - low[2]));
   return out;
 }
 
@@ -140,10 +141,10 @@ std::size_t run_region_growing(const SurfaceMesh& mesh, double max_distance) {
   using FaceRange = SurfaceMesh::Face_range;
   using NeighborQuery = RG::One_ring_neighbor_query<SurfaceMesh, FaceRange>;
   using RegionType = RG::Least_squares_plane_fit_region<Kernel, SurfaceMesh, FaceRange>;
-  using Sorting = RG::Least_squares_plane_fit_sorting<Kernel, SurfaceMesh, NeighborQuery, FaceRange>;
-  using RegionGrowing =
-      CGAL::Shape_detection::Region_growing<FaceRange, NeighborQuery, RegionType,
-                                            typename Sorting::Seed_map>;
+  using Sorting =
+      RG::Least_squares_plane_fit_sorting<Kernel, SurfaceMesh, NeighborQuery, FaceRange>;
+  using RegionGrowing = CGAL::Shape_detection::Region_growing<FaceRange, NeighborQuery, RegionType,
+                                                              typename Sorting::Seed_map>;
 
   const FaceRange face_range = faces(mesh);
   NeighborQuery neighbor_query(mesh);
@@ -178,8 +179,8 @@ std::vector<std::size_t> run_vsa(const SurfaceMesh& mesh) {
   std::srand(0);  // VSA draws seeds with std::rand: the same sequence every run
   std::vector<std::size_t> proxy_of_face(mesh.number_of_faces());
   CGAL::Surface_mesh_approximation::approximate_triangle_mesh(
-      mesh, CGAL::parameters::max_number_of_proxies(kProxies)
-                .face_proxy_map(FaceToProxy{&proxy_of_face}));
+      mesh, CGAL::parameters::max_number_of_proxies(kProxies).face_proxy_map(
+                FaceToProxy{&proxy_of_face}));
   return proxy_of_face;
 }
 
@@ -195,8 +196,9 @@ std::shared_ptr<const primseg::Mesh> load_input(const std::string& input) {
     return std::make_shared<const primseg::Mesh>(
         primseg::make_shape(input.substr(6), options).mesh);
   }
-  const std::filesystem::path path =
-      std::filesystem::exists(input) ? std::filesystem::path(input) : primseg::bench::cgal_mesh(input);
+  const std::filesystem::path path = std::filesystem::exists(input)
+                                         ? std::filesystem::path(input)
+                                         : primseg::bench::cgal_mesh(input);
   return std::make_shared<const primseg::Mesh>(primseg::read_mesh(path));
 }
 
@@ -233,19 +235,35 @@ std::string grouped(std::size_t value) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repetitions = 5;
+  int repetitions = 5, seeds = 1;
+  bool quality = false;
   std::vector<std::string> inputs;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--repetitions" && i + 1 < argc) {
       repetitions = std::max(1, std::atoi(argv[++i]));
+    } else if (arg == "--quality") {
+      quality = true;
+    } else if (arg == "--seeds" && i + 1 < argc) {
+      seeds = std::max(1, std::atoi(argv[++i]));
     } else if (arg == "-h" || arg == "--help") {
       std::cout << "usage: primseg_compare_cgal [--repetitions N] [INPUT...]\n"
+                   "       primseg_compare_cgal --quality [--seeds N]\n"
                    "INPUT: fandisk.off | bunny00.off (libcgal-demo) | shape:box_with_hole | "
-                   "path\n";
+                   "path\n"
+                   "--quality: primseg and CGAL Efficient RANSAC on the generated shapes with "
+                   "ground truth (N random poses each, default 1)\n";
       return 0;
     } else {
       inputs.push_back(arg);
+    }
+  }
+  if (quality) {
+    try {
+      return run_ransac_quality_comparison(seeds);
+    } catch (const std::exception& e) {
+      std::cerr << "primseg_compare_cgal: " << e.what() << "\n";
+      return 1;
     }
   }
   if (inputs.empty()) inputs = {"fandisk.off", "bunny00.off", "shape:box_with_hole"};
@@ -287,7 +305,9 @@ int main(int argc, char** argv) {
   }
 
   std::cout << "| input | faces | primseg full tree (ms) | CGAL region growing (ms) | regions "
-               "| CGAL VSA " << kProxies << " proxies (ms) | primseg / region growing "
+               "| CGAL VSA "
+            << kProxies
+            << " proxies (ms) | primseg / region growing "
                "| VSA / primseg |\n"
                "|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Row& row : rows) {
@@ -304,8 +324,7 @@ int main(int argc, char** argv) {
     std::cout << " " << row.input << " " << fixed(row.primseg.cpu_ms, 1) << " / "
               << fixed(row.region_growing.cpu_ms, 1) << " / " << fixed(row.vsa.cpu_ms, 1) << ";";
   std::cout << " hardware threads: " << std::thread::hardware_concurrency()
-            << "; load average before / after: " << load_before << " / " << load_average()
-            << ".\n";
+            << "; load average before / after: " << load_before << " / " << load_average() << ".\n";
   std::cout << "Region growing: planes, max distance " << kMaxDistanceFraction * 100
             << "% of the bounding-box diagonal, max angle " << kMaxAngleDegrees
             << " degrees, min region size " << kMinRegionSize
