@@ -1,19 +1,26 @@
 // primseg view: one self-contained HTML page to browse the whole hierarchy in a browser.
 //
 // The page gets the mesh and the merge tree as little-endian typed arrays in base64 (the layout
-// is documented by their reader, web/src/data.js), and cuts levels itself.
+// is documented by their reader, web/src/data.js), and cuts levels itself. It also gets the
+// automatic levels (auto_level.hpp) and, with --skeleton, the skeleton of one level and its skin
+// weights, which it poses itself as primseg deform does.
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 
 #include "../src/file_io.hpp"
 #include "command.hpp"
+#include "primseg/auto_level.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/skeleton.hpp"
+#include "primseg/skinning.hpp"
 #include "primseg/tree_io.hpp"
 #include "viewer_bundle.hpp"
 
@@ -76,8 +83,74 @@ std::string script_safe(const nlohmann::json& json) {
   return out;
 }
 
+/// The skeleton shown over the mesh (--skeleton) and its skin weights.
+struct PageSkeleton {
+  Skeleton skeleton;
+  SkinWeights weights;
+  double band = 0;
+};
+
+/// Compressed rows of a list of lists: (offsets of shape n + 1, values).
+template <typename Item, typename Member>
+std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> compressed_rows(
+    const std::vector<Item>& items, Member member) {
+  std::vector<std::uint32_t> offsets{0}, values;
+  for (const Item& item : items) {
+    const auto& row = item.*member;
+    values.insert(values.end(), row.begin(), row.end());
+    offsets.push_back(static_cast<std::uint32_t>(values.size()));
+  }
+  return {std::move(offsets), std::move(values)};
+}
+
+/// The skeleton's header entry and arrays (layout in web/src/data.js). Positions are absolute
+/// doubles here: the page poses the mesh as primseg deform does, to round-off.
+nlohmann::json append_skeleton(std::string& html, const Mesh& mesh, const PageSkeleton& page) {
+  const Skeleton& skeleton = page.skeleton;
+  std::vector<double> rest(mesh.positions.size() * 3);
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+    std::copy(mesh.positions[v].begin(), mesh.positions[v].end(), rest.begin() + 3 * v);
+  std::vector<double> joint_positions;
+  std::vector<std::uint8_t> joint_kinds, joint_visible, bone_visible;
+  for (const Joint& joint : skeleton.joints) {
+    joint_positions.insert(joint_positions.end(), joint.position.begin(), joint.position.end());
+    joint_kinds.push_back(static_cast<std::uint8_t>(joint.kind));
+    joint_visible.push_back(joint.visible ? 1 : 0);
+  }
+  std::vector<double> bone_points;
+  for (const Bone& bone : skeleton.bones) {
+    bone_points.insert(bone_points.end(), bone.point.begin(), bone.point.end());
+    bone_visible.push_back(bone.visible ? 1 : 0);
+  }
+  const auto [joint_bone_offsets, joint_bones] = compressed_rows(skeleton.joints, &Joint::bones);
+  const auto [bone_joint_offsets, bone_joints] = compressed_rows(skeleton.bones, &Bone::joints);
+  const BoneTree tree = bone_tree(skeleton);
+  append_array(html, "skeleton-rest", rest);
+  append_array(html, "skeleton-joint-positions", joint_positions);
+  append_array(html, "skeleton-joint-kinds", joint_kinds);
+  append_array(html, "skeleton-joint-visible", joint_visible);
+  append_array(html, "skeleton-joint-bone-offsets", joint_bone_offsets);
+  append_array(html, "skeleton-joint-bones", joint_bones);
+  append_array(html, "skeleton-bone-joint-offsets", bone_joint_offsets);
+  append_array(html, "skeleton-bone-joints", bone_joints);
+  append_array(html, "skeleton-bone-points", bone_points);
+  append_array(html, "skeleton-bone-visible", bone_visible);
+  append_array(html, "skeleton-bone-order", tree.order);
+  append_array(html, "skeleton-bone-parent-joint", tree.parent_joint);
+  append_array(html, "skeleton-bone-parent-bone", tree.parent_bone);
+  append_array(html, "skeleton-weight-offsets", page.weights.offsets);
+  append_array(html, "skeleton-weight-bones", page.weights.bones);
+  append_array(html, "skeleton-weight-values", page.weights.weights);
+  append_array(html, "skeleton-face-labels", skeleton.face_labels);
+  return {{"clusters", skeleton.cluster_count()},
+          {"joints", skeleton.joints.size()},
+          {"rootBone", skeleton.root_bone()},
+          {"band", page.band}};
+}
+
 std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
-                      std::uint32_t initial_clusters) {
+                      std::uint32_t initial_clusters, const AutoLevel& automatic,
+                      const std::optional<PageSkeleton>& skeleton) {
   const Mesh& mesh = hierarchy.mesh();
   const std::uint32_t f = hierarchy.face_count();
   const auto merges = hierarchy.merges();
@@ -134,9 +207,15 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
       {"weights", hierarchy.options().weights == VertexWeights::Uniform ? "uniform" : "area"},
       {"firstMergeWithParameters", real - with_parameters},
       {"initialClusters", initial_clusters},
-      // Later: automatic levels ("levels": [K...]) and the skeleton ("skeleton": {...}); the
-      // page draws them when present (web/src/hooks.ts).
+      {"autoLevel", automatic.clusters},
   };
+  // Automatic levels, best score first (as segment --clusters auto lists its candidates).
+  nlohmann::json levels = nlohmann::json::array();
+  for (const LevelCandidate& c : automatic.candidates)
+    levels.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
+  header["levels"] = std::move(levels);
+  std::string skeleton_arrays;
+  if (skeleton) header["skeleton"] = append_skeleton(skeleton_arrays, mesh, *skeleton);
   std::string html = "<script type=\"application/json\" id=\"primseg-header\">";
   html += script_safe(header);
   html += "</script>\n";
@@ -154,7 +233,7 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
     for (std::uint32_t face = 0; face < f; ++face) leaf_rms[face] = hierarchy.rms_estimate(face);
     append_array(html, "leaf-rms", leaf_rms);
   }
-  return html;
+  return html + skeleton_arrays;
 }
 
 bool same_mesh(const Mesh& a, const Mesh& b) {
@@ -169,6 +248,9 @@ Command add_view_command(CLI::App& app) {
     std::string mesh_path, output, primitives = "plane,cylinder,sphere";
     std::optional<std::string> tree_path;
     std::optional<std::string> clusters;  // K or auto
+    bool skeleton = false;
+    std::optional<std::string> skeleton_clusters;  // K or auto; default: the page's level
+    double band = SkinningOptions{}.band;
     unsigned threads = 0;
     bool quiet = false;
   };
@@ -182,6 +264,16 @@ Command add_view_command(CLI::App& app) {
                    std::string("Level shown when the page opens (default: the --tolerance ") +
                        kDefaultTolerance + " level)");
   view->add_option("-o,--output", o->output, "The HTML page to write")->required();
+  view->add_flag("--skeleton", o->skeleton,
+                 "Draw the skeleton of a level (primseg skeleton) with draggable joints that pose "
+                 "the mesh (primseg deform)");
+  view->add_option("--skeleton-clusters", o->skeleton_clusters,
+                   "Level of the skeleton: K or auto (default: the level the page opens at); "
+                   "implies --skeleton");
+  view->add_option("--band", o->band,
+                   "--skeleton: skinning blend half-width on each side of a boundary, in bone "
+                   "radii")
+      ->capture_default_str();
   view->add_option("--primitives", o->primitives,
                    "Primitive types when the hierarchy is built, comma-separated")
       ->capture_default_str();
@@ -203,7 +295,11 @@ Command add_view_command(CLI::App& app) {
         options.threads = o->threads;
         validate(options);
         auto mesh = std::make_shared<const Mesh>(read_mesh(o->mesh_path));
+        if (!(std::isfinite(o->band) && o->band >= 0))
+          throw InvalidInputError("--band: must be a finite number >= 0");
         if (o->clusters) validate_level({o->clusters, std::nullopt}, mesh->face_count());
+        if (o->skeleton_clusters)
+          validate_level({o->skeleton_clusters, std::nullopt}, mesh->face_count());
         const auto build_start = Clock::now();
         const Hierarchy hierarchy = [&] {
           if (!o->tree_path)
@@ -215,18 +311,38 @@ Command add_view_command(CLI::App& app) {
           return tree;
         }();
         const double build_seconds = seconds_since(build_start);
-        const std::uint32_t initial =
-            cut(hierarchy, {o->clusters, std::nullopt}).segmentation.cluster_count();
+        const ChosenLevel level = cut(hierarchy, {o->clusters, std::nullopt});
+        const std::uint32_t initial = level.segmentation.cluster_count();
+        const AutoLevel automatic = level.automatic ? *level.automatic : choose_level(hierarchy);
+        std::optional<PageSkeleton> skeleton;
+        if (o->skeleton || o->skeleton_clusters) {
+          const Segmentation bones =
+              o->skeleton_clusters
+                  ? cut(hierarchy, {o->skeleton_clusters, std::nullopt}).segmentation
+                  : level.segmentation;
+          SkinningOptions skinning;
+          skinning.band = o->band;
+          Skeleton extracted = extract_skeleton(hierarchy, bones);
+          SkinWeights weights = compute_skin_weights(*mesh, extracted, skinning);
+          skeleton = PageSkeleton{std::move(extracted), std::move(weights), o->band};
+        }
         std::string html(page.substr(0, marker));
-        html +=
-            page_data(hierarchy, std::filesystem::path(o->mesh_path).filename().string(), initial);
+        html += page_data(hierarchy, std::filesystem::path(o->mesh_path).filename().string(),
+                          initial, automatic, skeleton);
         html += page.substr(marker + kViewerDataMarker.size());
         detail::write_file_atomically(o->output, html);
-        if (!o->quiet)
-          std::printf("%s: %u faces, hierarchy %s in %.3f s; %s: %.1f MB, opens at %u clusters\n",
-                      o->mesh_path.c_str(), mesh->face_count(), o->tree_path ? "read" : "built",
-                      build_seconds, o->output.c_str(), static_cast<double>(html.size()) / 1e6,
-                      initial);
+        if (!o->quiet) {
+          const std::string bones =
+              skeleton
+                  ? ", skeleton of " + std::to_string(skeleton->skeleton.cluster_count()) + " bones"
+                  : "";
+          std::printf(
+              "%s: %u faces, hierarchy %s in %.3f s; %s: %.1f MB, opens at %u clusters (automatic "
+              "level %u)%s\n",
+              o->mesh_path.c_str(), mesh->face_count(), o->tree_path ? "read" : "built",
+              build_seconds, o->output.c_str(), static_cast<double>(html.size()) / 1e6, initial,
+              automatic.clusters, bones.c_str());
+        }
       }};
 }
 

@@ -34,6 +34,6 @@ function(primseg_add_viewer_tests)
   if(PRIMSEG_NODE AND EXISTS ${PRIMSEG_WEB_DIR}/node_modules/playwright-core)
     add_test(NAME web.viewer COMMAND ${PRIMSEG_NODE} --test ${PRIMSEG_WEB_DIR}/test/)
     set_tests_properties(web.viewer PROPERTIES RUN_SERIAL ON TIMEOUT 900
-      ENVIRONMENT "PRIMSEG=$<TARGET_FILE:primseg_cli>;PRIMSEG_WEB_ARTIFACTS=${PROJECT_BINARY_DIR}/web-artifacts")
+      ENVIRONMENT "PRIMSEG=$<TARGET_FILE:primseg_cli>;PRIMSEG_WEB_ARTIFACTS=${PROJECT_BINARY_DIR}/web-artifacts;PRIMSEG_STICK_FIGURE=$<TARGET_FILE:primseg_write_stick_figure>")
   endif()
 endfunction()

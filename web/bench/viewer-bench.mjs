@@ -3,9 +3,10 @@
 // 20 steps between log-spaced levels: the page's work, a cut and a recolouring, then apart the
 // time until the frame is drawn, which headless chromium does in software: SwiftShader).
 //
-// Usage: PRIMSEG=path/to/primseg node bench/viewer-bench.mjs MESH[,TREE]...
+// Usage: PRIMSEG=path/to/primseg node bench/viewer-bench.mjs MESH[,TREE]|PAGE.html...
 //        (a mesh named "torus1m" is generated: 1,000,000 triangles; with a TREE saved by
-//        primseg segment --tree, the hierarchy is read instead of built)
+//        primseg segment --tree, the hierarchy is read instead of built; a PAGE.html already
+//        written by primseg view is measured as it is)
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, statSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -24,9 +25,10 @@ for (const arg of process.argv.slice(2)) {
     mesh = join(work, 'torus1m.off');
     writeWavyTorus(mesh, 1000, 500);
   }
-  const html = join(work, basename(mesh) + '.html');
+  const given = mesh.endsWith('.html');
+  const html = given ? resolve(mesh) : join(work, basename(mesh) + '.html');
   const start = Date.now();
-  execFileSync(cli, ['view', mesh, ...(tree ? ['--tree', tree] : []), '-o', html, '--quiet']);
+  if (!given) execFileSync(cli, ['view', mesh, ...(tree ? ['--tree', tree] : []), '-o', html, '--quiet']);
   const viewSeconds = (Date.now() - start) / 1000;
   const loads = [];
   let steps = null;

@@ -30,6 +30,18 @@ async function readArray(document, name, ArrayType, required = true) {
  * rms Float64Array (F-1, merge nodes' RMS estimates, input units), types Uint8Array (F-1),
  * parameters Float64Array (9 per merge from firstMergeWithParameters to the last real one:
  * point 3 (relative to center), axis 3, radius, minor_radius, half_angle), leafRms or null.
+ *
+ * header.autoLevel: the automatic level's K (auto_level.hpp choose_level); header.levels: its
+ * candidates [{clusters, rms, score}], best score first.
+ *
+ * header.skeleton (primseg view --skeleton): {clusters K, joints J, rootBone, band}, and then
+ * `skeleton` holds (input units, absolute, not relative to center): rest Float64Array (V*3, the
+ * mesh's positions as primseg read them), jointPositions Float64Array (J*3), jointKinds
+ * Uint8Array (J: 0 sensitive, 1 locked, 2 virtual), jointVisible, boneVisible Uint8Array,
+ * jointBoneOffsets/jointBones and boneJointOffsets/boneJoints (compressed rows, Uint32Array),
+ * bonePoints Float64Array (K*3), boneOrder/boneParentJoint/boneParentBone Uint32Array (K, the
+ * bone tree of skinning.hpp, 0xffffffff for none), weightOffsets Uint32Array (V+1), weightBones
+ * Uint32Array, weightValues Float64Array (skin weights), faceLabels Uint32Array (F).
  */
 export async function readPageData(document) {
   const headerElement = document.getElementById('primseg-header');
@@ -57,5 +69,33 @@ export async function readPageData(document) {
     'faces of triangles');
   check(children.length === 2 * (F - 1) && rms.length === F - 1 && types.length === F - 1,
     'merges');
-  return { header, positions, triangles, faceOfTriangle, children, rms, types, parameters, leafRms };
+  const skeleton = header.skeleton ? await readSkeleton(document, header, check) : null;
+  return { header, positions, triangles, faceOfTriangle, children, rms, types, parameters, leafRms, skeleton };
+}
+
+const SKELETON_ARRAYS = {
+  rest: Float64Array, jointPositions: Float64Array, jointKinds: Uint8Array, jointVisible: Uint8Array,
+  jointBoneOffsets: Uint32Array, jointBones: Uint32Array, boneJointOffsets: Uint32Array,
+  boneJoints: Uint32Array, bonePoints: Float64Array, boneVisible: Uint8Array, boneOrder: Uint32Array,
+  boneParentJoint: Uint32Array, boneParentBone: Uint32Array, weightOffsets: Uint32Array,
+  weightBones: Uint32Array, weightValues: Float64Array, faceLabels: Uint32Array,
+};
+
+async function readSkeleton(document, header, check) {
+  const skeleton = {};
+  for (const [key, ArrayType] of Object.entries(SKELETON_ARRAYS)) {
+    const name = 'skeleton-' + key.replace(/[A-Z]/g, (c) => '-' + c.toLowerCase());
+    skeleton[key] = await readArray(document, name, ArrayType);
+  }
+  const J = header.skeleton.joints, K = header.skeleton.clusters, V = header.vertices;
+  const s = skeleton;
+  check(s.rest.length === 3 * V && s.weightOffsets.length === V + 1, 'skeleton rest positions');
+  check(s.jointPositions.length === 3 * J && s.jointKinds.length === J && s.jointVisible.length === J &&
+    s.jointBoneOffsets.length === J + 1, 'skeleton joints');
+  check(s.bonePoints.length === 3 * K && s.boneVisible.length === K && s.boneJointOffsets.length === K + 1 &&
+    s.boneOrder.length === K && s.boneParentJoint.length === K && s.boneParentBone.length === K, 'skeleton bones');
+  check(s.weightBones.length === s.weightValues.length && s.weightOffsets[V] === s.weightBones.length,
+    'skin weights');
+  check(s.faceLabels.length === header.faces, 'skeleton face labels');
+  return skeleton;
 }

@@ -1,13 +1,14 @@
 // Extension points for what other issues add to the page.
 //
-// - Automatic levels: when `primseg view` writes `"levels": [K, ...]` in the page header, they
-//   are ticked on the error plot and offered as buttons (main.js: showLevels). Nothing else is
-//   needed on the page side.
-// - Skeleton overlay: an overlay is an object {update(cut), dispose()} made by a factory
-//   registered here with a header key; the viewer calls the factory when the page header has that
-//   key (e.g. "skeleton"), with the context below, and calls update() after every change of
-//   level. Dragging joints is the overlay's own business (it gets the camera, the canvas and the
-//   mesh geometry, whose positions it may deform, then call requestRender()).
+// - Automatic levels: `primseg view` writes `"levels": [{clusters, rms, score}, ...]` and
+//   `"autoLevel": K` in the page header; they are marked on the error plot and offered as buttons
+//   (main.js: showLevels).
+// - Overlays: an overlay is an object {name, update(cut), dispose()} made by a factory registered
+//   here with a header key; the viewer calls the factory when the page header has that key, with
+//   the context below, and calls update() after every change of level. The skeleton
+//   (skeleton.js, key "skeleton") is one: dragging joints is its own business (it gets the
+//   camera, the canvas and the mesh geometry, whose positions it deforms, then calls
+//   requestRender()).
 
 const factories = new Map();
 

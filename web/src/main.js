@@ -13,6 +13,7 @@ import { Tree, TYPE_NAMES } from './hierarchy.js';
 import { clusterErrors, facePlane, primitiveSurface } from './primitives.js';
 import { ErrorPlot } from './plot.js';
 import { createOverlays } from './hooks.js';
+import './skeleton.js';
 
 const testMode = new URLSearchParams(location.search).has('test');
 const $ = (id) => document.getElementById(id);
@@ -59,6 +60,7 @@ class Viewer {
       header: this.header, data, tree: this.tree, scene: this.scene, camera: this.camera,
       canvas: this.renderer.domElement, geometry: this.geometry, requestRender: () => this.render(),
     });
+    this.skeleton = this.overlays.find((overlay) => overlay.name === 'skeleton') ?? null;
     this.setClusters(this.header.initialClusters);
   }
 
@@ -85,8 +87,10 @@ class Viewer {
     }
     this.geometry = new THREE.BufferGeometry();
     this.geometry.setAttribute('position', new THREE.BufferAttribute(corners, 3));
-    this.colors = new Uint8Array(T * 9);
-    this.colorAttribute = new THREE.BufferAttribute(this.colors, 3, true);
+    // RGBA bytes per corner, written as one 32-bit word (little-endian: R first) per corner.
+    this.colors = new Uint8Array(T * 12);
+    this.cornerColors = new Uint32Array(this.colors.buffer);
+    this.colorAttribute = new THREE.BufferAttribute(this.colors, 4, true);
     this.colorAttribute.setUsage(THREE.DynamicDrawUsage);
     this.geometry.setAttribute('color', this.colorAttribute);
     this.geometry.computeBoundingSphere();
@@ -181,7 +185,7 @@ class Viewer {
     });
 
     this.plot = new ErrorPlot($('plot'), this.tree.errorCurve, this.tree.minClusters, (K) => this.setClusters(K));
-    if (Array.isArray(this.header.levels)) this.showLevels(this.header.levels);
+    if (Array.isArray(this.header.levels)) this.showLevels(this.header.levels, this.header.autoLevel);
 
     // A click (not a drag) selects the cluster under the pointer.
     const canvas = this.renderer.domElement;
@@ -194,18 +198,27 @@ class Viewer {
     });
   }
 
-  /** Ticks automatic levels on the plot and offers them as buttons. */
-  showLevels(levels) {
-    this.plot.setLevels(levels);
+  /**
+   * Ticks the automatic levels on the plot and offers them as buttons, by increasing K.
+   * @param levels [{clusters, score, rms}] (or plain K); chosen: the automatic level's K
+   */
+  showLevels(levels, chosen) {
+    const marks = levels.map((level) => (typeof level === 'number' ? { clusters: level } : level))
+      .sort((a, b) => a.clusters - b.clusters);
+    this.plot.setLevels(marks, chosen);
     const box = $('levels');
     box.textContent = '';
-    for (const K of levels) {
+    for (const { clusters, score } of marks) {
       const button = document.createElement('button');
-      button.textContent = String(K);
-      button.addEventListener('click', () => this.setClusters(K));
+      button.textContent = String(clusters);
+      button.dataset.clusters = String(clusters);
+      button.title = (clusters === chosen ? 'the automatic level (--clusters auto)' : 'a candidate level') +
+        (score !== undefined ? `: the error curve jumps ${format(score)}x at the next merge` : '');
+      if (clusters === chosen) button.classList.add('chosen');
+      button.addEventListener('click', () => this.setClusters(clusters));
       box.appendChild(button);
     }
-    $('levels-row').style.display = levels.length ? '' : 'none';
+    $('levels-row').style.display = marks.length ? '' : 'none';
   }
 
   setClusters(K) {
@@ -247,36 +260,64 @@ class Viewer {
     $('status').textContent = `${K.toLocaleString('en')} clusters, largest RMS ${format(largest)}; step ${ms.toFixed(1)} ms`;
   }
 
-  // Colour of each cluster of the current cut, RGB bytes.
-  clusterColors() {
-    const cut = this.cut, tree = this.tree, K = cut.size;
-    const colors = new Uint8Array(3 * K);
-    for (let c = 0; c < K; ++c) {
-      let rgb;
-      if (testMode) rgb = [(c + 1) & 255, ((c + 1) >> 8) & 255, ((c + 1) >> 16) & 255];
-      else if (this.colorMode === 'type') rgb = TYPE_COLORS[tree.type(cut.nodes[c])] ?? [128, 128, 128];
-      else rgb = clusterColor(tree.representative[cut.nodes[c]]);
-      if (c === this.selected && !testMode) rgb = rgb.map((x) => Math.round(x + (255 - x) * 0.55));
-      colors.set(rgb, 3 * c);
+  // The colour of a cluster represented by a leaf, as a little-endian RGBA word: computed once
+  // per leaf, so that a step costs no allocation and no colour arithmetic per cluster.
+  leafColor(leaf) {
+    if (!this.leafColors) this.leafColors = new Uint32Array(this.tree.faceCount);
+    let word = this.leafColors[leaf];
+    if (word === 0) {
+      const [r, g, b] = clusterColor(leaf);
+      word = this.leafColors[leaf] = (r | (g << 8) | (b << 16) | 0xff000000) >>> 0;
     }
-    return colors;
+    return word;
+  }
+
+  // Colour of each cluster of the current cut: RGBA words (a reused buffer, K long).
+  clusterColors() {
+    const cut = this.cut, tree = this.tree, K = cut.size, nodes = cut.nodes;
+    if (!this.clusterWords || this.clusterWords.length < K) this.clusterWords = new Uint32Array(Math.max(K, 1024));
+    const words = this.clusterWords.subarray(0, K);
+    const pack = ([r, g, b]) => (r | (g << 8) | (b << 16) | 0xff000000) >>> 0;
+    if (testMode) for (let c = 0; c < K; ++c) words[c] = ((c + 1) & 0xffffff | 0xff000000) >>> 0;
+    else if (this.colorMode === 'type') {
+      const typeWords = TYPE_COLORS.map(pack), grey = pack([128, 128, 128]);
+      for (let c = 0; c < K; ++c) words[c] = typeWords[tree.type(nodes[c])] ?? grey;
+    } else {
+      const representative = tree.representative;
+      for (let c = 0; c < K; ++c) words[c] = this.leafColor(representative[nodes[c]]);
+    }
+    if (this.selected >= 0 && this.selected < K && !testMode) {
+      const w = words[this.selected];
+      words[this.selected] = pack([w & 255, (w >> 8) & 255, (w >> 16) & 255].map((x) => Math.round(x + (255 - x) * 0.55)));
+    }
+    return words;
+  }
+
+  /** RGB of cluster c of the current colours. */
+  clusterRgb(c) {
+    const w = this.currentColors[c];
+    return [w & 255, (w >> 8) & 255, (w >> 16) & 255];
   }
 
   recolor() {
-    const colors = this.clusterColors();
-    this.currentColors = colors;
+    const words = this.clusterColors();
+    this.currentColors = words;
     const faceCluster = this.cut.faceCluster, faceOfTriangle = this.data.faceOfTriangle;
-    const out = this.colors, T = out.length / 9;
+    const out = this.cornerColors, T = out.length / 3;
+    // Only the triangles whose colour changes are uploaded: [first, last].
+    let first = T, last = -1;
     for (let t = 0; t < T; ++t) {
-      const c = 3 * faceCluster[faceOfTriangle ? faceOfTriangle[t] : t];
-      const r = colors[c], g = colors[c + 1], b = colors[c + 2];
-      for (let k = 9 * t, end = k + 9; k < end; k += 3) {
-        out[k] = r;
-        out[k + 1] = g;
-        out[k + 2] = b;
-      }
+      const word = words[faceCluster[faceOfTriangle ? faceOfTriangle[t] : t]], k = 3 * t;
+      if (out[k] === word) continue;
+      out[k] = out[k + 1] = out[k + 2] = word;
+      if (t < first) first = t;
+      last = t;
     }
-    this.colorAttribute.needsUpdate = true;
+    if (last >= 0) {
+      this.colorAttribute.clearUpdateRanges();
+      this.colorAttribute.addUpdateRange(12 * first, 12 * (last - first + 1));
+      this.colorAttribute.needsUpdate = true;
+    }
     this.updateLegend();
     this.render();
   }
@@ -301,7 +342,7 @@ class Viewer {
       rows.push('<tr><td></td><td>id</td><td>type</td><td>faces</td></tr>');
       largest.forEach((c, rank) => {
         const node = cut.nodes[c];
-        rows.push(`<tr><td>${swatch(Array.from(this.currentColors.subarray(3 * c, 3 * c + 3)))}</td><td>${rank}</td><td>${TYPE_NAMES[tree.type(node)]}</td><td>${tree.faces[node]}</td></tr>`);
+        rows.push(`<tr><td>${swatch(this.clusterRgb(c))}</td><td>${rank}</td><td>${TYPE_NAMES[tree.type(node)]}</td><td>${tree.faces[node]}</td></tr>`);
       });
       if (cut.size > largest.length) rows.push(`<tr><td></td><td colspan="3">... ${cut.size - largest.length} more</td></tr>`);
     }
@@ -358,7 +399,7 @@ class Viewer {
       const surface = primitiveSurface(primitive, points, patch);
       if (!surface) continue;
       const base = vertices.length / 3;
-      const rgb = Array.from(this.currentColors.subarray(3 * c, 3 * c + 3)).map((x) => Math.min(255, x + 60) / 255);
+      const rgb = this.clusterRgb(c).map((x) => Math.min(255, x + 60) / 255);
       for (let i = 0; i < surface.vertices.length; i += 3) {
         vertices.push(surface.vertices[i], surface.vertices[i + 1], surface.vertices[i + 2]);
         colors.push(...rgb);
@@ -488,7 +529,21 @@ const ready = (async () => {
 })();
 ready.catch(showError);
 
+// The skeleton's interface (pages written with --skeleton): poses as primseg deform's POSE.json
+// reads them, {"rotations": [{"joint", "axis", "degrees"}]}, and the posed vertices.
+async function skeletonOf() {
+  const viewer = await ready;
+  if (!viewer.skeleton) throw new Error('this page has no skeleton: write it with primseg view --skeleton');
+  return viewer.skeleton;
+}
+
 window.primseg = {
   ready,
   testMode,
+  /** Poses the mesh (joints left out go back to rest); throws for a pose primseg refuses. */
+  setPose: async (pose) => (await skeletonOf()).setPose(pose),
+  /** The current pose, as a POSE.json object. */
+  pose: async () => (await skeletonOf()).pose(),
+  /** Posed vertex positions, input units: an Array of V*3 numbers. */
+  deformedPositions: async () => Array.from((await skeletonOf()).positions()),
 };

@@ -18,7 +18,8 @@ export class ErrorPlot {
     this.margin = { left: 44, right: 8, top: 8, bottom: 22 };
     const pick = (event) => {
       const rect = canvas.getBoundingClientRect();
-      onPick(this.clustersAt(event.clientX - rect.left));
+      const x = event.clientX - rect.left;
+      onPick(this.levelAt(x) ?? this.clustersAt(x));
     };
     canvas.addEventListener('click', pick);
     canvas.addEventListener('pointermove', (event) => {
@@ -40,9 +41,29 @@ export class ErrorPlot {
     return Math.max(1, Math.min(this.faces, Math.round(Math.exp(fraction * Math.log(Math.max(2, this.faces))))));
   }
 
-  /** Automatic levels to tick on the K axis (numbers of clusters). */
-  setLevels(levels) {
+  /** The automatic level whose mark is within a few pixels of x (nearest), or null. */
+  levelAt(x, pixels = 5) {
+    let best = null, bestDistance = pixels;
+    for (const { clusters } of this.levels) {
+      const distance = Math.abs(this.x(clusters) - x);
+      if (distance <= bestDistance) {
+        best = clusters;
+        bestDistance = distance;
+      }
+    }
+    return best;
+  }
+
+  /** Where each automatic level is marked: [{clusters, x, y}] in CSS pixels of the canvas. */
+  levelMarks() {
+    const h = this.canvas.clientHeight;
+    return this.levels.map(({ clusters }) => ({ clusters, x: this.x(clusters), y: h - this.margin.bottom + 3 }));
+  }
+
+  /** Automatic levels to mark on the K axis: [{clusters, score}], the chosen one's K. */
+  setLevels(levels, chosen) {
     this.levels = levels;
+    this.chosen = chosen;
     this.draw();
   }
 
@@ -95,9 +116,17 @@ export class ErrorPlot {
     }
     g.stroke();
 
-    g.fillStyle = '#ffd36b';
-    for (const K of this.levels) {
+    for (const { clusters: K } of this.levels) {
       const px = this.x(K);
+      // A dashed line up to the curve, a triangle under the axis (filled for the chosen level).
+      g.strokeStyle = 'rgba(255, 211, 107, 0.55)';
+      g.setLineDash([2, 3]);
+      g.beginPath();
+      g.moveTo(px, m.top + plotH);
+      g.lineTo(px, y(this.curve[K]));
+      g.stroke();
+      g.setLineDash([]);
+      g.fillStyle = K === this.chosen ? '#ffd36b' : 'rgba(255, 211, 107, 0.5)';
       g.beginPath();
       g.moveTo(px, m.top + plotH);
       g.lineTo(px - 4, m.top + plotH + 6);
