@@ -23,15 +23,28 @@ export function triangleAreas(positions, triangles) {
 
 /**
  * A level: `nodes[c]` is the tree node of cluster c (clusters in no particular order) and
- * `faceCluster[f]` the cluster of input face f.
+ * `faceCluster[f]` the cluster of input face f, made on first use (a slider step does not need
+ * it: it colours the clusters' ranges of the leaf order).
  */
 export class Cut {
-  constructor(nodes, faceCluster) {
+  constructor(nodes, tree) {
     this.nodes = nodes;
-    this.faceCluster = faceCluster;
+    this.tree = tree;
+    this.labels = null;
   }
   get size() {
     return this.nodes.length;
+  }
+  get faceCluster() {
+    if (!this.labels) {
+      const { leafOrder, leafStart, faces } = this.tree;
+      const labels = new Int32Array(this.tree.faceCount);
+      this.nodes.forEach((node, c) => {
+        for (let p = leafStart[node], end = p + faces[node]; p < end; ++p) labels[leafOrder[p]] = c;
+      });
+      this.labels = labels;
+    }
+    return this.labels;
   }
 }
 
@@ -77,7 +90,16 @@ export class Tree {
       if (!trailing && (p < 0 || p - F >= this.realMerges)) roots.push(node);
     }
     this.roots = Uint32Array.from(roots);
-    this.nodeLabel = new Int32Array(n);
+    // Leaf order: the leaves of every node are contiguous, from leafStart[node] (faces[node] of
+    // them), leafOrder[position] = face. The last node is the root of the whole tree.
+    const leafStart = (this.leafStart = new Uint32Array(n));
+    for (let node = n - 1; node >= F; --node) {
+      const a = children[2 * (node - F)], b = children[2 * (node - F) + 1];
+      leafStart[a] = leafStart[node];
+      leafStart[b] = leafStart[node] + faces[a];
+    }
+    this.leafOrder = new Uint32Array(F);
+    for (let f = 0; f < F; ++f) this.leafOrder[leafStart[f]] = f;
     this.errorCurve = this.computeErrorCurve();
   }
 
@@ -116,57 +138,40 @@ export class Tree {
     return this.data.header.components;
   }
 
-  /** The level with K clusters, as primseg cut --clusters K. O(F). */
+  /**
+   * The level with K clusters, as primseg cut --clusters K: the first F - K real merges applied
+   * (trailing merges joining components never). O(K): down from the root to the applied nodes.
+   */
   cutByCount(K) {
     const F = this.faceCount;
     K = Math.max(1, Math.min(F, Math.round(K)));
-    const applied = Math.min(this.realMerges, F - K);
-    const end = F + applied;
-    const parent = this.parent, label = this.nodeLabel;
-    const nodes = new Uint32Array(F - applied);
-    let k = 0;
-    for (let node = 0; node < end; ++node) {
-      const p = parent[node];
-      if (p < 0 || p >= end) {
-        label[node] = k;
-        nodes[k++] = node;
-      } else {
-        label[node] = -1;
-      }
+    const end = F + Math.min(this.realMerges, F - K);
+    const children = this.children;
+    const nodes = [];
+    const stack = [this.nodeCount - 1];
+    while (stack.length) {
+      const node = stack.pop();
+      if (node < end) nodes.push(node);
+      else stack.push(children[2 * (node - F) + 1], children[2 * (node - F)]);
     }
-    return new Cut(nodes.subarray(0, k), this.labelFaces(end));
+    return new Cut(Uint32Array.from(nodes), this);
   }
 
-  /** The level of tolerance T (input units), as primseg cut --tolerance T. O(F). */
+  /** The level of tolerance T (input units), as primseg cut --tolerance T. O(K). */
   cutByTolerance(tolerance) {
-    const F = this.faceCount, children = this.children, label = this.nodeLabel;
-    label.fill(-1);
+    const F = this.faceCount, children = this.children;
     const nodes = [];
     const stack = Array.from(this.roots).reverse();
     while (stack.length) {
       const node = stack.pop();
       if (node < F || this.rms(node) <= tolerance) {
-        label[node] = nodes.length;
         nodes.push(node);
       } else {
         const i = node - F;
         stack.push(children[2 * i + 1], children[2 * i]);
       }
     }
-    return new Cut(Uint32Array.from(nodes), this.labelFaces(this.nodeCount));
-  }
-
-  // Labels faces from nodeLabel (a label on each kept node, -1 below them up to `end`).
-  labelFaces(end) {
-    const F = this.faceCount, children = this.children, label = this.nodeLabel;
-    for (let node = end - 1; node >= F; --node) {
-      const l = label[node];
-      if (l < 0) continue;
-      const i = node - F;
-      label[children[2 * i]] = l;
-      label[children[2 * i + 1]] = l;
-    }
-    return label.slice(0, F);
+    return new Cut(Uint32Array.from(nodes), this);
   }
 
   // Orders clusters as primseg does: by decreasing area, ties by lowest face.

@@ -16,7 +16,8 @@ const factories = new Map();
  * Registers an overlay for pages whose header has `key`.
  * @param key header key, e.g. 'skeleton'
  * @param factory (context) => {update(cut), dispose()}; context: {header, value (header[key]),
- *   data, tree, scene, camera, canvas, geometry, requestRender}
+ *   data, tree, scene, camera, canvas, geometry (non-indexed: triangle slot s has corners 3s..3s+2),
+ *   drawOrder (the triangle of each slot), requestRender}
  */
 export function registerOverlay(key, factory) {
   factories.set(key, factory);

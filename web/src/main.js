@@ -58,7 +58,8 @@ class Viewer {
     this.setUpControls();
     this.overlays = createOverlays({
       header: this.header, data, tree: this.tree, scene: this.scene, camera: this.camera,
-      canvas: this.renderer.domElement, geometry: this.geometry, requestRender: () => this.render(),
+      canvas: this.renderer.domElement, geometry: this.geometry, drawOrder: this.drawOrder,
+      requestRender: () => this.render(),
     });
     this.skeleton = this.overlays.find((overlay) => overlay.name === 'skeleton') ?? null;
     this.setClusters(this.header.initialClusters);
@@ -75,16 +76,26 @@ class Viewer {
       : new THREE.Color().setRGB(0x1d / 255, 0x20 / 255, 0x26 / 255, THREE.LinearSRGBColorSpace));
     this.scene = new THREE.Scene();
 
-    const { positions, triangles } = this.data;
-    const T = triangles.length / 3;
+    const { positions, triangles, faceOfTriangle } = this.data;
+    const T = triangles.length / 3, F = this.tree.faceCount, leafStart = this.tree.leafStart;
+    // Triangles are drawn in the tree's leaf order: the triangles of any cluster of any level are
+    // one range of the buffers (a step fills ranges). drawOrder[slot] = triangle; the triangles
+    // of the leaves from position p on start at slot slotStart[p].
+    const slotStart = (this.slotStart = new Uint32Array(F + 1));
+    const leafOf = (t) => leafStart[faceOfTriangle ? faceOfTriangle[t] : t];
+    for (let t = 0; t < T; ++t) ++slotStart[leafOf(t) + 1];
+    for (let p = 0; p < F; ++p) slotStart[p + 1] += slotStart[p];
+    const next = slotStart.slice(0, F), drawOrder = (this.drawOrder = new Uint32Array(T));
+    for (let t = 0; t < T; ++t) drawOrder[next[leafOf(t)]++] = t;
     // Unshared corners: each triangle has its own colour (flat per-cluster colouring).
     const corners = new Float32Array(T * 9);
-    for (let i = 0; i < T * 3; ++i) {
-      const v = 3 * triangles[i];
-      corners[3 * i] = positions[v];
-      corners[3 * i + 1] = positions[v + 1];
-      corners[3 * i + 2] = positions[v + 2];
-    }
+    for (let slot = 0; slot < T; ++slot)
+      for (let k = 0; k < 3; ++k) {
+        const v = 3 * triangles[3 * drawOrder[slot] + k], i = 9 * slot + 3 * k;
+        corners[i] = positions[v];
+        corners[i + 1] = positions[v + 1];
+        corners[i + 2] = positions[v + 2];
+      }
     this.geometry = new THREE.BufferGeometry();
     this.geometry.setAttribute('position', new THREE.BufferAttribute(corners, 3));
     // RGBA bytes per corner, written as one 32-bit word (little-endian: R first) per corner.
@@ -302,20 +313,28 @@ class Viewer {
   recolor() {
     const words = this.clusterColors();
     this.currentColors = words;
-    const faceCluster = this.cut.faceCluster, faceOfTriangle = this.data.faceOfTriangle;
-    const out = this.cornerColors, T = out.length / 3;
-    // Only the triangles whose colour changes are uploaded: [first, last].
-    let first = T, last = -1;
-    for (let t = 0; t < T; ++t) {
-      const word = words[faceCluster[faceOfTriangle ? faceOfTriangle[t] : t]], k = 3 * t;
-      if (out[k] === word) continue;
-      out[k] = out[k + 1] = out[k + 2] = word;
-      if (t < first) first = t;
-      last = t;
+    const nodes = this.cut.nodes, out = this.cornerColors, slotStart = this.slotStart;
+    const { leafStart, faces } = this.tree;
+    // filled[node]: the colour word a node's range was filled with, for the clusters of the
+    // previous fill (else 0): a cluster kept with its colour is not written again.
+    if (!this.filled) this.filled = new Uint32Array(this.tree.nodeCount);
+    const filled = this.filled;
+    // Only the slots whose colour changes are uploaded: [first, last).
+    let first = Infinity, last = -1;
+    for (let c = 0; c < nodes.length; ++c) {
+      const node = nodes[c], word = words[c];
+      if (filled[node] === word) continue;
+      const from = slotStart[leafStart[node]], to = slotStart[leafStart[node] + faces[node]];
+      out.fill(word, 3 * from, 3 * to);
+      if (from < first) first = from;
+      if (to > last) last = to;
     }
-    if (last >= 0) {
+    for (const node of this.filledNodes ?? []) filled[node] = 0;
+    for (let c = 0; c < nodes.length; ++c) filled[nodes[c]] = words[c];
+    this.filledNodes = nodes;
+    if (last > first) {
       this.colorAttribute.clearUpdateRanges();
-      this.colorAttribute.addUpdateRange(12 * first, 12 * (last - first + 1));
+      this.colorAttribute.addUpdateRange(12 * first, 12 * (last - first));
       this.colorAttribute.needsUpdate = true;
     }
     this.updateLegend();
@@ -426,7 +445,8 @@ class Viewer {
     raycaster.setFromCamera(pointer, this.camera);
     const hit = raycaster.intersectObject(this.mesh, false)[0];
     if (!hit) return { cluster: -1 };
-    const face = this.data.faceOfTriangle ? this.data.faceOfTriangle[hit.faceIndex] : hit.faceIndex;
+    const triangle = this.drawOrder[hit.faceIndex];
+    const face = this.data.faceOfTriangle ? this.data.faceOfTriangle[triangle] : triangle;
     return { cluster: this.cut.faceCluster[face], face };
   }
 

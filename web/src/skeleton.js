@@ -148,13 +148,14 @@ class SkeletonOverlay {
     this.jointsNow = this.skeleton.posedJoints(transforms, this.jointsNow);
     const attribute = this.context.geometry.getAttribute('position');
     const corners = attribute.array, triangles = this.triangles, d = this.deformed;
-    const [cx, cy, cz] = this.center;
-    for (let i = 0; i < triangles.length; ++i) {
-      const v = 3 * triangles[i];
-      corners[3 * i] = d[v] - cx;
-      corners[3 * i + 1] = d[v + 1] - cy;
-      corners[3 * i + 2] = d[v + 2] - cz;
-    }
+    const drawOrder = this.context.drawOrder, [cx, cy, cz] = this.center;
+    for (let slot = 0; slot < drawOrder.length; ++slot)
+      for (let k = 0; k < 3; ++k) {
+        const v = 3 * triangles[3 * drawOrder[slot] + k], i = 9 * slot + 3 * k;
+        corners[i] = d[v] - cx;
+        corners[i + 1] = d[v + 1] - cy;
+        corners[i + 2] = d[v + 2] - cz;
+      }
     attribute.needsUpdate = true;
     this.place();
   }

@@ -143,7 +143,10 @@ test('a pose applied in the page moves every vertex where primseg deform moves i
     const viewer = await window.primseg.ready;
     const corners = viewer.geometry.getAttribute('position').array, t = viewer.data.triangles, c = viewer.header.center;
     const positions = new Float64Array(3 * viewer.header.vertices);
-    for (let i = 0; i < t.length; ++i) for (let a = 0; a < 3; ++a) positions[3 * t[i] + a] = corners[3 * i + a] + c[a];
+    viewer.drawOrder.forEach((triangle, slot) => {
+      for (let k = 0; k < 3; ++k)
+        for (let a = 0; a < 3; ++a) positions[3 * t[3 * triangle + k] + a] = corners[9 * slot + 3 * k + a] + c[a];
+    });
     return Array.from(positions);
   });
   assert.ok(largestDifference(drawn, expected) < 1e-5);
