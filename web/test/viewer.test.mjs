@@ -262,6 +262,8 @@ test('bad input: a clear error and exit status 1', () => {
     [['view', fandisk, '--clusters', '0', '-o', join(work, 'x.html')], /--clusters/],
     [['view', join(work, 'box.off'), '--tree', join(work, 'fandisk.tree'), '-o', join(work, 'x.html')], /was not built from/],
     [['view', fandisk], /output/i],
+    [['view', fandisk, '--skeleton-clusters', 'many', '-o', join(work, 'x.html')], /--clusters: 'many'/],
+    [['view', fandisk, '--skeleton', '--band', '-1', '-o', join(work, 'x.html')], /--band/],
   ];
   for (const [args, message] of cases) {
     const run = spawnSync(cli, args, { encoding: 'utf8' });
