@@ -194,17 +194,20 @@ void ClusterStats::merge(const ClusterStats& other, const EdgeStats& shared_edge
   // (c − o) = (c − o_other) + (o_other − o).
   normal_position += other.normal_position +
                      (other.moments.origin() - moments.origin()) * other.normal_sum.transpose();
+  face_planes += other.face_planes.translated(moments.origin() - other.moments.origin());
   moments.add(other.moments, max_degree);
   edges += other.edges;
   edges += shared_edges;
   normal_sum += other.normal_sum;
   area += other.area;
   triangle_count += other.triangle_count;
+  samples.merge(other.samples);
 }
 
 ClusterStats ClusterStats::translated(const Eigen::Vector3d& new_origin, int max_degree) const {
   ClusterStats result = *this;
   result.normal_position -= (new_origin - moments.origin()) * normal_sum.transpose();
+  result.face_planes = face_planes.translated(new_origin - moments.origin());
   result.moments = moments.translated(new_origin, max_degree);
   return result;
 }
@@ -215,6 +218,90 @@ double ClusterStats::normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vec
   // Σ A n · Q (c − p) = tr(Q Σ (c − o) (A n)ᵀ) − (A n)ᵀ Q (p − o), summed over triangles.
   const double sum = (q * normal_position).trace() - normal_sum.dot(q * (point - moments.origin()));
   return std::abs(sum) / (radius * area);
+}
+
+void FacePlaneStats::add_face(const Eigen::Vector3d& n, double area,
+                              const Eigen::Vector3d& centroid_offset) {
+  const double offset = n.dot(centroid_offset);
+  normal_normal[0] += area * n.x() * n.x();
+  normal_normal[1] += area * n.x() * n.y();
+  normal_normal[2] += area * n.x() * n.z();
+  normal_normal[3] += area * n.y() * n.y();
+  normal_normal[4] += area * n.y() * n.z();
+  normal_normal[5] += area * n.z() * n.z();
+  normal_offset += (area * offset) * n;
+  offset_square += area * offset * offset;
+}
+
+FacePlaneStats FacePlaneStats::translated(const Eigen::Vector3d& shift) const {
+  // n·(c − o − d) = n·(c − o) − n·d, summed with the weights A n and A.
+  if (shift.isZero(0)) return *this;
+  const Eigen::Vector3d nd = normal_normal_matrix() * shift;  // Σ A n (n·d)
+  FacePlaneStats result = *this;
+  result.normal_offset -= nd;
+  result.offset_square += -2 * normal_offset.dot(shift) + shift.dot(nd);
+  return result;
+}
+
+FacePlaneStats& FacePlaneStats::operator+=(const FacePlaneStats& other) {
+  for (int n = 0; n < 6; ++n) normal_normal[n] += other.normal_normal[n];
+  normal_offset += other.normal_offset;
+  offset_square += other.offset_square;
+  return *this;
+}
+
+Eigen::Matrix3d FacePlaneStats::normal_normal_matrix() const {
+  Eigen::Matrix3d m;
+  m << normal_normal[0], normal_normal[1], normal_normal[2], normal_normal[1], normal_normal[3],
+      normal_normal[4], normal_normal[2], normal_normal[4], normal_normal[5];
+  return m;
+}
+
+namespace {
+// Kept order: higher priority first; equal priorities keep their order (stable merges).
+bool before(const SurfaceSample& a, const SurfaceSample& b) {
+  return a.priority > b.priority;
+}
+}  // namespace
+
+void SampleReservoir::add(const SurfaceSample& sample) {
+  if (samples.size() > kCapacity && !before(sample, samples.back())) return;
+  const auto at = std::upper_bound(samples.begin(), samples.end(), sample, before);
+  samples.insert(at, sample);
+  if (samples.size() > kCapacity + 1) samples.pop_back();
+}
+
+void SampleReservoir::merge(const SampleReservoir& other) {
+  if (other.samples.empty()) return;
+  std::vector<SurfaceSample> merged;
+  merged.reserve(std::min(samples.size() + other.samples.size(), kCapacity + 1));
+  auto a = samples.cbegin();
+  auto b = other.samples.cbegin();
+  while (merged.size() < kCapacity + 1 && (a != samples.cend() || b != other.samples.cend())) {
+    if (b == other.samples.cend() || (a != samples.cend() && !before(*b, *a)))
+      merged.push_back(*a++);
+    else
+      merged.push_back(*b++);
+  }
+  samples = std::move(merged);
+}
+
+double SampleReservoir::threshold() const {
+  return samples.size() > kCapacity ? samples[kCapacity].priority : 0.0;
+}
+
+double SampleReservoir::estimator_weight(std::size_t i) const {
+  return std::max(samples[i].weight, threshold());
+}
+
+double SampleReservoir::priority_of(std::uint64_t corner_id, double weight) {
+  // splitmix64 of the corner's index: u uniform in (0, 1], the same in every run and merge order.
+  std::uint64_t z = corner_id + 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  const double u = static_cast<double>((z >> 11) + 1) * 0x1.0p-53;
+  return weight / u;
 }
 
 EdgeStats& EdgeStats::operator+=(const EdgeStats& other) {

@@ -270,7 +270,7 @@ std::array<double, 3> DualGraph::corner_weights(std::uint32_t t) const {
   return {area / 3, area / 3, area / 3};
 }
 
-ClusterStats DualGraph::face_stats(std::uint32_t f) const {
+ClusterStats DualGraph::face_stats(std::uint32_t f, bool with_samples) const {
   ClusterStats stats;
   const std::uint32_t begin = first_triangle_[f], end = first_triangle_[f + 1];
   {
@@ -289,7 +289,17 @@ ClusterStats DualGraph::face_stats(std::uint32_t f) const {
         (positions_[tri[0]] + positions_[tri[1]] + positions_[tri[2]]) / 3;
     stats.normal_position += (centroid - stats.moments.origin()) * (0.5 * n).transpose();
     stats.normal_sum += 0.5 * n;
-    stats.area += 0.5 * n.norm();
+    const double area = 0.5 * n.norm();
+    if (area > 0)
+      stats.face_planes.add_face(n / (2 * area), area, centroid - stats.moments.origin());
+    if (with_samples) {
+      const Eigen::Vector3f unit =
+          area > 0 ? Eigen::Vector3f((n / (2 * area)).cast<float>()) : Eigen::Vector3f::Zero();
+      for (int c = 0; c < 3; ++c)
+        stats.samples.add({positions_[tri[c]], unit, w[c],
+                           SampleReservoir::priority_of(std::uint64_t{t} * 3 + c, w[c])});
+    }
+    stats.area += area;
     ++stats.triangle_count;
   }
   auto it =

@@ -133,6 +133,106 @@ class CylinderModel final : public GeometricModel {
   double radius_;
 };
 
+// Parameters: the apex's displacement, the axis tilted by (α, β), the half-angle change. In the
+// half-plane through the axis and x, with h along the axis and ρ across it, the signed distance
+// to the generator is d = ρ cos θ − h sin θ (positive outside); t = h cos θ + ρ sin θ is the
+// distance along the generator.
+class ConeModel final : public GeometricModel {
+ public:
+  ConeModel(const Eigen::Vector3d& apex, const Eigen::Vector3d& axis, double half_angle)
+      : apex_(apex), axis_(axis.normalized()), half_angle_(half_angle) {
+    std::tie(u_, v_) = orthonormal_pair(axis_);
+  }
+  int parameter_count() const override { return 6; }
+  double residual(const Eigen::Vector3d& x, double* gradient) const override {
+    const Eigen::Vector3d y = x - apex_;
+    const double h = axis_.dot(y);
+    const Eigen::Vector3d radial = y - h * axis_;
+    const double rho = radial.norm();
+    const Eigen::Vector3d direction = rho > 0 ? Eigen::Vector3d(radial / rho) : u_;
+    const double c = std::cos(half_angle_), s = std::sin(half_angle_);
+    const double t = h * c + rho * s;
+    // ∂d/∂apex = −(outward normal); tilting the axis by α along u moves h by ρ (r̂·u) and ρ by
+    // −h (r̂·u), so ∂d/∂α = −t (r̂·u); ∂d/∂θ = −t.
+    const Eigen::Vector3d normal = c * direction - s * axis_;
+    for (int i = 0; i < 3; ++i) gradient[i] = -normal[i];
+    gradient[3] = -t * direction.dot(u_);
+    gradient[4] = -t * direction.dot(v_);
+    gradient[5] = -t;
+    return rho * c - h * s;
+  }
+  std::unique_ptr<GeometricModel> stepped(const double* step) const override {
+    return std::make_unique<ConeModel>(apex_ + Eigen::Vector3d(step[0], step[1], step[2]),
+                                       axis_ + step[3] * u_ + step[4] * v_, half_angle_ + step[5]);
+  }
+  Primitive primitive() const override {
+    Primitive p;
+    p.type = PrimitiveType::Cone;
+    p.point = to_vec3(apex_);
+    p.axis = to_vec3(axis_);
+    p.half_angle = half_angle_;
+    return p;
+  }
+
+ private:
+  Eigen::Vector3d apex_, axis_, u_, v_;
+  double half_angle_;
+};
+
+// Parameters: the centre's displacement, the axis tilted by (α, β), the major and minor radius
+// changes. In the half-plane through the axis and x (h along the axis, ρ across it) the tube's
+// centre is at (ρ, h) = (R, 0) and d = |(ρ − R, h)| − r.
+class TorusModel final : public GeometricModel {
+ public:
+  TorusModel(const Eigen::Vector3d& centre, const Eigen::Vector3d& axis, double major_radius,
+             double minor_radius)
+      : centre_(centre),
+        axis_(axis.normalized()),
+        major_radius_(major_radius),
+        minor_radius_(minor_radius) {
+    std::tie(u_, v_) = orthonormal_pair(axis_);
+  }
+  int parameter_count() const override { return 7; }
+  double residual(const Eigen::Vector3d& x, double* gradient) const override {
+    const Eigen::Vector3d y = x - centre_;
+    const double h = axis_.dot(y);
+    const Eigen::Vector3d radial = y - h * axis_;
+    const double rho = radial.norm();
+    const Eigen::Vector3d direction = rho > 0 ? Eigen::Vector3d(radial / rho) : u_;
+    const double tube = std::hypot(rho - major_radius_, h);
+    // Unit direction from the tube's centre to x, in the (ρ, h) half-plane.
+    const double q_rho = tube > 0 ? (rho - major_radius_) / tube : 1;
+    const double q_h = tube > 0 ? h / tube : 0;
+    const Eigen::Vector3d normal = q_rho * direction + q_h * axis_;
+    for (int i = 0; i < 3; ++i) gradient[i] = -normal[i];
+    // Tilting the axis by α along u moves h by ρ (r̂·u) and ρ by −h (r̂·u).
+    const double tilt = q_h * rho - q_rho * h;
+    gradient[3] = tilt * direction.dot(u_);
+    gradient[4] = tilt * direction.dot(v_);
+    gradient[5] = -q_rho;
+    gradient[6] = -1;
+    return tube - minor_radius_;
+  }
+  std::unique_ptr<GeometricModel> stepped(const double* step) const override {
+    return std::make_unique<TorusModel>(centre_ + Eigen::Vector3d(step[0], step[1], step[2]),
+                                        axis_ + step[3] * u_ + step[4] * v_,
+                                        major_radius_ + step[5], minor_radius_ + step[6]);
+  }
+  Primitive primitive() const override {
+    Primitive p;
+    p.type = PrimitiveType::Torus;
+    p.point = to_vec3(centre_);
+    p.axis = to_vec3(axis_);
+    p.radius = major_radius_;
+    p.minor_radius = minor_radius_;
+    return p;
+  }
+
+ private:
+  Eigen::Vector3d centre_, axis_, u_, v_;
+  double major_radius_, minor_radius_;
+};
+
 }  // namespace
 
 std::unique_ptr<GeometricModel> geometric_model_for(const Primitive& p) {
@@ -144,8 +244,10 @@ std::unique_ptr<GeometricModel> geometric_model_for(const Primitive& p) {
     case PrimitiveType::Cylinder:
       return std::make_unique<CylinderModel>(to_eigen(p.point), to_eigen(p.axis), p.radius);
     case PrimitiveType::Cone:
+      return std::make_unique<ConeModel>(to_eigen(p.point), to_eigen(p.axis), p.half_angle);
     case PrimitiveType::Torus:
-      return nullptr;
+      return std::make_unique<TorusModel>(to_eigen(p.point), to_eigen(p.axis), p.radius,
+                                          p.minor_radius);
   }
   return nullptr;
 }
@@ -229,6 +331,11 @@ Primitive canonical(Primitive p, const Primitive& initial_normalised) {
     p.radius = std::abs(p.radius);
   } else if (p.type == PrimitiveType::Sphere) {
     p.radius = std::abs(p.radius);
+  } else if (p.type == PrimitiveType::Cone) {
+    p.axis = {axis.x(), axis.y(), axis.z()};  // from the apex into the cone: keep its side
+  } else if (p.type == PrimitiveType::Torus) {
+    const Eigen::Vector3d a = canonical_axis(axis);
+    p.axis = {a.x(), a.y(), a.z()};
   }
   return p;
 }
@@ -260,20 +367,25 @@ GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> point
     double current = cost(*model, n, weights);
     double lambda = 1e-3;
     double gradient[detail::kMaxParameters];
+    // At most kMaxParameters: fixed-capacity matrices, no heap and no blocked products (the torus
+    // fit runs this on its 32-point sample for every candidate merge).
+    using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, detail::kMaxParameters,
+                                 detail::kMaxParameters>;
+    using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, detail::kMaxParameters, 1>;
     while (result.iterations < options.max_iterations && current > 0) {
-      Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(k, k);
-      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(k);
+      Matrix normal = Matrix::Zero(k, k);
+      Vector rhs = Vector::Zero(k);
       for (std::size_t i = 0; i < n.points.size(); ++i) {
         const double d = model->residual(n.points[i], gradient);
-        const Eigen::Map<const Eigen::VectorXd> g(gradient, k);
+        const Eigen::Map<const Vector> g(gradient, k);
         normal.noalias() += weights[i] * g * g.transpose();
         rhs.noalias() -= weights[i] * d * g;
       }
       bool accepted = false;
       while (lambda < 1e16) {
-        Eigen::MatrixXd damped = normal;
+        Matrix damped = normal;
         for (int j = 0; j < k; ++j) damped(j, j) += lambda * normal(j, j) + 1e-300;
-        const Eigen::VectorXd step = damped.ldlt().solve(rhs);
+        const Vector step = damped.ldlt().solve(rhs);
         if (!step.allFinite()) {
           lambda *= 10;
           continue;

@@ -91,7 +91,8 @@ namespace {
 // Leaves are not stored: their fit is recomputed from the face, by the same rule as merges.
 detail::SelectedModel select_leaf(const HierarchyOptions& options, const DualGraph& graph,
                                   std::uint32_t face) {
-  return detail::ModelSelector(options).select(graph.face_stats(face).centred());
+  const detail::ModelSelector selector(options);
+  return selector.select(graph.face_stats(face, selector.needs_samples()).centred());
 }
 
 }  // namespace
@@ -271,7 +272,7 @@ class HierarchyBuilder::Impl {
     const std::uint32_t slot = slot_of_node_[node];
     const std::uint32_t index = stats_index_of_slot_[slot];
     if (index != kNone) return stats_[index];
-    leaf = graph_->face_stats(slot);
+    leaf = graph_->face_stats(slot, selector_.needs_samples());
     return leaf;
   }
 

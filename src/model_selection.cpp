@@ -28,6 +28,10 @@ void validate(const HierarchyOptions& options) {
 }
 
 namespace detail {
+namespace {
+// Normal agreements closer than this are equal (round-off of the sums).
+constexpr double kAlignmentTieMargin = 1e-6;
+}  // namespace
 
 ModelSelector::ModelSelector(const HierarchyOptions& options) : options_(options) {
   validate(options);
@@ -35,6 +39,7 @@ ModelSelector::ModelSelector(const HierarchyOptions& options) : options_(options
   std::sort(types.begin(), types.end());
   for (PrimitiveType t : types) {
     fitters_.push_back(&fitter_for(t));
+    needs_samples_ = needs_samples_ || fitters_.back()->needs_samples();
     if (t != PrimitiveType::Plane)
       min_curved_triangles_ = std::min(min_curved_triangles_, fitters_.back()->min_triangles());
   }
@@ -65,13 +70,20 @@ SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactErro
                                   options_.type_penalty[static_cast<int>(fitter->type())]);
     if (!fit.valid || !std::isfinite(fit.error)) continue;
     SelectedModel candidate = finish(std::move(fit));
-    if (!found || candidate.cost < best.cost) {
+    // Exact fits tie at cost 0: the vertices of a coarse tessellation lie exactly on several
+    // surfaces (a band between two circles lies on a cone, a sphere and tori), but the face
+    // normals follow only the true one. Among exact fits the better normal agreement wins;
+    // other ties keep the earlier (simpler) type.
+    const bool better_exact =
+        found && candidate.cost == 0 && best.cost == 0 &&
+        candidate.fit.normal_alignment > best.fit.normal_alignment + kAlignmentTieMargin;
+    if (!found || candidate.cost < best.cost || better_exact) {
       best = candidate;
       found = true;
     }
-    // Costs are never negative and equal costs keep the earlier (simpler) type: nothing after
-    // an exact fit can win, so the richer fits need not run (most candidates in flat regions).
-    if (found && best.cost == 0) break;
+    // Costs are never negative: nothing after an exact fit whose normals agree everywhere (a
+    // flat plane) can win, so the richer fits need not run (most candidates in flat regions).
+    if (found && best.cost == 0 && best.fit.normal_alignment >= 1 - kAlignmentTieMargin) break;
   }
   if (!found) best = finish(fitter_for(PrimitiveType::Plane).fit(centred));
   if (lazy && best.cost > 0 && bound > 0) {

@@ -21,9 +21,10 @@ struct SelectedModel {
 using ExactError = std::function<double(const Primitive&)>;
 
 /// The rule: every enabled type with enough triangles is fitted; invalid fits drop out; errors at
-/// most zero_cost_tolerance × Σ w |x − c|² snap to 0; the smallest error × penalty wins, ties to
-/// the lower type. If no enabled type is valid the cluster is reported as a plane (the limit of
-/// every curved type as its radius grows), whether or not planes are enabled.
+/// most zero_cost_tolerance × Σ w |x − c|² snap to 0; the smallest error × penalty wins; among
+/// exact fits (cost 0) the best normal agreement (PrimitiveFit::normal_alignment) wins, other
+/// ties go to the lower type. If no enabled type is valid the cluster is reported as a plane (the
+/// limit of every curved type as its radius grows), whether or not planes are enabled.
 class ModelSelector {
  public:
   explicit ModelSelector(const HierarchyOptions& options);
@@ -32,6 +33,8 @@ class ModelSelector {
   int moment_degree(std::uint32_t triangle_count) const {
     return triangle_count >= min_curved_triangles_ ? 4 : 2;
   }
+  /// Whether some enabled type reads ClusterStats::samples (DualGraph::face_stats must fill them).
+  bool needs_samples() const { return needs_samples_; }
   /// `centred`: statistics with moments about the cluster's centroid, up to
   /// moment_degree(centred.triangle_count). `exact`: if given, replaces each fit's error by the
   /// exact one.
@@ -40,6 +43,7 @@ class ModelSelector {
  private:
   std::vector<const PrimitiveFitter*> fitters_;  // ascending type
   std::uint32_t min_curved_triangles_ = UINT32_MAX;
+  bool needs_samples_ = false;
   HierarchyOptions options_;
 };
 

@@ -91,6 +91,10 @@ TEST(ClusterStats, RandomMergeSequencesEqualTheWholeMeshStatistics) {
     // The normal-position moment translates exactly too.
     const ClusterStats centred = total.centred();
     Eigen::Matrix3d np = Eigen::Matrix3d::Zero();
+    // So do the face-plane moments: direct sums of A n nᵀ, A n (n·(c − o)), A (n·(c − o))².
+    Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d n_offset = Eigen::Vector3d::Zero();
+    double offset_square = 0;
     for (std::uint32_t t = 0; t < shape.mesh.triangle_count(); ++t) {
       const Triangle& tri = shape.mesh.triangles[t];
       Eigen::Vector3d n = (graph.position(tri[1]) - graph.position(tri[0]))
@@ -99,8 +103,17 @@ TEST(ClusterStats, RandomMergeSequencesEqualTheWholeMeshStatistics) {
       const Eigen::Vector3d c =
           (graph.position(tri[0]) + graph.position(tri[1]) + graph.position(tri[2])) / 3;
       np += (c - centred.moments.origin()) * (0.5 * n).transpose();
+      const double area = 0.5 * n.norm();
+      const Eigen::Vector3d unit = n.normalized();
+      const double offset = unit.dot(c - centred.moments.origin());
+      nn += area * unit * unit.transpose();
+      n_offset += area * offset * unit;
+      offset_square += area * offset * offset;
     }
     EXPECT_LT((np - centred.normal_position).norm(), 1e-12);
+    EXPECT_LT((nn - centred.face_planes.normal_normal_matrix()).norm(), 1e-12);
+    EXPECT_LT((n_offset - centred.face_planes.normal_offset).norm(), 1e-12);
+    EXPECT_NEAR(offset_square, centred.face_planes.offset_square, 1e-12);
   }
 }
 

@@ -117,21 +117,59 @@ TEST(GeometricFit, PlaneOfNoisyPointsIsTheLeastSquaresPlane) {
   EXPECT_NEAR(fit.rms, std::sqrt(solver.eigenvalues()[0] / 500.0), 1e-12);
 }
 
-TEST(GeometricFit, TypesWithoutAModelAreReturnedAsTheyAre) {
-  Primitive torus;
-  torus.type = PrimitiveType::Torus;
-  torus.point = {0, 0, 0};
-  torus.axis = {0, 0, 1};
-  torus.radius = 2;
-  torus.minor_radius = 0.5;
-  const std::vector<Vec3> points{{2.5, 0, 0}, {0, 2.6, 0}};
-  const std::vector<double> weights{1, 1};
-  const GeometricFit fit = fit_geometric(torus, points, weights);
-  EXPECT_EQ(fit.primitive.radius, 2);
-  EXPECT_EQ(fit.iterations, 0);
-  EXPECT_NEAR(fit.max, 0.1, 1e-12);
-  EXPECT_FALSE(has_geometric_model(PrimitiveType::Torus));
-  EXPECT_TRUE(has_geometric_model(PrimitiveType::Cylinder));
+// Points exactly on a cone or torus at a random pose, a start off by a few percent: the
+// refinement lands on the surface to round-off.
+TEST(GeometricFit, RecoversConesAndToriFromPerturbedStarts) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int trial = 0; trial < 10; ++trial) {
+    const auto rotation = testing::random_rotation(rng);
+    const Eigen::Matrix3d r =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&rotation[0][0]);
+    const Eigen::Vector3d origin(10 * unit(rng) - 5, 10 * unit(rng) - 5, 10 * unit(rng) - 5);
+    const Eigen::Vector3d axis = r.col(2);
+    const double half_angle = 0.2 + unit(rng), major = 1 + unit(rng), minor = 0.2 + 0.5 * unit(rng);
+    std::vector<Vec3> cone_points, torus_points;
+    for (int i = 0; i < 300; ++i) {
+      const double phi = 2 * unit(rng), t = 0.5 + unit(rng), psi = 3 * unit(rng) - 1.5;
+      const Eigen::Vector3d radial = r * Eigen::Vector3d(std::cos(phi), std::sin(phi), 0);
+      const Eigen::Vector3d c =
+          origin + t * (std::cos(half_angle) * axis + std::sin(half_angle) * radial);
+      const Eigen::Vector3d x =
+          origin + (major + minor * std::cos(psi)) * radial + minor * std::sin(psi) * axis;
+      cone_points.push_back({c.x(), c.y(), c.z()});
+      torus_points.push_back({x.x(), x.y(), x.z()});
+    }
+    const std::vector<double> weights(300, 1.0);
+    const Eigen::Vector3d tilted = (axis + Eigen::Vector3d(0.03, -0.02, 0.01)).normalized();
+    const Eigen::Vector3d moved = origin + Eigen::Vector3d(0.02, 0.01, -0.03);
+
+    Primitive cone;
+    cone.type = PrimitiveType::Cone;
+    cone.point = {moved.x(), moved.y(), moved.z()};
+    cone.axis = {tilted.x(), tilted.y(), tilted.z()};
+    cone.half_angle = half_angle * 1.05;
+    const GeometricFit cone_fit = fit_geometric(cone, cone_points, weights);
+    EXPECT_LE((eigen(cone_fit.primitive.point) - origin).norm(), 1e-9) << trial;
+    EXPECT_GT(eigen(cone_fit.primitive.axis).dot(axis), 1 - 1e-12) << trial;
+    EXPECT_NEAR(cone_fit.primitive.half_angle, half_angle, 1e-9) << trial;
+    EXPECT_LE(cone_fit.max, 1e-9) << trial;
+
+    Primitive torus;
+    torus.type = PrimitiveType::Torus;
+    torus.point = {moved.x(), moved.y(), moved.z()};
+    torus.axis = {tilted.x(), tilted.y(), tilted.z()};
+    torus.radius = major * 1.03;
+    torus.minor_radius = minor * 0.95;
+    const GeometricFit torus_fit = fit_geometric(torus, torus_points, weights);
+    EXPECT_LE((eigen(torus_fit.primitive.point) - origin).norm(), 1e-9) << trial;
+    EXPECT_NEAR(std::abs(eigen(torus_fit.primitive.axis).dot(axis)), 1, 1e-12) << trial;
+    EXPECT_NEAR(torus_fit.primitive.radius, major, 1e-9) << trial;
+    EXPECT_NEAR(torus_fit.primitive.minor_radius, minor, 1e-9) << trial;
+    EXPECT_LE(torus_fit.max, 1e-9) << trial;
+  }
+  for (int t = 0; t < kPrimitiveTypeCount; ++t)
+    EXPECT_TRUE(has_geometric_model(static_cast<PrimitiveType>(t)));
 }
 
 TEST(GeometricFit, RejectsBadInput) {

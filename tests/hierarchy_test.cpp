@@ -37,11 +37,13 @@ SegmentationScore score_at_true_count(const GroundTruthShape& shape, const Hiera
   return score_segmentation(seg.labels, shape.region_of_face, face_areas(h), types, truth_types);
 }
 
-// Whether every region of the shape has a type this build can fit (the generator also makes
-// cones and tori, which join these tests when their fitters exist).
+// Whether every region of the shape has a type of the default primitive set (cones and tori,
+// which are opt-in, have their own test below).
 bool fittable(const GroundTruthShape& shape) {
-  return std::all_of(shape.regions.begin(), shape.regions.end(),
-                     [](const Primitive& p) { return has_fitter(p.type); });
+  const std::vector<PrimitiveType> types = HierarchyOptions{}.primitives;
+  return std::all_of(shape.regions.begin(), shape.regions.end(), [&](const Primitive& p) {
+    return std::find(types.begin(), types.end(), p.type) != types.end();
+  });
 }
 
 struct Variant {
@@ -90,6 +92,34 @@ TEST(Hierarchy, NoisyCadShapesKeepAMeanIouAboveNinetyPercent) {
       ++count;
     }
   EXPECT_GE(sum / count, 0.90);
+}
+
+// With cones and tori enabled, the shapes that contain them (a chamfer, a countersink, a fillet)
+// are segmented with every region recovered and typed right. The CAD-style fillet is left out:
+// its coarse quarter torus is still split wrongly (see README, Measured quality).
+TEST(Hierarchy, ConesAndToriAreRecoveredWhenEnabled) {
+  HierarchyOptions options;
+  options.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
+                        PrimitiveType::Cone, PrimitiveType::Torus};
+  int cones = 0, tori = 0;
+  for (const Variant& variant : kVariants)
+    for (const std::string& name : shape_names()) {
+      const GroundTruthShape shape = make_shape(name, variant_options(variant, 0));
+      const auto has = [&](PrimitiveType type) {
+        return std::any_of(shape.regions.begin(), shape.regions.end(),
+                           [&](const Primitive& p) { return p.type == type; });
+      };
+      if (!has(PrimitiveType::Cone) && !has(PrimitiveType::Torus)) continue;
+      if (has(PrimitiveType::Torus) && variant.tessellation == Tessellation::Cad) continue;
+      cones += has(PrimitiveType::Cone);
+      tori += has(PrimitiveType::Torus);
+      const SegmentationScore score =
+          score_at_true_count(shape, build_hierarchy(shape.mesh, options));
+      EXPECT_GE(score.min_iou, 0.95) << name << " seed " << variant.seed;
+      EXPECT_EQ(score.type_accuracy, 1.0) << name << " seed " << variant.seed;
+    }
+  EXPECT_EQ(cones, 8);
+  EXPECT_EQ(tori, 2);
 }
 
 TEST(Hierarchy, IsAFullBinaryTreeWithCostsAndTypes) {

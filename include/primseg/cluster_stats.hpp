@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <vector>
 
 namespace primseg {
 
@@ -71,6 +72,62 @@ struct EdgeStats {
   Eigen::Matrix3d tensor_matrix() const;
 };
 
+/// Moments of the cluster's face planes, about an origin o (ClusterStats keeps them about
+/// moments.origin()): with A a triangle's area, n its unit normal and c its centroid,
+/// Σ A n nᵀ, Σ A n (n·(c − o)) and Σ A (n·(c − o))². The point a minimising
+/// Σ A (n·(a − c))² (the point nearest every face plane: a cone's apex) solves
+/// (Σ A n nᵀ)(a − o) = Σ A n (n·(c − o)). Translating them to another origin is exact.
+struct FacePlaneStats {
+  /// Σ A n nᵀ as the upper triangle (xx, xy, xz, yy, yz, zz).
+  std::array<double, 6> normal_normal{};
+  /// Σ A n (n·(c − o)).
+  Eigen::Vector3d normal_offset = Eigen::Vector3d::Zero();
+  /// Σ A (n·(c − o))².
+  double offset_square = 0;
+
+  /// Adds a triangle of area `area`, unit normal n and centroid at `centroid_offset` = c − o.
+  void add_face(const Eigen::Vector3d& n, double area, const Eigen::Vector3d& centroid_offset);
+  /// The same sums about o + shift.
+  FacePlaneStats translated(const Eigen::Vector3d& shift) const;
+  FacePlaneStats& operator+=(const FacePlaneStats& other);
+  Eigen::Matrix3d normal_normal_matrix() const;
+};
+
+/// A triangle corner of a cluster with its face's unit normal: what the torus fit uses, since no
+/// moment of bounded degree describes a torus (its algebraic distance has degree 4, its square 8).
+struct SurfaceSample {
+  Eigen::Vector3d position;  ///< working frame
+  Eigen::Vector3f normal;    ///< unit normal of the corner's triangle (consistently oriented)
+  double weight = 0;         ///< the corner's weight w
+  double priority = 0;       ///< w / u, u in (0, 1] fixed per corner (see SampleReservoir)
+};
+
+/// A priority sample (Duffield, Lund and Thorup, 2007) of a cluster's weighted corners: the
+/// kCapacity + 1 corners of highest priority w / u, where u is a pseudo-random number fixed per
+/// corner (a hash of its index). The sample of a union is the best kCapacity + 1 of the union of
+/// the samples, so merging is exact, associative and deterministic, and its size is bounded.
+/// With τ the lowest kept priority, the other kCapacity corners with estimator weights
+/// max(w, τ) give an unbiased estimate Σ max(w, τ) f(x) of Σ w f(x) over the whole cluster;
+/// clusters of at most kCapacity corners are kept whole (τ = 0: exact sums).
+struct SampleReservoir {
+  static constexpr std::size_t kCapacity = 32;
+  /// Descending priority, at most kCapacity + 1.
+  std::vector<SurfaceSample> samples;
+
+  /// Adds one corner (its priority already set).
+  void add(const SurfaceSample& sample);
+  /// Adds the samples of a disjoint cluster.
+  void merge(const SampleReservoir& other);
+  /// τ: the priority of the (kCapacity + 1)-th sample, 0 when the cluster is kept whole.
+  double threshold() const;
+  /// Number of samples of the estimate (at most kCapacity).
+  std::size_t estimate_size() const { return std::min(samples.size(), kCapacity); }
+  /// Estimator weight max(w, τ) of sample i < estimate_size().
+  double estimator_weight(std::size_t i) const;
+  /// The priority w / u of corner `corner_id` of weight w.
+  static double priority_of(std::uint64_t corner_id, double weight);
+};
+
 /// Everything a primitive fit needs to know about a cluster; all sums over its triangles, so the
 /// statistics of a union are the sums of its parts (plus the tensor of the edges between them).
 struct ClusterStats {
@@ -83,10 +140,15 @@ struct ClusterStats {
   /// Σ over triangles of (centroid − moments.origin()) (area × unit normal)ᵀ: with normal_sum,
   /// it gives how well the face normals agree with a curved primitive's normal field.
   Eigen::Matrix3d normal_position = Eigen::Matrix3d::Zero();
+  /// The face planes about moments.origin() (for the cone's apex).
+  FacePlaneStats face_planes;
   /// Σ triangle area (working frame).
   double area = 0;
   /// Number of triangles (the fits' minimum support is counted in triangles).
   std::uint32_t triangle_count = 0;
+  /// A bounded sample of the corners, kept only when a type that needs it (the torus) is
+  /// enabled; empty otherwise.
+  SampleReservoir samples;
 
   /// Adds other (which must not share triangles with this) and the edges between the two. With
   /// max_degree 2 the moments of degree 3 and 4 are left zero (see Moments::translated).

@@ -81,8 +81,9 @@ class DualGraph {
   double triangle_area(std::uint32_t t) const;
   /// Weight of each corner of triangle t (working frame).
   std::array<double, 3> corner_weights(std::uint32_t t) const;
-  /// Statistics of input face f alone (its triangles and the edges between them).
-  ClusterStats face_stats(std::uint32_t f) const;
+  /// Statistics of input face f alone (its triangles and the edges between them); with
+  /// `with_samples`, its corners in ClusterStats::samples too (for the torus).
+  ClusterStats face_stats(std::uint32_t f, bool with_samples = false) const;
 
  private:
   const Mesh* mesh_;

@@ -74,8 +74,11 @@ def test_segment_argument_errors(fandisk):
         primseg.segment(V_OK)
     with pytest.raises(ValueError, match="segment.mesh. takes no F"):
         primseg.segment(mesh, F_OK)
-    with pytest.raises(ValueError, match=r"unknown primitive 'cone' \(available: 'plane', 'cylinder', 'sphere'\)"):
-        primseg.segment(mesh, primitives=("plane", "cone"))
+    with pytest.raises(
+        ValueError,
+        match=r"unknown primitive 'ellipsoid' \(available: 'plane', 'cylinder', 'sphere', 'cone', 'torus'\)",
+    ):
+        primseg.segment(mesh, primitives=("plane", "ellipsoid"))
     with pytest.raises(ValueError, match="primitives: expected names, got 3"):
         primseg.segment(mesh, primitives=["plane", 3])
     with pytest.raises(ValueError, match="weights: must be 'area' or 'uniform', not 'volume'"):

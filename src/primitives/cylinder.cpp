@@ -56,8 +56,8 @@ PrimitiveFit CylinderFitter::fit(const ClusterStats& centred) const {
   if (!circle.valid) return result;
 
   const Eigen::Vector3d point = m.origin() + basis.transpose() * circle.centre;
-  if (centred.normal_alignment(projector, point, circle.radius) < kMinNormalAlignment)
-    return result;
+  result.normal_alignment = centred.normal_alignment(projector, point, circle.radius);
+  if (result.normal_alignment < kMinNormalAlignment) return result;
   result.valid = true;
   result.error = circle.error;
   result.primitive.point = {point.x(), point.y(), point.z()};

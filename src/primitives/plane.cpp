@@ -29,6 +29,7 @@ PrimitiveFit PlaneFitter::fit(const ClusterStats& centred) const {
   const double alignment = normal.dot(centred.normal_sum);
   if (alignment < 0 || (alignment == 0 && canonical_axis(normal) != normal)) normal = -normal;
   result.superset_error_bound = result.error;
+  if (centred.area > 0) result.normal_alignment = centred.normal_sum.norm() / centred.area;
   result.primitive.point = {centroid.x(), centroid.y(), centroid.z()};
   result.primitive.axis = {normal.x(), normal.y(), normal.z()};
   return result;

@@ -3,9 +3,11 @@
 #include <string>
 
 #include "primseg/error.hpp"
+#include "primseg/primitives/cone.hpp"
 #include "primseg/primitives/cylinder.hpp"
 #include "primseg/primitives/plane.hpp"
 #include "primseg/primitives/sphere.hpp"
+#include "primseg/primitives/torus.hpp"
 
 namespace primseg {
 namespace {
@@ -14,6 +16,8 @@ const PrimitiveFitter* find_fitter(PrimitiveType type) {
   static const PlaneFitter plane;
   static const CylinderFitter cylinder;
   static const SphereFitter sphere;
+  static const ConeFitter cone;
+  static const TorusFitter torus;
   switch (type) {
     case PrimitiveType::Plane:
       return &plane;
@@ -21,6 +25,10 @@ const PrimitiveFitter* find_fitter(PrimitiveType type) {
       return &cylinder;
     case PrimitiveType::Sphere:
       return &sphere;
+    case PrimitiveType::Cone:
+      return &cone;
+    case PrimitiveType::Torus:
+      return &torus;
     default:
       return nullptr;
   }

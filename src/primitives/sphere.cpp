@@ -25,9 +25,9 @@ PrimitiveFit SphereFitter::fit(const ClusterStats& centred) const {
   result.superset_error_bound = sphere.objective_minimum;
   if (!sphere.valid) return result;
   const Eigen::Vector3d centre = m.origin() + sphere.centre;
-  if (centred.normal_alignment(Eigen::Matrix3d::Identity(), centre, sphere.radius) <
-      kMinNormalAlignment)
-    return result;
+  result.normal_alignment =
+      centred.normal_alignment(Eigen::Matrix3d::Identity(), centre, sphere.radius);
+  if (result.normal_alignment < kMinNormalAlignment) return result;
   result.valid = true;
   result.error = sphere.error;
   result.primitive.point = {centre.x(), centre.y(), centre.z()};

@@ -201,7 +201,7 @@ TEST(Batch, BadArgumentsAreRejectedWithAMessage) {
   for (const Case& c : std::vector<Case>{
            {base + " --shard 3/3", "--shard: '3/3' is not i/n"},
            {base + " --shard 1", "--shard: '1' is not i/n"},
-           {base + " --primitives cone", "unknown primitive 'cone'"},
+           {base + " --primitives ellipsoid", "unknown primitive 'ellipsoid'"},
            {"batch '" + (dir / "missing").string() + "' --out '" + (dir / "out").string() + "'",
             "missing"},
            {"batch '" + (in / "parts").string() + "/..' --out x --max-memory 0", "--max-memory"},

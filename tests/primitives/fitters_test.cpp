@@ -6,9 +6,11 @@
 #include <random>
 
 #include "primseg/dual_graph.hpp"
+#include "primseg/primitives/cone.hpp"
 #include "primseg/primitives/cylinder.hpp"
 #include "primseg/primitives/plane.hpp"
 #include "primseg/primitives/sphere.hpp"
+#include "primseg/primitives/torus.hpp"
 #include "support/test_support.hpp"
 
 namespace primseg {
@@ -169,6 +171,221 @@ TEST(CylinderFitter, AxisWithinTwoDegreesUnderOnePercentNoise) {
   }
 }
 
+// A band of a cone (apex at the origin, axis +z, half-angle θ) between distances t0 and t1 from
+// the apex along the generators, over `turn` radians, triangulated ring by generator.
+Eigen::Vector3d cone_point(double half_angle, double t, double phi) {
+  return t * Eigen::Vector3d(std::sin(half_angle) * std::cos(phi),
+                             std::sin(half_angle) * std::sin(phi), std::cos(half_angle));
+}
+
+TEST(ConeFitter, RecoversRingByGeneratorConesExactly) {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Pose pose = random_pose(rng);
+    const double half_angle = 0.1 + 1.3 * unit(rng);  // 6 to 80 degrees
+    const double t0 = 0.2 + unit(rng), t1 = t0 + 0.5 + unit(rng);
+    const double turn = 1.5 + 4.5 * unit(rng);
+    // Inside of the cone (a countersink) on odd trials: the faces turn to the axis.
+    const bool hole = trial % 2;
+    const Mesh mesh = grid_mesh(4, 16, [&](double u, double v) {
+      return pose.apply(cone_point(half_angle, t0 + (t1 - t0) * u, (hole ? -turn : turn) * v));
+    });
+    Primitive cone;
+    const PrimitiveFit fit = fit_whole(mesh, ConeFitter(), &cone);
+    ASSERT_TRUE(fit.valid) << trial;
+    EXPECT_EQ(cone.type, PrimitiveType::Cone);
+    const Vec3 apex = pose.apply(Eigen::Vector3d::Zero());
+    EXPECT_LT(distance(cone.point, apex), 1e-6 * pose.scale) << trial;
+    const Eigen::Vector3d axis(cone.axis[0], cone.axis[1], cone.axis[2]);
+    // From the apex into the cone.
+    EXPECT_GT(axis.dot(pose.rotation.col(2)), 1 - 1e-6) << trial;
+    EXPECT_NEAR(cone.half_angle, half_angle, 1e-6) << trial;
+    for (const Vec3& p : mesh.positions) EXPECT_LT(cone.distance(p), 1e-6 * pose.scale);
+    const DualGraph graph(mesh, VertexWeights::Area);
+    EXPECT_LT(fit.error, 1e-12 * whole_mesh_stats(graph).moments.second_moment().trace());
+  }
+}
+
+TEST(ConeFitter, PointedConeWithItsApexInTheCluster) {
+  std::mt19937_64 rng(31);
+  for (int trial = 0; trial < 10; ++trial) {
+    const Pose pose = random_pose(rng);
+    const double half_angle = 0.3 + 0.1 * trial;
+    // A fan of triangles around the apex, closed all the way round, and two rings below it.
+    const Mesh mesh = grid_mesh(3, 24, [&](double u, double v) {
+      return pose.apply(cone_point(half_angle, 1e-3 + u, 2 * M_PI * v));
+    });
+    Primitive cone;
+    const PrimitiveFit fit = fit_whole(mesh, ConeFitter(), &cone);
+    ASSERT_TRUE(fit.valid) << trial;
+    EXPECT_LT(distance(cone.point, pose.apply(Eigen::Vector3d::Zero())), 1e-6 * pose.scale);
+    EXPECT_NEAR(cone.half_angle, half_angle, 1e-6);
+  }
+}
+
+TEST(ConeFitter, JitteredVerticesOnTheConeAndNoiseAlongTheNormals) {
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> jitter(-0.25, 0.25);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Pose pose = random_pose(rng);
+    const double half_angle = M_PI / 4;
+    // Irregular rings (every vertex still on the cone, so face planes miss the apex slightly),
+    // then the same with Gaussian noise of 0.2% of the size along the normals.
+    for (const bool noisy : {false, true}) {
+      std::vector<double> offsets(21 * 41);
+      for (double& o : offsets) o = jitter(rng);
+      const Mesh mesh = grid_mesh(20, 40, [&](double u, double v) {
+        const int i = static_cast<int>(std::lround(u * 20)),
+                  j = static_cast<int>(std::lround(v * 40));
+        const double o = offsets[i * 41 + j];
+        const double t = 0.5 + (i + o * (i > 0 && i < 20)) / 20.0;
+        const double phi = 3.0 * (j + o * (j > 0 && j < 40)) / 40.0;
+        const Eigen::Vector3d normal(std::cos(half_angle) * std::cos(phi),
+                                     std::cos(half_angle) * std::sin(phi), -std::sin(half_angle));
+        return pose.apply(cone_point(half_angle, t, phi) + (noisy ? noise(rng) : 0.0) * normal);
+      });
+      Primitive cone;
+      const PrimitiveFit fit = fit_whole(mesh, ConeFitter(), &cone);
+      ASSERT_TRUE(fit.valid) << trial << noisy;
+      const double tolerance = noisy ? 0.02 : 2e-3;
+      EXPECT_LT(distance(cone.point, pose.apply(Eigen::Vector3d::Zero())), tolerance * pose.scale)
+          << trial << noisy;
+      EXPECT_LT(angle_between_axes(cone.axis, pose.rotation.col(2)), tolerance) << trial << noisy;
+      EXPECT_NEAR(cone.half_angle, half_angle, tolerance) << trial << noisy;
+      // The error is an honest L2: close to the exact Σ w d² of the reported cone.
+      if (noisy) {
+        const DualGraph graph(mesh, VertexWeights::Area);
+        double exact = 0;
+        for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+          const auto w = graph.corner_weights(t);
+          for (int c = 0; c < 3; ++c) {
+            const Eigen::Vector3d& x = graph.position(mesh.triangles[t][c]);
+            exact += w[c] * std::pow(fit.primitive.distance({x.x(), x.y(), x.z()}), 2);
+          }
+        }
+        EXPECT_NEAR(fit.error, exact, 0.2 * exact) << trial;
+      }
+    }
+  }
+}
+
+TEST(ConeFitter, NearlyCylindricalOrFlatConesAreNotCones) {
+  // Below kMinConeHalfAngle a cone is the cylinder it nearly is; near 90° the plane.
+  for (const double degrees : {1.0, 89.0}) {
+    const double half_angle = degrees * M_PI / 180;
+    const Mesh mesh = grid_mesh(4, 16, [&](double u, double v) {
+      const Eigen::Vector3d p = cone_point(half_angle, 1 + u, 2.0 * v);
+      return Vec3{p.x(), p.y(), p.z()};
+    });
+    Primitive cone;
+    EXPECT_FALSE(fit_whole(mesh, ConeFitter(), &cone).valid) << degrees;
+  }
+  // A cylinder and a sphere cap.
+  const Mesh cylinder = grid_mesh(4, 12, [](double u, double v) {
+    return Vec3{std::cos(2 * v), std::sin(2 * v), 1.5 * u};
+  });
+  Primitive p;
+  EXPECT_FALSE(fit_whole(cylinder, ConeFitter(), &p).valid);
+}
+
+TEST(ConeFitter, PointsOnBothNappesAreNotACone) {
+  // Two opposite bands of the double cone x² + y² = z²: the quadric fits them, one cone does not.
+  const Mesh mesh = grid_mesh(8, 16, [](double u, double v) {
+    const double t = -1.5 + 3 * u + (u > 0.49 && u < 0.51 ? 0.01 : 0);
+    const Eigen::Vector3d p = cone_point(M_PI / 4, t, 2.0 * v);
+    return Vec3{p.x(), p.y(), p.z()};
+  });
+  Primitive p;
+  EXPECT_FALSE(fit_whole(mesh, ConeFitter(), &p).valid);
+}
+
+// A patch of the torus of centre 0, axis +z, radii R and r: tube angle ψ (0 on the outer
+// equator), angle φ around the axis.
+Eigen::Vector3d torus_point(double major, double minor, double psi, double phi) {
+  const double rho = major + minor * std::cos(psi);
+  return {rho * std::cos(phi), rho * std::sin(phi), minor * std::sin(psi)};
+}
+
+TEST(TorusFitter, RecoversTorusPatchesAtRandomPosesAndScales) {
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Pose pose = random_pose(rng);
+    const double major = 0.5 + unit(rng), minor = (0.1 + 0.8 * unit(rng)) * major;
+    // From a quarter of the tube (a fillet) to most of it, a third of the way round or more.
+    const double psi0 = -1.5 * unit(rng), psi1 = psi0 + M_PI / 2 + 2 * unit(rng);
+    const double turn = 2 + 4 * unit(rng);
+    const Mesh mesh = grid_mesh(8, 24, [&](double u, double v) {
+      return pose.apply(torus_point(major, minor, psi0 + (psi1 - psi0) * u, turn * v));
+    });
+    Primitive torus;
+    const PrimitiveFit fit = fit_whole(mesh, TorusFitter(), &torus);
+    ASSERT_TRUE(fit.valid) << trial;
+    EXPECT_EQ(torus.type, PrimitiveType::Torus);
+    const double s = pose.scale;
+    EXPECT_LT(distance(torus.point, pose.apply(Eigen::Vector3d::Zero())), 1e-6 * s) << trial;
+    EXPECT_LT(angle_between_axes(torus.axis, pose.rotation.col(2)), 1e-6) << trial;
+    EXPECT_NEAR(torus.radius, major * s, 1e-6 * s) << trial;
+    EXPECT_NEAR(torus.minor_radius, minor * s, 1e-6 * s) << trial;
+    for (const Vec3& p : mesh.positions) EXPECT_LT(torus.distance(p), 1e-6 * s);
+    const DualGraph graph(mesh, VertexWeights::Area);
+    EXPECT_LT(fit.error, 1e-12 * whole_mesh_stats(graph).moments.second_moment().trace());
+  }
+}
+
+TEST(TorusFitter, NoisyTorusErrorEstimatesTheExactError) {
+  std::mt19937_64 rng(43);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  for (int trial = 0; trial < 10; ++trial) {
+    const Pose pose = random_pose(rng);
+    const Mesh mesh = grid_mesh(30, 60, [&](double u, double v) {
+      const double psi = -1 + 2.5 * u, phi = 4 * v;
+      const Eigen::Vector3d normal(std::cos(psi) * std::cos(phi), std::cos(psi) * std::sin(phi),
+                                   std::sin(psi));
+      return pose.apply(torus_point(1, 0.3, psi, phi) + noise(rng) * normal);
+    });
+    Primitive torus;
+    const PrimitiveFit fit = fit_whole(mesh, TorusFitter(), &torus);
+    ASSERT_TRUE(fit.valid) << trial;
+    EXPECT_NEAR(torus.radius, pose.scale, 0.02 * pose.scale);
+    EXPECT_NEAR(torus.minor_radius, 0.3 * pose.scale, 0.02 * pose.scale);
+    EXPECT_LT(angle_between_axes(torus.axis, pose.rotation.col(2)), 0.02);
+    const DualGraph graph(mesh, VertexWeights::Area);
+    double exact = 0;
+    for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      const auto w = graph.corner_weights(t);
+      for (int c = 0; c < 3; ++c) {
+        const Eigen::Vector3d& x = graph.position(mesh.triangles[t][c]);
+        exact += w[c] * std::pow(fit.primitive.distance({x.x(), x.y(), x.z()}), 2);
+      }
+    }
+    // A sampled estimate (32 corners): within a factor of two of the exact Σ w d².
+    EXPECT_GT(fit.error, 0.5 * exact) << trial;
+    EXPECT_LT(fit.error, 2 * exact) << trial;
+  }
+}
+
+TEST(TorusFitter, CylindersConesAndSpheresAreNotTori) {
+  const Mesh cylinder = grid_mesh(4, 12, [](double u, double v) {
+    return Vec3{std::cos(2 * v), std::sin(2 * v), 1.5 * u};
+  });
+  const Mesh cone = grid_mesh(4, 16, [](double u, double v) {
+    const Eigen::Vector3d p = cone_point(0.7, 1 + u, 2.0 * v);
+    return Vec3{p.x(), p.y(), p.z()};
+  });
+  const Mesh sphere = grid_mesh(6, 8, [](double u, double v) {
+    const double theta = 0.4 + 0.5 * u, phi = 1.2 * v;
+    return Vec3{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+  });
+  for (const Mesh* mesh : {&cylinder, &cone, &sphere}) {
+    Primitive p;
+    const PrimitiveFit fit = fit_whole(*mesh, TorusFitter(), &p);
+    EXPECT_FALSE(fit.valid) << "R " << p.radius << " r " << p.minor_radius;
+  }
+}
+
 TEST(Fitters, DegenerateClustersNeverYieldNonFiniteOrWinningCurvedFits) {
   // One triangle, a collinear sliver, and a flat patch given to the curved fitters.
   const Mesh triangle =
@@ -183,6 +400,8 @@ TEST(Fitters, DegenerateClustersNeverYieldNonFiniteOrWinningCurvedFits) {
     for (double c : p.axis) EXPECT_TRUE(std::isfinite(c));
     EXPECT_FALSE(fit_whole(*mesh, SphereFitter(), &p).valid);
     EXPECT_FALSE(fit_whole(*mesh, CylinderFitter(), &p).valid);
+    EXPECT_FALSE(fit_whole(*mesh, ConeFitter(), &p).valid);
+    EXPECT_FALSE(fit_whole(*mesh, TorusFitter(), &p).valid);
   }
 }
 

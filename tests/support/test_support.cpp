@@ -87,8 +87,8 @@ void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation,
 namespace primseg::testing {
 
 ClusterStats whole_mesh_stats(const DualGraph& graph) {
-  ClusterStats stats = graph.face_stats(0);
-  for (std::uint32_t f = 1; f < graph.face_count(); ++f) stats.merge(graph.face_stats(f), {});
+  ClusterStats stats = graph.face_stats(0, true);
+  for (std::uint32_t f = 1; f < graph.face_count(); ++f) stats.merge(graph.face_stats(f, true), {});
   for (const DualEdge& e : graph.edges()) stats.edges += e.shared;
   return stats.centred();
 }

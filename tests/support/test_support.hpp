@@ -63,7 +63,7 @@ Mesh grid_mesh(int rows, int cols, Surface&& p, bool alternate = false) {
 }
 
 /// Statistics of the whole mesh as one cluster, accumulated face by face and edge by edge the way
-/// the engine does, with moments centred at the centroid.
+/// the engine does (corner samples included), with moments centred at the centroid.
 ClusterStats whole_mesh_stats(const DualGraph& graph);
 
 }  // namespace primseg::testing

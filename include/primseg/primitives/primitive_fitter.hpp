@@ -27,6 +27,10 @@ struct PrimitiveFit {
   /// over the type's parameters of a sum of non-negative per-point terms (plane, Pratt sphere);
   /// 0 where no bound is known. Lets the hierarchy leave candidates unevaluated (lazy mode).
   double superset_error_bound = 0;
+  /// How well the face normals follow the primitive's (ClusterStats::normal_alignment for the
+  /// curved types, |Σ A n| / Σ A for a plane): 1 when they agree everywhere. Breaks ties between
+  /// exact fits (see ModelSelector).
+  double normal_alignment = 1;
 };
 
 /// A primitive type's fitter.
@@ -39,6 +43,8 @@ class PrimitiveFitter {
   virtual std::uint32_t min_triangles() const = 0;
   /// Fits the type to statistics whose moments are centred at the cluster's centroid.
   virtual PrimitiveFit fit(const ClusterStats& centred) const = 0;
+  /// Whether the fit reads ClusterStats::samples (then the engine keeps them, at a memory cost).
+  virtual bool needs_samples() const { return false; }
 };
 
 /// Curved fits must agree with the face normals (ClusterStats::normal_alignment at least this):

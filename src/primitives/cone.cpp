@@ -1,0 +1,354 @@
+// Cone: apex from the face planes, then a Taubin fit of the cone at that apex.
+//
+// 1. Every tangent plane of a cone passes through its apex a, so a is the point nearest every
+//    face plane: it minimises Σ A (n·(a − c))² (A area, n unit normal, c centroid of a face),
+//    the 3×3 linear system (Σ A n nᵀ)(a − o) = Σ A n (n·(c − o)) of FacePlaneStats. A cylinder or
+//    a plane has coplanar normals: the system is singular, the apex at infinity.
+// 2. With y = x − a, a cone with apex a is a quadric yᵀ M y = 0, M symmetric (6 coefficients m).
+//    Taubin's fit minimises Σ w (yᵀMy)² / Σ w |2My|² (both quadratic forms in m, from the moments
+//    of degree 4 and 2 about the apex): a 6×6 generalised eigenproblem. The axis u is the
+//    eigenvector of M's eigenvalue of distinct sign.
+// 3. A circular cone is M = u uᵀ − cos²θ I: the same Taubin ratio over the span of u uᵀ and I
+//    (a 2×2 generalised eigenproblem) gives cos²θ and the error of the reported cone.
+// 4. Noise in the face normals biases the apex of step 1 (errors in variables: about σ_n² times
+//    the cluster's distance to the apex over the normals' spread), and the axis and angle with
+//    it. A few Levenberg–Marquardt steps on the same Taubin ratio over all six parameters
+//    (refine_cone) follow, each kept only if it lowers the ratio; on exact data there is nothing
+//    to lower.
+// The error W × Σ w f² / Σ w |∇f|² (W = Σ w, f = yᵀMy) is the usual first-order estimate of
+// Σ w d²: on the cone |∇f| = sin 2θ |y| grows with the distance to the apex, and dividing by its
+// weighted mean square is unbiased when the deviations do not depend on that distance.
+#include "primseg/primitives/cone.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <array>
+#include <cmath>
+
+namespace primseg {
+namespace {
+
+// Normals spanning less than this (smallest eigenvalue of Σ A n nᵀ over the area) leave the
+// apex undetermined: flat or cylindrical data.
+constexpr double kMinNormalSpread = 1e-9;
+// Largest distance from the centroid to the apex, relative to the RMS spread of the points:
+// beyond it the fit loses precision (moments of degree 4 about the apex) and the cluster is a
+// cylinder or a plane for any practical purpose.
+constexpr double kMaxRelativeApexDistance = 100;
+// Σ w (u·y) over sqrt(W Σ w (u·y)²): 0.94 for a pointed cone sampled evenly by area, 1 for a
+// narrow band; near 0 for points on both nappes, which the reported (one-sided) cone misses.
+constexpr double kMinOneSidedness = 0.85;
+// Levenberg–Marquardt steps of the joint refinement (each about a microsecond).
+constexpr int kRefinementSteps = 6;
+
+// The 6 coefficients m of a symmetric M in the order (xx, yy, zz, xy, xz, yz); yᵀMy = Σ m_k φ_k
+// with φ = (x², y², z², 2xy, 2xz, 2yz).
+using Coefficients = Eigen::Matrix<double, 6, 1>;
+constexpr std::array<std::array<int, 3>, 6> kExponents = {
+    {{2, 0, 0}, {0, 2, 0}, {0, 0, 2}, {1, 1, 0}, {1, 0, 1}, {0, 1, 1}}};
+constexpr std::array<double, 6> kMultiplicity = {1, 1, 1, 2, 2, 2};
+// (row, column) of M for each coefficient.
+constexpr std::array<std::array<int, 2>, 6> kEntries = {
+    {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
+
+Coefficients coefficients_of(const Eigen::Matrix3d& m) {
+  Coefficients c;
+  for (int k = 0; k < 6; ++k) c(k) = m(kEntries[k][0], kEntries[k][1]);
+  return c;
+}
+
+Eigen::Matrix3d matrix_of(const Coefficients& c) {
+  Eigen::Matrix3d m;
+  for (int k = 0; k < 6; ++k)
+    m(kEntries[k][0], kEntries[k][1]) = m(kEntries[k][1], kEntries[k][0]) = c(k);
+  return m;
+}
+
+// Σ w φ φᵀ and Σ w (∇φ)ᵀ∇φ (so that mᵀ A m = Σ w f², mᵀ B m = Σ w |∇f|²) from moments about the
+// apex, with lengths multiplied by `scale`.
+struct TaubinSystem {
+  Eigen::Matrix<double, 6, 6> a, b;
+};
+
+TaubinSystem taubin_system(const Moments& about_apex, double scale) {
+  const double scale2 = scale * scale, scale4 = scale2 * scale2;
+  TaubinSystem system;
+  for (int k = 0; k < 6; ++k)
+    for (int l = 0; l < 6; ++l)
+      system.a(k, l) =
+          kMultiplicity[k] * kMultiplicity[l] * scale4 *
+          about_apex.at(kExponents[k][0] + kExponents[l][0], kExponents[k][1] + kExponents[l][1],
+                        kExponents[k][2] + kExponents[l][2]);
+  // ∇f = 2My; row r of My is yᵀ G_r m, with G_r selecting, for each coefficient, the coordinate
+  // of y it multiplies in that row.
+  const Eigen::Matrix3d s = about_apex.second_moment() * scale2;
+  system.b.setZero();
+  for (int r = 0; r < 3; ++r) {
+    Eigen::Matrix<double, 3, 6> g = Eigen::Matrix<double, 3, 6>::Zero();
+    for (int k = 0; k < 6; ++k) {
+      const int row = kEntries[k][0], column = kEntries[k][1];
+      if (row == r)
+        g(column, k) = 1;
+      else if (column == r)
+        g(row, k) = 1;
+    }
+    system.b += 4 * g.transpose().lazyProduct(s.lazyProduct(g));
+  }
+  return system;
+}
+
+// The best circular cone with a given apex (steps 2 and 3), in the moments' frame.
+struct ConeAtApex {
+  bool valid = false;
+  Moments about_apex;
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();  // either sign
+  double cos2 = 0;                                 // cos² of the half-angle
+  double ratio = 0;  // Σ w f² / Σ w |∇f|², in units of the RMS spread squared
+};
+
+ConeAtApex cone_at_apex(const Moments& moments, const Eigen::Vector3d& apex, double scale) {
+  ConeAtApex cone;
+  cone.about_apex = moments.translated(apex);
+  const TaubinSystem system = taubin_system(cone.about_apex, scale);
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> quadric(system.a,
+                                                                                      system.b);
+  if (quadric.info() != Eigen::Success) return cone;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(
+      matrix_of(quadric.eigenvectors().col(0)));
+  const Eigen::Vector3d mu = shape.eigenvalues();  // ascending
+  // The eigenvalue of distinct sign is the one farther from the middle one.
+  const int distinct = mu(1) - mu(0) > mu(2) - mu(1) ? 0 : 2;
+  cone.axis = shape.eigenvectors().col(distinct).normalized();
+
+  // M = x₀ u uᵀ − x₁ I.
+  Eigen::Matrix<double, 6, 2> span;
+  span.col(0) = coefficients_of(cone.axis * cone.axis.transpose());
+  span.col(1) = -coefficients_of(Eigen::Matrix3d::Identity());
+  const Eigen::Matrix2d a2 = span.transpose().lazyProduct(system.a.lazyProduct(span));
+  const Eigen::Matrix2d b2 = span.transpose().lazyProduct(system.b.lazyProduct(span));
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> circular(a2, b2);
+  if (circular.info() != Eigen::Success) return cone;
+  const Eigen::Vector2d x = circular.eigenvectors().col(0);
+  cone.cos2 = x(1) / x(0);
+  cone.ratio = std::max(0.0, circular.eigenvalues()(0));
+  cone.valid = cone.cos2 > 0 && cone.cos2 < 1 && std::isfinite(cone.ratio);
+  return cone;
+}
+
+// Polynomials of degree at most 2 in y, as coefficients of (1, x, y, z, x², y², z², xy, xz, yz):
+// Σ w p q = pᵀ G q with G the 10×10 Gram matrix of moments up to degree 4.
+using Poly = Eigen::Matrix<double, 10, 1>;
+using Gram = Eigen::Matrix<double, 10, 10>;
+constexpr std::array<std::array<int, 3>, 10> kLowMonomials = {{{0, 0, 0},
+                                                               {1, 0, 0},
+                                                               {0, 1, 0},
+                                                               {0, 0, 1},
+                                                               {2, 0, 0},
+                                                               {0, 2, 0},
+                                                               {0, 0, 2},
+                                                               {1, 1, 0},
+                                                               {1, 0, 1},
+                                                               {0, 1, 1}}};
+
+Gram gram_of(const Moments& moments, double scale) {
+  double power[5] = {1, scale, scale * scale, 0, 0};
+  power[3] = power[2] * scale;
+  power[4] = power[2] * power[2];
+  Gram g;
+  for (int i = 0; i < 10; ++i)
+    for (int j = i; j < 10; ++j) {
+      const auto& a = kLowMonomials[i];
+      const auto& b = kLowMonomials[j];
+      const int degree = a[0] + a[1] + a[2] + b[0] + b[1] + b[2];
+      g(i, j) = g(j, i) = moments.at(a[0] + b[0], a[1] + b[1], a[2] + b[2]) * power[degree];
+    }
+  return g;
+}
+
+Poly constant_poly(double c) {
+  Poly p = Poly::Zero();
+  p(0) = c;
+  return p;
+}
+Poly linear_poly(const Eigen::Vector3d& v) {
+  Poly p = Poly::Zero();
+  p.segment<3>(1) = v;
+  return p;
+}
+Poly quadratic_poly(const Eigen::Matrix3d& q) {  // yᵀ q y
+  Poly p = Poly::Zero();
+  p(4) = q(0, 0);
+  p(5) = q(1, 1);
+  p(6) = q(2, 2);
+  p(7) = q(0, 1) + q(1, 0);
+  p(8) = q(0, 2) + q(2, 0);
+  p(9) = q(1, 2) + q(2, 1);
+  return p;
+}
+
+struct ConeParameters {
+  Eigen::Vector3d apex, axis;
+  double cos2;
+};
+
+// N = Σ w f² and D = Σ w |∇f|² of f = yᵀ(u uᵀ − cos²θ I)y, lengths multiplied by `scale`.
+std::pair<double, double> taubin_terms(const Gram& g, const ConeParameters& cone) {
+  const Eigen::Matrix3d m =
+      cone.axis * cone.axis.transpose() - cone.cos2 * Eigen::Matrix3d::Identity();
+  const Poly f = quadratic_poly(m);
+  double d = 0;
+  for (int i = 0; i < 3; ++i) {
+    const Poly gradient = linear_poly(2 * m.row(i).transpose());
+    d += gradient.dot(g.lazyProduct(gradient));
+  }
+  return {f.dot(g.lazyProduct(f)), d};
+}
+
+// Levenberg–Marquardt on Taubin's ratio R = N / D over all six parameters at once (apex, axis
+// tilt, cos²θ): a minimum of R is a stationary point of N − R D at fixed R. Every term is a
+// polynomial of degree at most 2 in y, so the gradients and Gauss–Newton Hessians of N and D are
+// Gram-matrix products of the moments about the current apex. Refining the apex alone, then the
+// axis and angle, crawls along the valley where moving the apex along the axis trades with the
+// angle; the joint step does not.
+void refine_cone(const Moments& moments, double scale, ConeParameters& cone, double& ratio,
+                 Moments& about_apex) {
+  Gram g = gram_of(about_apex, scale);
+  double lambda = 1e-3;
+  for (int iteration = 0; iteration < kRefinementSteps; ++iteration) {
+    const Eigen::Vector3d u = cone.axis;
+    Eigen::Index least;
+    u.cwiseAbs().minCoeff(&least);
+    const Eigen::Vector3d e1 = u.cross(Eigen::Vector3d::Unit(least)).normalized();
+    const Eigen::Vector3d e2 = u.cross(e1);
+    const Eigen::Matrix3d m = u * u.transpose() - cone.cos2 * Eigen::Matrix3d::Identity();
+    const Poly f = quadratic_poly(m);
+    Eigen::Matrix<double, 10, 6> jacobian;  // ∂f / ∂(apex, tilt e1, tilt e2, cos²θ)
+    for (int k = 0; k < 3; ++k) jacobian.col(k) = linear_poly(-2 * m.row(k).transpose());
+    jacobian.col(3) = quadratic_poly(u * e1.transpose() + e1 * u.transpose());
+    jacobian.col(4) = quadratic_poly(u * e2.transpose() + e2 * u.transpose());
+    jacobian.col(5) = quadratic_poly(-Eigen::Matrix3d::Identity());
+    // Small fixed sizes: coefficient-wise products (lazyProduct) beat Eigen's blocked kernels.
+    const Poly gf = g.lazyProduct(f);
+    const Eigen::Matrix<double, 10, 6> gj = g.lazyProduct(jacobian);
+    const Eigen::Matrix<double, 6, 1> grad_n = 2 * jacobian.transpose().lazyProduct(gf);
+    const Eigen::Matrix<double, 6, 6> hess_n = 2 * jacobian.transpose().lazyProduct(gj);
+    Eigen::Matrix<double, 6, 1> grad_d = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix<double, 6, 6> hess_d = Eigen::Matrix<double, 6, 6>::Zero();
+    double d = 0;
+    for (int i = 0; i < 3; ++i) {
+      const Poly gradient = linear_poly(2 * m.row(i).transpose());  // (∇f)_i = 2 (My)_i
+      Eigen::Matrix<double, 10, 6> dgradient;
+      for (int k = 0; k < 3; ++k) dgradient.col(k) = constant_poly(-2 * m(i, k));
+      dgradient.col(3) = linear_poly(2 * (u(i) * e1 + e1(i) * u));
+      dgradient.col(4) = linear_poly(2 * (u(i) * e2 + e2(i) * u));
+      dgradient.col(5) = linear_poly(-2 * Eigen::Vector3d::Unit(i));
+      const Poly g_gradient = g.lazyProduct(gradient);
+      grad_d += 2 * dgradient.transpose().lazyProduct(g_gradient);
+      hess_d += 2 * dgradient.transpose().lazyProduct(g.lazyProduct(dgradient));
+      d += gradient.dot(g_gradient);
+    }
+    if (!(d > 0)) return;
+    const double r = f.dot(gf) / d;
+    const Eigen::Matrix<double, 6, 1> gradient = grad_n - r * grad_d;
+    const Eigen::Matrix<double, 6, 6> hessian = hess_n - r * hess_d;
+    bool accepted = false;
+    while (lambda < 1e8) {
+      Eigen::Matrix<double, 6, 6> damped = hessian;
+      for (int k = 0; k < 6; ++k) damped(k, k) += lambda * std::abs(hessian(k, k)) + 1e-300;
+      const Eigen::Matrix<double, 6, 1> step = damped.ldlt().solve(-gradient);
+      if (!step.allFinite()) {
+        lambda *= 10;
+        continue;
+      }
+      ConeParameters next = cone;
+      next.apex += step.head<3>() / scale;
+      next.axis = (u + step(3) * e1 + step(4) * e2).normalized();
+      next.cos2 += step(5);
+      if (!(next.cos2 > 0 && next.cos2 < 1)) {
+        lambda *= 10;
+        continue;
+      }
+      Moments moved = moments.translated(next.apex);
+      const Gram next_gram = gram_of(moved, scale);
+      const auto [n, next_d] = taubin_terms(next_gram, next);
+      const double next_ratio = n / next_d;
+      if (next_ratio < ratio) {
+        const bool converged = ratio - next_ratio <= 1e-12 * ratio;
+        cone = next;
+        ratio = next_ratio;
+        about_apex = std::move(moved);
+        g = next_gram;
+        lambda = std::max(lambda / 10, 1e-9);
+        accepted = !converged;
+        break;
+      }
+      lambda *= 10;
+    }
+    if (!accepted) return;
+  }
+}
+
+}  // namespace
+
+std::uint32_t ConeFitter::min_triangles() const {
+  return 6;
+}
+
+PrimitiveFit ConeFitter::fit(const ClusterStats& centred) const {
+  PrimitiveFit result;
+  result.primitive.type = PrimitiveType::Cone;
+  const Moments& m = centred.moments;
+  const double weight = m.weight();
+  if (centred.triangle_count < min_triangles() || !(centred.area > 0) || !(weight > 0))
+    return result;
+  const double spread2 = m.second_moment().trace() / weight;
+  if (!(spread2 > 0) || !std::isfinite(spread2)) return result;
+  const double scale = 1 / std::sqrt(spread2);
+
+  // 1. The apex.
+  const Eigen::Matrix3d normals = centred.face_planes.normal_normal_matrix();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> normal_eigen(normals);
+  if (!(normal_eigen.eigenvalues()(0) > kMinNormalSpread * centred.area)) return result;
+  const Eigen::Vector3d apex_offset =
+      normal_eigen.eigenvectors() *
+      ((normal_eigen.eigenvectors().transpose() * centred.face_planes.normal_offset)
+           .cwiseQuotient(normal_eigen.eigenvalues()));
+  if (!(apex_offset.norm() * scale <= kMaxRelativeApexDistance)) return result;
+  // 2, 3. The cone at that apex; 4. all its parameters refined together.
+  ConeAtApex start = cone_at_apex(m, m.origin() + apex_offset, scale);
+  if (!start.valid) return result;
+  ConeParameters cone{m.origin() + apex_offset, start.axis, start.cos2};
+  double ratio = start.ratio;
+  Moments about_apex = std::move(start.about_apex);
+  refine_cone(m, scale, cone, ratio, about_apex);
+  if (!((cone.apex - m.origin()).norm() * scale <= kMaxRelativeApexDistance)) return result;
+  const Eigen::Vector3d apex = cone.apex;
+  Eigen::Vector3d axis = cone.axis;
+  const double cos2 = cone.cos2;
+  const double half_angle = std::acos(std::sqrt(cos2));
+  if (!(half_angle >= kMinConeHalfAngle && half_angle <= M_PI / 2 - kMinConeHalfAngle))
+    return result;
+  // One nappe, the axis pointing into it.
+  const Eigen::Vector3d mean_offset = (m.origin() - apex);  // centroid − apex
+  if (axis.dot(mean_offset) < 0) axis = -axis;
+  const double along_sum = weight * axis.dot(mean_offset);
+  const double along_square = axis.dot(about_apex.second_moment() * axis);
+  if (!(along_sum > kMinOneSidedness * std::sqrt(weight * along_square))) return result;
+
+  // Face normals must follow the cone's: n·(u uᵀ − cos²θ I)(c − a) = ± cos θ sin θ |c − a|.
+  const double cos_angle = std::cos(half_angle), sin_angle = std::sin(half_angle);
+  const double rms_distance = std::sqrt(about_apex.second_moment().trace() / weight);
+  const Eigen::Matrix3d q = axis * axis.transpose() - cos2 * Eigen::Matrix3d::Identity();
+  result.normal_alignment = centred.normal_alignment(q, apex, cos_angle * sin_angle * rms_distance);
+  if (result.normal_alignment < kMinNormalAlignment) return result;
+
+  result.valid = true;
+  result.error = weight * ratio * spread2;
+  result.primitive.point = {apex.x(), apex.y(), apex.z()};
+  result.primitive.axis = {axis.x(), axis.y(), axis.z()};
+  result.primitive.half_angle = half_angle;
+  return result;
+}
+
+}  // namespace primseg

@@ -1,0 +1,172 @@
+// Torus: from the cluster's bounded corner sample (ClusterStats::samples, at most 32 corners with
+// their face normals), so a candidate costs the same for any cluster size.
+//
+// 1. Axis: every normal line of a surface of revolution meets its axis. A line (d, m) in Plücker
+//    coordinates meets the axis (a, p × a) iff d·(p × a) + a·m = 0, linear in (a, p × a): the
+//    weighted least squares over the samples' normal lines, with |a| = 1, is a 3×3 eigenproblem
+//    once p × a is eliminated. Coplanar normals (a cylinder, a plane) leave it undetermined.
+// 2. Profile: in the half-plane through the axis, (ρ, h) = (distance to the axis, height) of the
+//    samples lie on the tube's circle: Pratt's circle fit gives the major radius (its centre's
+//    ρ), the centre's height and the minor radius.
+// 3. A few Levenberg–Marquardt steps of the true Euclidean distance (geometric_fit.hpp) over the
+//    samples, so that points exactly on a torus give it exactly.
+// The error is the priority-sampling estimate of Σ w d² (estimator weights max(w, τ), see
+// SampleReservoir), normalised to the cluster's exact weight; when the sample is not the whole
+// cluster it is scaled by n / (n − 7), the usual correction for the 7 parameters fitted to the
+// same n points. It is an honest first-order L2 like the other types', but a sampled one: its
+// relative noise is about 1/sqrt(32) for large clusters.
+#include "primseg/primitives/torus.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <vector>
+
+#include "primitives/pratt_fit.hpp"
+#include "primseg/geometric_fit.hpp"
+
+namespace primseg {
+namespace {
+
+constexpr int kParameters = 7;
+// The smallest eigenvalue of Σ ŵ n nᵀ over Σ ŵ below this: normals (nearly) coplanar, no torus.
+constexpr double kMinNormalSpread = 1e-9;
+// A torus whose major radius is below this fraction of its minor radius is the sphere it nearly
+// is (a sphere is a torus of major radius 0 about any axis through its centre).
+constexpr double kMinRelativeMajorRadius = 0.05;
+// Largest minor radius, relative to the RMS spread of the cluster: a wider tube bends the cluster
+// by less than a fortieth of its size across, and the torus is standing in for a cone, a
+// cylinder or a plane (a cone's band is fitted by tori of growing tube as closely as wanted).
+constexpr double kMaxRelativeMinorRadius = 20;
+// Levenberg–Marquardt steps on the sample (each O(32)).
+constexpr int kRefinementSteps = 8;
+
+}  // namespace
+
+std::uint32_t TorusFitter::min_triangles() const {
+  return 8;
+}
+
+PrimitiveFit TorusFitter::fit(const ClusterStats& centred) const {
+  PrimitiveFit result;
+  result.primitive.type = PrimitiveType::Torus;
+  const Moments& m = centred.moments;
+  const double weight = m.weight();
+  const SampleReservoir& reservoir = centred.samples;
+  const std::size_t n = reservoir.estimate_size();
+  if (centred.triangle_count < min_triangles() || !(weight > 0) || n <= kParameters + 1)
+    return result;
+  const double spread2 = m.second_moment().trace() / weight;
+  if (!(spread2 > 0) || !std::isfinite(spread2)) return result;
+  const double scale = 1 / std::sqrt(spread2);
+
+  // Samples about the centroid, in units of the RMS spread.
+  std::vector<Vec3> points(n);
+  std::vector<double> weights(n);
+  std::vector<Eigen::Vector3d> positions(n), normals(n);
+  double sample_weight = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    positions[i] = (reservoir.samples[i].position - m.origin()) * scale;
+    normals[i] = reservoir.samples[i].normal.cast<double>();
+    weights[i] = reservoir.estimator_weight(i);
+    points[i] = {positions[i].x(), positions[i].y(), positions[i].z()};
+    sample_weight += weights[i];
+  }
+  if (!(sample_weight > 0)) return result;
+
+  // 1. The axis. Rows l = (x × n, n) against (a, p × a).
+  Eigen::Matrix<double, 6, 6> lines = Eigen::Matrix<double, 6, 6>::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Matrix<double, 6, 1> l;
+    l << positions[i].cross(normals[i]), normals[i];
+    lines.noalias() += weights[i] * l * l.transpose();
+  }
+  const Eigen::Matrix3d nn = lines.bottomRightCorner<3, 3>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> normal_eigen(nn);
+  if (!(normal_eigen.eigenvalues()(0) > kMinNormalSpread * sample_weight)) return result;
+  const Eigen::Matrix3d nn_inverse = normal_eigen.eigenvectors() *
+                                     normal_eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                                     normal_eigen.eigenvectors().transpose();
+  const Eigen::Matrix3d cross_block = lines.topRightCorner<3, 3>();
+  const Eigen::Matrix3d reduced =
+      lines.topLeftCorner<3, 3>() - cross_block * nn_inverse * cross_block.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axis_eigen(reduced);
+  Eigen::Vector3d axis = axis_eigen.eigenvectors().col(0).normalized();
+  Eigen::Vector3d moment = -nn_inverse * cross_block.transpose() * axis;
+  moment -= axis * axis.dot(moment);                   // a Plücker line: moment ⊥ direction
+  const Eigen::Vector3d on_axis = axis.cross(moment);  // the axis point nearest the centroid
+
+  // 2. The tube's circle in the (ρ, h) half-plane.
+  detail::CentredMomentsND<2> profile;
+  std::vector<Eigen::Vector2d> rho_h(n);
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d y = positions[i] - on_axis;
+    const double h = axis.dot(y);
+    rho_h[i] = {(y - h * axis).norm(), h};
+    mean += weights[i] * rho_h[i];
+  }
+  mean /= sample_weight;
+  profile.weight = sample_weight;
+  profile.second.setZero();
+  profile.third.setZero();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d p = rho_h[i] - mean;
+    profile.second.noalias() += weights[i] * p * p.transpose();
+    profile.third += weights[i] * p * p.squaredNorm();
+    profile.fourth += weights[i] * p.squaredNorm() * p.squaredNorm();
+  }
+  const detail::PrattResult<2> circle = detail::pratt_fit(profile);
+  if (!circle.valid) return result;
+  const Eigen::Vector2d tube_centre = mean + circle.centre;
+  if (!(tube_centre.x() > 0)) return result;  // the tube's centre circle must have a radius
+
+  // 3. Geometric refinement on the sample.
+  Primitive start;
+  start.type = PrimitiveType::Torus;
+  const Eigen::Vector3d centre = on_axis + tube_centre.y() * axis;
+  start.point = {centre.x(), centre.y(), centre.z()};
+  start.axis = {axis.x(), axis.y(), axis.z()};
+  start.radius = tube_centre.x();
+  start.minor_radius = circle.radius;
+  GeometricFitOptions options;
+  options.max_iterations = kRefinementSteps;
+  const GeometricFit refined = fit_geometric(start, points, weights, options);
+  const Primitive& torus = refined.primitive;
+  if (!(torus.minor_radius > 0 && torus.radius >= kMinRelativeMajorRadius * torus.minor_radius) ||
+      !(torus.radius <= detail::kMaxRelativeRadius &&
+        torus.minor_radius <= kMaxRelativeMinorRadius))
+    return result;
+
+  // Face normals must follow the torus's: mean |n · ν| over the sample.
+  const Eigen::Vector3d torus_centre(torus.point[0], torus.point[1], torus.point[2]);
+  const Eigen::Vector3d torus_axis(torus.axis[0], torus.axis[1], torus.axis[2]);
+  double alignment = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 nearest = torus.closest_point(points[i]);
+    const Eigen::Vector3d y = positions[i] - torus_centre;
+    const Eigen::Vector3d radial = y - torus_axis * torus_axis.dot(y);
+    if (!(radial.squaredNorm() > 0)) continue;  // on the axis: no normal, no agreement
+    const Eigen::Vector3d ring = torus_centre + radial.normalized() * torus.radius;
+    const Eigen::Vector3d normal =
+        (Eigen::Vector3d(nearest[0], nearest[1], nearest[2]) - ring).normalized();
+    alignment += weights[i] * std::abs(normal.dot(normals[i]));
+  }
+  result.normal_alignment = alignment / sample_weight;
+  if (!(result.normal_alignment >= kMinNormalAlignment)) return result;
+
+  double error = refined.rms * refined.rms * weight;  // refined.rms: Σ ŵ d² / Σ ŵ
+  if (reservoir.threshold() > 0) error *= double(n) / double(n - kParameters);
+  result.valid = true;
+  result.error = error * spread2;
+  const Eigen::Vector3d input_centre = m.origin() + torus_centre / scale;
+  result.primitive = torus;
+  const Eigen::Vector3d canonical = canonical_axis(torus_axis);
+  result.primitive.axis = {canonical.x(), canonical.y(), canonical.z()};
+  result.primitive.point = {input_centre.x(), input_centre.y(), input_centre.z()};
+  result.primitive.radius = torus.radius / scale;
+  result.primitive.minor_radius = torus.minor_radius / scale;
+  return result;
+}
+
+}  // namespace primseg
