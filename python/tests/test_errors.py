@@ -165,8 +165,8 @@ def test_denoise_argument_errors():
                    {"min_crease_angle": -1.0}, {"smoothing_steps": -1}):
         with pytest.raises(ValueError):
             primseg.denoise(mesh, **option)
-    with pytest.raises(ValueError, match="unknown primitive 'cone'"):
-        primseg.denoise(mesh, primitives="cone")
+    with pytest.raises(ValueError, match="unknown primitive 'ellipsoid'"):
+        primseg.denoise(mesh, primitives="ellipsoid")
     with pytest.raises(ValueError, match="weights: must be 'area' or 'uniform', not 3"):
         primseg.denoise(mesh, weights=3)
     tree = primseg.segment(mesh)
@@ -191,7 +191,7 @@ def test_skeleton_and_pose_errors(cgal_mesh):
     with pytest.raises(ValueError, match=r"k must be between 1 and the number of faces \(2\), not 0"):
         primseg.skeleton(mesh, k=0)
     with pytest.raises(ValueError, match="unknown primitive"):
-        primseg.skeleton(mesh, primitives=("cylinder", "torus"))
+        primseg.skeleton(mesh, primitives=("cylinder", "ellipsoid"))
     skeleton = primseg.skeleton(primseg.read_mesh(cgal_mesh("man.off")), k=20)
     locked = [j["id"] for j in skeleton.joints if j["kind"] != "sensitive"]
     assert locked
