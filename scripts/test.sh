@@ -7,4 +7,6 @@ bash scripts/install-deps.sh
 build=${PRIMSEG_BUILD_DIR:-build}
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPRIMSEG_WERROR=ON "$@" >/dev/null
 cmake --build "$build"
-ctest --test-dir "$build" --output-on-failure -j "$(nproc)"
+# PRIMSEG_CTEST_ARGS: extra CTest arguments, e.g. "-E python.pytest".
+read -r -a ctest_args <<<"${PRIMSEG_CTEST_ARGS:-}"
+ctest --test-dir "$build" --output-on-failure -j "$(nproc)" "${ctest_args[@]}"

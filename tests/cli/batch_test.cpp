@@ -250,6 +250,25 @@ TEST(Limits, MaxFacesAndMaxMemoryRefuseBeforeTheBuild) {
   fs::remove_all(dir);
 }
 
+// A shell prefix under which an attempt to allocate for a declared count fails. `ulimit -v` does
+// it, but AddressSanitizer reserves terabytes of shadow address space at start and cannot run
+// under it; its own cap on one allocation does the same there.
+std::string memory_limit_prefix() {
+#if defined(__SANITIZE_ADDRESS__)
+  constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  constexpr bool kAddressSanitizer = true;
+#else
+  constexpr bool kAddressSanitizer = false;
+#endif
+#else
+  constexpr bool kAddressSanitizer = false;
+#endif
+  if (kAddressSanitizer) return "ASAN_OPTIONS=abort_on_error=1:max_allocation_size_mb=1000 ";
+  return "ulimit -v 1000000; ";
+}
+
 TEST(Limits, ImpossibleDeclaredCountsAreRefusedWithoutAllocating) {
   const fs::path dir = testing::temp_directory("limits-counts");
   std::ofstream(dir / "huge.off") << "OFF\n1000000000 2000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
@@ -259,8 +278,7 @@ TEST(Limits, ImpossibleDeclaredCountsAreRefusedWithoutAllocating) {
                                      "vertex_indices\nend_header\n";
   for (const char* name : {"huge.off", "huge.ply"}) {
     std::string output;
-    // ulimit -v: an attempt to allocate for the declared count would fail as out of memory.
-    EXPECT_EQ(testing::run_command("ulimit -v 1000000; '" + testing::cli_path().string() +
+    EXPECT_EQ(testing::run_command(memory_limit_prefix() + "'" + testing::cli_path().string() +
                                        "' segment '" + (dir / name).string() + "' -q 2>&1",
                                    &output),
               1)
@@ -306,10 +324,10 @@ TEST(Interrupt, CtrlCLeavesCompleteOutputsOrNone) {
       EXPECT_EQ(slurp(dir / "out.tree"), tree);
     }
     if (names.count("out.json")) {
-      EXPECT_NO_THROW(json::parse(slurp(dir / "out.json")));
+      EXPECT_TRUE(json::accept(slurp(dir / "out.json")));
     }
     if (names.count("out.ply")) {
-      EXPECT_NO_THROW(read_mesh(dir / "out.ply"));
+      EXPECT_NO_THROW((void)read_mesh(dir / "out.ply"));
     }
   }
   EXPECT_GE(interrupted, 1);
