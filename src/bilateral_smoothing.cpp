@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "primseg/error.hpp"
+#include "vertex_triangles.hpp"
 
 namespace primseg {
 namespace {
@@ -15,22 +16,6 @@ namespace {
 Eigen::Vector3d to_eigen(const Vec3& v) {
   return {v[0], v[1], v[2]};
 }
-
-// Compressed rows: the triangles around each vertex.
-struct VertexTriangles {
-  std::vector<std::uint32_t> offsets;
-  std::vector<std::uint32_t> triangles;
-
-  explicit VertexTriangles(const Mesh& mesh) : offsets(mesh.vertex_count() + 1, 0) {
-    for (const Triangle& t : mesh.triangles)
-      for (const std::uint32_t v : t) ++offsets[v + 1];
-    for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) offsets[v + 1] += offsets[v];
-    triangles.resize(offsets.back());
-    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-      for (const std::uint32_t v : mesh.triangles[t]) triangles[fill[v]++] = t;
-  }
-};
 
 // The faces sharing a vertex with each face (itself included), as compressed rows, sorted.
 std::vector<std::vector<std::uint32_t>> face_neighbourhoods(const Mesh& mesh,
@@ -64,7 +49,7 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
   Mesh smoothed = mesh;
   const std::uint32_t face_count = mesh.triangle_count();
   if (face_count == 0) return smoothed;
-  const VertexTriangles around(mesh);
+  const VertexTriangles around = vertex_triangles(mesh);
   const std::vector<std::vector<std::uint32_t>> rings = face_neighbourhoods(mesh, around);
 
   std::vector<Eigen::Vector3d> centroids(face_count), normals(face_count);

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "primseg/error.hpp"
+#include "vertex_triangles.hpp"
 
 namespace primseg {
 namespace {
@@ -241,7 +242,6 @@ Denoiser::Denoiser(Mesh mesh, DenoiseOptions options)
   input_normals_.reserve(mesh_.triangles.size());
   std::vector<double> edge_sum(n, 0);
   std::vector<std::uint32_t> edge_count(n, 0);
-  vertex_triangle_offsets_.assign(n + 1, 0);
   for (const Triangle& t : mesh_.triangles) {
     const Eigen::Vector3d a = to_eigen(mesh_.positions[t[0]]), b = to_eigen(mesh_.positions[t[1]]),
                           c = to_eigen(mesh_.positions[t[2]]);
@@ -254,16 +254,11 @@ Denoiser::Denoiser(Mesh mesh, DenoiseOptions options)
       edge_sum[v] += length;
       ++edge_count[u];
       ++edge_count[v];
-      ++vertex_triangle_offsets_[u + 1];
     }
   }
-  for (std::uint32_t v = 0; v < n; ++v)
-    vertex_triangle_offsets_[v + 1] += vertex_triangle_offsets_[v];
-  vertex_triangles_.resize(vertex_triangle_offsets_[n]);
-  std::vector<std::uint32_t> fill(vertex_triangle_offsets_.begin(),
-                                  vertex_triangle_offsets_.end() - 1);
-  for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t)
-    for (const std::uint32_t v : mesh_.triangles[t]) vertex_triangles_[fill[v]++] = t;
+  VertexTriangles rows = vertex_triangles(mesh_);
+  vertex_triangle_offsets_ = std::move(rows.offsets);
+  vertex_triangles_ = std::move(rows.triangles);
   local_edge_length_.resize(n);
   for (std::uint32_t v = 0; v < n; ++v)
     local_edge_length_[v] = edge_count[v] ? edge_sum[v] / edge_count[v] : 0;
