@@ -57,8 +57,9 @@ nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy)
 void add_level_options(CLI::App& command, LevelOptions& options) {
   auto* clusters =
       command.add_option("--clusters", options.level.clusters,
-                         "Number of clusters K (1..F), or 'auto': the level after which the "
-                         "error curve jumps most (candidates and scores in the JSON)");
+                         "Number of clusters K (1..F), or 'auto': the finest level after which "
+                         "the error curve jumps (x2), else its knee (rule, candidates and scores "
+                         "in the JSON)");
   auto* tolerance = command.add_option(
       "--tolerance", options.level.tolerance,
       std::string("Largest RMS distance of a cluster to its primitive, in input units or T% of "
@@ -111,6 +112,7 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohm
   if (!refinement.is_null()) summary["level"]["refinement"] = std::move(refinement);
   if (level.automatic) {
     summary["level"]["requested_clusters"] = "auto";
+    summary["level"]["rule"] = to_string(level.automatic->rule);
     nlohmann::json candidates = nlohmann::json::array();
     for (const LevelCandidate& c : level.automatic->candidates)
       candidates.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});

@@ -3,10 +3,121 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "primseg/error.hpp"
 
 namespace primseg {
+namespace {
+
+// The knee search never narrows the curve below this many levels: a few points past a knee
+// are not enough for the right-hand line.
+constexpr std::size_t kMinKneeRange = 20;
+
+// Sums of a run of points (x, y), for the least-squares line through them in O(1).
+struct LineSums {
+  double n = 0, x = 0, y = 0, xx = 0, xy = 0, yy = 0;
+  void add(double px, double py) {
+    n += 1;
+    x += px;
+    y += py;
+    xx += px * px;
+    xy += px * py;
+    yy += py * py;
+  }
+  LineSums minus(const LineSums& o) const {
+    return {n - o.n, x - o.x, y - o.y, xx - o.xx, xy - o.xy, yy - o.yy};
+  }
+  // Slope of the least-squares line (0 without spread in x).
+  double slope() const {
+    const double sxx = n > 0 ? xx - x * x / n : 0;
+    return sxx > 0 ? (xy - x * y / n) / sxx : 0;
+  }
+  // Root-mean-square residual of the least-squares line (0 for two points or fewer).
+  double line_rms() const {
+    if (n < 3) return 0;
+    const double sxx = xx - x * x / n, sxy = xy - x * y / n, syy = yy - y * y / n;
+    const double residual = sxx > 0 ? syy - sxy * sxy / sxx : syy;
+    return std::sqrt(std::max(residual, 0.0) / n);
+  }
+};
+
+// The L-method (Salvador and Chan 2004) on points (x_i, y_i), i in [0, count): the split after
+// which two least-squares lines, one through the points up to it and one through the rest, fit
+// best (each line's RMS residual weighted by its share of the points). Returns the index of the
+// last point of the left line; both lines get at least two points.
+std::size_t l_method_knee(const std::vector<double>& x, const std::vector<double>& y,
+                          std::size_t count) {
+  std::vector<LineSums> prefix(count + 1);
+  for (std::size_t i = 0; i < count; ++i) {
+    prefix[i + 1] = prefix[i];
+    prefix[i + 1].add(x[i], y[i]);
+  }
+  std::size_t best = 1;
+  double best_fit = std::numeric_limits<double>::infinity();
+  for (std::size_t last = 1; last + 2 < count; ++last) {
+    const LineSums left = prefix[last + 1], right = prefix[count].minus(prefix[last + 1]);
+    const double fit =
+        (left.n * left.line_rms() + right.n * right.line_rms()) / static_cast<double>(count);
+    if (fit < best_fit) {
+      best_fit = fit;
+      best = last;
+    }
+  }
+  return best;
+}
+
+// The knee of log(floored rms) against K over K in [c, finest] (see AutoLevelRule::Knee), or
+// nullopt when the curve has no significant bend.
+template <typename Floored>
+std::optional<std::uint32_t> curve_knee(const std::vector<ErrorCurvePoint>& curve, std::uint32_t c,
+                                        std::uint32_t finest, const Floored& floored,
+                                        const AutoLevelOptions& options) {
+  std::vector<double> x, y;
+  for (std::uint32_t k = c; k <= finest && k - c < curve.size(); ++k) {
+    x.push_back(static_cast<double>(k));
+    y.push_back(std::log(floored(curve[k - c].rms)));
+  }
+  if (x.size() < 4) return std::nullopt;
+  // The search starts at levels of ten faces per cluster on average: finer, the curve falls
+  // towards zero as clusters shrink to a few triangles that fit exactly, a second knee that says
+  // nothing about the surfaces. Then, as the L-method prescribes, the range is cut to three
+  // times the knee, until the knee stops moving to coarser levels: a long tail pulls it right.
+  const std::size_t faces = curve.back().clusters;
+  std::size_t count =
+      std::clamp<std::size_t>(faces / 10, std::min(kMinKneeRange, x.size()), x.size());
+  std::size_t knee = count;
+  for (int round = 0; round < 32 && count >= 4; ++round) {
+    const std::size_t found = l_method_knee(x, y, count);
+    if (found >= knee) break;
+    knee = found;
+    count = std::min(x.size(), std::max<std::size_t>(3 * knee + 1, kMinKneeRange));
+  }
+  if (knee >= count || knee + 2 >= count) return std::nullopt;
+  // Significant only if the curve falls by at least min_score down to the knee, and the coarse
+  // line is at least min_score times steeper than the fine one: a curve that only wavers (one
+  // noisy sphere) or falls evenly has a best split too, but no bend.
+  LineSums left, right;
+  for (std::size_t i = 0; i < count; ++i) (i <= knee ? left : right).add(x[i], y[i]);
+  const double fall = y[0] - y[knee];
+  if (!(fall >= std::log(options.min_score))) return std::nullopt;
+  if (!(-left.slope() >= options.min_score * std::max(-right.slope(), 0.0))) return std::nullopt;
+  return c + static_cast<std::uint32_t>(knee);
+}
+
+}  // namespace
+
+std::string_view to_string(AutoLevelRule rule) {
+  switch (rule) {
+    case AutoLevelRule::Jump:
+      return "jump";
+    case AutoLevelRule::Knee:
+      return "knee";
+    case AutoLevelRule::Components:
+      break;
+  }
+  return "components";
+}
 
 std::vector<ErrorCurvePoint> error_curve(const Hierarchy& hierarchy) {
   const std::uint32_t f = hierarchy.face_count();
@@ -61,6 +172,16 @@ AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& optio
   std::uint32_t chosen = c;
   for (const LevelCandidate& candidate : candidates)
     if (candidate.score >= options.min_score) chosen = std::max(chosen, candidate.clusters);
+  AutoLevelRule rule = chosen > c ? AutoLevelRule::Jump : AutoLevelRule::Components;
+  // No jump: the knee of log rms against K. Real parts with blends descend steadily while
+  // merges join different surfaces, and flatten once they only join pieces of one surface.
+  if (rule == AutoLevelRule::Components && options.knee_fallback) {
+    const std::optional<std::uint32_t> knee = curve_knee(curve, c, finest, floored, options);
+    if (knee) {
+      chosen = *knee;
+      rule = AutoLevelRule::Knee;
+    }
+  }
   std::stable_sort(
       candidates.begin(), candidates.end(),
       [](const LevelCandidate& a, const LevelCandidate& b) { return a.score > b.score; });
@@ -72,6 +193,7 @@ AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& optio
   candidates = std::move(kept);
   AutoLevel level;
   level.clusters = chosen;
+  level.rule = rule;
   level.candidates = std::move(candidates);
   return level;
 }

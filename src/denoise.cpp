@@ -221,6 +221,8 @@ void validate(const DenoiseOptions& options) {
     if (options.smoothing_steps > 0)
       throw InvalidInputError("denoise: choose Taubin or bilateral smoothing, not both");
   }
+  if (options.relabel_passes < 0)
+    throw InvalidInputError("denoise: the relabelling passes must be a non-negative count");
   if (options.max_solver_steps < 1)
     throw InvalidInputError("denoise: the solver needs at least one step");
   validate(options.hierarchy);
@@ -329,6 +331,7 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
   std::vector<double> residuals;
   for (std::size_t c = 0; c < primitives.size(); ++c) {
     const PrimitiveType type = primitives[c].type;
+    if (points[c].empty()) continue;  // a cluster that relabelling emptied
     if (type != PrimitiveType::Plane && type != PrimitiveType::Sphere &&
         type != PrimitiveType::Cylinder)
       continue;
@@ -363,6 +366,60 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
   }
 }
 
+void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
+                       Segmentation& segmentation) const {
+  std::vector<std::uint32_t>& labels = segmentation.labels;
+  // The faces' triangles, and the clusters of the faces around each face (sharing a vertex).
+  std::vector<std::uint32_t> face_offsets(mesh_.face_count() + 1, 0), face_triangles;
+  for (const std::uint32_t f : mesh_.face_of_triangle) ++face_offsets[f + 1];
+  for (std::uint32_t f = 0; f < mesh_.face_count(); ++f) face_offsets[f + 1] += face_offsets[f];
+  face_triangles.resize(mesh_.triangle_count());
+  {
+    std::vector<std::uint32_t> next(face_offsets.begin(), face_offsets.end() - 1);
+    for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t)
+      face_triangles[next[mesh_.face_of_triangle[t]]++] = t;
+  }
+  const std::vector<Primitive> hierarchy_fits = primitives;
+  std::vector<std::uint32_t> near, next;
+  for (int pass = 0; pass < options_.relabel_passes; ++pass) {
+    next = labels;
+    bool changed = false;
+    for (std::uint32_t f = 0; f < mesh_.face_count(); ++f) {
+      near.clear();
+      for (std::uint32_t i = face_offsets[f]; i < face_offsets[f + 1]; ++i)
+        for (const std::uint32_t v : mesh_.triangles[face_triangles[i]])
+          for (std::uint32_t j = vertex_triangle_offsets_[v]; j < vertex_triangle_offsets_[v + 1];
+               ++j)
+            near.push_back(labels[mesh_.face_of_triangle[vertex_triangles_[j]]]);
+      std::sort(near.begin(), near.end());
+      near.erase(std::unique(near.begin(), near.end()), near.end());
+      if (near.size() < 2) continue;
+      // The cluster whose primitive the face's corners are nearest to (sum of squared
+      // distances); ties keep the lower label, the face's own first.
+      double best_cost = std::numeric_limits<double>::infinity();
+      std::uint32_t best = labels[f];
+      for (const std::uint32_t c : near) {
+        double cost = 0;
+        for (std::uint32_t i = face_offsets[f]; i < face_offsets[f + 1]; ++i)
+          for (const std::uint32_t v : mesh_.triangles[face_triangles[i]]) {
+            const double d = primitives[c].distance(judged.positions[v]);
+            cost += d * d;
+          }
+        if (cost < best_cost || (cost == best_cost && c == labels[f])) {
+          best_cost = cost;
+          best = c;
+        }
+      }
+      changed |= best != labels[f];
+      next[f] = best;
+    }
+    labels.swap(next);
+    if (!changed) break;
+    primitives = hierarchy_fits;
+    if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
+  }
+}
+
 SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmentation) {
   const Mesh& segmented = hierarchy.mesh();
   if (segmented.vertex_count() != mesh_.vertex_count() || segmented.triangles != mesh_.triangles ||
@@ -376,6 +433,12 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   for (const ClusterReport& cluster : describe_clusters(hierarchy, segmentation))
     primitives.push_back(cluster.primitive);
   if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
+  Segmentation relabeled;
+  if (options_.relabel_passes > 0) {
+    relabeled = segmentation;
+    relabel(segmented, primitives, relabeled);
+  }
+  const Segmentation& labelled = options_.relabel_passes > 0 ? relabeled : segmentation;
 
   SnapReport report;
   report.clusters = segmentation.cluster_count();
@@ -390,7 +453,7 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   auto candidates = [&](std::uint32_t v, std::vector<std::uint32_t>& clusters) {
     clusters.clear();
     for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i)
-      clusters.push_back(segmentation.labels[mesh_.face_of_triangle[vertex_triangles_[i]]]);
+      clusters.push_back(labelled.labels[mesh_.face_of_triangle[vertex_triangles_[i]]]);
     std::sort(clusters.begin(), clusters.end());
     clusters.erase(std::unique(clusters.begin(), clusters.end()), clusters.end());
     std::vector<std::pair<double, std::uint32_t>> by_distance;

@@ -8,6 +8,7 @@
 /// joins two different surfaces: the level just before a large jump is significant.
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "primseg/hierarchy.hpp"
@@ -37,6 +38,25 @@ struct AutoLevelOptions {
   double min_score = 2.0;
   /// Candidates reported besides the chosen level (the best-scored ones).
   std::uint32_t max_candidates = 5;
+  /// When no jump is significant, choose the knee of the curve (AutoLevelRule::Knee) rather
+  /// than one cluster per component.
+  bool knee_fallback = true;
+};
+
+/// Which rule chose the level.
+enum class AutoLevelRule {
+  /// The finest K whose score reaches min_score: a jump of the curve.
+  Jump,
+  /// No significant jump: the knee of log rms against K, by the L-method (Salvador and Chan
+  /// 2004): two least-squares lines, one through the coarse levels and one through the fine
+  /// ones, fitted for every split; the chosen K ends the coarse line of the best-fitting split.
+  /// The range of K is then cut to three times the knee (at least 20 levels) and the search
+  /// repeated until the knee stops moving to coarser levels, so that a long flat tail does not
+  /// pull it to the right.
+  Knee,
+  /// One cluster per component (no significant jump, and no knee: fallback off or too few
+  /// levels).
+  Components,
 };
 
 /// A candidate level and how strongly the curve singles it out.
@@ -49,13 +69,17 @@ struct LevelCandidate {
   double score = 0;
 };
 
+/// "jump", "knee" or "components".
+std::string_view to_string(AutoLevelRule rule);
+
 /// The chosen level and the candidates.
 struct AutoLevel {
   /// The chosen K: the finest level with a significant score (a coarser jump, however large,
   /// only says that the regions of the finer level are themselves grouped: a small chamfer
-  /// joining a face is a smaller jump than two large faces joining, and just as real), or one
-  /// cluster per component when no jump is significant.
+  /// joining a face is a smaller jump than two large faces joining, and just as real); when no
+  /// jump is significant, the knee of the curve; else one cluster per component (see `rule`).
   std::uint32_t clusters = 0;
+  AutoLevelRule rule = AutoLevelRule::Components;  ///< how `clusters` was chosen
   /// Best score first: the best-scored levels, and the chosen one wherever it ranks.
   std::vector<LevelCandidate> candidates;
 };

@@ -67,6 +67,15 @@ struct DenoiseOptions {
   /// noise is averaged on smooth parts while edges stay sharp, which segments noisy CAD parts
   /// better (fandisk with 0.3% noise: RMS 3.3x lower at K = 40 against 2.6x with 5 Taubin steps).
   std::optional<BilateralSmoothingOptions> bilateral_smoothing;
+  /// After the refit, each face moves to the cluster, among its own and those of the faces
+  /// sharing a vertex with it, whose primitive its corners are nearest to (sum of squared
+  /// distances, measured on the segmented copy: smoothed when smoothing is on), and the
+  /// primitives are refitted; this many passes, fewer when a pass moves nothing. The hierarchy's
+  /// borders follow its greedy merges on the smoothed copy and zigzag across blends; the
+  /// primitives, refitted on many vertices, know better where each surface ends (fandisk with
+  /// 0.3% noise, bilateral smoothing: RMS 3.4x lower at K = 30 against 2.7x without). 0 keeps the
+  /// hierarchy's labels. >= 0.
+  int relabel_passes = 2;
   /// Gauss–Newton steps for curved primitives (a plane-only system converges in one).
   int max_solver_steps = 20;
   /// Hierarchy options used to segment the mesh at each iteration.
@@ -122,6 +131,10 @@ class Denoiser {
 
  private:
   void refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const;
+  // Moves faces to the nearest primitive of their neighbourhood, judged on `judged`'s positions
+  // (see DenoiseOptions::relabel_passes), and refits.
+  void relabel(const Mesh& judged, std::vector<Primitive>& primitives,
+               Segmentation& segmentation) const;
 
   Mesh mesh_;
   DenoiseOptions options_;
