@@ -17,6 +17,7 @@
 #include "../src/file_io.hpp"
 #include "command.hpp"
 #include "primseg/auto_level.hpp"
+#include "primseg/cut.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/skeleton.hpp"
@@ -30,10 +31,10 @@ namespace {
 static_assert(std::endian::native == std::endian::little,
               "the page reads the arrays as little-endian typed arrays");
 
-/// Merges whose primitive parameters go into the page: the last ones, that is every cluster of
-/// every level with at most this many + 1 clusters. Finer levels show their clusters' type and
-/// RMS estimate only (a 1M-face page would otherwise carry 72 MB of parameters).
-constexpr std::uint32_t kMergesWithParameters = 32768;
+/// The page carries the refined primitive and exact errors of every cluster of every level of
+/// at most this many clusters (at most twice as many nodes). Finer levels show their clusters'
+/// type and RMS estimate only (a 1M-face page would otherwise carry 180 MB of them).
+constexpr std::uint32_t kMaxClustersWithParameters = 16385;
 
 std::string base64(const void* data, std::size_t size) {
   static constexpr char kAlphabet[] =
@@ -148,9 +149,11 @@ nlohmann::json append_skeleton(std::string& html, const Mesh& mesh, const PageSk
           {"band", page.band}};
 }
 
+/// The page's data. `fit_seconds`: set to the time the geometric fits took.
 std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
                       std::uint32_t initial_clusters, const AutoLevel& automatic,
-                      const std::optional<PageSkeleton>& skeleton) {
+                      const std::optional<PageSkeleton>& skeleton, unsigned threads,
+                      double& fit_seconds) {
   const Mesh& mesh = hierarchy.mesh();
   const std::uint32_t f = hierarchy.face_count();
   const auto merges = hierarchy.merges();
@@ -181,22 +184,44 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
     rms[i] = hierarchy.rms_estimate(static_cast<std::uint32_t>(f + i));
     types[i] = static_cast<std::uint8_t>(merges[i].primitive.type);
   }
-  // Parameters of the last merges, relative to the same centre as the positions.
+  // The clusters of the levels of at most kMaxClustersWithParameters clusters: the nodes whose
+  // parent is one of the last real merges, a trailing merge or none (component roots).
   const std::uint32_t real = f - hierarchy.component_count();
-  const std::uint32_t with_parameters = std::min(real, kMergesWithParameters);
-  std::vector<double> parameters;
-  parameters.reserve(std::size_t{with_parameters} * 9);
-  for (std::uint32_t i = real - with_parameters; i < real; ++i) {
-    const Primitive& p = merges[i].primitive;
+  const std::uint32_t components = hierarchy.component_count();
+  const std::uint32_t carried_merges =
+      components > kMaxClustersWithParameters
+          ? 0
+          : std::min(real, kMaxClustersWithParameters - components);
+  std::vector<std::uint32_t> carried;
+  if (components <= kMaxClustersWithParameters)
+    for (std::uint32_t node = 0; node < f + real; ++node) {
+      const std::uint32_t parent = hierarchy.parents()[node];
+      if (parent == std::numeric_limits<std::uint32_t>::max() ||
+          parent - f >= real - carried_merges)
+        carried.push_back(node);
+    }
+  // Their primitives as every cut reports them: the geometric fit and its exact errors.
+  DescribeOptions describe;
+  describe.threads = threads;
+  const auto fit_start = Clock::now();
+  const std::vector<ClusterReport> reports = describe_nodes(hierarchy, carried, describe);
+  fit_seconds = seconds_since(fit_start);
+  std::vector<double> parameters, errors;
+  parameters.reserve(carried.size() * 9);
+  errors.reserve(carried.size() * 2);
+  for (const ClusterReport& r : reports) {
+    const Primitive& p = r.primitive;
     for (int a = 0; a < 3; ++a) parameters.push_back(p.point[a] - center[a]);
     for (int a = 0; a < 3; ++a) parameters.push_back(p.axis[a]);
     parameters.push_back(p.radius);
     parameters.push_back(p.minor_radius);
     parameters.push_back(p.half_angle);
+    errors.push_back(r.rms);
+    errors.push_back(r.max);
   }
 
   nlohmann::json header = {
-      {"format", 1},
+      {"format", 2},
       {"name", mesh_name},
       {"faces", f},
       {"vertices", mesh.vertex_count()},
@@ -205,7 +230,7 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
       {"center", center},
       {"bboxDiagonal", bounding_box_diagonal(mesh)},
       {"weights", hierarchy.options().weights == VertexWeights::Uniform ? "uniform" : "area"},
-      {"firstMergeWithParameters", real - with_parameters},
+      {"maxClustersWithParameters", kMaxClustersWithParameters},
       {"initialClusters", initial_clusters},
       {"autoLevel", automatic.clusters},
   };
@@ -226,7 +251,9 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
   append_array(html, "children", children);
   append_array(html, "rms", rms);
   append_array(html, "types", types);
+  append_array(html, "parameter-nodes", carried);
   append_array(html, "parameters", parameters);
+  append_array(html, "errors", errors);
   // A polygon face may be non-planar: its own RMS is then not zero.
   if (mesh.triangle_count() != f) {
     std::vector<double> leaf_rms(f);
@@ -327,8 +354,9 @@ Command add_view_command(CLI::App& app) {
           skeleton = PageSkeleton{std::move(extracted), std::move(weights), o->band};
         }
         std::string html(page.substr(0, marker));
+        double fit_seconds = 0;
         html += page_data(hierarchy, std::filesystem::path(o->mesh_path).filename().string(),
-                          initial, automatic, skeleton);
+                          initial, automatic, skeleton, o->threads, fit_seconds);
         html += page.substr(marker + kViewerDataMarker.size());
         detail::write_file_atomically(o->output, html);
         if (!o->quiet) {
@@ -337,11 +365,11 @@ Command add_view_command(CLI::App& app) {
                   ? ", skeleton of " + std::to_string(skeleton->skeleton.cluster_count()) + " bones"
                   : "";
           std::printf(
-              "%s: %u faces, hierarchy %s in %.3f s; %s: %.1f MB, opens at %u clusters (automatic "
-              "level %u)%s\n",
+              "%s: %u faces, hierarchy %s in %.3f s, geometric fits in %.3f s; %s: %.1f MB, opens "
+              "at %u clusters (automatic level %u)%s\n",
               o->mesh_path.c_str(), mesh->face_count(), o->tree_path ? "read" : "built",
-              build_seconds, o->output.c_str(), static_cast<double>(html.size()) / 1e6, initial,
-              automatic.clusters, bones.c_str());
+              build_seconds, fit_seconds, o->output.c_str(), static_cast<double>(html.size()) / 1e6,
+              initial, automatic.clusters, bones.c_str());
         }
       }};
 }

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <string>
 
+#include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "working_primitive.hpp"
 
@@ -128,59 +129,127 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
   return describe_clusters(hierarchy, segmentation, start, options);
 }
 
+namespace {
+
+// Appends every triangle corner of triangle t, working frame, with its weight.
+void append_corners(const Hierarchy& hierarchy, std::uint32_t t, std::vector<Vec3>& points,
+                    std::vector<double>& weights) {
+  const DualGraph& graph = hierarchy.graph();
+  const std::array<double, 3> w = graph.corner_weights(t);
+  for (int corner = 0; corner < 3; ++corner) {
+    const Eigen::Vector3d& x = graph.position(hierarchy.mesh().triangles[t][corner]);
+    points.push_back({x.x(), x.y(), x.z()});
+    weights.push_back(w[corner]);
+  }
+}
+
+// Fills the primitive, rms and max of a report from the cluster's corners (working frame, in
+// ascending triangle order: describe_clusters and describe_nodes give the same bits) and its
+// area from the working-frame sum.
+void fit_report(const WorkingFrame& frame, const Primitive& start, std::span<const Vec3> points,
+                std::span<const double> weights, const DescribeOptions& options, ClusterReport& r) {
+  GeometricFitOptions fit_options = options.fit;
+  if (!options.geometric_fit) fit_options.max_iterations = 0;
+  r.algebraic = start;
+  // Fitted and measured in the working frame (no overflow for huge inputs), scaled back.
+  const GeometricFit fit =
+      fit_geometric(detail::to_working(frame, start), points, weights, fit_options);
+  r.primitive = fit.iterations > 0 ? frame.to_input(fit.primitive) : start;
+  r.rms = std::ldexp(fit.rms, frame.exponent);
+  r.max = std::ldexp(fit.max, frame.exponent);
+  r.area = std::ldexp(r.area, 2 * frame.exponent);
+}
+
+}  // namespace
+
 std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
                                              const Segmentation& segmentation,
                                              const std::vector<Primitive>& start,
                                              const DescribeOptions& options) {
   const Mesh& mesh = hierarchy.mesh();
   const DualGraph& graph = hierarchy.graph();
-  const WorkingFrame& frame = graph.frame();
   const std::uint32_t k = segmentation.cluster_count();
   if (start.size() != k || segmentation.labels.size() != mesh.face_count())
     throw InvalidInputError("describe_clusters: the segmentation does not match the mesh");
-  // Every triangle corner of each cluster with its weight, working frame, grouped by cluster.
-  std::vector<std::size_t> offset(k + 1, 0);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-    offset[segmentation.labels[mesh.face_of_triangle[t]] + 1] += 3;
-  for (std::uint32_t c = 0; c < k; ++c) offset[c + 1] += offset[c];
-  std::vector<Vec3> points(offset[k]);
-  std::vector<double> weights(offset[k]);
-  std::vector<std::size_t> next(offset.begin(), offset.end() - 1);
-  std::vector<ClusterReport> reports(k);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
-    const std::uint32_t f = mesh.face_of_triangle[t];
-    const std::uint32_t c = segmentation.labels[f];
-    if (c >= k)
+  for (std::uint32_t label : segmentation.labels)
+    if (label >= k)
       throw InvalidInputError("describe_clusters: a label is not below the cluster count");
-    const std::array<double, 3> w = graph.corner_weights(t);
-    for (int corner = 0; corner < 3; ++corner) {
-      const Eigen::Vector3d& x = graph.position(mesh.triangles[t][corner]);
-      points[next[c]] = {x.x(), x.y(), x.z()};
-      weights[next[c]++] = w[corner];
-    }
-    reports[c].area += graph.triangle_area(t);
-  }
+  // Triangles of each cluster in ascending order (compressed rows).
+  std::vector<std::uint32_t> offset(k + 1, 0);
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
+    ++offset[segmentation.labels[mesh.face_of_triangle[t]] + 1];
+  for (std::uint32_t c = 0; c < k; ++c) offset[c + 1] += offset[c];
+  std::vector<std::uint32_t> triangles(offset[k]);
+  std::vector<std::uint32_t> next(offset.begin(), offset.end() - 1);
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
+    triangles[next[segmentation.labels[mesh.face_of_triangle[t]]]++] = t;
+  std::vector<ClusterReport> reports(k);
   for (std::uint32_t f = 0; f < mesh.face_count(); ++f)
     ++reports[segmentation.labels[f]].face_count;
-  GeometricFitOptions fit_options = options.fit;
-  if (!options.geometric_fit) fit_options.max_iterations = 0;
-  for (std::uint32_t c = 0; c < k; ++c) {
+  // Each cluster on its own: the same result for any thread count.
+  const unsigned threads = detail::thread_count(options.threads);
+  std::vector<std::vector<Vec3>> points(threads);
+  std::vector<std::vector<double>> weights(threads);
+  detail::parallel_for_threads(k, threads, [&](std::size_t c, unsigned thread) {
     ClusterReport& r = reports[c];
-    r.id = c;
+    r.id = static_cast<std::uint32_t>(c);
     r.node = segmentation.nodes[c];
-    r.algebraic = start[c];
-    // Fitted and measured in the working frame (no overflow for huge inputs), scaled back.
-    const Primitive working = detail::to_working(frame, start[c]);
-    const std::span<const Vec3> cluster_points(points.data() + offset[c],
-                                               offset[c + 1] - offset[c]);
-    const std::span<const double> cluster_weights(weights.data() + offset[c],
-                                                  offset[c + 1] - offset[c]);
-    const GeometricFit fit = fit_geometric(working, cluster_points, cluster_weights, fit_options);
-    r.primitive = fit.iterations > 0 ? frame.to_input(fit.primitive) : start[c];
-    r.rms = std::ldexp(fit.rms, frame.exponent);
-    r.max = std::ldexp(fit.max, frame.exponent);
-    r.area = std::ldexp(r.area, 2 * frame.exponent);
+    points[thread].clear();
+    weights[thread].clear();
+    for (std::uint32_t i = offset[c]; i < offset[c + 1]; ++i) {
+      append_corners(hierarchy, triangles[i], points[thread], weights[thread]);
+      r.area += graph.triangle_area(triangles[i]);
+    }
+    fit_report(graph.frame(), start[c], points[thread], weights[thread], options, r);
+  });
+  return reports;
+}
+
+std::vector<ClusterReport> describe_nodes(const Hierarchy& hierarchy,
+                                          std::span<const std::uint32_t> nodes,
+                                          const DescribeOptions& options) {
+  const DualGraph& graph = hierarchy.graph();
+  const std::uint32_t f = hierarchy.face_count();
+  const auto merges = hierarchy.merges();
+  for (std::uint32_t node : nodes)
+    if (node >= hierarchy.node_count() || (node >= f && merges[node - f].trailing))
+      throw InvalidInputError("describe_nodes: " + std::to_string(node) +
+                              " is not a node of the tree, or joins components");
+  // Leaf order: the faces of every node are contiguous, from leaf_start[node].
+  std::vector<std::uint32_t> leaf_start(hierarchy.node_count(), 0);
+  for (std::uint32_t node = hierarchy.node_count(); node-- > f;) {
+    const Merge& merge = merges[node - f];
+    leaf_start[merge.first] = leaf_start[node];
+    leaf_start[merge.second] = leaf_start[node] + hierarchy.face_count(merge.first);
   }
+  std::vector<std::uint32_t> leaf_order(f);
+  for (std::uint32_t face = 0; face < f; ++face) leaf_order[leaf_start[face]] = face;
+
+  std::vector<ClusterReport> reports(nodes.size());
+  const unsigned threads = detail::thread_count(options.threads);
+  std::vector<std::vector<std::uint32_t>> faces(threads);
+  std::vector<std::vector<Vec3>> points(threads);
+  std::vector<std::vector<double>> weights(threads);
+  detail::parallel_for_threads(nodes.size(), threads, [&](std::size_t i, unsigned thread) {
+    ClusterReport& r = reports[i];
+    r.id = static_cast<std::uint32_t>(i);
+    r.node = nodes[i];
+    r.face_count = hierarchy.face_count(r.node);
+    // Its faces in ascending order: their triangles are then in ascending order, as a cut's.
+    std::vector<std::uint32_t>& node_faces = faces[thread];
+    node_faces.assign(leaf_order.begin() + leaf_start[r.node],
+                      leaf_order.begin() + leaf_start[r.node] + r.face_count);
+    std::sort(node_faces.begin(), node_faces.end());
+    points[thread].clear();
+    weights[thread].clear();
+    for (std::uint32_t face : node_faces)
+      for (std::uint32_t t = graph.first_triangle(face); t < graph.first_triangle(face + 1); ++t) {
+        append_corners(hierarchy, t, points[thread], weights[thread]);
+        r.area += graph.triangle_area(t);
+      }
+    fit_report(graph.frame(), hierarchy.primitive(r.node), points[thread], weights[thread], options,
+               r);
+  });
   return reports;
 }
 

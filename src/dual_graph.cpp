@@ -296,8 +296,8 @@ ClusterStats DualGraph::face_stats(std::uint32_t f, bool with_samples) const {
       const Eigen::Vector3f unit =
           area > 0 ? Eigen::Vector3f((n / (2 * area)).cast<float>()) : Eigen::Vector3f::Zero();
       for (int c = 0; c < 3; ++c)
-        stats.samples.add({positions_[tri[c]], unit, w[c],
-                           SampleReservoir::priority_of(std::uint64_t{t} * 3 + c, w[c])});
+        stats.samples.add({positions_[tri[c]], unit, (centroid - positions_[tri[c]]).cast<float>(),
+                           w[c], SampleReservoir::priority_of(std::uint64_t{t} * 3 + c, w[c])});
     }
     stats.area += area;
     ++stats.triangle_count;

@@ -94,5 +94,50 @@ TEST(Cut, ScipyLinkageIsTheTreeWithStrictlyIncreasingHeights) {
   EXPECT_GT(inversions, 0u);  // fandisk has greedy costs that drop: the rule is exercised
 }
 
+// primseg view carries describe_nodes' reports for the page's clicks: they must be the cut's.
+TEST(Cut, NodeReportsAreTheCutsReportsBitForBit) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.noise = 0.002;
+  const GroundTruthShape shape = make_shape("cylinder_with_sphere_cap", options);
+  const Hierarchy h = build_hierarchy(shape.mesh);
+  std::set<PrimitiveType> types;
+  for (std::uint32_t k : {1u, 2u, 3u, 5u, 40u, h.face_count()}) {
+    const Segmentation seg = cut_by_count(h, k);
+    const auto expected = describe_clusters(h, seg);
+    DescribeOptions serial;
+    serial.threads = 1;
+    const auto reports = describe_nodes(h, seg.nodes, serial);
+    ASSERT_EQ(reports.size(), expected.size());
+    for (std::size_t c = 0; c < reports.size(); ++c) {
+      const ClusterReport &r = reports[c], &e = expected[c];
+      EXPECT_EQ(r.id, c);
+      EXPECT_EQ(r.node, e.node);
+      EXPECT_EQ(r.face_count, e.face_count);
+      EXPECT_EQ(r.area, e.area);
+      EXPECT_EQ(r.rms, e.rms);
+      EXPECT_EQ(r.max, e.max);
+      EXPECT_EQ(r.primitive.type, e.primitive.type);
+      EXPECT_EQ(r.primitive.point, e.primitive.point);
+      EXPECT_EQ(r.primitive.axis, e.primitive.axis);
+      EXPECT_EQ(r.primitive.radius, e.primitive.radius);
+      types.insert(r.primitive.type);
+    }
+  }
+  EXPECT_TRUE(types.count(PrimitiveType::Cylinder) && types.count(PrimitiveType::Sphere));
+  // Any thread count gives the same reports.
+  const Segmentation seg = cut_by_count(h, 40);
+  DescribeOptions two;
+  two.threads = 2;
+  const auto a = describe_nodes(h, seg.nodes, two);
+  const auto b = describe_nodes(h, seg.nodes);
+  for (std::size_t c = 0; c < a.size(); ++c) {
+    EXPECT_EQ(a[c].rms, b[c].rms);
+    EXPECT_EQ(a[c].primitive.point, b[c].primitive.point);
+  }
+  const std::uint32_t trailing_or_outside[] = {h.node_count()};
+  EXPECT_THROW(describe_nodes(h, trailing_or_outside), InvalidInputError);
+}
+
 }  // namespace
 }  // namespace primseg

@@ -93,13 +93,17 @@ struct FacePlaneStats {
   Eigen::Matrix3d normal_normal_matrix() const;
 };
 
-/// A triangle corner of a cluster with its face's unit normal: what the torus fit uses, since no
-/// moment of bounded degree describes a torus (its algebraic distance has degree 4, its square 8).
+/// A triangle corner of a cluster with its face's unit normal and centroid: what the torus fit
+/// uses, since no moment of bounded degree describes a torus (its algebraic distance has degree
+/// 4, its square 8).
 struct SurfaceSample {
   Eigen::Vector3d position;  ///< working frame
   Eigen::Vector3f normal;    ///< unit normal of the corner's triangle (consistently oriented)
-  double weight = 0;         ///< the corner's weight w
-  double priority = 0;       ///< w / u, u in (0, 1] fixed per corner (see SampleReservoir)
+  /// The triangle's centroid − position: where the face's normal is compared with the fitted
+  /// surface's (at a corner, a coarse facet may touch a wrong surface with the right normal).
+  Eigen::Vector3f to_centroid;
+  double weight = 0;    ///< the corner's weight w
+  double priority = 0;  ///< w / u, u in (0, 1] fixed per corner (see SampleReservoir)
 };
 
 /// A priority sample (Duffield, Lund and Thorup, 2007) of a cluster's weighted corners: the

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "primseg/geometric_fit.hpp"
@@ -54,6 +55,8 @@ struct DescribeOptions {
   /// (fit_geometric); off: report the starting primitive as it is.
   bool geometric_fit = true;
   GeometricFitOptions fit;
+  /// Threads over the clusters (0: all hardware threads); the reports are the same for any.
+  unsigned threads = 0;
 };
 
 /// Reports of every cluster of a cut, in label order, each started from its node's primitive.
@@ -68,6 +71,15 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
                                              const Segmentation& segmentation,
                                              const std::vector<Primitive>& start,
                                              const DescribeOptions& options = {});
+
+/// Reports of tree nodes, in the order given, each the report describe_clusters makes when the
+/// node is a cluster of a cut (same primitive, rms, max and area, bit for bit): what `primseg
+/// view` carries for the levels a user may click. `id` is the node's index in `nodes`. O(size of
+/// the node) per node and geometric fit iteration, plus O(F) once. Throws InvalidInputError for
+/// a node outside the tree or a trailing merge (which joins components and has no fit).
+std::vector<ClusterReport> describe_nodes(const Hierarchy& hierarchy,
+                                          std::span<const std::uint32_t> nodes,
+                                          const DescribeOptions& options = {});
 
 /// The whole tree as SciPy's linkage matrix, shape (F − 1, 4): children node ids, height, face
 /// count; row i creates node F + i (Hierarchy::merges() order, trailing merges last).

@@ -1,5 +1,5 @@
 // Torus: from the cluster's bounded corner sample (ClusterStats::samples, at most 32 corners with
-// their face normals), so a candidate costs the same for any cluster size.
+// their faces' normals and centroids), so a candidate costs the same for any cluster size.
 //
 // 1. Axis: every normal line of a surface of revolution meets its axis. A line (d, m) in Plücker
 //    coordinates meets the axis (a, p × a) iff d·(p × a) + a·m = 0, linear in (a, p × a): the
@@ -19,6 +19,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -138,21 +139,32 @@ PrimitiveFit TorusFitter::fit(const ClusterStats& centred) const {
         torus.minor_radius <= kMaxRelativeMinorRadius))
     return result;
 
-  // Face normals must follow the torus's: mean |n · ν| over the sample.
+  // Face normals must follow the torus's across each face: mean |n · ν| over the sample, ν the
+  // torus's normal at the point nearest the corner, and again nearest the face's centroid (where
+  // the cylinder and sphere compare them); the lower mean counts. The corners alone are not
+  // enough: the vertices of a flat cap's fan all lie on the torus's top circle, where its normal
+  // is the cap's, yet the faces between them leave the torus.
   const Eigen::Vector3d torus_centre(torus.point[0], torus.point[1], torus.point[2]);
   const Eigen::Vector3d torus_axis(torus.axis[0], torus.axis[1], torus.axis[2]);
-  double alignment = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 nearest = torus.closest_point(points[i]);
-    const Eigen::Vector3d y = positions[i] - torus_centre;
+  // |f · ν(x)| for the face normal f, 0 on the axis (no normal, no agreement).
+  auto agreement = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& face_normal) {
+    const Eigen::Vector3d y = x - torus_centre;
     const Eigen::Vector3d radial = y - torus_axis * torus_axis.dot(y);
-    if (!(radial.squaredNorm() > 0)) continue;  // on the axis: no normal, no agreement
+    if (!(radial.squaredNorm() > 0)) return 0.0;
+    const Vec3 nearest = torus.closest_point({x.x(), x.y(), x.z()});
     const Eigen::Vector3d ring = torus_centre + radial.normalized() * torus.radius;
     const Eigen::Vector3d normal =
         (Eigen::Vector3d(nearest[0], nearest[1], nearest[2]) - ring).normalized();
-    alignment += weights[i] * std::abs(normal.dot(normals[i]));
+    return std::abs(normal.dot(face_normal));
+  };
+  double at_corners = 0, at_centroids = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    at_corners += weights[i] * agreement(positions[i], normals[i]);
+    const Eigen::Vector3d centroid =
+        positions[i] + reservoir.samples[i].to_centroid.cast<double>() * scale;
+    at_centroids += weights[i] * agreement(centroid, normals[i]);
   }
-  result.normal_alignment = alignment / sample_weight;
+  result.normal_alignment = std::min(at_corners, at_centroids) / sample_weight;
   if (!(result.normal_alignment >= kMinNormalAlignment)) return result;
 
   double error = refined.rms * refined.rms * weight;  // refined.rms: Σ ŵ d² / Σ ŵ

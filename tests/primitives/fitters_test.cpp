@@ -386,6 +386,35 @@ TEST(TorusFitter, CylindersConesAndSpheresAreNotTori) {
   }
 }
 
+// A CAD-style fillet (a quarter torus) and the flat top it rounds into, a fan of triangles whose
+// vertices all lie on the torus's top circle, where the torus's normal is the top's: every
+// vertex is on the torus, but the fan's faces leave it. The fillet is a torus, the union is not.
+TEST(TorusFitter, AFlatFanOnTheTopCircleIsNotPartOfTheTorus) {
+  const double major = 2, minor = 0.5, span = 1.5 * M_PI;
+  const auto torus_point = [&](double tube, double around) {
+    const double ring = major + minor * std::cos(tube);
+    return Vec3{ring * std::cos(around), ring * std::sin(around), minor * std::sin(tube)};
+  };
+  const Mesh fillet =
+      grid_mesh(4, 24, [&](double u, double v) { return torus_point(M_PI / 2 * u, span * v); });
+  std::vector<Vec3> positions = fillet.positions;
+  std::vector<Triangle> triangles = fillet.triangles;
+  const auto first = static_cast<std::uint32_t>(positions.size());
+  const int arc = 24;
+  for (int j = 0; j <= arc; ++j) positions.push_back(torus_point(M_PI / 2, span * j / arc));
+  for (std::uint32_t j = 1; j < arc; ++j) triangles.push_back({first, first + j, first + j + 1});
+  const Mesh with_top = Mesh::from_triangles(std::move(positions), std::move(triangles));
+
+  Primitive p;
+  const PrimitiveFit alone = fit_whole(fillet, TorusFitter(), &p);
+  ASSERT_TRUE(alone.valid);
+  EXPECT_NEAR(p.radius, major, 1e-6);
+  EXPECT_NEAR(p.minor_radius, minor, 1e-6);
+  const PrimitiveFit both = fit_whole(with_top, TorusFitter(), &p);
+  EXPECT_FALSE(both.valid) << "normal agreement " << both.normal_alignment << ", R " << p.radius
+                           << " r " << p.minor_radius;
+}
+
 TEST(Fitters, DegenerateClustersNeverYieldNonFiniteOrWinningCurvedFits) {
   // One triangle, a collinear sliver, and a flat patch given to the curved fitters.
   const Mesh triangle =

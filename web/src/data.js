@@ -24,12 +24,16 @@ async function readArray(document, name, ArrayType, required = true) {
 /**
  * The page's data.
  * header: {faces F, vertices V, triangles T, components C, center [3], bboxDiagonal, weights,
- *          firstMergeWithParameters, initialClusters, name, levels?, skeleton?}
+ *          maxClustersWithParameters, initialClusters, name, levels?, skeleton?}
  * positions Float32Array (V*3, relative to header.center), triangles Uint32Array (T*3),
  * faceOfTriangle Uint32Array (T) or null for the identity, children Uint32Array ((F-1)*2),
  * rms Float64Array (F-1, merge nodes' RMS estimates, input units), types Uint8Array (F-1),
- * parameters Float64Array (9 per merge from firstMergeWithParameters to the last real one:
- * point 3 (relative to center), axis 3, radius, minor_radius, half_angle), leafRms or null.
+ * parameterNodes Uint32Array (ascending: every cluster of every level of at most
+ * header.maxClustersWithParameters clusters, as primseg cut --clusters K makes them), and for
+ * each of them the primitive primseg reports (the geometric fit, cut.hpp describe_clusters):
+ * parameters Float64Array (9 per node: point 3 (relative to center), axis 3, radius,
+ * minor_radius, half_angle) and errors Float64Array (2 per node: exact RMS and maximum distance
+ * of the node's vertices to it, input units); leafRms or null.
  *
  * header.autoLevel: the automatic level's K (auto_level.hpp choose_level); header.levels: its
  * candidates [{clusters, rms, score}], best score first.
@@ -47,16 +51,18 @@ export async function readPageData(document) {
   const headerElement = document.getElementById('primseg-header');
   if (!headerElement) throw new Error('the page has no primseg data: was it written by primseg view?');
   const header = JSON.parse(headerElement.textContent);
-  if (header.format !== 1) throw new Error(`unknown page data format ${header.format}`);
-  const [positions, triangles, faceOfTriangle, children, rms, types, parameters, leafRms] =
-    await Promise.all([
+  if (header.format !== 2) throw new Error(`unknown page data format ${header.format}`);
+  const [positions, triangles, faceOfTriangle, children, rms, types, parameterNodes, parameters, errors,
+    leafRms] = await Promise.all([
       readArray(document, 'positions', Float32Array),
       readArray(document, 'triangles', Uint32Array),
       readArray(document, 'face-of-triangle', Uint32Array, false),
       readArray(document, 'children', Uint32Array),
       readArray(document, 'rms', Float64Array),
       readArray(document, 'types', Uint8Array),
+      readArray(document, 'parameter-nodes', Uint32Array),
       readArray(document, 'parameters', Float64Array),
+      readArray(document, 'errors', Float64Array),
       readArray(document, 'leaf-rms', Float64Array, false),
     ]);
   const F = header.faces;
@@ -69,8 +75,12 @@ export async function readPageData(document) {
     'faces of triangles');
   check(children.length === 2 * (F - 1) && rms.length === F - 1 && types.length === F - 1,
     'merges');
+  check(parameters.length === 9 * parameterNodes.length && errors.length === 2 * parameterNodes.length &&
+    parameterNodes.every((node, i) => node < 2 * F - 1 && (i === 0 || node > parameterNodes[i - 1])),
+  'primitive parameters');
   const skeleton = header.skeleton ? await readSkeleton(document, header, check) : null;
-  return { header, positions, triangles, faceOfTriangle, children, rms, types, parameters, leafRms, skeleton };
+  return { header, positions, triangles, faceOfTriangle, children, rms, types, parameterNodes, parameters, errors,
+    leafRms, skeleton };
 }
 
 const SKELETON_ARRAYS = {

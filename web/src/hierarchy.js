@@ -118,10 +118,25 @@ export class Tree {
     return node >= this.faceCount ? this.data.types[node - this.faceCount] : 0;
   }
 
-  /** Fitted primitive of a merge node, if the page carries it; relative to header.center. */
+  /** Index of a node among those whose primitive the page carries, or -1. O(log). */
+  parameterIndex(node) {
+    const nodes = this.data.parameterNodes;
+    let low = 0, high = nodes.length;
+    while (low < high) {
+      const middle = (low + high) >>> 1;
+      if (nodes[middle] < node) low = middle + 1;
+      else high = middle;
+    }
+    return low < nodes.length && nodes[low] === node ? low : -1;
+  }
+
+  /**
+   * The primitive primseg reports for a node as a cluster (the geometric fit), if the page
+   * carries it: {type, point (relative to header.center), axis, radius, minorRadius, halfAngle}.
+   */
   primitive(node) {
-    const i = node - this.faceCount - this.data.header.firstMergeWithParameters;
-    if (node < this.faceCount || i < 0 || node - this.faceCount >= this.realMerges) return null;
+    const i = this.parameterIndex(node);
+    if (i < 0) return null;
     const p = this.data.parameters.subarray(9 * i, 9 * i + 9);
     return {
       type: this.type(node),
@@ -131,6 +146,12 @@ export class Tree {
       minorRadius: p[7],
       halfAngle: p[8],
     };
+  }
+
+  /** Exact RMS and maximum distance of a node's vertices to primitive(node), or null. */
+  errors(node) {
+    const i = this.parameterIndex(node);
+    return i < 0 ? null : { rms: this.data.errors[2 * i], max: this.data.errors[2 * i + 1] };
   }
 
   /** Smallest number of clusters any cut has (one per connected component). */

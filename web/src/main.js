@@ -387,6 +387,8 @@ class Viewer {
       this.primitiveMesh.geometry.dispose();
       this.primitiveMesh = null;
     }
+    // The clusters whose primitive is drawn (primseg's reported fit: Tree.primitive).
+    this.drawnPrimitives = [];
     if (!$('show-primitives').checked) return this.render();
     const cut = this.cut;
     if (cut.size > MAX_DRAWN_PRIMITIVES) {
@@ -417,6 +419,7 @@ class Viewer {
       }
       const surface = primitiveSurface(primitive, points, patch);
       if (!surface) continue;
+      this.drawnPrimitives.push(c);
       const base = vertices.length / 3;
       const rgb = this.clusterRgb(c).map((x) => Math.min(255, x + 60) / 255);
       for (let i = 0; i < surface.vertices.length; i += 3) {
@@ -477,7 +480,10 @@ class Viewer {
       rmsEstimate: tree.rms(node),
     };
     if (primitive) {
-      const { rms, max } = clusterErrors(primitive, this.data.positions, this.data.triangles, ids, this.cornerWeight());
+      // primseg's own figures where the page carries them; else (a single face of a fine level)
+      // measured here, on the page's float32 positions.
+      const { rms, max } = tree.errors(node) ??
+        clusterErrors(primitive, this.data.positions, this.data.triangles, ids, this.cornerWeight());
       info.rms = rms;
       info.max = max;
       const center = header.center;

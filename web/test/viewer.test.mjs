@@ -56,6 +56,27 @@ function assertSameLabels(labels, expected, area, diagonal, what) {
   if (renumbered) console.log(`# ${what}: ${renumbered} of ${area.length} clusters of near-equal area numbered in another order`);
 }
 
+/**
+ * Asserts that the page's report of a cluster (its click panel) is primseg cut's (its JSON):
+ * the same geometric fit and the same exact errors. The page gets primseg's numbers as doubles:
+ * RMS and max are equal; the parameters are too, but for the round-off of the page's centring
+ * (point − center + center), far below 1e-12 of the diagonal.
+ */
+function assertSameReport(info, expected, diagonal, what) {
+  assert.equal(info.type, expected.type, what);
+  assert.equal(info.faces, expected.faces, what);
+  assert.ok(Math.abs(info.area - expected.area) < 1e-5 * expected.area, `${what}: area ${info.area} vs ${expected.area}`);
+  assert.equal(info.rms, expected.rms, `${what}: rms`);
+  assert.equal(info.max, expected.max, `${what}: max`);
+  assert.deepEqual(Object.keys(info.params).sort(), Object.keys(expected.params).sort(), what);
+  for (const [key, value] of Object.entries(expected.params)) {
+    const shown = info.params[key];
+    const length = /radius|center|point|apex/.test(key) ? diagonal : 1;  // angles, unit vectors: 1
+    const values = Array.isArray(value) ? value : [value], got = Array.isArray(shown) ? shown : [shown];
+    values.forEach((v, a) => assert.ok(Math.abs(got[a] - v) <= 1e-12 * length, `${what}: ${key} ${got} vs ${values}`));
+  }
+}
+
 /** Distinct non-background colours drawn from six axis views, as cluster indices (code - 1). */
 async function drawnClusters(page) {
   const codes = new Set();
@@ -218,17 +239,40 @@ test('fandisk: a click reports the cluster under the pointer, as primseg reports
     assert.equal(info.faces, expected.faces);
     const panel = await page.textContent('#info');
     assert.match(panel, new RegExp(`cluster ${expected.id} of ${K}`));
-    const diagonal = 1.2; // fandisk's, about
-    // The CLI reports the primitive refined by a geometric fit (geometric_fit.hpp, which lowers
-    // the RMS distance) and its errors; the page shows the tree's own fit and its exact errors.
-    assert.ok(info.rms >= expected.rms - 1e-6 * diagonal && info.rms <= 1.5 * expected.rms + 1e-6 * diagonal,
-      `rms ${info.rms} vs ${expected.rms} (refined)`);
-    assert.ok(info.max >= info.rms - 1e-12, `max ${info.max} below rms ${info.rms}`);
-    assert.ok(Math.abs(info.area - expected.area) < 1e-5 * expected.area, `area ${info.area} vs ${expected.area}`);
-    if (expected.type === 'cylinder' || expected.type === 'sphere')
-      assert.ok(Math.abs(info.params.radius - expected.params.radius) < 0.05 * expected.params.radius,
-        `radius ${info.params.radius} vs ${expected.params.radius} (refined)`);
+    assertSameReport(info, expected, 1.2 /* fandisk's diagonal, about */, `cluster ${expected.id}`);
+    for (const row of ['RMS', 'max error']) assert.ok(panel.includes(row), `the panel shows the ${row}`);
   }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('fandisk: every cluster\'s panel shows the fit and errors primseg cut reports, at every kind of level', async () => {
+  const { page, errors } = await openViewer(browser, join(work, 'fandisk.html'));
+  const tree = join(work, 'fandisk.tree'), labelsFile = join(work, 'panel.labels'), jsonFile = join(work, 'panel.json');
+  const diagonal = await page.evaluate(async () => (await window.primseg.ready).header.bboxDiagonal);
+  const seen = new Set();
+  // Coarse levels, one where single faces are clusters, and a level by tolerance.
+  for (const [option, value] of [['--clusters', '1'], ['--clusters', '27'], ['--clusters', '300'],
+    ['--clusters', '9000'], ['--tolerance', '0.1%']]) {
+    primseg('cut', tree, option, value, '--labels', labelsFile, '--json', jsonFile, '--quiet');
+    const labels = readLabels(labelsFile), clusters = JSON.parse(readFileSync(jsonFile, 'utf8')).clusters;
+    const tolerance = value.endsWith('%') ? (Number(value.slice(0, -1)) / 100) * diagonal : 0;
+    const shown = await page.evaluate(async ([byCount, x]) => {
+      const viewer = await window.primseg.ready;
+      if (byCount) viewer.setClusters(x);
+      else viewer.setTolerance(x);
+      const faceCluster = viewer.cut.faceCluster, first = new Int32Array(viewer.cut.size).fill(-1);
+      faceCluster.forEach((c, f) => { if (first[c] < 0) first[c] = f; });
+      return Array.from(first, (face, c) => ({ face, ...viewer.describe(c, face) }));
+    }, [option === '--clusters', option === '--clusters' ? Number(value) : tolerance]);
+    assert.equal(shown.length, clusters.length);
+    for (const info of shown) {
+      const expected = clusters[labels[info.face]];
+      assertSameReport(info, expected, diagonal, `${option} ${value}, cluster ${expected.id}`);
+      seen.add(expected.type);
+    }
+  }
+  for (const type of ['plane', 'cylinder', 'sphere']) assert.ok(seen.has(type), `a ${type} cluster is compared`);
   assert.deepEqual(errors, []);
   await page.close();
 });
@@ -236,11 +280,24 @@ test('fandisk: a click reports the cluster under the pointer, as primseg reports
 test('fandisk: screenshot with the fitted primitives drawn', async () => {
   const { page, errors } = await openViewer(browser, join(work, 'fandisk.html'), { width: 1100, height: 700 });
   await page.check('#show-primitives');
-  const drawn = await page.evaluate(async () => {
+  const { drawn, surfaces } = await page.evaluate(async () => {
     const viewer = await window.primseg.ready;
-    return viewer.primitiveMesh ? viewer.primitiveMesh.geometry.index.count / 3 : 0;
+    const faceCluster = viewer.cut.faceCluster;
+    // Each drawn surface with a face of its cluster and its parameters as the panel shows them.
+    const surfaces = viewer.drawnPrimitives.map((c) => {
+      const face = faceCluster.indexOf(c);
+      return { face, ...viewer.describe(c, face) };
+    });
+    return { drawn: viewer.primitiveMesh ? viewer.primitiveMesh.geometry.index.count / 3 : 0, surfaces };
   });
   assert.ok(drawn > 0, 'primitive surfaces are drawn');
+  // The surfaces drawn are primseg's reported (geometric) fits, one per cluster of the level.
+  primseg('cut', join(work, 'fandisk.tree'), '--clusters', '27', '--labels', join(work, 'd.labels'),
+    '--json', join(work, 'd.json'), '--quiet');
+  const labels = readLabels(join(work, 'd.labels'));
+  const clusters = JSON.parse(readFileSync(join(work, 'd.json'), 'utf8')).clusters;
+  assert.equal(surfaces.length, 27);
+  for (const info of surfaces) assertSameReport(info, clusters[labels[info.face]], 1.2, `drawn cluster ${info.id}`);
   await page.uncheck('#show-primitives');
   await page.selectOption('#color-mode', 'type');
   await page.screenshot({ path: join(artifacts, 'fandisk-types.png') });
