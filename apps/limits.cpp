@@ -41,7 +41,7 @@ void add_limit_options(CLI::App& command, ResourceLimits& limits) {
           "--max-memory",
           [&limits](const std::string& text) { limits.max_memory = parse_byte_size(text); },
           "Refuse inputs whose estimated peak memory exceeds this (bytes, or with a K, M, G "
-          "suffix; about 1.5 KB per face)")
+          "suffix; about 1 KB per face)")
       ->type_name("SIZE");
 }
 

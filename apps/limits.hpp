@@ -11,9 +11,9 @@
 
 namespace primseg::cli {
 
-/// Peak memory of `segment` per input face, measured with bench/primseg_bench_memory (whole
-/// process, 1,150 to 1,480 bytes per face from 13k to 224k faces), rounded up.
-inline constexpr std::uint64_t kBytesPerFace = 1536;
+/// Peak memory of `segment` per input face, with a margin: measured with bench/scaling.sh (whole
+/// process, 532 to 784 bytes per face from 1.2M down to 13k faces).
+inline constexpr std::uint64_t kBytesPerFace = 1024;
 
 struct ResourceLimits {
   std::optional<std::uint32_t> max_faces;  ///< refuse meshes with more input faces

@@ -178,10 +178,10 @@ class HierarchyBuilder::Impl {
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights);
     const std::uint32_t f = mesh_->face_count();
     const unsigned threads = detail::thread_count(options_.threads);
-    // Statistics are stored for merged clusters only (at most F / 2 live at once); a single
-    // face's are recomputed when needed, which costs less than a fit.
+    // Statistics are stored for clusters of three faces or more only (at most F / 3 live at
+    // once); a single face's or a pair's are recomputed when needed (see store_pair()).
     stats_index_of_slot_.assign(f, kNone);
-    stats_.reserve(f / 2 + 1);  // address space only: pages are touched as clusters form
+    stats_.reserve(f / 3 + 1);  // address space only: pages are touched as clusters form
     merges_.reserve(f - 1);
     slot_of_node_.assign(2 * std::size_t{f}, kNone);
     for (std::uint32_t face = 0; face < f; ++face) slot_of_node_[face] = face;
