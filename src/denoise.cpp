@@ -368,17 +368,13 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
 
 void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
                        Segmentation& segmentation) const {
+  if (options_.relabel_passes == 0) return;
   std::vector<std::uint32_t>& labels = segmentation.labels;
-  // The faces' triangles, and the clusters of the faces around each face (sharing a vertex).
-  std::vector<std::uint32_t> face_offsets(mesh_.face_count() + 1, 0), face_triangles;
+  // Face f's triangles are [face_offsets[f], face_offsets[f + 1]): a valid mesh's
+  // face_of_triangle is non-decreasing.
+  std::vector<std::uint32_t> face_offsets(mesh_.face_count() + 1, 0);
   for (const std::uint32_t f : mesh_.face_of_triangle) ++face_offsets[f + 1];
   for (std::uint32_t f = 0; f < mesh_.face_count(); ++f) face_offsets[f + 1] += face_offsets[f];
-  face_triangles.resize(mesh_.triangle_count());
-  {
-    std::vector<std::uint32_t> next(face_offsets.begin(), face_offsets.end() - 1);
-    for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t)
-      face_triangles[next[mesh_.face_of_triangle[t]]++] = t;
-  }
   const std::vector<Primitive> hierarchy_fits = primitives;
   std::vector<std::uint32_t> near, next;
   for (int pass = 0; pass < options_.relabel_passes; ++pass) {
@@ -387,7 +383,7 @@ void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
     for (std::uint32_t f = 0; f < mesh_.face_count(); ++f) {
       near.clear();
       for (std::uint32_t i = face_offsets[f]; i < face_offsets[f + 1]; ++i)
-        for (const std::uint32_t v : mesh_.triangles[face_triangles[i]])
+        for (const std::uint32_t v : mesh_.triangles[i])
           for (std::uint32_t j = vertex_triangle_offsets_[v]; j < vertex_triangle_offsets_[v + 1];
                ++j)
             near.push_back(labels[mesh_.face_of_triangle[vertex_triangles_[j]]]);
@@ -401,7 +397,7 @@ void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
       for (const std::uint32_t c : near) {
         double cost = 0;
         for (std::uint32_t i = face_offsets[f]; i < face_offsets[f + 1]; ++i)
-          for (const std::uint32_t v : mesh_.triangles[face_triangles[i]]) {
+          for (const std::uint32_t v : mesh_.triangles[i]) {
             const double d = primitives[c].distance(judged.positions[v]);
             cost += d * d;
           }
@@ -433,12 +429,8 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   for (const ClusterReport& cluster : describe_clusters(hierarchy, segmentation))
     primitives.push_back(cluster.primitive);
   if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
-  Segmentation relabeled;
-  if (options_.relabel_passes > 0) {
-    relabeled = segmentation;
-    relabel(segmented, primitives, relabeled);
-  }
-  const Segmentation& labelled = options_.relabel_passes > 0 ? relabeled : segmentation;
+  Segmentation labelled = segmentation;
+  relabel(segmented, primitives, labelled);
 
   SnapReport report;
   report.clusters = segmentation.cluster_count();
