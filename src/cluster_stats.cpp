@@ -81,6 +81,13 @@ inline void apply_translation_terms(std::index_sequence<n...>, const double* shi
    ...);
 }
 
+// values[n] += w x^i y^j z^k for every monomial n, unrolled at compile time.
+template <std::size_t... n>
+inline void add_monomials(std::index_sequence<n...>, const double* px, const double* py,
+                          const double* pz, double w, double* values) {
+  ((values[n] += w * (px[kMonomials[n].i] * py[kMonomials[n].j] * pz[kMonomials[n].k])), ...);
+}
+
 // Monomial index of the full tensor entry with axes (a, b, c, d) (a 4-digit base-3 number;
 // lower degrees pad with the axis value 3, which adds no exponent).
 constexpr std::array<std::uint8_t, 256> make_axes_index() {
@@ -101,9 +108,11 @@ constexpr int axes(int a, int b, int c = 3, int d = 3) {
 
 }  // namespace
 
-int Moments::index(int i, int j, int k) {
-  return kIndex[(i * 5 + j) * 5 + k];
-}
+static_assert([] {
+  for (int n = 0; n < Moments::kCount; ++n)
+    if (Moments::index(kMonomials[n].i, kMonomials[n].j, kMonomials[n].k) != n) return false;
+  return true;
+}());
 
 Eigen::Vector3d Moments::centroid() const {
   if (!(values_[0] > 0)) return origin_;
@@ -112,7 +121,7 @@ Eigen::Vector3d Moments::centroid() const {
                        values_[0];
 }
 
-void Moments::add_point(const Eigen::Vector3d& x, double w) {
+void Moments::add_point(const Eigen::Vector3d& x, double w, int max_degree) {
   const Eigen::Vector3d d = x - origin_;
   double px[5], py[5], pz[5];
   px[0] = py[0] = pz[0] = 1;
@@ -121,15 +130,16 @@ void Moments::add_point(const Eigen::Vector3d& x, double w) {
     py[p] = py[p - 1] * d.y();
     pz[p] = pz[p - 1] * d.z();
   }
-  for (int n = 0; n < kCount; ++n) {
-    const Monomial& m = kMonomials[n];
-    values_[n] += w * (px[m.i] * py[m.j] * pz[m.k]);
-  }
+  if (max_degree >= 4)
+    add_monomials(std::make_index_sequence<kCount>(), px, py, pz, w, values_.data());
+  else
+    add_monomials(std::make_index_sequence<kCountUpToDegree2>(), px, py, pz, w, values_.data());
 }
 
 Moments Moments::translated(const Eigen::Vector3d& new_origin, int max_degree) const {
   // Σ w (y − d)^α with y = x − o and d = o' − o: each target monomial α is a fixed combination
   // Σ_β C(α, β) (−d)^(α−β) M_β over sub-monomials β ≤ α, listed once in kTranslationTerms.
+  if (new_origin == origin_ && max_degree >= 4) return *this;
   const Eigen::Vector3d d = new_origin - origin_;
   double px[5], py[5], pz[5];
   px[0] = py[0] = pz[0] = 1;

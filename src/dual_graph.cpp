@@ -263,28 +263,74 @@ double DualGraph::triangle_area(std::uint32_t t) const {
 }
 
 std::array<double, 3> DualGraph::corner_weights(std::uint32_t t) const {
+  return corner_weights(t, weights_ == VertexWeights::Area ? triangle_area(t) : 0.0);
+}
+
+std::array<double, 3> DualGraph::corner_weights(std::uint32_t t, double area) const {
   const Triangle& tri = mesh_->triangles[t];
   if (weights_ == VertexWeights::Uniform)
     return {1.0 / valence_[tri[0]], 1.0 / valence_[tri[1]], 1.0 / valence_[tri[2]]};
-  const double area = triangle_area(t);
   return {area / 3, area / 3, area / 3};
 }
 
-ClusterStats DualGraph::face_stats(std::uint32_t f, bool with_samples) const {
+ClusterStats DualGraph::face_stats(std::uint32_t f, bool with_samples, int max_degree) const {
   ClusterStats stats;
+  face_stats(f, stats, with_samples, max_degree);
+  return stats;
+}
+
+void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_samples,
+                           int max_degree) const {
   const std::uint32_t begin = first_triangle_[f], end = first_triangle_[f + 1];
-  {
+  // Area vectors and corner weights first: the moments are taken about the weighted centroid of
+  // the corners (the first triangle's centroid if they weigh nothing), so that the statistics are
+  // centred as the fitters and unions expect. Most faces are one triangle.
+  struct Corners {
+    Eigen::Vector3d normal;  // oriented, length twice the area
+    std::array<double, 3> weights;
+  };
+  constexpr std::uint32_t kInline = 4;
+  std::array<Corners, kInline> inline_corners;
+  std::vector<Corners> many;
+  Corners* corners = inline_corners.data();
+  if (end - begin > kInline) {
+    many.resize(end - begin);
+    corners = many.data();
+  }
+  Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
+  double weight = 0;
+  for (std::uint32_t t = begin; t < end; ++t) {
+    const Triangle& tri = mesh_->triangles[t];
+    Corners& c = corners[t - begin];
+    c.normal =
+        (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
+    if (flipped_[t]) c.normal = -c.normal;
+    c.weights = corner_weights(t, 0.5 * c.normal.norm());
+    for (int k = 0; k < 3; ++k) {
+      weighted_sum += c.weights[k] * positions_[tri[k]];
+      weight += c.weights[k];
+    }
+  }
+  if (weight > 0) {
+    stats.moments = Moments(weighted_sum / weight);
+  } else {
     const Triangle& first = mesh_->triangles[begin];
     stats.moments =
         Moments((positions_[first[0]] + positions_[first[1]] + positions_[first[2]]) / 3);
   }
+  stats.edges = {};
+  stats.normal_sum.setZero();
+  stats.normal_position.setZero();
+  stats.face_planes = {};
+  stats.area = 0;
+  stats.triangle_count = 0;
+  stats.samples.samples.clear();
   for (std::uint32_t t = begin; t < end; ++t) {
     const Triangle& tri = mesh_->triangles[t];
-    const std::array<double, 3> w = corner_weights(t);
-    for (int c = 0; c < 3; ++c) stats.moments.add_point(positions_[tri[c]], w[c]);
-    Eigen::Vector3d n =
-        (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
-    if (flipped_[t]) n = -n;
+    const Corners& c = corners[t - begin];
+    for (int k = 0; k < 3; ++k)
+      stats.moments.add_point(positions_[tri[k]], c.weights[k], max_degree);
+    const Eigen::Vector3d& n = c.normal;
     const Eigen::Vector3d centroid =
         (positions_[tri[0]] + positions_[tri[1]] + positions_[tri[2]]) / 3;
     stats.normal_position += (centroid - stats.moments.origin()) * (0.5 * n).transpose();
@@ -295,9 +341,10 @@ ClusterStats DualGraph::face_stats(std::uint32_t f, bool with_samples) const {
     if (with_samples) {
       const Eigen::Vector3f unit =
           area > 0 ? Eigen::Vector3f((n / (2 * area)).cast<float>()) : Eigen::Vector3f::Zero();
-      for (int c = 0; c < 3; ++c)
-        stats.samples.add({positions_[tri[c]], unit, (centroid - positions_[tri[c]]).cast<float>(),
-                           w[c], SampleReservoir::priority_of(std::uint64_t{t} * 3 + c, w[c])});
+      for (int k = 0; k < 3; ++k)
+        stats.samples.add({positions_[tri[k]], unit, (centroid - positions_[tri[k]]).cast<float>(),
+                           c.weights[k],
+                           SampleReservoir::priority_of(std::uint64_t{t} * 3 + k, c.weights[k])});
     }
     stats.area += area;
     ++stats.triangle_count;
@@ -306,7 +353,7 @@ ClusterStats DualGraph::face_stats(std::uint32_t f, bool with_samples) const {
       std::lower_bound(internal_edges_.begin(), internal_edges_.end(), f,
                        [](const auto& entry, std::uint32_t face) { return entry.first < face; });
   for (; it != internal_edges_.end() && it->first == f; ++it) stats.edges += it->second;
-  return stats;
+  stats.moments.discard_first_moments();
 }
 
 }  // namespace primseg

@@ -6,6 +6,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "indexed_heap.hpp"
 #include "model_selection.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
@@ -16,18 +17,19 @@ namespace {
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr std::uint32_t kPairTag = 1u << 31;
 
-// Candidate merges ordered by (cost, primitive type, degree of the merged node, smaller id, larger
-// id). On equal cost (in practice: zero, exact fits) simpler types go first, so flat regions are
-// whole before exact curved fits can reach into them.
+// A candidate merge in the queue: the dual edge's id and its key. Candidates are ordered by
+// (cost, exactness, primitive type, merged degree, smaller node id, larger node id). On equal cost
+// simpler types go first, so flat regions are whole before exact curved fits can reach into them.
 //
-// Lazy evaluation adds entries whose cost is only a lower bound of the candidate's (exact =
-// false). At equal cost a bound comes before every exact entry, so when an exact entry reaches
-// the top every bound left is strictly above it: it is the same minimum the eager scheme finds.
+// Lazy evaluation queues candidates whose cost is only a lower bound of theirs (exact = false). At
+// equal cost a bound comes before every exact entry, so when an exact entry reaches the top every
+// bound left is strictly above it: it is the same minimum the eager scheme finds.
 //
-// 24 bytes, as the heap holds up to 1.25 entries per live edge. An entry is stale once either
-// cluster has merged: node ids are never reused, so (low, high) tells it apart from the edge's
-// current clusters, and live entries have distinct keys.
-struct HeapEntry {
+// The merged degree is part of the key only at cost zero, where the exact fits of flat and
+// exactly curved regions tie in large numbers: it is taken when the candidate is evaluated. Above
+// zero the degree is 0 in the key, and exact ties among the cheapest candidates (rare) are settled
+// by their current degrees when they reach the top (see step()).
+struct QueuedCandidate {
   static constexpr std::uint32_t kMaxDegree = (1u << 28) - 1;
 
   double cost;
@@ -35,35 +37,21 @@ struct HeapEntry {
   // kMaxDegree: a cluster with 2^28 neighbours is beyond any mesh this ranks), so that comparing
   // ranks compares (exact, type, degree).
   std::uint32_t rank;
-  std::uint32_t low, high;
-  std::uint32_t edge;
+  std::uint32_t id;  // the dual edge
 
-  HeapEntry() = default;
-  HeapEntry(double key_cost, bool is_exact, PrimitiveType type, std::uint32_t merged_degree,
-            std::uint32_t a, std::uint32_t b, std::uint32_t edge_id)
+  QueuedCandidate() = default;
+  QueuedCandidate(double key_cost, bool is_exact, PrimitiveType type, std::uint32_t edge_id)
       : cost(key_cost),
         rank(std::uint32_t{is_exact} << 31 | static_cast<std::uint32_t>(type) << 28),
-        low(std::min(a, b)),
-        high(std::max(a, b)),
-        edge(edge_id) {
-    set_degree(merged_degree);
-  }
+        id(edge_id) {}
   bool exact() const { return (rank >> 31) != 0; }
   std::uint32_t degree() const { return rank & kMaxDegree; }
   void set_degree(std::uint32_t merged_degree) {
     rank = (rank & ~kMaxDegree) | std::min(merged_degree, kMaxDegree);
   }
 };
-static_assert(sizeof(HeapEntry) == 24);
+static_assert(sizeof(QueuedCandidate) == 16);
 static_assert(kPrimitiveTypeCount <= 8);
-
-// std heaps are max-heaps: "a after b" puts the smallest key on top.
-bool comes_after(const HeapEntry& a, const HeapEntry& b) {
-  if (a.cost != b.cost) return a.cost > b.cost;
-  if (a.rank != b.rank) return a.rank > b.rank;
-  if (a.low != b.low) return a.low > b.low;
-  return a.high > b.high;
-}
 
 // 16 bytes: the builder keeps one per dual edge.
 struct LiveEdge {
@@ -76,9 +64,8 @@ struct LiveEdge {
   float cost_bound = 0;
 
   bool alive() const { return a != kNone; }
-  bool is_current(const HeapEntry& entry) const {
-    return alive() && std::min(a, b) == entry.low && std::max(a, b) == entry.high;
-  }
+  std::uint32_t low() const { return std::min(a, b); }
+  std::uint32_t high() const { return std::max(a, b); }
   void raise_cost_bound(double bound) {
     if (!(bound > cost_bound)) return;
     float rounded = static_cast<float>(std::min<double>(bound, std::numeric_limits<float>::max()));
@@ -87,6 +74,28 @@ struct LiveEdge {
   }
 };
 static_assert(sizeof(LiveEdge) == 16);
+
+// The queue's order; node ids break the remaining ties (live candidates have distinct pairs).
+struct ComesFirst {
+  const std::vector<LiveEdge>* edges;
+  bool operator()(const QueuedCandidate& x, const QueuedCandidate& y) const {
+    if (x.cost != y.cost) return x.cost < y.cost;
+    if (x.rank != y.rank) return x.rank < y.rank;
+    const LiveEdge& ex = (*edges)[x.id];
+    const LiveEdge& ey = (*edges)[y.id];
+    if (ex.low() != ey.low()) return ex.low() < ey.low();
+    return ex.high() < ey.high();
+  }
+};
+
+using CandidateQueue = detail::IndexedHeap<QueuedCandidate, ComesFirst>;
+
+// Statistics of the clusters that are not stored (faces and pairs), recomputed for a candidate:
+// kept from one evaluation to the next so that their storage is reused.
+struct Scratch {
+  ClusterStats clusters[2];
+  ClusterStats faces[2];  // of a pair
+};
 
 }  // namespace
 
@@ -172,7 +181,10 @@ std::vector<std::array<double, 4>> Hierarchy::linkage() const {
 class HierarchyBuilder::Impl {
  public:
   Impl(std::shared_ptr<const Mesh> mesh, HierarchyOptions options)
-      : mesh_(std::move(mesh)), options_(std::move(options)), selector_(options_) {
+      : mesh_(std::move(mesh)),
+        options_(std::move(options)),
+        selector_(options_),
+        queue_(0, ComesFirst{&edges_}) {
     if (!mesh_) throw InvalidInputError("no mesh");
     mesh_->validate();
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights);
@@ -213,52 +225,34 @@ class HierarchyBuilder::Impl {
       }
     stamp_.assign(f, 0);
     marker_.assign(f, kNone);
-    // Every candidate's cost is independent of the others: evaluate them in parallel, then the
-    // degrees (which share scratch arrays) in order.
     lazy_ = options_.evaluation != CandidateEvaluation::Eager && !options_.exact_costs;
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
-    // Compaction keeps the heap within a quarter of the live edges of stale entries (plus one
-    // merge's pushes), so it never outgrows this.
-    heap_.reserve(heap_capacity(edges_.size()) + 64);
-    heap_.resize(edges_.size());
-    detail::parallel_for(edges_.size(), threads, [&](std::size_t id) {
-      heap_[id] = evaluate(static_cast<std::uint32_t>(id));
+    // Every candidate's cost is independent of the others: evaluate them in parallel, then the
+    // degrees (which share scratch arrays) in order.
+    std::vector<QueuedCandidate> candidates(edges_.size());
+    std::vector<Scratch> scratch(threads);
+    detail::parallel_for_threads(edges_.size(), threads, [&](std::size_t id, unsigned thread) {
+      candidates[id] = evaluate(static_cast<std::uint32_t>(id), scratch[thread]);
     });
-    for (HeapEntry& entry : heap_) entry.set_degree(merged_degree(entry.low, entry.high));
-    evaluations_ = heap_.size();
-    std::make_heap(heap_.begin(), heap_.end(), comes_after);
-    live_edges_ = static_cast<std::uint32_t>(edges_.size());
+    for (QueuedCandidate& c : candidates)
+      if (c.cost == 0) c.set_degree(merged_degree(edges_[c.id].a, edges_[c.id].b));
+    evaluations_ = candidates.size();
+    queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{&edges_});
+    queue_.assign(std::move(candidates));
     total_merges_ = f - graph_->component_count();
   }
 
   bool step() {
-    while (!heap_.empty()) {
-      std::pop_heap(heap_.begin(), heap_.end(), comes_after);
-      HeapEntry entry = heap_.back();
-      heap_.pop_back();
-      const LiveEdge& edge = edges_[entry.edge];
-      if (!edge.is_current(entry)) continue;
-      if (!entry.exact()) {
-        // A bound reached the top: evaluate the candidate. It keeps the degree it was queued
-        // with, as the eager scheme's entry would have.
-        const std::uint32_t degree = entry.degree();
-        entry = evaluate(entry.edge);
+    while (!queue_.empty()) {
+      const QueuedCandidate top = queue_.top();
+      if (!top.exact()) {
+        // A bound reached the top: evaluate the candidate. (Its cost is above the bound, so
+        // never zero: no degree.)
+        queue_.update(evaluate(top.id, scratch_));
         ++evaluations_;
-        entry.set_degree(degree);
-        heap_.push_back(entry);
-        std::push_heap(heap_.begin(), heap_.end(), comes_after);
         continue;
       }
-      // Neighbours of the two clusters may have merged since this entry was pushed, which only
-      // lowers the merged degree: requeue with the current one so the tie rule sees it.
-      const std::uint32_t degree = merged_degree(edge.a, edge.b);
-      if (degree != entry.degree()) {
-        entry.set_degree(degree);
-        heap_.push_back(entry);
-        std::push_heap(heap_.begin(), heap_.end(), comes_after);
-        continue;
-      }
-      merge(entry.edge);
+      merge(top.cost > 0 ? settle_tie(top) : top.id);
       return true;
     }
     return false;
@@ -321,6 +315,38 @@ class HierarchyBuilder::Impl {
     return degree;
   }
 
+  // The top is the cheapest candidate, at a positive cost. Candidates of exactly the same cost
+  // and type (a connected group of the heap around its top) are ranked by the degree their merge
+  // would make now, then by node ids; the winner's edge.
+  std::uint32_t settle_tie(const QueuedCandidate& top) {
+    auto ties_top = [&](const QueuedCandidate& c) {
+      return c.cost == top.cost && c.rank == top.rank;
+    };
+    // Breadth-first from the top over children that tie it: every tie has only tying ancestors.
+    tied_.assign(1, 0);
+    for (std::size_t i = 0; i < tied_.size(); ++i) {
+      const std::size_t first = CandidateQueue::kArity * tied_[i] + 1;
+      const std::size_t end = std::min(first + CandidateQueue::kArity, queue_.size());
+      for (std::size_t c = first; c < end; ++c)
+        if (ties_top(queue_.at(c))) tied_.push_back(c);
+    }
+    if (tied_.size() == 1) return top.id;  // the usual case
+    std::uint32_t best = top.id, best_degree = merged_degree(edges_[top.id].a, edges_[top.id].b);
+    for (std::size_t position : tied_) {
+      const std::uint32_t id = queue_.at(position).id;
+      if (id == top.id) continue;
+      const std::uint32_t degree = merged_degree(edges_[id].a, edges_[id].b);
+      const LiveEdge& e = edges_[id];
+      const LiveEdge& b = edges_[best];
+      if (degree < best_degree ||
+          (degree == best_degree && std::pair(e.low(), e.high()) < std::pair(b.low(), b.high()))) {
+        best = id;
+        best_degree = degree;
+      }
+    }
+    return best;
+  }
+
   // The mesh edges between the two clusters of live edge `id`.
   const EdgeStats& shared_edges(std::uint32_t id) const {
     const std::uint32_t pooled = edges_[id].combined_shared;
@@ -349,29 +375,44 @@ class HierarchyBuilder::Impl {
     if (e.combined_shared != kNone) free_combined_shared_.push_back(e.combined_shared);
     e.combined_shared = kNone;
     e.a = e.b = kNone;
-    --live_edges_;
+    queue_.erase(id);
   }
 
-  // A live cluster's statistics: stored for a merged cluster, computed into `leaf` for a face
-  // (whose slot is its face id).
-  // (computed into `leaf` for a face or a pair of faces, whose statistics are not stored).
-  const ClusterStats& stats_of(std::uint32_t node, ClusterStats& leaf) const {
+  // A live cluster's centred statistics: stored for a merged cluster of three faces or more,
+  // computed into `scratch` for a face or a pair of faces, with the moments up to `max_degree`
+  // (2 for a candidate only a plane can fit: see ModelSelector::moment_degree()).
+  const ClusterStats& stats_of(std::uint32_t node, Scratch& scratch, int part,
+                              int max_degree) const {
     const std::uint32_t slot = slot_of_node_[node];
     const std::uint32_t index = stats_index_of_slot_[slot];
     const bool samples = selector_.needs_samples();
+    ClusterStats& stats = scratch.clusters[part];
     if (index == kNone) {
-      leaf = graph_->face_stats(slot, samples);
+      graph_->face_stats(slot, stats, samples, max_degree);
     } else if (index == newest_pair_key_) {
       return newest_pair_;
     } else if (index & kPairTag) {
-      // The same sum, in the same order, as union_stats() made when the pair merged.
+      // The same union, by the same operations, as when the pair merged.
       const DualEdge& e = graph_->edges()[index & ~kPairTag];
-      leaf = graph_->face_stats(e.first, samples);
-      leaf.merge(graph_->face_stats(e.second, samples), e.shared);
+      graph_->face_stats(e.first, scratch.faces[0], samples, max_degree);
+      graph_->face_stats(e.second, scratch.faces[1], samples, max_degree);
+      stats = ClusterView(scratch.faces[0], scratch.faces[1], e.shared).stats(max_degree);
     } else {
       return stats_[index];
     }
-    return leaf;
+    return stats;
+  }
+
+  std::uint32_t triangle_count(std::uint32_t node) const {
+    const std::uint32_t slot = slot_of_node_[node];
+    const std::uint32_t index = stats_index_of_slot_[slot];
+    if (index == kNone) return graph_->first_triangle(slot + 1) - graph_->first_triangle(slot);
+    if (index & kPairTag) {
+      const DualEdge& e = graph_->edges()[index & ~kPairTag];
+      return graph_->first_triangle(e.first + 1) - graph_->first_triangle(e.first) +
+             graph_->first_triangle(e.second + 1) - graph_->first_triangle(e.second);
+    }
+    return stats_[index].triangle_count;
   }
 
   // Pairs of faces are most of the merged clusters alive at once (all of them at the peak on a
@@ -404,22 +445,8 @@ class HierarchyBuilder::Impl {
     index = kNone;
   }
 
-  // The statistics of a ∪ b, moments up to the degree the fits will use (all of them when the
-  // result is kept).
-  ClusterStats union_stats(std::uint32_t id, bool keep) const {
-    const LiveEdge& e = edges_[id];
-    ClusterStats leaf_a, leaf_b;
-    const ClusterStats& a = stats_of(e.a, leaf_a);
-    const ClusterStats& b = stats_of(e.b, leaf_b);
-    const int degree = keep ? 4 : selector_.moment_degree(a.triangle_count + b.triangle_count);
-    ClusterStats stats = a;
-    stats.merge(b, shared_edges(id), degree);
-    return stats;
-  }
-
-  detail::SelectedModel select(const ClusterStats& stats, const LiveEdge& e) const {
-    const ClusterStats centred_stats = stats.centred(selector_.moment_degree(stats.triangle_count));
-    if (!options_.exact_costs) return selector_.select(centred_stats);
+  detail::SelectedModel select(const ClusterView& cluster, const LiveEdge& e) const {
+    if (!options_.exact_costs) return selector_.select(cluster);
     const detail::ExactError exact = [&](const Primitive& primitive) {
       double sum = 0;
       for (std::uint32_t node : {e.a, e.b})
@@ -435,16 +462,19 @@ class HierarchyBuilder::Impl {
           }
       return sum;
     };
-    return selector_.select(centred_stats, &exact);
+    return selector_.select(cluster, &exact);
   }
 
-  // A candidate's entry without its degree. Reads shared state and writes only this edge's
-  // bound (safe in parallel over distinct edges).
-  HeapEntry evaluate(std::uint32_t id) {
+  // A candidate's queue entry, without its degree. Reads shared state and writes only this
+  // edge's bound (safe in parallel over distinct edges).
+  QueuedCandidate evaluate(std::uint32_t id, Scratch& scratch) {
     LiveEdge& e = edges_[id];
-    const detail::SelectedModel model = select(union_stats(id, false), e);
+    const int degree = selector_.moment_degree(triangle_count(e.a) + triangle_count(e.b));
+    const ClusterView cluster(stats_of(e.a, scratch, 0, degree), stats_of(e.b, scratch, 1, degree),
+                              shared_edges(id));
+    const detail::SelectedModel model = select(cluster, e);
     if (lazy_) e.raise_cost_bound(model.superset_cost_bound);
-    return {model.cost, true, model.fit.primitive.type, 0, e.a, e.b, id};
+    return {model.cost, true, model.fit.primitive.type, id};
   }
 
   // The edge's cost bound if it holds for the current union, else 0. A cost that would snap to
@@ -452,37 +482,26 @@ class HierarchyBuilder::Impl {
   // any bound from a subset, so the bound holds only above that level. The union's spread is
   // exact from the parts' (Σ w |x − c|² adds a w_a w_b / (w_a + w_b) |c_a − c_b|² term); the
   // factor 2 covers round-off.
-  double queued_bound(const LiveEdge& e) const {
+  double queued_bound(const LiveEdge& e) {
     if (!(e.cost_bound > 0)) return 0;
-    ClusterStats leaf_a, leaf_b;
-    const Moments& a = stats_of(e.a, leaf_a).moments;
-    const Moments& b = stats_of(e.b, leaf_b).moments;
+    const Moments& a = stats_of(e.a, scratch_, 0, 2).moments;
+    const Moments& b = stats_of(e.b, scratch_, 1, 2).moments;
     const double wa = a.weight(), wb = b.weight();
     if (!(wa > 0) || !(wb > 0)) return 0;
-    const double spread = centred_spread(a) + centred_spread(b) +
-                          wa * wb / (wa + wb) * (a.centroid() - b.centroid()).squaredNorm();
+    const double spread = a.second_moment().trace() + b.second_moment().trace() +
+                          wa * wb / (wa + wb) * (a.origin() - b.origin()).squaredNorm();
     return e.cost_bound > 2 * max_penalty_ * options_.zero_cost_tolerance * spread ? e.cost_bound
                                                                                    : 0.0;
-  }
-
-  static double centred_spread(const Moments& m) {
-    const Eigen::Vector3d first(m.at(1, 0, 0), m.at(0, 1, 0), m.at(0, 0, 1));
-    return m.at(2, 0, 0) + m.at(0, 2, 0) + m.at(0, 0, 2) - first.squaredNorm() / m.weight();
-  }
-
-  HeapEntry candidate(std::uint32_t id) {
-    HeapEntry entry = evaluate(id);
-    ++evaluations_;
-    entry.set_degree(merged_degree(edges_[id].a, edges_[id].b));
-    return entry;
   }
 
   void merge(std::uint32_t edge_id) {
     LiveEdge& edge = edges_[edge_id];
     const std::uint32_t a = edge.a, b = edge.b;
     const std::uint32_t slot_a = slot_of_node_[a], slot_b = slot_of_node_[b];
-    ClusterStats merged = union_stats(edge_id, true);
-    const detail::SelectedModel model = select(merged, edge);
+    const ClusterView cluster(stats_of(a, scratch_, 0, 4), stats_of(b, scratch_, 1, 4),
+                              shared_edges(edge_id));
+    const detail::SelectedModel model = select(cluster, edge);
+    ClusterStats merged = cluster.stats();
     const std::uint32_t node = next_node();
 
     Merge record;
@@ -490,7 +509,7 @@ class HierarchyBuilder::Impl {
     record.second = std::max(a, b);
     record.cost = model.cost;
     record.error = model.fit.error;
-    record.weight = merged.moments.weight();
+    record.weight = cluster.weight();
     record.face_count = face_count_of_slot_[slot_a] + face_count_of_slot_[slot_b];
     record.primitive = graph_->frame().to_input(model.fit.primitive);
     merges_.push_back(record);
@@ -547,27 +566,15 @@ class HierarchyBuilder::Impl {
       const LiveEdge& e = edges_[id];
       // A zero bound would reach the top before the next merge anyway: evaluate it now.
       const double bound = lazy_ ? queued_bound(e) : 0;
-      if (bound > 0)
-        heap_.push_back(
-            {bound, false, PrimitiveType::Plane, merged_degree(e.a, e.b), e.a, e.b, id});
-      else
-        heap_.push_back(candidate(id));
-      std::push_heap(heap_.begin(), heap_.end(), comes_after);
+      if (bound > 0) {
+        queue_.update({bound, false, PrimitiveType::Plane, id});
+        continue;
+      }
+      QueuedCandidate candidate = evaluate(id, scratch_);
+      ++evaluations_;
+      if (candidate.cost == 0) candidate.set_degree(merged_degree(e.a, e.b));
+      queue_.update(candidate);
     }
-    compact_heap_if_stale();
-  }
-
-  // Re-evaluated candidates leave their old entries behind; drop them once they outnumber the
-  // live ones. The pop order does not change: live entries have distinct keys.
-  void compact_heap_if_stale() {
-    if (heap_.size() <= heap_capacity(live_edges_)) return;
-    std::erase_if(heap_,
-                  [&](const HeapEntry& entry) { return !edges_[entry.edge].is_current(entry); });
-    std::make_heap(heap_.begin(), heap_.end(), comes_after);
-  }
-
-  static std::size_t heap_capacity(std::size_t live_edges) {
-    return live_edges + live_edges / 4 + 1024;
   }
 
   // What only the merge loop needs (about two thirds of the peak memory) is freed before the
@@ -585,9 +592,10 @@ class HierarchyBuilder::Impl {
     release(edges_);
     release(combined_shared_);
     release(free_combined_shared_);
-    release(heap_);
+    queue_.clear();
     release(stamp_);
     release(marker_);
+    release(tied_);
     release(next_face_);
     release(face_list_head_);
     release(face_list_tail_);
@@ -603,8 +611,7 @@ class HierarchyBuilder::Impl {
     std::sort(roots.begin(), roots.end());
     const double cost = max_cost_ > 0 ? 2 * max_cost_ : 1.0;
     std::uint32_t joined = roots.front().second;
-    ClusterStats leaf;
-    double weight = stats_of(joined, leaf).moments.weight();
+    double weight = stats_of(joined, scratch_, 0, 2).moments.weight();
     std::uint32_t faces = face_count_of_slot_[slot_of_node_[joined]];
     for (std::size_t i = 1; i < roots.size(); ++i) {
       const std::uint32_t other = roots[i].second;
@@ -612,7 +619,7 @@ class HierarchyBuilder::Impl {
       record.first = std::min(joined, other);
       record.second = std::max(joined, other);
       record.cost = cost;
-      record.weight = weight += stats_of(other, leaf).moments.weight();
+      record.weight = weight += stats_of(other, scratch_, 0, 2).moments.weight();
       record.face_count = faces += face_count_of_slot_[slot_of_node_[other]];
       record.trailing = true;
       joined = next_node();
@@ -640,14 +647,15 @@ class HierarchyBuilder::Impl {
   std::vector<LiveEdge> edges_;
   std::vector<EdgeStats> combined_shared_;  // see LiveEdge::combined_shared
   std::vector<std::uint32_t> free_combined_shared_;
-  std::vector<HeapEntry> heap_;
   std::vector<Merge> merges_;
   std::vector<std::uint32_t> stamp_;  // per slot
   std::uint32_t current_stamp_ = 0;
   std::vector<std::uint32_t> marker_;                                       // per slot
+  std::vector<std::size_t> tied_;  // settle_tie()'s queue positions
+  Scratch scratch_;                // the merge loop's
+  CandidateQueue queue_;  // after edges_, which its order reads
   std::vector<std::uint32_t> next_face_, face_list_head_, face_list_tail_;  // exact_costs only
   std::uint32_t total_merges_ = 0;
-  std::uint32_t live_edges_ = 0;
   double max_cost_ = 0;
   std::uint64_t evaluations_ = 0;
   bool lazy_ = false;

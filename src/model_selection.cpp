@@ -45,8 +45,8 @@ ModelSelector::ModelSelector(const HierarchyOptions& options) : options_(options
   }
 }
 
-SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactError* exact) const {
-  const double spread = centred.moments.second_moment().trace();
+SelectedModel ModelSelector::select(const ClusterView& cluster, const ExactError* exact) const {
+  const double spread = cluster.second_moment().trace();
   const double zero_level = options_.zero_cost_tolerance * spread;
   const bool lazy = options_.evaluation != CandidateEvaluation::Eager && !exact;
   double bound = std::numeric_limits<double>::infinity();  // min over types of penalised bounds
@@ -60,14 +60,18 @@ SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactErro
   SelectedModel best;
   bool found = false;
   for (const PrimitiveFitter* fitter : fitters_) {
-    if (centred.triangle_count < fitter->min_triangles()) {
+    if (cluster.triangle_count() < fitter->min_triangles()) {
       bound = 0;  // the type may fit a larger cluster: nothing is known
       continue;
     }
-    PrimitiveFit fit = fitter->fit(centred);
-    if (lazy)
-      bound = std::min(bound, fit.superset_error_bound *
-                                  options_.type_penalty[static_cast<int>(fitter->type())]);
+    // A type wins only below the best cost so far: its fit may stop once its error is certainly
+    // not below best.cost / penalty. (Not when the error is replaced by the exact one, nor at the
+    // zero level, where exact fits tie and normal agreement decides.)
+    const double penalty = options_.type_penalty[static_cast<int>(fitter->type())];
+    double error_to_beat = std::numeric_limits<double>::infinity();
+    if (found && !exact && best.cost / penalty > zero_level) error_to_beat = best.cost / penalty;
+    PrimitiveFit fit = fitter->fit(cluster, error_to_beat);
+    if (lazy) bound = std::min(bound, fit.superset_error_bound * penalty);
     if (!fit.valid || !std::isfinite(fit.error)) continue;
     SelectedModel candidate = finish(std::move(fit));
     // Exact fits tie at cost 0: the vertices of a coarse tessellation lie exactly on several
@@ -85,7 +89,7 @@ SelectedModel ModelSelector::select(const ClusterStats& centred, const ExactErro
     // flat plane) can win, so the richer fits need not run (most candidates in flat regions).
     if (found && best.cost == 0 && best.fit.normal_alignment >= 1 - kAlignmentTieMargin) break;
   }
-  if (!found) best = finish(fitter_for(PrimitiveType::Plane).fit(centred));
+  if (!found) best = finish(fitter_for(PrimitiveType::Plane).fit(cluster));
   if (lazy && best.cost > 0 && bound > 0) {
     // Round-off in the fits is of order 1e-16 of the spread; the margin keeps the bound below
     // every computed cost of a superset.

@@ -35,10 +35,13 @@ class ModelSelector {
   }
   /// Whether some enabled type reads ClusterStats::samples (DualGraph::face_stats must fill them).
   bool needs_samples() const { return needs_samples_; }
-  /// `centred`: statistics with moments about the cluster's centroid, up to
-  /// moment_degree(centred.triangle_count). `exact`: if given, replaces each fit's error by the
-  /// exact one.
-  SelectedModel select(const ClusterStats& centred, const ExactError* exact = nullptr) const;
+  /// The model of a cluster or of the union of two (a merge candidate). `exact`: if given,
+  /// replaces each fit's error by the exact one.
+  SelectedModel select(const ClusterView& cluster, const ExactError* exact = nullptr) const;
+  /// `centred`: statistics with moments about the cluster's centroid.
+  SelectedModel select(const ClusterStats& centred, const ExactError* exact = nullptr) const {
+    return select(ClusterView(centred), exact);
+  }
 
  private:
   std::vector<const PrimitiveFitter*> fitters_;  // ascending type

@@ -24,8 +24,12 @@ class Moments {
   Moments() = default;
   explicit Moments(const Eigen::Vector3d& origin) : origin_(origin) {}
 
-  /// Index of monomial x^i y^j z^k (i + j + k <= 4) in values().
-  static int index(int i, int j, int k);
+  /// Index of monomial x^i y^j z^k (i + j + k <= 4) in values(): monomials by degree, then by
+  /// decreasing exponent of x, then of y.
+  static constexpr int index(int i, int j, int k) {
+    const int d = i + j + k;
+    return d * (d + 1) * (d + 2) / 6 + (d - i) * (d - i + 1) / 2 + (d - i - j);
+  }
 
   const Eigen::Vector3d& origin() const { return origin_; }
   const std::array<double, kCount>& values() const { return values_; }
@@ -36,8 +40,11 @@ class Moments {
   /// Weighted mean of the points (the origin for zero weight).
   Eigen::Vector3d centroid() const;
 
-  /// Adds the point x with weight w.
-  void add_point(const Eigen::Vector3d& x, double w);
+  /// Adds the point x with weight w (to the moments up to max_degree: 2 or 4).
+  void add_point(const Eigen::Vector3d& x, double w, int max_degree = 4);
+  /// Sets the first moments to zero: for moments about a centroid the caller computed, whose
+  /// first moments are only round-off (the centroid then is the origin exactly).
+  void discard_first_moments() { values_[1] = values_[2] = values_[3] = 0; }
   /// Number of monomials of degree at most 2 (the first entries of values()).
   static constexpr int kCountUpToDegree2 = 10;
 

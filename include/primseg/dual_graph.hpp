@@ -81,9 +81,15 @@ class DualGraph {
   double triangle_area(std::uint32_t t) const;
   /// Weight of each corner of triangle t (working frame).
   std::array<double, 3> corner_weights(std::uint32_t t) const;
-  /// Statistics of input face f alone (its triangles and the edges between them); with
-  /// `with_samples`, its corners in ClusterStats::samples too (for the torus).
-  ClusterStats face_stats(std::uint32_t f, bool with_samples = false) const;
+  /// The same, with the triangle's area (triangle_area(t)) already known.
+  std::array<double, 3> corner_weights(std::uint32_t t, double area) const;
+  /// Statistics of input face f alone (its triangles and the edges between them), centred: about
+  /// the weighted centroid of its corners (first moments zero). With `with_samples`, its corners
+  /// in ClusterStats::samples too (for the torus). With max_degree 2 the moments of degree 3 and 4
+  /// are left zero (enough for a plane).
+  ClusterStats face_stats(std::uint32_t f, bool with_samples = false, int max_degree = 4) const;
+  /// The same into `stats` (whatever it held before), reusing its storage.
+  void face_stats(std::uint32_t f, ClusterStats& stats, bool with_samples, int max_degree) const;
 
  private:
   const Mesh* mesh_;

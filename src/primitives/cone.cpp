@@ -295,7 +295,8 @@ std::uint32_t ConeFitter::min_triangles() const {
   return 6;
 }
 
-PrimitiveFit ConeFitter::fit(const ClusterStats& centred) const {
+PrimitiveFit ConeFitter::fit(const ClusterView& cluster, double /*error_to_beat*/) const {
+  const ClusterStats& centred = cluster.stats();
   PrimitiveFit result;
   result.primitive.type = PrimitiveType::Cone;
   const Moments& m = centred.moments;

@@ -6,11 +6,11 @@
 // Its error is the circle's Σ w (|p − c|² − r²)² / (4r²), first-order in the distance.
 #include "primseg/primitives/cylinder.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
 
 #include "primitives/pratt_fit.hpp"
+#include "symmetric_eigen3.hpp"
 
 namespace primseg {
 namespace {
@@ -24,17 +24,19 @@ std::uint32_t CylinderFitter::min_triangles() const {
   return 4;
 }
 
-PrimitiveFit CylinderFitter::fit(const ClusterStats& centred) const {
+PrimitiveFit CylinderFitter::fit(const ClusterView& cluster, double error_to_beat) const {
   PrimitiveFit result;
   result.primitive.type = PrimitiveType::Cylinder;
-  if (centred.triangle_count < min_triangles() || !(centred.area > 0)) return result;
+  if (cluster.triangle_count() < min_triangles() || !(cluster.area() > 0)) return result;
 
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(centred.edges.tensor_matrix());
-  const Eigen::Vector3d lambda = solver.eigenvalues();
-  const int largest = std::abs(lambda(0)) > std::abs(lambda(2)) ? 0 : 2;
-  if (!(std::abs(lambda(largest)) > kMinRelativeAxisEigenvalue * std::sqrt(centred.area)))
-    return result;
-  const Eigen::Vector3d axis = canonical_axis(solver.eigenvectors().col(largest).normalized());
+  // Every eigenvalue is at most 3 max |T_ij| in magnitude: flat clusters stop here.
+  const Eigen::Matrix3d tensor = cluster.edge_tensor();
+  const double min_eigenvalue = kMinRelativeAxisEigenvalue * std::sqrt(cluster.area());
+  if (!(3 * tensor.cwiseAbs().maxCoeff() > min_eigenvalue)) return result;
+  const detail::SymmetricEigen3 eigen = detail::symmetric_eigen3(tensor);
+  const int largest = std::abs(eigen.values(0)) > std::abs(eigen.values(2)) ? 0 : 2;
+  if (!(std::abs(eigen.values(largest)) > min_eigenvalue)) return result;
+  const Eigen::Vector3d axis = canonical_axis(eigen.vectors.col(largest).normalized());
 
   // Orthonormal basis (u, v) of the plane orthogonal to the axis.
   Eigen::Index least_aligned;
@@ -44,19 +46,22 @@ PrimitiveFit CylinderFitter::fit(const ClusterStats& centred) const {
   Eigen::Matrix<double, 2, 3> basis;
   basis.row(0) = u.transpose();
   basis.row(1) = v.transpose();
-  const Eigen::Matrix3d projector = Eigen::Matrix3d::Identity() - axis * axis.transpose();
 
-  const Moments& m = centred.moments;
+  // With Q = I − a aᵀ: Σ w y (yᵀQy) and Σ w (yᵀQy)² from the radial and axial moments.
+  const ClusterView::RadialMoments& radial = cluster.radial_moments();
+  const ClusterView::AxialMoments axial = cluster.axial_moments(axis);
   detail::CentredMomentsND<2> moments;
-  moments.weight = m.weight();
-  moments.second = basis * m.second_moment() * basis.transpose();
-  moments.third = basis * m.third_moment_contracted(projector);
-  moments.fourth = m.fourth_moment_contracted(projector);
-  const detail::PrattResult<2> circle = detail::pratt_fit(moments);
+  moments.weight = cluster.weight();
+  moments.second = basis * cluster.second_moment() * basis.transpose();
+  moments.third = basis * (radial.third - axial.third);
+  moments.fourth = radial.fourth - 2 * axial.mixed + axial.fourth;
+  const detail::PrattResult<2> circle = detail::pratt_fit(moments, error_to_beat);
+  result.beaten = circle.beaten;
   if (!circle.valid) return result;
 
-  const Eigen::Vector3d point = m.origin() + basis.transpose() * circle.centre;
-  result.normal_alignment = centred.normal_alignment(projector, point, circle.radius);
+  const Eigen::Vector3d point = cluster.centroid() + basis.transpose() * circle.centre;
+  const Eigen::Matrix3d projector = Eigen::Matrix3d::Identity() - axis * axis.transpose();
+  result.normal_alignment = cluster.normal_alignment(projector, point, circle.radius);
   if (result.normal_alignment < kMinNormalAlignment) return result;
   result.valid = true;
   result.error = circle.error;

@@ -1,15 +1,49 @@
 #include "primitives/pratt_fit.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
+#include "symmetric_eigen3.hpp"
+
 namespace primseg::detail {
+namespace {
+
+MomentEigensystem<2> eigensystem_of(const Eigen::Matrix2d& c) {
+  // One Jacobi rotation: tan 2θ = 2 c01 / (c00 − c11), |θ| <= π/4, exact for any gap.
+  double cosine = 1, sine = 0;
+  if (c(0, 1) != 0) {
+    const double zeta = (c(1, 1) - c(0, 0)) / (2 * c(0, 1));
+    const double tangent =
+        (zeta >= 0 ? 1.0 : -1.0) / (std::abs(zeta) + std::sqrt(1 + zeta * zeta));
+    cosine = 1 / std::sqrt(1 + tangent * tangent);
+    sine = tangent * cosine;
+  }
+  MomentEigensystem<2> e;
+  e.vectors << cosine, sine, -sine, cosine;
+  for (int k = 0; k < 2; ++k) e.values(k) = e.vectors.col(k).dot(c * e.vectors.col(k));
+  if (e.values(0) > e.values(1)) {
+    std::swap(e.values(0), e.values(1));
+    e.vectors.col(0).swap(e.vectors.col(1));
+  }
+  return e;
+}
+
+MomentEigensystem<3> eigensystem_of(const Eigen::Matrix3d& c) {
+  const SymmetricEigen3 e = symmetric_eigen3(c);
+  return {e.values, e.vectors};
+}
+
+}  // namespace
 
 template <int D>
-PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments) {
+PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to_beat) {
+  return pratt_fit(moments, eigensystem_of(moments.second), objective_to_beat);
+}
+
+template <int D>
+PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, const MomentEigensystem<D>& second,
+                         double objective_to_beat) {
   using Vector = Eigen::Matrix<double, D, 1>;
-  using Matrix = Eigen::Matrix<double, D, D>;
   PrattResult<D> result;
   const double w = moments.weight;
   const double spread2 = moments.second.trace() / w;
@@ -20,38 +54,53 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments) {
   const double scale2 = scale * scale;
   const double f = moments.fourth * scale2 * scale2;  // Σ w |p|⁴
   const Vector t = moments.third * (scale2 * scale);  // Σ w p |p|²
-  const Matrix c = moments.second * scale2;           // Σ w p pᵀ
-  const double s = c.trace();                         // Σ w |p|²
+  const double s = moments.second.trace() * scale2;   // Σ w |p|²
 
   // With θ = (A, B, C) and centred points, the rows of (M − ηN) θ = 0 give
   //   C = −(s + 2η) A / w,   B = −(c − ηI)⁻¹ t A,
   // and A ≠ 0 solves the secular equation
-  //   g(η) = f − (s + 2η)² / w − Σ_k τ_k² / (λ_k − η) = 0,   τ = Uᵀ t,  c = U Λ Uᵀ.
-  // On [0, λ_min) g is strictly decreasing with g(0) ≥ 0 (a Schur complement of the positive
-  // semi-definite M), so the smallest η ≥ 0 is its only root there. No root before λ_min means
-  // the optimum is the plane limit (A = 0): not a sphere.
-  Eigen::SelfAdjointEigenSolver<Matrix> eigen(c);
-  const Vector lambda = eigen.eigenvalues();
-  const Vector tau = eigen.eigenvectors().transpose() * t;
-  auto g = [&](double eta, double* derivative) {
-    double value = f - (s + 2 * eta) * (s + 2 * eta) / w;
-    double slope = -4 * (s + 2 * eta) / w;
-    for (int k = 0; k < D; ++k) {
+  //   g(η) = f − (s + 2η)² / w − Σ_k τ_k² / (λ_k − η) = 0,   τ = Uᵀ t,  c = U Λ Uᵀ,
+  // with c = Σ w p pᵀ of the scaled points. On [0, λ_min) g is strictly decreasing with
+  // g(0) ≥ 0 (a Schur complement of the positive semi-definite M), so the smallest η ≥ 0 is its
+  // only root there. No root before λ_min means the optimum is the plane limit (A = 0): not a
+  // sphere.
+  const Vector lambda = second.values * scale2;
+  const Vector tau = second.vectors.transpose() * t;
+  // h(η) = (λ_0 − η) g(η) has the same root on [0, λ_0) but no pole at λ_0 (Newton's method on g
+  // itself keeps overshooting into the pole, and bisecting back, when the root is near it).
+  auto h = [&](double eta, double* derivative) {
+    double rest = f - (s + 2 * eta) * (s + 2 * eta) / w;
+    double rest_slope = -4 * (s + 2 * eta) / w;
+    for (int k = 1; k < D; ++k) {
       const double gap = lambda(k) - eta;
-      value -= tau(k) * tau(k) / gap;
-      slope -= tau(k) * tau(k) / (gap * gap);
+      rest -= tau(k) * tau(k) / gap;
+      rest_slope -= tau(k) * tau(k) / (gap * gap);
     }
-    *derivative = slope;
-    return value;
+    const double gap = lambda(0) - eta;
+    *derivative = gap * rest_slope - rest;
+    return gap * rest - tau(0) * tau(0);
   };
   double lo = 0, hi = lambda(0);
   if (!(hi > 0)) return result;  // flat data: the plane itself
+  // Steps below this are round-off. (Relative to the whole bracket: relative to a shrinking one,
+  // a root at the round-off level of 0 would take every iteration bisecting towards it.)
+  const double resolution = 1e-15 * hi;
   double eta = 0, slope = 0;
-  double value = g(eta, &slope);
+  // g decreases: the root is at least x exactly when g(x) >= 0, i.e. h(x) >= 0 below λ_0.
+  const double beat = objective_to_beat * scale2;
+  if (beat > 0 && beat < hi) {
+    if (h(beat, &slope) >= 0) {
+      result.beaten = true;
+      result.objective_minimum = objective_to_beat;
+      return result;
+    }
+    hi = beat;
+  }
+  double value = h(eta, &slope);
   if (!(value > 0)) {
     eta = 0;  // an exact fit (round-off can make g(0) a hair negative)
   } else {
-    for (int iteration = 0; iteration < 200; ++iteration) {
+    for (int iteration = 0; iteration < 100; ++iteration) {
       if (value > 0)
         lo = eta;
       else
@@ -59,9 +108,9 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments) {
       // Newton while it stays inside the bracket, bisection otherwise.
       double next = eta - value / slope;
       if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-      if (!(std::abs(next - eta) > 1e-15 * std::max(hi, 1e-300))) break;
+      if (!(std::abs(next - eta) > resolution)) break;
       eta = next;
-      value = g(eta, &slope);
+      value = h(eta, &slope);
       if (value == 0) break;
     }
   }
@@ -70,7 +119,7 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments) {
   if (!(gap_to_plane > 1e-12 * lambda(D - 1))) return result;
 
   Vector b = Vector::Zero();
-  for (int k = 0; k < D; ++k) b -= eigen.eigenvectors().col(k) * (tau(k) / (lambda(k) - eta));
+  for (int k = 0; k < D; ++k) b -= second.vectors.col(k) * (tau(k) / (lambda(k) - eta));
   // With A = 1: centre −B/2, r² = (|B|² − 4C) / 4 = |B|²/4 + (s + 2η)/w.
   const double relative_radius = std::sqrt(b.squaredNorm() / 4 + (s + 2 * eta) / w);
   if (!(relative_radius <= kMaxRelativeRadius)) return result;
@@ -81,7 +130,11 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments) {
   return result;
 }
 
-template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&);
-template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&);
+template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, double);
+template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&, double);
+template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, const MomentEigensystem<2>&,
+                                     double);
+template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&, const MomentEigensystem<3>&,
+                                     double);
 
 }  // namespace primseg::detail

@@ -11,22 +11,26 @@ std::uint32_t SphereFitter::min_triangles() const {
   return 4;
 }
 
-PrimitiveFit SphereFitter::fit(const ClusterStats& centred) const {
+PrimitiveFit SphereFitter::fit(const ClusterView& cluster, double error_to_beat) const {
   PrimitiveFit result;
   result.primitive.type = PrimitiveType::Sphere;
-  if (centred.triangle_count < min_triangles()) return result;
-  const Moments& m = centred.moments;
+  if (cluster.triangle_count() < min_triangles()) return result;
+  const ClusterView::RadialMoments& radial = cluster.radial_moments();
   detail::CentredMomentsND<3> moments;
-  moments.weight = m.weight();
-  moments.second = m.second_moment();
-  moments.third = m.third_moment_contracted(Eigen::Matrix3d::Identity());
-  moments.fourth = m.fourth_moment_contracted(Eigen::Matrix3d::Identity());
-  const detail::PrattResult<3> sphere = detail::pratt_fit(moments);
+  moments.weight = cluster.weight();
+  moments.second = cluster.second_moment();
+  moments.third = radial.third;
+  moments.fourth = radial.fourth;
+  // The plane's eigen-decomposition of the same second moment, shared.
+  const detail::PrattResult<3> sphere = detail::pratt_fit(
+      moments, {cluster.second_moment_eigenvalues(), cluster.second_moment_eigenvectors()},
+      error_to_beat);
   result.superset_error_bound = sphere.objective_minimum;
+  result.beaten = sphere.beaten;
   if (!sphere.valid) return result;
-  const Eigen::Vector3d centre = m.origin() + sphere.centre;
+  const Eigen::Vector3d centre = cluster.centroid() + sphere.centre;
   result.normal_alignment =
-      centred.normal_alignment(Eigen::Matrix3d::Identity(), centre, sphere.radius);
+      cluster.normal_alignment(Eigen::Matrix3d::Identity(), centre, sphere.radius);
   if (result.normal_alignment < kMinNormalAlignment) return result;
   result.valid = true;
   result.error = sphere.error;

@@ -48,7 +48,8 @@ std::uint32_t TorusFitter::min_triangles() const {
   return 8;
 }
 
-PrimitiveFit TorusFitter::fit(const ClusterStats& centred) const {
+PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat*/) const {
+  const ClusterStats& centred = cluster.stats();
   PrimitiveFit result;
   result.primitive.type = PrimitiveType::Torus;
   const Moments& m = centred.moments;

@@ -14,7 +14,8 @@ class ConeFitter final : public PrimitiveFitter {
  public:
   PrimitiveType type() const override { return PrimitiveType::Cone; }
   std::uint32_t min_triangles() const override;
-  PrimitiveFit fit(const ClusterStats& centred) const override;
+  using PrimitiveFitter::fit;
+  PrimitiveFit fit(const ClusterView& cluster, double error_to_beat) const override;
 };
 
 }  // namespace primseg

@@ -10,7 +10,8 @@ class CylinderFitter final : public PrimitiveFitter {
  public:
   PrimitiveType type() const override { return PrimitiveType::Cylinder; }
   std::uint32_t min_triangles() const override;
-  PrimitiveFit fit(const ClusterStats& centred) const override;
+  using PrimitiveFitter::fit;
+  PrimitiveFit fit(const ClusterView& cluster, double error_to_beat) const override;
 };
 
 }  // namespace primseg

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "primseg/cluster_stats.hpp"
+#include "primseg/cluster_view.hpp"
 #include "primseg/primitive.hpp"
 
 namespace primseg {
@@ -27,6 +28,9 @@ struct PrimitiveFit {
   /// over the type's parameters of a sum of non-negative per-point terms (plane, Pratt sphere);
   /// 0 where no bound is known. Lets the hierarchy leave candidates unevaluated (lazy mode).
   double superset_error_bound = 0;
+  /// True when the fit stopped early because its error is at least the error to beat (see
+  /// PrimitiveFitter::fit); then valid is false and the error is not known.
+  bool beaten = false;
   /// How well the face normals follow the primitive's (ClusterStats::normal_alignment for the
   /// curved types, |Σ A n| / Σ A for a plane): 1 when they agree everywhere. Breaks ties between
   /// exact fits (see ModelSelector).
@@ -41,8 +45,17 @@ class PrimitiveFitter {
   /// Fewest triangles a cluster needs before this type is fitted at all: below it every cluster
   /// fits exactly (two triangles always lie on a sphere), which says nothing about the shape.
   virtual std::uint32_t min_triangles() const = 0;
+  /// Fits the type to a cluster, or to the union of two (a merge candidate). `error_to_beat`:
+  /// the type cannot win the cluster unless its error is below this (another type has that
+  /// cost), so a fitter may stop as soon as its error is certainly at least this and return an
+  /// invalid fit with `beaten` set and superset_error_bound at most its error. Infinity: fit
+  /// fully.
+  virtual PrimitiveFit fit(const ClusterView& cluster, double error_to_beat) const = 0;
+  PrimitiveFit fit(const ClusterView& cluster) const {
+    return fit(cluster, std::numeric_limits<double>::infinity());
+  }
   /// Fits the type to statistics whose moments are centred at the cluster's centroid.
-  virtual PrimitiveFit fit(const ClusterStats& centred) const = 0;
+  PrimitiveFit fit(const ClusterStats& centred) const { return fit(ClusterView(centred)); }
   /// Whether the fit reads ClusterStats::samples (then the engine keeps them, at a memory cost).
   virtual bool needs_samples() const { return false; }
 };

@@ -1,0 +1,102 @@
+#pragma once
+/// @file cluster_view.hpp
+/// What a primitive fitter reads of a cluster: its weighted moments about its centroid and the
+/// contractions of them each fit needs. A view is either one cluster or the union of two disjoint
+/// clusters; for a union, every quantity is combined from the two parts' centred moments in
+/// constant time, without forming the union's 35 moments (what a merge candidate costs).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+
+#include "primseg/cluster_stats.hpp"
+
+namespace primseg {
+
+/// A cluster's statistics as the fitters read them. Points y are relative to centroid(), in the
+/// working frame; Σ runs over the weighted triangle corners of the cluster.
+///
+/// The parts must outlive the view, have moments about their own centroids (origin = centroid;
+/// ClusterStats::centred()) and, for a union, share no triangle.
+class ClusterView {
+ public:
+  /// One cluster, with statistics centred at its centroid.
+  explicit ClusterView(const ClusterStats& centred);
+  /// The union of two disjoint clusters with centred statistics; `shared` holds the mesh edges
+  /// between them.
+  ClusterView(const ClusterStats& a, const ClusterStats& b, const EdgeStats& shared);
+
+  /// Σ w.
+  double weight() const { return weight_; }
+  /// The weighted centroid (working frame).
+  const Eigen::Vector3d& centroid() const { return centroid_; }
+  /// Σ w y yᵀ, shape (3, 3).
+  const Eigen::Matrix3d& second_moment() const { return second_moment_; }
+  /// Eigenvalues of second_moment() in ascending order (computed on first use, then kept).
+  const Eigen::Vector3d& second_moment_eigenvalues() const;
+  /// Unit eigenvectors of second_moment() as columns, in the order of the eigenvalues.
+  const Eigen::Matrix3d& second_moment_eigenvectors() const;
+
+  std::uint32_t triangle_count() const { return triangle_count_; }
+  /// Σ triangle area.
+  double area() const { return area_; }
+  /// Σ area × unit normal (consistently oriented normals).
+  const Eigen::Vector3d& normal_sum() const { return normal_sum_; }
+  /// The normal-variation tensor Σ |e| β(e) ê êᵀ of the cluster's internal edges, shape (3, 3).
+  Eigen::Matrix3d edge_tensor() const;
+
+  /// Σ w y |y|² (shape 3) and Σ w |y|⁴: the radial moments a sphere fit needs.
+  struct RadialMoments {
+    Eigen::Vector3d third = Eigen::Vector3d::Zero();
+    double fourth = 0;
+  };
+  /// (Computed on first use, then kept.)
+  const RadialMoments& radial_moments() const;
+
+  /// For a unit axis a: Σ w y (a·y)² (shape 3), Σ w |y|² (a·y)² and Σ w (a·y)⁴: with the radial
+  /// moments, what a fit in the plane orthogonal to a needs (Q = I − a aᵀ gives
+  /// Σ w y (yᵀQy) = radial.third − third and Σ w (yᵀQy)² = radial.fourth − 2 mixed + fourth).
+  struct AxialMoments {
+    Eigen::Vector3d third = Eigen::Vector3d::Zero();
+    double mixed = 0;
+    double fourth = 0;
+  };
+  AxialMoments axial_moments(const Eigen::Vector3d& axis) const;
+
+  /// ClusterStats::normal_alignment of the cluster: the area-weighted mean |n · ν| of the face
+  /// normals against the field ν(x) = Q (x − point) / radius.
+  double normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vector3d& point,
+                          double radius) const;
+
+  /// The cluster's whole statistics, centred at centroid() (for a union: formed on first use,
+  /// then kept; the first moments are exactly zero).
+  const ClusterStats& stats() const;
+  /// The same, formed anew, with the moments up to max_degree only (2: those of degree 3 and 4
+  /// are left zero; the others are the same, bit for bit, as stats()').
+  ClusterStats stats(int max_degree) const;
+
+ private:
+  // The parts, with the shift from their centroid to the view's: y = y_part + shift.
+  const ClusterStats* parts_[2] = {nullptr, nullptr};
+  Eigen::Vector3d shifts_[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  int part_count_ = 0;
+  const EdgeStats* shared_ = nullptr;
+
+  double weight_ = 0;
+  Eigen::Vector3d centroid_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d second_moment_ = Eigen::Matrix3d::Zero();
+  std::uint32_t triangle_count_ = 0;
+  double area_ = 0;
+  Eigen::Vector3d normal_sum_ = Eigen::Vector3d::Zero();
+
+  struct Eigensystem {
+    Eigen::Vector3d values;
+    Eigen::Matrix3d vectors;
+  };
+  mutable std::optional<Eigensystem> eigensystem_;
+  mutable std::optional<RadialMoments> radial_;
+  mutable std::optional<ClusterStats> union_stats_;
+  const Eigensystem& eigensystem() const;
+};
+
+}  // namespace primseg
