@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <type_traits>
 
+#include "batch_pool.hpp"
 #include "indexed_heap.hpp"
 #include "model_selection.hpp"
 #include "parallel.hpp"
@@ -18,7 +20,7 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr std::uint32_t kPairTag = 1u << 31;
 
 // A candidate merge in the queue: the dual edge's id and its key. Candidates are ordered by
-// (cost, exactness, primitive type, merged degree, smaller node id, larger node id). On equal cost
+// (cost, exactness, primitive type, merged degree, dual edge id). On equal cost
 // simpler types go first, so flat regions are whole before exact curved fits can reach into them.
 //
 // Lazy evaluation queues candidates whose cost is only a lower bound of theirs (exact = false). At
@@ -45,6 +47,7 @@ struct QueuedCandidate {
         rank(std::uint32_t{is_exact} << 31 | static_cast<std::uint32_t>(type) << 28),
         id(edge_id) {}
   bool exact() const { return (rank >> 31) != 0; }
+  PrimitiveType type() const { return static_cast<PrimitiveType>((rank >> 28) & 7); }
   std::uint32_t degree() const { return rank & kMaxDegree; }
   void set_degree(std::uint32_t merged_degree) {
     rank = (rank & ~kMaxDegree) | std::min(merged_degree, kMaxDegree);
@@ -55,7 +58,7 @@ static_assert(kPrimitiveTypeCount <= 8);
 
 // 16 bytes: the builder keeps one per dual edge.
 struct LiveEdge {
-  std::uint32_t a, b;  // current node ids of the two clusters; a = kNone once dead
+  std::uint32_t a, b;  // slots of the two clusters (see HierarchyBuilder::Impl); a = kNone once dead
   // The mesh edges between the two clusters are those of the input dual edge with this id until
   // two edges to a common neighbour are combined; then their sum lives in a pool at this index.
   std::uint32_t combined_shared = kNone;
@@ -64,8 +67,6 @@ struct LiveEdge {
   float cost_bound = 0;
 
   bool alive() const { return a != kNone; }
-  std::uint32_t low() const { return std::min(a, b); }
-  std::uint32_t high() const { return std::max(a, b); }
   void raise_cost_bound(double bound) {
     if (!(bound > cost_bound)) return;
     float rounded = static_cast<float>(std::min<double>(bound, std::numeric_limits<float>::max()));
@@ -75,20 +76,32 @@ struct LiveEdge {
 };
 static_assert(sizeof(LiveEdge) == 16);
 
-// The queue's order; node ids break the remaining ties (live candidates have distinct pairs).
+// The queue's order. The dual edge's id settles the remaining ties: it is fixed for the edge's
+// life, where the clusters' node ids change as they merge.
 struct ComesFirst {
-  const std::vector<LiveEdge>* edges;
   bool operator()(const QueuedCandidate& x, const QueuedCandidate& y) const {
     if (x.cost != y.cost) return x.cost < y.cost;
     if (x.rank != y.rank) return x.rank < y.rank;
-    const LiveEdge& ex = (*edges)[x.id];
-    const LiveEdge& ey = (*edges)[y.id];
-    if (ex.low() != ey.low()) return ex.low() < ey.low();
-    return ex.high() < ey.high();
+    return x.id < y.id;
   }
 };
 
 using CandidateQueue = detail::IndexedHeap<QueuedCandidate, ComesFirst>;
+
+// What the builder keeps of a slot: a live cluster lives in the slot of one of its input faces
+// (that face's id). Two slots share a cache line, and a candidate's evaluation reads its two
+// clusters' slots only.
+struct Slot {
+  std::uint32_t node;   // the cluster's node id; kNone once merged into another slot
+  std::uint32_t stats;  // index into the pool of statistics; kNone: a face; kPairTag | edge: a pair
+  std::uint32_t faces;      // input faces in the cluster
+  std::uint32_t triangles;  // triangles in the cluster
+  std::uint32_t min_face;   // its lowest input face (orders the trailing merges)
+  std::uint32_t first_link;  // head of its adjacency list; kNone if empty
+  std::uint32_t marker;      // merge(): the kept edge to this neighbour, else kNone
+  std::uint32_t stamp;       // merged_degree(): the last count this neighbour was counted in
+};
+static_assert(sizeof(Slot) == 32);
 
 // Statistics of the clusters that are not stored (faces and pairs), recomputed for a candidate:
 // kept from one evaluation to the next so that their storage is reused.
@@ -184,22 +197,21 @@ class HierarchyBuilder::Impl {
       : mesh_(std::move(mesh)),
         options_(std::move(options)),
         selector_(options_),
-        queue_(0, ComesFirst{&edges_}) {
+        pool_(detail::thread_count(options_.threads)),
+        scratch_(pool_.thread_count()),
+        queue_(0, ComesFirst{}) {
     if (!mesh_) throw InvalidInputError("no mesh");
     mesh_->validate();
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights);
     const std::uint32_t f = mesh_->face_count();
-    const unsigned threads = detail::thread_count(options_.threads);
     // Statistics are stored for clusters of three faces or more only (at most F / 3 live at
     // once); a single face's or a pair's are recomputed when needed (see store_pair()).
-    stats_index_of_slot_.assign(f, kNone);
     stats_.reserve(f / 3 + 1);  // address space only: pages are touched as clusters form
     merges_.reserve(f - 1);
-    slot_of_node_.assign(2 * std::size_t{f}, kNone);
-    for (std::uint32_t face = 0; face < f; ++face) slot_of_node_[face] = face;
-    face_count_of_slot_.assign(f, 1);
-    min_face_of_slot_.resize(f);
-    for (std::uint32_t face = 0; face < f; ++face) min_face_of_slot_[face] = face;
+    slots_.resize(f);
+    for (std::uint32_t face = 0; face < f; ++face)
+      slots_[face] = {face, kNone, 1, graph_->first_triangle(face + 1) - graph_->first_triangle(face),
+                      face, kNone, kNone, 0};
     if (options_.exact_costs) {
       next_face_.assign(f, kNone);
       face_list_head_.resize(f);
@@ -214,30 +226,27 @@ class HierarchyBuilder::Impl {
     edges_.reserve(dual_edges.size());
     for (const DualEdge& e : dual_edges) edges_.push_back({e.first, e.second});
     // Each face's list in increasing edge id: prepend in decreasing order.
-    first_link_.assign(f, kNone);
     next_link_.resize(2 * dual_edges.size());
     for (std::size_t id = dual_edges.size(); id-- > 0;)
       for (std::uint32_t side = 0; side < 2; ++side) {
         const std::uint32_t face = side == 0 ? dual_edges[id].first : dual_edges[id].second;
         const auto link = static_cast<std::uint32_t>(2 * id + side);
-        next_link_[link] = first_link_[face];
-        first_link_[face] = link;
+        next_link_[link] = slots_[face].first_link;
+        slots_[face].first_link = link;
       }
-    stamp_.assign(f, 0);
-    marker_.assign(f, kNone);
     lazy_ = options_.evaluation != CandidateEvaluation::Eager && !options_.exact_costs;
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
     // Every candidate's cost is independent of the others: evaluate them in parallel, then the
     // degrees (which share scratch arrays) in order.
     std::vector<QueuedCandidate> candidates(edges_.size());
-    std::vector<Scratch> scratch(threads);
-    detail::parallel_for_threads(edges_.size(), threads, [&](std::size_t id, unsigned thread) {
-      candidates[id] = evaluate(static_cast<std::uint32_t>(id), scratch[thread]);
-    });
+    auto first_evaluation = [&](std::size_t id, unsigned thread) {
+      candidates[id] = evaluate(static_cast<std::uint32_t>(id), scratch_[thread]);
+    };
+    pool_.run(edges_.size(), first_evaluation);
     for (QueuedCandidate& c : candidates)
       if (c.cost == 0) c.set_degree(merged_degree(edges_[c.id].a, edges_[c.id].b));
     evaluations_ = candidates.size();
-    queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{&edges_});
+    queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{});
     queue_.assign(std::move(candidates));
     total_merges_ = f - graph_->component_count();
   }
@@ -248,11 +257,11 @@ class HierarchyBuilder::Impl {
       if (!top.exact()) {
         // A bound reached the top: evaluate the candidate. (Its cost is above the bound, so
         // never zero: no degree.)
-        queue_.update(evaluate(top.id, scratch_));
+        queue_.update(evaluate(top.id, scratch_[0]));
         ++evaluations_;
         continue;
       }
-      merge(top.cost > 0 ? settle_tie(top) : top.id);
+      merge(top.cost > 0 ? settle_tie(top) : top);
       return true;
     }
     return false;
@@ -287,16 +296,17 @@ class HierarchyBuilder::Impl {
     return mesh_->face_count() + static_cast<std::uint32_t>(merges_.size());
   }
 
-  std::uint32_t other_end(const LiveEdge& e, std::uint32_t node) const {
-    return e.a == node ? e.b : e.a;
+  static std::uint32_t other_end(const LiveEdge& e, std::uint32_t slot) {
+    return e.a == slot ? e.b : e.a;
   }
 
-  // Number of clusters adjacent to a ∪ b; unlinks dead edges from the two lists on the way.
+  // Number of clusters adjacent to the union of the clusters in slots a and b; unlinks dead
+  // edges from the two lists on the way.
   std::uint32_t merged_degree(std::uint32_t a, std::uint32_t b) {
     ++current_stamp_;
     std::uint32_t degree = 0;
-    for (std::uint32_t node : {a, b}) {
-      std::uint32_t* link = &first_link_[slot_of_node_[node]];
+    for (std::uint32_t slot : {a, b}) {
+      std::uint32_t* link = &slots_[slot].first_link;
       while (*link != kNone) {
         const LiveEdge& e = edges_[*link / 2];
         if (!e.alive()) {
@@ -304,9 +314,9 @@ class HierarchyBuilder::Impl {
           continue;
         }
         link = &next_link_[*link];
-        const std::uint32_t other = other_end(e, node);
+        const std::uint32_t other = other_end(e, slot);
         if (other == a || other == b) continue;
-        std::uint32_t& stamp = stamp_[slot_of_node_[other]];
+        std::uint32_t& stamp = slots_[other].stamp;
         if (stamp == current_stamp_) continue;
         stamp = current_stamp_;
         ++degree;
@@ -317,8 +327,8 @@ class HierarchyBuilder::Impl {
 
   // The top is the cheapest candidate, at a positive cost. Candidates of exactly the same cost
   // and type (a connected group of the heap around its top) are ranked by the degree their merge
-  // would make now, then by node ids; the winner's edge.
-  std::uint32_t settle_tie(const QueuedCandidate& top) {
+  // would make now, then by edge id; the winner.
+  QueuedCandidate settle_tie(const QueuedCandidate& top) {
     auto ties_top = [&](const QueuedCandidate& c) {
       return c.cost == top.cost && c.rank == top.rank;
     };
@@ -330,17 +340,15 @@ class HierarchyBuilder::Impl {
       for (std::size_t c = first; c < end; ++c)
         if (ties_top(queue_.at(c))) tied_.push_back(c);
     }
-    if (tied_.size() == 1) return top.id;  // the usual case
-    std::uint32_t best = top.id, best_degree = merged_degree(edges_[top.id].a, edges_[top.id].b);
+    if (tied_.size() == 1) return top;  // the usual case
+    QueuedCandidate best = top;
+    std::uint32_t best_degree = merged_degree(edges_[top.id].a, edges_[top.id].b);
     for (std::size_t position : tied_) {
-      const std::uint32_t id = queue_.at(position).id;
-      if (id == top.id) continue;
-      const std::uint32_t degree = merged_degree(edges_[id].a, edges_[id].b);
-      const LiveEdge& e = edges_[id];
-      const LiveEdge& b = edges_[best];
-      if (degree < best_degree ||
-          (degree == best_degree && std::pair(e.low(), e.high()) < std::pair(b.low(), b.high()))) {
-        best = id;
+      const QueuedCandidate& candidate = queue_.at(position);
+      if (candidate.id == top.id) continue;
+      const std::uint32_t degree = merged_degree(edges_[candidate.id].a, edges_[candidate.id].b);
+      if (degree < best_degree || (degree == best_degree && candidate.id < best.id)) {
+        best = candidate;
         best_degree = degree;
       }
     }
@@ -371,20 +379,19 @@ class HierarchyBuilder::Impl {
   }
 
   void kill_edge(std::uint32_t id) {
+    queue_.erase(id);
     LiveEdge& e = edges_[id];
     if (e.combined_shared != kNone) free_combined_shared_.push_back(e.combined_shared);
     e.combined_shared = kNone;
     e.a = e.b = kNone;
-    queue_.erase(id);
   }
 
   // A live cluster's centred statistics: stored for a merged cluster of three faces or more,
   // computed into `scratch` for a face or a pair of faces, with the moments up to `max_degree`
   // (2 for a candidate only a plane can fit: see ModelSelector::moment_degree()).
-  const ClusterStats& stats_of(std::uint32_t node, Scratch& scratch, int part,
+  const ClusterStats& stats_of(std::uint32_t slot, Scratch& scratch, int part,
                               int max_degree) const {
-    const std::uint32_t slot = slot_of_node_[node];
-    const std::uint32_t index = stats_index_of_slot_[slot];
+    const std::uint32_t index = slots_[slot].stats;
     const bool samples = selector_.needs_samples();
     ClusterStats& stats = scratch.clusters[part];
     if (index == kNone) {
@@ -403,30 +410,18 @@ class HierarchyBuilder::Impl {
     return stats;
   }
 
-  std::uint32_t triangle_count(std::uint32_t node) const {
-    const std::uint32_t slot = slot_of_node_[node];
-    const std::uint32_t index = stats_index_of_slot_[slot];
-    if (index == kNone) return graph_->first_triangle(slot + 1) - graph_->first_triangle(slot);
-    if (index & kPairTag) {
-      const DualEdge& e = graph_->edges()[index & ~kPairTag];
-      return graph_->first_triangle(e.first + 1) - graph_->first_triangle(e.first) +
-             graph_->first_triangle(e.second + 1) - graph_->first_triangle(e.second);
-    }
-    return stats_[index].triangle_count;
-  }
-
   // Pairs of faces are most of the merged clusters alive at once (all of them at the peak on a
   // subdivided mesh, 40% on a scan): recomputing theirs from the two faces costs about a fifth
   // of a fit and saves their 568 bytes each. The newest pair's are kept, for the evaluation of
   // its candidates that follows.
   void store_pair(std::uint32_t slot, std::uint32_t edge_id, ClusterStats&& stats) {
     release_stats(slot);
-    stats_index_of_slot_[slot] = newest_pair_key_ = kPairTag | edge_id;
+    slots_[slot].stats = newest_pair_key_ = kPairTag | edge_id;
     newest_pair_ = std::move(stats);
   }
 
   void store_stats(std::uint32_t slot, ClusterStats&& stats) {
-    std::uint32_t& index = stats_index_of_slot_[slot];
+    std::uint32_t& index = slots_[slot].stats;
     if (index == kNone || (index & kPairTag)) {
       if (free_stats_.empty()) {
         index = static_cast<std::uint32_t>(stats_.size());
@@ -440,7 +435,7 @@ class HierarchyBuilder::Impl {
   }
 
   void release_stats(std::uint32_t slot) {
-    std::uint32_t& index = stats_index_of_slot_[slot];
+    std::uint32_t& index = slots_[slot].stats;
     if (index != kNone && !(index & kPairTag)) free_stats_.push_back(index);
     index = kNone;
   }
@@ -449,8 +444,8 @@ class HierarchyBuilder::Impl {
     if (!options_.exact_costs) return selector_.select(cluster);
     const detail::ExactError exact = [&](const Primitive& primitive) {
       double sum = 0;
-      for (std::uint32_t node : {e.a, e.b})
-        for (std::uint32_t f = face_list_head_[slot_of_node_[node]]; f != kNone; f = next_face_[f])
+      for (std::uint32_t slot : {e.a, e.b})
+        for (std::uint32_t f = face_list_head_[slot]; f != kNone; f = next_face_[f])
           for (std::uint32_t t = graph_->first_triangle(f); t < graph_->first_triangle(f + 1);
                ++t) {
             const std::array<double, 3> w = graph_->corner_weights(t);
@@ -469,7 +464,7 @@ class HierarchyBuilder::Impl {
   // edge's bound (safe in parallel over distinct edges).
   QueuedCandidate evaluate(std::uint32_t id, Scratch& scratch) {
     LiveEdge& e = edges_[id];
-    const int degree = selector_.moment_degree(triangle_count(e.a) + triangle_count(e.b));
+    const int degree = selector_.moment_degree(slots_[e.a].triangles + slots_[e.b].triangles);
     const ClusterView cluster(stats_of(e.a, scratch, 0, degree), stats_of(e.b, scratch, 1, degree),
                               shared_edges(id));
     const detail::SelectedModel model = select(cluster, e);
@@ -484,8 +479,8 @@ class HierarchyBuilder::Impl {
   // factor 2 covers round-off.
   double queued_bound(const LiveEdge& e) {
     if (!(e.cost_bound > 0)) return 0;
-    const Moments& a = stats_of(e.a, scratch_, 0, 2).moments;
-    const Moments& b = stats_of(e.b, scratch_, 1, 2).moments;
+    const Moments& a = stats_of(e.a, scratch_[0], 0, 2).moments;
+    const Moments& b = stats_of(e.b, scratch_[0], 1, 2).moments;
     const double wa = a.weight(), wb = b.weight();
     if (!(wa > 0) || !(wb > 0)) return 0;
     const double spread = a.second_moment().trace() + b.second_moment().trace() +
@@ -494,58 +489,22 @@ class HierarchyBuilder::Impl {
                                                                                    : 0.0;
   }
 
-  void merge(std::uint32_t edge_id) {
-    LiveEdge& edge = edges_[edge_id];
-    const std::uint32_t a = edge.a, b = edge.b;
-    const std::uint32_t slot_a = slot_of_node_[a], slot_b = slot_of_node_[b];
-    const ClusterView cluster(stats_of(a, scratch_, 0, 4), stats_of(b, scratch_, 1, 4),
-                              shared_edges(edge_id));
-    const detail::SelectedModel model = select(cluster, edge);
-    ClusterStats merged = cluster.stats();
-    const std::uint32_t node = next_node();
-
-    Merge record;
-    record.first = std::min(a, b);
-    record.second = std::max(a, b);
-    record.cost = model.cost;
-    record.error = model.fit.error;
-    record.weight = cluster.weight();
-    record.face_count = face_count_of_slot_[slot_a] + face_count_of_slot_[slot_b];
-    record.primitive = graph_->frame().to_input(model.fit.primitive);
-    merges_.push_back(record);
-    max_cost_ = std::max(max_cost_, model.cost);
-
-    // The merged cluster lives in a's slot; b's is released.
-    release_stats(slot_b);
-    if (record.face_count == 2)
-      store_pair(slot_a, edge_id, std::move(merged));
-    else
-      store_stats(slot_a, std::move(merged));
-    face_count_of_slot_[slot_a] = record.face_count;
-    min_face_of_slot_[slot_a] = std::min(min_face_of_slot_[slot_a], min_face_of_slot_[slot_b]);
-    slot_of_node_[node] = slot_a;
-    slot_of_node_[a] = slot_of_node_[b] = kNone;
-    if (options_.exact_costs) {
-      next_face_[face_list_tail_[slot_a]] = face_list_head_[slot_b];
-      face_list_tail_[slot_a] = face_list_tail_[slot_b];
-    }
-    kill_edge(edge_id);
-
-    // Rename a and b to the new node; two edges to a common neighbour become one. The merged
-    // list is a's kept links, then b's, in their order.
+  // Moves b's edges to a's slot, where two edges to a common neighbour become one (their mesh
+  // edges summed, the second killed), and returns the head of the merged list: a's kept links,
+  // then b's, in their order.
+  std::uint32_t relink(std::uint32_t slot_a, std::uint32_t slot_b) {
     std::uint32_t head = kNone;
     std::uint32_t* tail = &head;
-    for (std::uint32_t old : {a, b}) {
-      const std::uint32_t slot = old == a ? slot_a : slot_b;
-      for (std::uint32_t link = first_link_[slot], next; link != kNone; link = next) {
+    for (std::uint32_t slot : {slot_a, slot_b}) {
+      for (std::uint32_t link = slots_[slot].first_link, next; link != kNone; link = next) {
         next = next_link_[link];
         const std::uint32_t id = link / 2;
         LiveEdge& e = edges_[id];
         if (!e.alive()) continue;
-        std::uint32_t& marker = marker_[slot_of_node_[other_end(e, old)]];
+        std::uint32_t& marker = slots_[other_end(e, slot)].marker;
         if (marker == kNone) {
           marker = id;
-          (e.a == old ? e.a : e.b) = node;
+          (e.a == slot ? e.a : e.b) = slot_a;
           *tail = link;
           tail = &next_link_[link];
         } else {
@@ -556,25 +515,101 @@ class HierarchyBuilder::Impl {
       }
     }
     *tail = kNone;
-    first_link_[slot_a] = head;
-    first_link_[slot_b] = kNone;
+    slots_[slot_a].first_link = head;
+    slots_[slot_b].first_link = kNone;
     for (std::uint32_t link = head; link != kNone; link = next_link_[link])
-      marker_[slot_of_node_[other_end(edges_[link / 2], node)]] = kNone;
+      slots_[other_end(edges_[link / 2], slot_a)].marker = kNone;
+    return head;
+  }
 
+  // Asks for the cache lines the evaluation of candidate `id` with the cluster in `slot` reads
+  // most: that cluster's statistics if stored, and the mesh edges between the two clusters.
+  void prefetch_candidate(std::uint32_t id, std::uint32_t slot) const {
+    const std::uint32_t index = slots_[slot].stats;
+    if (index != kNone && !(index & kPairTag)) {
+      const char* stats = reinterpret_cast<const char*>(&stats_[index]);
+      for (std::size_t offset = 0; offset < sizeof(ClusterStats); offset += 64)
+        __builtin_prefetch(stats + offset);
+    }
+    const std::uint32_t pooled = edges_[id].combined_shared;
+    if (pooled == kNone)
+      __builtin_prefetch(&graph_->edges()[id]);
+    else
+      __builtin_prefetch(&combined_shared_[pooled]);
+  }
+
+  // Applies the candidate's merge.
+  void merge(const QueuedCandidate& candidate) {
+    const std::uint32_t edge_id = candidate.id;
+    const LiveEdge edge = edges_[edge_id];
+    const std::uint32_t slot_a = edge.a, slot_b = edge.b;
+    const std::uint32_t a = slots_[slot_a].node, b = slots_[slot_b].node;
+    // A copy: combining edges below may move the pool it is in.
+    const EdgeStats shared = shared_edges(edge_id);
+    kill_edge(edge_id);
+    const std::uint32_t head = relink(slot_a, slot_b);
+    // What the new cluster's candidates will read arrives while its own fit is computed.
+    for (std::uint32_t link = head; link != kNone; link = next_link_[link])
+      prefetch_candidate(link / 2, other_end(edges_[link / 2], slot_a));
+
+    const ClusterView cluster(stats_of(slot_a, scratch_[0], 0, 4),
+                              stats_of(slot_b, scratch_[0], 1, 4), shared);
+    // The type is known: only its fit is needed, and it has the candidate's cost exactly.
+    const detail::SelectedModel model =
+        options_.exact_costs ? select(cluster, edge) : selector_.refit(cluster, candidate.type());
+    ClusterStats merged = cluster.stats(4);
+    const std::uint32_t node = next_node();
+
+    Merge record;
+    record.first = std::min(a, b);
+    record.second = std::max(a, b);
+    record.cost = model.cost;
+    record.error = model.fit.error;
+    record.weight = cluster.weight();
+    record.face_count = slots_[slot_a].faces + slots_[slot_b].faces;
+    record.primitive = graph_->frame().to_input(model.fit.primitive);
+    merges_.push_back(record);
+    max_cost_ = std::max(max_cost_, model.cost);
+
+    // The merged cluster lives in a's slot; b's is released.
+    release_stats(slot_b);
+    if (record.face_count == 2)
+      store_pair(slot_a, edge_id, std::move(merged));
+    else
+      store_stats(slot_a, std::move(merged));
+    Slot& kept = slots_[slot_a];
+    kept.faces = record.face_count;
+    kept.triangles += slots_[slot_b].triangles;
+    kept.min_face = std::min(kept.min_face, slots_[slot_b].min_face);
+    kept.node = node;
+    slots_[slot_b].node = kNone;
+    if (options_.exact_costs) {
+      next_face_[face_list_tail_[slot_a]] = face_list_head_[slot_b];
+      face_list_tail_[slot_a] = face_list_tail_[slot_b];
+    }
+
+    // The new cluster's candidates: those under a bound that holds wait in the queue (a zero
+    // bound would reach the top before the next merge anyway), the others are evaluated, on all
+    // threads, and queued in list order.
+    batch_.clear();
     for (std::uint32_t link = head; link != kNone; link = next_link_[link]) {
       const std::uint32_t id = link / 2;
-      const LiveEdge& e = edges_[id];
-      // A zero bound would reach the top before the next merge anyway: evaluate it now.
-      const double bound = lazy_ ? queued_bound(e) : 0;
-      if (bound > 0) {
+      const double bound = lazy_ ? queued_bound(edges_[id]) : 0;
+      if (bound > 0)
         queue_.update({bound, false, PrimitiveType::Plane, id});
-        continue;
-      }
-      QueuedCandidate candidate = evaluate(id, scratch_);
-      ++evaluations_;
-      if (candidate.cost == 0) candidate.set_degree(merged_degree(e.a, e.b));
-      queue_.update(candidate);
+      else
+        batch_.push_back({0, false, PrimitiveType::Plane, id});
     }
+    auto evaluate_batch = [&](std::size_t i, unsigned thread) {
+      batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
+    };
+    pool_.run(batch_.size(), evaluate_batch);
+    for (QueuedCandidate& evaluated : batch_) {
+      if (evaluated.cost == 0)
+        evaluated.set_degree(merged_degree(edges_[evaluated.id].a, edges_[evaluated.id].b));
+      queue_.update(evaluated);
+    }
+    evaluations_ += batch_.size();
   }
 
   // What only the merge loop needs (about two thirds of the peak memory) is freed before the
@@ -582,19 +617,13 @@ class HierarchyBuilder::Impl {
   void release_working_memory() {
     auto release = [](auto& vector) { std::decay_t<decltype(vector)>().swap(vector); };
     release(stats_);
-    release(stats_index_of_slot_);
     release(free_stats_);
-    release(slot_of_node_);
-    release(face_count_of_slot_);
-    release(min_face_of_slot_);
-    release(first_link_);
+    release(slots_);
     release(next_link_);
     release(edges_);
     release(combined_shared_);
     release(free_combined_shared_);
     queue_.clear();
-    release(stamp_);
-    release(marker_);
     release(tied_);
     release(next_face_);
     release(face_list_head_);
@@ -604,23 +633,22 @@ class HierarchyBuilder::Impl {
   // Components are joined in the order of their lowest face, each trailing merge costed above
   // every real one so that cuts and dendrograms keep them last.
   void add_trailing_merges() {
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> roots;  // (lowest face, node)
-    for (std::uint32_t node = 0; node < next_node(); ++node)
-      if (slot_of_node_[node] != kNone)
-        roots.push_back({min_face_of_slot_[slot_of_node_[node]], node});
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> roots;  // (lowest face, slot)
+    for (std::uint32_t slot = 0; slot < slots_.size(); ++slot)
+      if (slots_[slot].node != kNone) roots.push_back({slots_[slot].min_face, slot});
     std::sort(roots.begin(), roots.end());
     const double cost = max_cost_ > 0 ? 2 * max_cost_ : 1.0;
-    std::uint32_t joined = roots.front().second;
-    double weight = stats_of(joined, scratch_, 0, 2).moments.weight();
-    std::uint32_t faces = face_count_of_slot_[slot_of_node_[joined]];
+    std::uint32_t joined = slots_[roots.front().second].node;
+    double weight = stats_of(roots.front().second, scratch_[0], 0, 2).moments.weight();
+    std::uint32_t faces = slots_[roots.front().second].faces;
     for (std::size_t i = 1; i < roots.size(); ++i) {
-      const std::uint32_t other = roots[i].second;
+      const std::uint32_t slot = roots[i].second, other = slots_[slot].node;
       Merge record;
       record.first = std::min(joined, other);
       record.second = std::max(joined, other);
       record.cost = cost;
-      record.weight = weight += stats_of(other, scratch_, 0, 2).moments.weight();
-      record.face_count = faces += face_count_of_slot_[slot_of_node_[other]];
+      record.weight = weight += stats_of(slot, scratch_[0], 0, 2).moments.weight();
+      record.face_count = faces += slots_[slot].faces;
       record.trailing = true;
       joined = next_node();
       merges_.push_back(record);
@@ -630,30 +658,25 @@ class HierarchyBuilder::Impl {
   std::shared_ptr<const Mesh> mesh_;
   HierarchyOptions options_;
   detail::ModelSelector selector_;
+  detail::BatchPool pool_;
+  std::vector<Scratch> scratch_;  // per thread of pool_
   std::unique_ptr<DualGraph> graph_;
   std::vector<ClusterStats> stats_;  // merged clusters' statistics, pooled
-  // Per slot: an index into stats_, kNone for a single face, kPairTag | dual edge id for a pair.
-  std::vector<std::uint32_t> stats_index_of_slot_;
   std::uint32_t newest_pair_key_ = kNone;  // see store_pair()
   ClusterStats newest_pair_;
   std::vector<std::uint32_t> free_stats_;  // unused entries of stats_
-  std::vector<std::uint32_t> slot_of_node_;
-  std::vector<std::uint32_t> face_count_of_slot_;
-  std::vector<std::uint32_t> min_face_of_slot_;
+  std::vector<Slot> slots_;                // per input face
   // Adjacency as intrusive lists: link 2 id + side is edge id on the list of the slot of its
-  // a (side 0) or b (side 1) cluster. Dead edges are unlinked lazily.
-  std::vector<std::uint32_t> first_link_;  // per slot: first link, kNone if empty
+  // a (side 0) or b (side 1) cluster, from Slot::first_link. Dead edges are unlinked lazily.
   std::vector<std::uint32_t> next_link_;   // per link
   std::vector<LiveEdge> edges_;
   std::vector<EdgeStats> combined_shared_;  // see LiveEdge::combined_shared
   std::vector<std::uint32_t> free_combined_shared_;
   std::vector<Merge> merges_;
-  std::vector<std::uint32_t> stamp_;  // per slot
-  std::uint32_t current_stamp_ = 0;
-  std::vector<std::uint32_t> marker_;                                       // per slot
+  std::uint32_t current_stamp_ = 0;  // see Slot::stamp
   std::vector<std::size_t> tied_;  // settle_tie()'s queue positions
-  Scratch scratch_;                // the merge loop's
-  CandidateQueue queue_;  // after edges_, which its order reads
+  std::vector<QueuedCandidate> batch_;  // the candidates merge() evaluates
+  CandidateQueue queue_;
   std::vector<std::uint32_t> next_face_, face_list_head_, face_list_tail_;  // exact_costs only
   std::uint32_t total_merges_ = 0;
   double max_cost_ = 0;

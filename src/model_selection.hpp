@@ -38,12 +38,18 @@ class ModelSelector {
   /// The model of a cluster or of the union of two (a merge candidate). `exact`: if given,
   /// replaces each fit's error by the exact one.
   SelectedModel select(const ClusterView& cluster, const ExactError* exact = nullptr) const;
+  /// What select(cluster) chose, given the type it chose: only that type is fitted (its fit is
+  /// the same whatever select() had to beat), with the same error and cost.
+  SelectedModel refit(const ClusterView& cluster, PrimitiveType chosen) const;
   /// `centred`: statistics with moments about the cluster's centroid.
   SelectedModel select(const ClusterStats& centred, const ExactError* exact = nullptr) const {
     return select(ClusterView(centred), exact);
   }
 
  private:
+  // The fit's error, exact if asked, zero-snapped, and its cost.
+  SelectedModel finish(PrimitiveFit fit, double zero_level, const ExactError* exact) const;
+
   std::vector<const PrimitiveFitter*> fitters_;  // ascending type
   std::uint32_t min_curved_triangles_ = UINT32_MAX;
   bool needs_samples_ = false;

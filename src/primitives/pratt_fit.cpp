@@ -87,14 +87,13 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, const MomentEigensy
   const double resolution = 1e-15 * hi;
   double eta = 0, slope = 0;
   // g decreases: the root is at least x exactly when g(x) >= 0, i.e. h(x) >= 0 below λ_0.
+  // (The bracket is not narrowed to x when the fit is not beaten: the fit is then the same, bit
+  // for bit, whatever the objective to beat.)
   const double beat = objective_to_beat * scale2;
-  if (beat > 0 && beat < hi) {
-    if (h(beat, &slope) >= 0) {
-      result.beaten = true;
-      result.objective_minimum = objective_to_beat;
-      return result;
-    }
-    hi = beat;
+  if (beat > 0 && beat < hi && h(beat, &slope) >= 0) {
+    result.beaten = true;
+    result.objective_minimum = objective_to_beat;
+    return result;
   }
   double value = h(eta, &slope);
   if (!(value > 0)) {

@@ -48,7 +48,7 @@ inline constexpr double kMaxRelativeRadius = 1e3;
 
 /// Pratt's fit. With a finite `objective_to_beat`, a fit whose minimum objective is certainly at
 /// least that (one evaluation of the secular function) returns at once, beaten; the others are
-/// solved as usual within the tighter bracket.
+/// the same, bit for bit, as without it.
 template <int D>
 PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments,
                          double objective_to_beat = std::numeric_limits<double>::infinity());

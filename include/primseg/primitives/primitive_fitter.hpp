@@ -49,7 +49,8 @@ class PrimitiveFitter {
   /// the type cannot win the cluster unless its error is below this (another type has that
   /// cost), so a fitter may stop as soon as its error is certainly at least this and return an
   /// invalid fit with `beaten` set and superset_error_bound at most its error. Infinity: fit
-  /// fully.
+  /// fully. A fit that is not beaten must be the same, bit for bit, as with an infinite
+  /// error_to_beat (the hierarchy refits the winning type alone when it applies a merge).
   virtual PrimitiveFit fit(const ClusterView& cluster, double error_to_beat) const = 0;
   PrimitiveFit fit(const ClusterView& cluster) const {
     return fit(cluster, std::numeric_limits<double>::infinity());
