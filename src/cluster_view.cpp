@@ -103,20 +103,12 @@ ClusterView::ClusterView(const ClusterStats& a, const ClusterStats& b, const Edg
   }
 }
 
-const ClusterView::Eigensystem& ClusterView::eigensystem() const {
-  if (!eigensystem_) {
-    const detail::SymmetricEigen3 e = detail::symmetric_eigen3(second_moment_);
-    eigensystem_ = Eigensystem{e.values, e.vectors};
+const ClusterView::Eigenpair& ClusterView::smallest_eigenpair() const {
+  if (!smallest_) {
+    const detail::Eigenpair e = detail::smallest_eigenpair(second_moment_);
+    smallest_ = Eigenpair{e.value, e.vector};
   }
-  return *eigensystem_;
-}
-
-const Eigen::Vector3d& ClusterView::second_moment_eigenvalues() const {
-  return eigensystem().values;
-}
-
-const Eigen::Matrix3d& ClusterView::second_moment_eigenvectors() const {
-  return eigensystem().vectors;
+  return *smallest_;
 }
 
 Eigen::Matrix3d ClusterView::edge_tensor() const {
@@ -174,10 +166,17 @@ double ClusterView::normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vect
   if (!(area_ > 0) || !(radius > 0)) return 0;
   // Σ A n · Q (c − p) over the triangles = tr(Q Σ (c − o)(A n)ᵀ) − (Σ A n)ᵀ Q (p − o), with each
   // part's Σ (c − o_p)(A n)ᵀ moved to the view's centroid by δ_p (Σ A n)ᵀ.
-  Eigen::Matrix3d normal_position = Eigen::Matrix3d::Zero();
-  for (int p = 0; p < part_count_; ++p)
-    normal_position += parts_[p]->normal_position + shifts_[p] * parts_[p]->normal_sum.transpose();
-  const double sum = (q * normal_position).trace() - normal_sum_.dot(q * (point - centroid_));
+  if (!normal_position_) {
+    Eigen::Matrix3d& sum = normal_position_.emplace(parts_[0]->normal_position);
+    sum.noalias() += shifts_[0] * parts_[0]->normal_sum.transpose();
+    for (int p = 1; p < part_count_; ++p) {
+      sum += parts_[p]->normal_position;
+      sum.noalias() += shifts_[p] * parts_[p]->normal_sum.transpose();
+    }
+  }
+  // tr(Q N) = Σ_ij Q_ij N_ji.
+  const double trace = q.cwiseProduct(normal_position_->transpose()).sum();
+  const double sum = trace - normal_sum_.dot(q * (point - centroid_));
   return std::abs(sum) / (radius * area_);
 }
 

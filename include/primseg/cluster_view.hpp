@@ -32,10 +32,10 @@ class ClusterView {
   const Eigen::Vector3d& centroid() const { return centroid_; }
   /// Σ w y yᵀ, shape (3, 3).
   const Eigen::Matrix3d& second_moment() const { return second_moment_; }
-  /// Eigenvalues of second_moment() in ascending order (computed on first use, then kept).
-  const Eigen::Vector3d& second_moment_eigenvalues() const;
-  /// Unit eigenvectors of second_moment() as columns, in the order of the eigenvalues.
-  const Eigen::Matrix3d& second_moment_eigenvectors() const;
+  /// The smallest eigenvalue of second_moment() and a unit eigenvector of it (computed on first
+  /// use, then kept): the plane's error and normal.
+  double smallest_eigenvalue() const { return smallest_eigenpair().value; }
+  const Eigen::Vector3d& smallest_eigenvector() const { return smallest_eigenpair().vector; }
 
   std::uint32_t triangle_count() const { return triangle_count_; }
   /// Σ triangle area.
@@ -89,14 +89,15 @@ class ClusterView {
   double area_ = 0;
   Eigen::Vector3d normal_sum_ = Eigen::Vector3d::Zero();
 
-  struct Eigensystem {
-    Eigen::Vector3d values;
-    Eigen::Matrix3d vectors;
+  struct Eigenpair {
+    double value;
+    Eigen::Vector3d vector;
   };
-  mutable std::optional<Eigensystem> eigensystem_;
+  mutable std::optional<Eigenpair> smallest_;
   mutable std::optional<RadialMoments> radial_;
+  mutable std::optional<Eigen::Matrix3d> normal_position_;  // Σ (c − centroid)(A n)ᵀ
   mutable std::optional<ClusterStats> union_stats_;
-  const Eigensystem& eigensystem() const;
+  const Eigenpair& smallest_eigenpair() const;
 };
 
 }  // namespace primseg

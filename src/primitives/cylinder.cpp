@@ -33,10 +33,9 @@ PrimitiveFit CylinderFitter::fit(const ClusterView& cluster, double error_to_bea
   const Eigen::Matrix3d tensor = cluster.edge_tensor();
   const double min_eigenvalue = kMinRelativeAxisEigenvalue * std::sqrt(cluster.area());
   if (!(3 * tensor.cwiseAbs().maxCoeff() > min_eigenvalue)) return result;
-  const detail::SymmetricEigen3 eigen = detail::symmetric_eigen3(tensor);
-  const int largest = std::abs(eigen.values(0)) > std::abs(eigen.values(2)) ? 0 : 2;
-  if (!(std::abs(eigen.values(largest)) > min_eigenvalue)) return result;
-  const Eigen::Vector3d axis = canonical_axis(eigen.vectors.col(largest).normalized());
+  const detail::Eigenpair dominant = detail::dominant_eigenpair(tensor);
+  if (!(std::abs(dominant.value) > min_eigenvalue)) return result;
+  const Eigen::Vector3d axis = canonical_axis(dominant.vector);
 
   // Orthonormal basis (u, v) of the plane orthogonal to the axis.
   Eigen::Index least_aligned;

@@ -16,8 +16,8 @@ PrimitiveFit PlaneFitter::fit(const ClusterView& cluster, double /*error_to_beat
   const Eigen::Vector3d& normal_sum = cluster.normal_sum();
   Eigen::Vector3d normal;
   if (cluster.weight() > 0) {
-    result.error = std::max(0.0, cluster.second_moment_eigenvalues()(0));
-    normal = cluster.second_moment_eigenvectors().col(0);
+    result.error = std::max(0.0, cluster.smallest_eigenvalue());
+    normal = cluster.smallest_eigenvector();
   } else {
     // A cluster of zero-area faces carries no weight: nothing to fit, no error.
     result.error = 0;

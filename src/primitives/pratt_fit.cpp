@@ -8,7 +8,13 @@
 namespace primseg::detail {
 namespace {
 
-MomentEigensystem<2> eigensystem_of(const Eigen::Matrix2d& c) {
+template <int D>
+struct Eigensystem {
+  Eigen::Matrix<double, D, 1> values;  // ascending
+  Eigen::Matrix<double, D, D> vectors;
+};
+
+Eigensystem<2> eigensystem_of(const Eigen::Matrix2d& c) {
   // One Jacobi rotation: tan 2θ = 2 c01 / (c00 − c11), |θ| <= π/4, exact for any gap.
   double cosine = 1, sine = 0;
   if (c(0, 1) != 0) {
@@ -18,7 +24,7 @@ MomentEigensystem<2> eigensystem_of(const Eigen::Matrix2d& c) {
     cosine = 1 / std::sqrt(1 + tangent * tangent);
     sine = tangent * cosine;
   }
-  MomentEigensystem<2> e;
+  Eigensystem<2> e;
   e.vectors << cosine, sine, -sine, cosine;
   for (int k = 0; k < 2; ++k) e.values(k) = e.vectors.col(k).dot(c * e.vectors.col(k));
   if (e.values(0) > e.values(1)) {
@@ -28,22 +34,45 @@ MomentEigensystem<2> eigensystem_of(const Eigen::Matrix2d& c) {
   return e;
 }
 
-MomentEigensystem<3> eigensystem_of(const Eigen::Matrix3d& c) {
+Eigensystem<3> eigensystem_of(const Eigen::Matrix3d& c) {
   const SymmetricEigen3 e = symmetric_eigen3(c);
   return {e.values, e.vectors};
+}
+
+double smallest_eigenvalue_of(const Eigen::Matrix2d& c) {
+  const double half_gap = 0.5 * (c(0, 0) - c(1, 1));
+  return 0.5 * (c(0, 0) + c(1, 1)) - std::sqrt(half_gap * half_gap + c(0, 1) * c(0, 1));
+}
+
+double smallest_eigenvalue_of(const Eigen::Matrix3d& c) {
+  return smallest_eigenpair(c).value;
+}
+
+// t·adj(M) t and det M for a symmetric M (t·M⁻¹t times det M, with no division).
+double adjugate_form(const Eigen::Matrix2d& m, const Eigen::Vector2d& t, double* det) {
+  *det = m(0, 0) * m(1, 1) - m(0, 1) * m(0, 1);
+  return m(1, 1) * t(0) * t(0) + m(0, 0) * t(1) * t(1) - 2 * m(0, 1) * t(0) * t(1);
+}
+
+double adjugate_form(const Eigen::Matrix3d& m, const Eigen::Vector3d& t, double* det) {
+  const double a00 = m(1, 1) * m(2, 2) - m(1, 2) * m(1, 2);
+  const double a11 = m(0, 0) * m(2, 2) - m(0, 2) * m(0, 2);
+  const double a22 = m(0, 0) * m(1, 1) - m(0, 1) * m(0, 1);
+  const double a01 = m(0, 2) * m(1, 2) - m(0, 1) * m(2, 2);
+  const double a02 = m(0, 1) * m(1, 2) - m(0, 2) * m(1, 1);
+  const double a12 = m(0, 1) * m(0, 2) - m(0, 0) * m(1, 2);
+  *det = m(0, 0) * a00 + m(0, 1) * a01 + m(0, 2) * a02;
+  return a00 * t(0) * t(0) + a11 * t(1) * t(1) + a22 * t(2) * t(2) +
+         2 * (a01 * t(0) * t(1) + a02 * t(0) * t(2) + a12 * t(1) * t(2));
 }
 
 }  // namespace
 
 template <int D>
-PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to_beat) {
-  return pratt_fit(moments, eigensystem_of(moments.second), objective_to_beat);
-}
-
-template <int D>
-PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, const MomentEigensystem<D>& second,
-                         double objective_to_beat) {
+PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to_beat,
+                         double smallest_eigenvalue) {
   using Vector = Eigen::Matrix<double, D, 1>;
+  using Matrix = Eigen::Matrix<double, D, D>;
   PrattResult<D> result;
   const double w = moments.weight;
   const double spread2 = moments.second.trace() / w;
@@ -64,6 +93,24 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, const MomentEigensy
   // g(0) ≥ 0 (a Schur complement of the positive semi-definite M), so the smallest η ≥ 0 is its
   // only root there. No root before λ_min means the optimum is the plane limit (A = 0): not a
   // sphere.
+  if (std::isnan(smallest_eigenvalue)) smallest_eigenvalue = smallest_eigenvalue_of(moments.second);
+  const double lambda_min = smallest_eigenvalue * scale2;
+  if (!(lambda_min > 0)) return result;  // flat data: the plane itself
+  // g decreases: the root is at least x exactly when g(x) >= 0. For x below λ_min, c − xI is
+  // positive definite and g(x) det(c − xI) = (f − (s + 2x)²/w) det − t·adj(c − xI) t.
+  const double beat = objective_to_beat * scale2;
+  if (beat > 0 && beat < lambda_min) {
+    const Matrix shifted = moments.second * scale2 - Matrix::Identity() * beat;
+    double det = 0;
+    const double form = adjugate_form(shifted, t, &det);
+    if ((f - (s + 2 * beat) * (s + 2 * beat) / w) * det - form >= 0) {
+      result.beaten = true;
+      result.objective_minimum = objective_to_beat;
+      return result;
+    }
+  }
+
+  const Eigensystem<D> second = eigensystem_of(moments.second);
   const Vector lambda = second.values * scale2;
   const Vector tau = second.vectors.transpose() * t;
   // h(η) = (λ_0 − η) g(η) has the same root on [0, λ_0) but no pole at λ_0 (Newton's method on g
@@ -81,20 +128,11 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, const MomentEigensy
     return gap * rest - tau(0) * tau(0);
   };
   double lo = 0, hi = lambda(0);
-  if (!(hi > 0)) return result;  // flat data: the plane itself
+  if (!(hi > 0)) return result;  // round-off: flat data after all
   // Steps below this are round-off. (Relative to the whole bracket: relative to a shrinking one,
   // a root at the round-off level of 0 would take every iteration bisecting towards it.)
   const double resolution = 1e-15 * hi;
   double eta = 0, slope = 0;
-  // g decreases: the root is at least x exactly when g(x) >= 0, i.e. h(x) >= 0 below λ_0.
-  // (The bracket is not narrowed to x when the fit is not beaten: the fit is then the same, bit
-  // for bit, whatever the objective to beat.)
-  const double beat = objective_to_beat * scale2;
-  if (beat > 0 && beat < hi && h(beat, &slope) >= 0) {
-    result.beaten = true;
-    result.objective_minimum = objective_to_beat;
-    return result;
-  }
   double value = h(eta, &slope);
   if (!(value > 0)) {
     eta = 0;  // an exact fit (round-off can make g(0) a hair negative)
@@ -129,11 +167,7 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, const MomentEigensy
   return result;
 }
 
-template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, double);
-template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&, double);
-template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, const MomentEigensystem<2>&,
-                                     double);
-template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&, const MomentEigensystem<3>&,
-                                     double);
+template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, double, double);
+template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&, double, double);
 
 }  // namespace primseg::detail

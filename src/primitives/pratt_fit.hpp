@@ -19,14 +19,6 @@ struct CentredMomentsND {
   double fourth = 0;                   // Σ w |p|⁴
 };
 
-/// The eigen-decomposition of CentredMomentsND::second: ascending eigenvalues, unit eigenvectors
-/// as columns.
-template <int D>
-struct MomentEigensystem {
-  Eigen::Matrix<double, D, 1> values;
-  Eigen::Matrix<double, D, D> vectors;
-};
-
 template <int D>
 struct PrattResult {
   bool valid = false;
@@ -47,21 +39,15 @@ struct PrattResult {
 inline constexpr double kMaxRelativeRadius = 1e3;
 
 /// Pratt's fit. With a finite `objective_to_beat`, a fit whose minimum objective is certainly at
-/// least that (one evaluation of the secular function) returns at once, beaten; the others are
-/// the same, bit for bit, as without it.
+/// least that returns at once, beaten (one evaluation of the secular function, without an
+/// eigen-decomposition); the others are the same, bit for bit, as without it.
+/// `smallest_eigenvalue`: that of moments.second if known (NaN: computed here).
 template <int D>
 PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments,
-                         double objective_to_beat = std::numeric_limits<double>::infinity());
-/// The same with the eigen-decomposition of moments.second already known.
-template <int D>
-PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, const MomentEigensystem<D>& second,
-                         double objective_to_beat = std::numeric_limits<double>::infinity());
+                         double objective_to_beat = std::numeric_limits<double>::infinity(),
+                         double smallest_eigenvalue = std::numeric_limits<double>::quiet_NaN());
 
-extern template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, double);
-extern template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&, double);
-extern template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&,
-                                            const MomentEigensystem<2>&, double);
-extern template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&,
-                                            const MomentEigensystem<3>&, double);
+extern template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, double, double);
+extern template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&, double, double);
 
 }  // namespace primseg::detail

@@ -21,10 +21,9 @@ PrimitiveFit SphereFitter::fit(const ClusterView& cluster, double error_to_beat)
   moments.second = cluster.second_moment();
   moments.third = radial.third;
   moments.fourth = radial.fourth;
-  // The plane's eigen-decomposition of the same second moment, shared.
-  const detail::PrattResult<3> sphere = detail::pratt_fit(
-      moments, {cluster.second_moment_eigenvalues(), cluster.second_moment_eigenvectors()},
-      error_to_beat);
+  // The plane's smallest eigenvalue of the same second moment, shared.
+  const detail::PrattResult<3> sphere =
+      detail::pratt_fit(moments, error_to_beat, cluster.smallest_eigenvalue());
   result.superset_error_bound = sphere.objective_minimum;
   result.beaten = sphere.beaten;
   if (!sphere.valid) return result;
