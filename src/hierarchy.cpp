@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -108,6 +109,18 @@ static_assert(sizeof(Slot) == 32);
 struct Scratch {
   ClusterStats clusters[2];
   ClusterStats faces[2];  // of a pair
+
+  // Statistics of recently read faces by face id, direct-mapped: the first evaluation reads a
+  // face once per edge, with its edges to higher faces in a row, and a face next to a growing
+  // cluster is read again at each of the cluster's merges.
+  static constexpr std::uint32_t kCachedFaces = 64;
+  std::array<std::uint32_t, kCachedFaces> cached_face;
+  std::array<int, kCachedFaces> cached_degree;
+  std::array<ClusterStats, kCachedFaces> cached_stats;
+  // Entries an evaluation is still reading, not to be evicted (kNone: none).
+  std::array<std::uint32_t, 2> pinned;
+
+  Scratch() { cached_face.fill(kNone); }
 };
 
 }  // namespace
@@ -238,11 +251,16 @@ class HierarchyBuilder::Impl {
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
     // Every candidate's cost is independent of the others: evaluate them in parallel, then the
     // degrees (which share scratch arrays) in order.
+    // In chunks of consecutive edges: those of a face to its higher neighbours follow each other,
+    // and the face's statistics stay in the thread's cache.
     std::vector<QueuedCandidate> candidates(edges_.size());
-    auto first_evaluation = [&](std::size_t id, unsigned thread) {
-      candidates[id] = evaluate(static_cast<std::uint32_t>(id), scratch_[thread]);
+    constexpr std::size_t kChunk = 256;
+    auto first_evaluation = [&](std::size_t chunk, unsigned thread) {
+      const std::size_t end = std::min(edges_.size(), (chunk + 1) * kChunk);
+      for (std::size_t id = chunk * kChunk; id < end; ++id)
+        candidates[id] = evaluate(static_cast<std::uint32_t>(id), scratch_[thread]);
     };
-    pool_.run(edges_.size(), first_evaluation);
+    pool_.run((edges_.size() + kChunk - 1) / kChunk, first_evaluation);
     for (QueuedCandidate& c : candidates)
       if (c.cost == 0) c.set_degree(merged_degree(edges_[c.id].a, edges_[c.id].b));
     evaluations_ = candidates.size();
@@ -389,25 +407,44 @@ class HierarchyBuilder::Impl {
   // A live cluster's centred statistics: stored for a merged cluster of three faces or more,
   // computed into `scratch` for a face or a pair of faces, with the moments up to `max_degree`
   // (2 for a candidate only a plane can fit: see ModelSelector::moment_degree()).
+  // Part 0 of a union must be read before part 1: its statistics stay in place while part 1's are
+  // read.
   const ClusterStats& stats_of(std::uint32_t slot, Scratch& scratch, int part,
                               int max_degree) const {
+    if (part == 0) scratch.pinned.fill(kNone);
     const std::uint32_t index = slots_[slot].stats;
-    const bool samples = selector_.needs_samples();
     ClusterStats& stats = scratch.clusters[part];
-    if (index == kNone) {
-      graph_->face_stats(slot, stats, samples, max_degree);
-    } else if (index == newest_pair_key_) {
-      return newest_pair_;
-    } else if (index & kPairTag) {
+    if (index == kNone) return face_stats(slot, max_degree, scratch, part, stats);
+    if (index == newest_pair_key_) return newest_pair_;
+    if (index & kPairTag) {
       // The same union, by the same operations, as when the pair merged.
       const DualEdge& e = graph_->edges()[index & ~kPairTag];
-      graph_->face_stats(e.first, scratch.faces[0], samples, max_degree);
-      graph_->face_stats(e.second, scratch.faces[1], samples, max_degree);
-      stats = ClusterView(scratch.faces[0], scratch.faces[1], e.shared).stats(max_degree);
-    } else {
-      return stats_[index];
+      const std::array<std::uint32_t, 2> pinned = scratch.pinned;
+      const ClusterStats& first = face_stats(e.first, max_degree, scratch, 1, scratch.faces[0]);
+      const ClusterStats& second = face_stats(e.second, max_degree, scratch, 1, scratch.faces[1]);
+      stats = ClusterView(first, second, e.shared).stats(max_degree);
+      scratch.pinned = pinned;
+      return stats;
     }
-    return stats;
+    return stats_[index];
+  }
+
+  // A face's statistics (moments up to max_degree at least) from the scratch's cache, read into
+  // `fallback` instead when its entry is pinned; pins the entry used in pinned[pin].
+  const ClusterStats& face_stats(std::uint32_t face, int max_degree, Scratch& scratch, int pin,
+                                 ClusterStats& fallback) const {
+    const std::uint32_t entry = face % Scratch::kCachedFaces;
+    if (std::find(scratch.pinned.begin(), scratch.pinned.end(), entry) != scratch.pinned.end()) {
+      graph_->face_stats(face, fallback, selector_.needs_samples(), max_degree);
+      return fallback;
+    }
+    scratch.pinned[pin] = entry;
+    if (scratch.cached_face[entry] != face || scratch.cached_degree[entry] < max_degree) {
+      graph_->face_stats(face, scratch.cached_stats[entry], selector_.needs_samples(), max_degree);
+      scratch.cached_face[entry] = face;
+      scratch.cached_degree[entry] = max_degree;
+    }
+    return scratch.cached_stats[entry];
   }
 
   // Pairs of faces are most of the merged clusters alive at once (all of them at the peak on a
@@ -465,8 +502,9 @@ class HierarchyBuilder::Impl {
   QueuedCandidate evaluate(std::uint32_t id, Scratch& scratch) {
     LiveEdge& e = edges_[id];
     const int degree = selector_.moment_degree(slots_[e.a].triangles + slots_[e.b].triangles);
-    const ClusterView cluster(stats_of(e.a, scratch, 0, degree), stats_of(e.b, scratch, 1, degree),
-                              shared_edges(id));
+    const ClusterStats& a = stats_of(e.a, scratch, 0, degree);  // (part 0 first)
+    const ClusterStats& b = stats_of(e.b, scratch, 1, degree);
+    const ClusterView cluster(a, b, shared_edges(id));
     const detail::SelectedModel model = select(cluster, e);
     if (lazy_) e.raise_cost_bound(model.superset_cost_bound);
     return {model.cost, true, model.fit.primitive.type, id};
@@ -552,8 +590,9 @@ class HierarchyBuilder::Impl {
     for (std::uint32_t link = head; link != kNone; link = next_link_[link])
       prefetch_candidate(link / 2, other_end(edges_[link / 2], slot_a));
 
-    const ClusterView cluster(stats_of(slot_a, scratch_[0], 0, 4),
-                              stats_of(slot_b, scratch_[0], 1, 4), shared);
+    const ClusterStats& stats_a = stats_of(slot_a, scratch_[0], 0, 4);  // (part 0 first)
+    const ClusterStats& stats_b = stats_of(slot_b, scratch_[0], 1, 4);
+    const ClusterView cluster(stats_a, stats_b, shared);
     // The type is known: only its fit is needed, and it has the candidate's cost exactly.
     const detail::SelectedModel model =
         options_.exact_costs ? select(cluster, edge) : selector_.refit(cluster, candidate.type());

@@ -83,7 +83,8 @@ inline IsolatedRoot isolated_root(const Eigen::Matrix3d& a) {
   IsolatedRoot root;
   root.scale = std::max({std::abs(a(0, 0)), std::abs(a(1, 1)), std::abs(a(2, 2)),
                          std::abs(a(0, 1)), std::abs(a(0, 2)), std::abs(a(1, 2))});
-  if (!std::isfinite(root.scale)) {
+  // (std::max passes a NaN over: the sum of the entries does not.)
+  if (!std::isfinite(root.scale + a(0, 0) + a(1, 1) + a(2, 2) + a(0, 1) + a(0, 2) + a(1, 2))) {
     root.kind = IsolatedRoot::kNotFinite;
     return root;
   }

@@ -443,5 +443,55 @@ TEST(Fitters, SlightlyNoisyFlatPatchDoesNotBecomeAHugeSphere) {
   EXPECT_FALSE(sphere.valid) << "radius " << p.radius;
 }
 
+TEST(Fitters, AFitIsBeatenOnlyAtOrAboveItsErrorAndIsUnchangedOtherwise) {
+  // Noisy curved patches (a sphere cap and a cylinder band) and a noisy plane, at every error to
+  // beat from far below to far above each fitter's own error.
+  std::mt19937_64 rng(31);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const Mesh cap = grid_mesh(12, 12, [&](double u, double v) {
+    const double theta = 0.3 + 0.8 * u, phi = 1.5 * v;
+    const double r = 1 + noise(rng);
+    return Vec3{r * std::sin(theta) * std::cos(phi), r * std::sin(theta) * std::sin(phi),
+                r * std::cos(theta)};
+  });
+  const Mesh band = grid_mesh(12, 12, [&](double u, double v) {
+    const double r = 0.5 + noise(rng);
+    return Vec3{r * std::cos(2 * v), r * std::sin(2 * v), 3 * u};
+  });
+  const Mesh plane = grid_mesh(12, 12, [&](double u, double v) { return Vec3{u, v, noise(rng)}; });
+  int beaten = 0, unchanged = 0;
+  for (const Mesh* mesh : {&cap, &band, &plane}) {
+    const DualGraph graph(*mesh, VertexWeights::Area);
+    const ClusterStats stats = whole_mesh_stats(graph);
+    const ClusterView view(stats);
+    for (const PrimitiveFitter* fitter :
+         {static_cast<const PrimitiveFitter*>(&fitter_for(PrimitiveType::Plane)),
+          &fitter_for(PrimitiveType::Cylinder), &fitter_for(PrimitiveType::Sphere)}) {
+      const PrimitiveFit full = fitter->fit(view);
+      if (!full.valid || !(full.error > 0)) continue;
+      for (double factor : {1e-3, 0.5, 0.99, 1.01, 2.0, 1e3}) {
+        const double to_beat = factor * full.error;
+        const PrimitiveFit fit = fitter->fit(view, to_beat);
+        if (fit.beaten) {
+          ++beaten;
+          EXPECT_FALSE(fit.valid);
+          EXPECT_GE(full.error, to_beat * (1 - 1e-9)) << to_string(fitter->type()) << factor;
+          EXPECT_LE(fit.superset_error_bound, full.error * (1 + 1e-9));
+        } else {
+          ++unchanged;
+          EXPECT_EQ(fit.valid, full.valid);
+          EXPECT_EQ(fit.error, full.error);
+          EXPECT_EQ(fit.primitive.point, full.primitive.point);
+          EXPECT_EQ(fit.primitive.axis, full.primitive.axis);
+          EXPECT_EQ(fit.primitive.radius, full.primitive.radius);
+          EXPECT_EQ(fit.normal_alignment, full.normal_alignment);
+        }
+      }
+    }
+  }
+  EXPECT_GT(beaten, 0);
+  EXPECT_GT(unchanged, 0);
+}
+
 }  // namespace
 }  // namespace primseg

@@ -95,6 +95,50 @@ TEST(PrattFit, CircleMinimisesTheNormalisedAlgebraicDistance) {
   check_against_direct_objective<2>(4);
 }
 
+// With an objective to beat: beaten exactly when the minimum objective is at least that, and
+// otherwise the same fit, bit for bit, as without it.
+template <int D>
+void check_objective_to_beat(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  int beaten = 0, solved = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const WeightedPoints<D> set = noisy_arc<D>(rng, trial % 2 ? 0.02 : 0.2, 0.5 + trial * 0.1);
+    Eigen::Matrix<double, D, 1> centroid;
+    const CentredMomentsND<D> moments = set.centred_moments(&centroid);
+    const PrattResult<D> full = pratt_fit<D>(moments);
+    ASSERT_GT(full.objective_minimum, 0);
+    for (double factor : {0.01, 0.5, 0.999, 1.001, 2.0, 100.0}) {
+      const double beat = factor * full.objective_minimum;
+      const PrattResult<D> fit = pratt_fit<D>(moments, beat);
+      if (fit.beaten) {
+        ++beaten;
+        EXPECT_GE(full.objective_minimum, beat * (1 - 1e-9)) << factor;
+        EXPECT_FALSE(fit.valid);
+        EXPECT_EQ(fit.objective_minimum, beat);  // a lower bound of the minimum
+      } else {
+        ++solved;
+        EXPECT_LT(full.objective_minimum, beat * (1 + 1e-9)) << factor;
+        EXPECT_EQ(fit.valid, full.valid);
+        EXPECT_EQ(fit.error, full.error);
+        EXPECT_EQ(fit.radius, full.radius);
+        EXPECT_EQ(fit.centre, full.centre);
+        EXPECT_EQ(fit.objective_minimum, full.objective_minimum);
+      }
+    }
+  }
+  // Both outcomes occur (0.01 and 0.5 are beaten unless the plane limit is nearer; 2 and 100
+  // never are).
+  EXPECT_GT(beaten, 40);
+  EXPECT_GT(solved, 80);
+}
+
+TEST(PrattFit, SphereStopsOnceBeatenAndIsUnchangedOtherwise) {
+  check_objective_to_beat<3>(5);
+}
+TEST(PrattFit, CircleStopsOnceBeatenAndIsUnchangedOtherwise) {
+  check_objective_to_beat<2>(6);
+}
+
 TEST(PrattFit, FlatDataIsNotACurve) {
   WeightedPoints<2> line;
   for (int i = 0; i < 20; ++i) {

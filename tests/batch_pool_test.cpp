@@ -1,0 +1,61 @@
+// The helper-thread pool runs every job exactly once, on thread indices in range, for batches of
+// any size, rethrows a job's exception, and needs no helper to show up (an overloaded machine).
+#include "batch_pool.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <stdexcept>
+#include <vector>
+
+namespace primseg::detail {
+namespace {
+
+TEST(BatchPool, RunsEveryJobOnceForAnyBatchSizeAndThreadCount) {
+  for (unsigned threads : {1u, 2u, 3u, 8u}) {
+    BatchPool pool(threads);
+    ASSERT_EQ(pool.thread_count(), threads);
+    for (std::size_t count : {0, 1, 2, 3, 5, 17, 1000, 100000}) {
+      std::vector<std::atomic<int>> runs(count);
+      std::atomic<bool> thread_in_range{true};
+      auto job = [&](std::size_t i, unsigned thread) {
+        runs[i].fetch_add(1);
+        if (thread >= pool.thread_count()) thread_in_range = false;
+      };
+      pool.run(count, job);
+      for (std::size_t i = 0; i < count; ++i) ASSERT_EQ(runs[i].load(), 1) << i;
+      EXPECT_TRUE(thread_in_range);
+    }
+  }
+}
+
+TEST(BatchPool, ManySmallBatchesInARow) {
+  BatchPool pool(2);
+  std::vector<double> results(6);
+  double total = 0;
+  for (int batch = 0; batch < 200000; ++batch) {
+    auto job = [&](std::size_t i, unsigned) { results[i] = double(batch) * double(i); };
+    pool.run(results.size(), job);
+    for (std::size_t i = 0; i < results.size(); ++i) ASSERT_EQ(results[i], double(batch) * double(i));
+    total += results[5];
+  }
+  EXPECT_GT(total, 0);
+}
+
+TEST(BatchPool, RethrowsAJobsExceptionAfterTheBatch) {
+  BatchPool pool(2);
+  std::atomic<int> runs{0};
+  auto job = [&](std::size_t i, unsigned) {
+    runs.fetch_add(1);
+    if (i == 3) throw std::runtime_error("job 3 failed");
+  };
+  EXPECT_THROW(pool.run(10, job), std::runtime_error);
+  EXPECT_EQ(runs.load(), 10);
+  // The pool is usable afterwards.
+  auto fine = [&](std::size_t, unsigned) { runs.fetch_add(1); };
+  pool.run(10, fine);
+  EXPECT_EQ(runs.load(), 20);
+}
+
+}  // namespace
+}  // namespace primseg::detail
