@@ -72,12 +72,33 @@ constexpr std::size_t count_terms_up_to_degree2() {
 constexpr std::size_t kTermsUpToDegree2 = count_terms_up_to_degree2();
 static_assert(kTermsUpToDegree2 == 28);
 
-template <std::size_t... n>
+// The terms whose source is not a first moment: all that is needed for moments about their own
+// centroid (first moments zero), about two thirds of them. Same order.
+constexpr bool is_first_moment(int index) {
+  return index >= 1 && index <= 3;
+}
+constexpr std::size_t count_centred_terms(std::size_t end) {
+  std::size_t n = 0;
+  for (std::size_t t = 0; t < end; ++t) n += !is_first_moment(kTranslationTerms[t].source);
+  return n;
+}
+template <std::size_t count>
+constexpr std::array<TranslationTerm, count> make_centred_terms() {
+  std::array<TranslationTerm, count> terms{};
+  std::size_t n = 0;
+  for (const TranslationTerm& term : kTranslationTerms)
+    if (!is_first_moment(term.source) && n < count) terms[n++] = term;
+  return terms;
+}
+constexpr auto kCentredTerms =
+    make_centred_terms<count_centred_terms(kTranslationTerms.size())>();
+constexpr std::size_t kCentredTermsUpToDegree2 = count_centred_terms(kTermsUpToDegree2);
+
+template <const auto& terms, std::size_t... n>
 inline void apply_translation_terms(std::index_sequence<n...>, const double* shift,
                                     const double* source, double* target) {
-  ((target[kTranslationTerms[n].target] += kTranslationTerms[n].coefficient *
-                                           shift[kTranslationTerms[n].shift] *
-                                           source[kTranslationTerms[n].source]),
+  ((target[terms[n].target] += terms[n].coefficient * shift[terms[n].shift] *
+                               source[terms[n].source]),
    ...);
 }
 
@@ -155,12 +176,23 @@ Moments Moments::translated(const Eigen::Vector3d& new_origin, int max_degree) c
   // Terms are listed by target monomial, and monomials by degree. Unrolled at compile time: with
   // constant indices the compiler interleaves the 35 independent sums (each still added in the
   // listed order, so results are the same bit for bit).
-  if (max_degree >= 4)
-    apply_translation_terms(std::make_index_sequence<kTranslationTerms.size()>(), shift,
-                            values_.data(), result.values_.data());
+  // Moments about their centroid (as every cluster's are in the hierarchy) skip the terms of the
+  // zero first moments.
+  const double* source = values_.data();
+  double* target = result.values_.data();
+  const bool centred = values_[1] == 0 && values_[2] == 0 && values_[3] == 0;
+  if (centred && max_degree >= 4)
+    apply_translation_terms<kCentredTerms>(std::make_index_sequence<kCentredTerms.size()>(),
+                                           shift, source, target);
+  else if (centred)
+    apply_translation_terms<kCentredTerms>(std::make_index_sequence<kCentredTermsUpToDegree2>(),
+                                           shift, source, target);
+  else if (max_degree >= 4)
+    apply_translation_terms<kTranslationTerms>(
+        std::make_index_sequence<kTranslationTerms.size()>(), shift, source, target);
   else
-    apply_translation_terms(std::make_index_sequence<kTermsUpToDegree2>(), shift, values_.data(),
-                            result.values_.data());
+    apply_translation_terms<kTranslationTerms>(std::make_index_sequence<kTermsUpToDegree2>(),
+                                               shift, source, target);
   return result;
 }
 

@@ -21,7 +21,7 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr std::uint32_t kPairTag = 1u << 31;
 
 // A candidate merge in the queue: the dual edge's id and its key. Candidates are ordered by
-// (cost, exactness, primitive type, merged degree, dual edge id). On equal cost
+// (cost, exactness, primitive type, merged degree, smaller node id, larger node id). On equal cost
 // simpler types go first, so flat regions are whole before exact curved fits can reach into them.
 //
 // Lazy evaluation queues candidates whose cost is only a lower bound of theirs (exact = false). At
@@ -77,13 +77,17 @@ struct LiveEdge {
 };
 static_assert(sizeof(LiveEdge) == 16);
 
-// The queue's order. The dual edge's id settles the remaining ties: it is fixed for the edge's
-// life, where the clusters' node ids change as they merge.
+// The (smaller, larger) node ids of an edge's clusters when it was queued: the queue's last key.
+using NodePair = std::array<std::uint32_t, 2>;
+
+// The queue's order. The node ids settle the remaining ties (live candidates have distinct
+// pairs), as they were when the candidate was queued: kept per edge, out of the 16-byte node.
 struct ComesFirst {
+  const std::vector<NodePair>* queued_pairs;
   bool operator()(const QueuedCandidate& x, const QueuedCandidate& y) const {
     if (x.cost != y.cost) return x.cost < y.cost;
     if (x.rank != y.rank) return x.rank < y.rank;
-    return x.id < y.id;
+    return (*queued_pairs)[x.id] < (*queued_pairs)[y.id];
   }
 };
 
@@ -212,7 +216,7 @@ class HierarchyBuilder::Impl {
         selector_(options_),
         pool_(detail::thread_count(options_.threads)),
         scratch_(pool_.thread_count()),
-        queue_(0, ComesFirst{}) {
+        queue_(0, ComesFirst{&queued_pairs_}) {
     if (!mesh_) throw InvalidInputError("no mesh");
     mesh_->validate();
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights);
@@ -249,23 +253,27 @@ class HierarchyBuilder::Impl {
       }
     lazy_ = options_.evaluation != CandidateEvaluation::Eager && !options_.exact_costs;
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
-    // Every candidate's cost is independent of the others: evaluate them in parallel, then the
-    // degrees (which share scratch arrays) in order.
+    // Every candidate's cost and first degree is independent of the others: all in parallel.
     // In chunks of consecutive edges: those of a face to its higher neighbours follow each other,
     // and the face's statistics stay in the thread's cache.
     std::vector<QueuedCandidate> candidates(edges_.size());
     constexpr std::size_t kChunk = 256;
     auto first_evaluation = [&](std::size_t chunk, unsigned thread) {
       const std::size_t end = std::min(edges_.size(), (chunk + 1) * kChunk);
-      for (std::size_t id = chunk * kChunk; id < end; ++id)
-        candidates[id] = evaluate(static_cast<std::uint32_t>(id), scratch_[thread]);
+      for (std::size_t id = chunk * kChunk; id < end; ++id) {
+        QueuedCandidate& c = candidates[id];
+        c = evaluate(static_cast<std::uint32_t>(id), scratch_[thread]);
+        if (c.cost == 0) c.set_degree(first_merged_degree(edges_[id].a, edges_[id].b));
+      }
     };
     pool_.run((edges_.size() + kChunk - 1) / kChunk, first_evaluation);
-    for (QueuedCandidate& c : candidates)
-      if (c.cost == 0) c.set_degree(merged_degree(edges_[c.id].a, edges_[c.id].b));
     evaluations_ = candidates.size();
-    queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{});
-    queue_.assign(std::move(candidates));
+    queued_pairs_.resize(edges_.size());
+    for (std::size_t id = 0; id < edges_.size(); ++id)
+      queued_pairs_[id] = {dual_edges[id].first, dual_edges[id].second};  // faces: first < second
+    queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()),
+                            ComesFirst{&queued_pairs_});
+    queue_.assign(candidates);
     total_merges_ = f - graph_->component_count();
   }
 
@@ -314,6 +322,18 @@ class HierarchyBuilder::Impl {
     return mesh_->face_count() + static_cast<std::uint32_t>(merges_.size());
   }
 
+  // Queues a candidate of the new cluster with its current node ids. (Set just before: the
+  // queue's order reads them for the candidate's old entry until it is replaced.)
+  void requeue(const QueuedCandidate& candidate) {
+    queued_pairs_[candidate.id] = node_pair(edges_[candidate.id]);
+    queue_.update(candidate);
+  }
+
+  NodePair node_pair(const LiveEdge& e) const {
+    const std::uint32_t a = slots_[e.a].node, b = slots_[e.b].node;
+    return {std::min(a, b), std::max(a, b)};
+  }
+
   static std::uint32_t other_end(const LiveEdge& e, std::uint32_t slot) {
     return e.a == slot ? e.b : e.a;
   }
@@ -343,9 +363,34 @@ class HierarchyBuilder::Impl {
     return degree;
   }
 
+  // merged_degree() before any merge, writing nothing (safe on several threads): faces have few
+  // neighbours, counted distinct by a linear search of those seen.
+  std::uint32_t first_merged_degree(std::uint32_t a, std::uint32_t b) const {
+    std::array<std::uint32_t, 32> inline_seen;
+    std::vector<std::uint32_t> many_seen;
+    std::uint32_t count = 0;
+    for (std::uint32_t slot : {a, b})
+      for (std::uint32_t link = slots_[slot].first_link; link != kNone; link = next_link_[link]) {
+        const std::uint32_t other = other_end(edges_[link / 2], slot);
+        if (other == a || other == b) continue;
+        if (count < inline_seen.size()) {
+          if (std::find(inline_seen.begin(), inline_seen.begin() + count, other) ==
+              inline_seen.begin() + count)
+            inline_seen[count++] = other;
+        } else {
+          many_seen.push_back(other);  // sorted out below
+        }
+      }
+    if (many_seen.empty()) return count;
+    many_seen.insert(many_seen.end(), inline_seen.begin(), inline_seen.end());
+    std::sort(many_seen.begin(), many_seen.end());
+    return static_cast<std::uint32_t>(std::unique(many_seen.begin(), many_seen.end()) -
+                                      many_seen.begin());
+  }
+
   // The top is the cheapest candidate, at a positive cost. Candidates of exactly the same cost
   // and type (a connected group of the heap around its top) are ranked by the degree their merge
-  // would make now, then by edge id; the winner.
+  // would make now, then by node ids; the winner.
   QueuedCandidate settle_tie(const QueuedCandidate& top) {
     auto ties_top = [&](const QueuedCandidate& c) {
       return c.cost == top.cost && c.rank == top.rank;
@@ -365,7 +410,8 @@ class HierarchyBuilder::Impl {
       const QueuedCandidate& candidate = queue_.at(position);
       if (candidate.id == top.id) continue;
       const std::uint32_t degree = merged_degree(edges_[candidate.id].a, edges_[candidate.id].b);
-      if (degree < best_degree || (degree == best_degree && candidate.id < best.id)) {
+      if (degree < best_degree ||
+          (degree == best_degree && queued_pairs_[candidate.id] < queued_pairs_[best.id])) {
         best = candidate;
         best_degree = degree;
       }
@@ -415,8 +461,9 @@ class HierarchyBuilder::Impl {
     const std::uint32_t index = slots_[slot].stats;
     ClusterStats& stats = scratch.clusters[part];
     if (index == kNone) return face_stats(slot, max_degree, scratch, part, stats);
-    if (index == newest_pair_key_) return newest_pair_;
     if (index & kPairTag) {
+      const CachedPair& cached = pair_cache_[index % kCachedPairs];
+      if (cached.key == index) return cached.stats;
       // The same union, by the same operations, as when the pair merged.
       const DualEdge& e = graph_->edges()[index & ~kPairTag];
       const std::array<std::uint32_t, 2> pinned = scratch.pinned;
@@ -448,13 +495,16 @@ class HierarchyBuilder::Impl {
   }
 
   // Pairs of faces are most of the merged clusters alive at once (all of them at the peak on a
-  // subdivided mesh, 40% on a scan): recomputing theirs from the two faces costs about a fifth
-  // of a fit and saves their 568 bytes each. The newest pair's are kept, for the evaluation of
-  // its candidates that follows.
+  // subdivided mesh, 40% on a scan): recomputing theirs from the two faces saves their 568 bytes
+  // each. The most recent pairs' are kept in a small cache (they are next to the clusters that
+  // grow): most reads of a pair's statistics hit it.
   void store_pair(std::uint32_t slot, std::uint32_t edge_id, ClusterStats&& stats) {
     release_stats(slot);
-    slots_[slot].stats = newest_pair_key_ = kPairTag | edge_id;
-    newest_pair_ = std::move(stats);
+    const std::uint32_t key = kPairTag | edge_id;
+    slots_[slot].stats = key;
+    CachedPair& entry = pair_cache_[key % kCachedPairs];
+    entry.key = key;
+    entry.stats = std::move(stats);
   }
 
   void store_stats(std::uint32_t slot, ClusterStats&& stats) {
@@ -569,6 +619,7 @@ class HierarchyBuilder::Impl {
       for (std::size_t offset = 0; offset < sizeof(ClusterStats); offset += 64)
         __builtin_prefetch(stats + offset);
     }
+    queue_.prefetch(id);
     const std::uint32_t pooled = edges_[id].combined_shared;
     if (pooled == kNone)
       __builtin_prefetch(&graph_->edges()[id]);
@@ -582,21 +633,30 @@ class HierarchyBuilder::Impl {
     const LiveEdge edge = edges_[edge_id];
     const std::uint32_t slot_a = edge.a, slot_b = edge.b;
     const std::uint32_t a = slots_[slot_a].node, b = slots_[slot_b].node;
-    // A copy: combining edges below may move the pool it is in.
+    // A copy: combining edges in relink() may move the pool it is in.
     const EdgeStats shared = shared_edges(edge_id);
-    kill_edge(edge_id);
-    const std::uint32_t head = relink(slot_a, slot_b);
-    // What the new cluster's candidates will read arrives while its own fit is computed.
-    for (std::uint32_t link = head; link != kNone; link = next_link_[link])
-      prefetch_candidate(link / 2, other_end(edges_[link / 2], slot_a));
-
     const ClusterStats& stats_a = stats_of(slot_a, scratch_[0], 0, 4);  // (part 0 first)
     const ClusterStats& stats_b = stats_of(slot_b, scratch_[0], 1, 4);
     const ClusterView cluster(stats_a, stats_b, shared);
-    // The type is known: only its fit is needed, and it has the candidate's cost exactly.
-    const detail::SelectedModel model =
-        options_.exact_costs ? select(cluster, edge) : selector_.refit(cluster, candidate.type());
-    ClusterStats merged = cluster.stats(4);
+    // Two independent jobs, on two threads when there are: the new cluster's edges, and its fit
+    // and statistics. (The type is known: only its fit is needed, and it has the candidate's cost
+    // exactly.)
+    std::uint32_t head = kNone;
+    detail::SelectedModel model;
+    auto jobs = [&](std::size_t job, unsigned) {
+      if (job == 0) {
+        kill_edge(edge_id);
+        head = relink(slot_a, slot_b);
+        // What the new cluster's candidates will read arrives while the other job runs.
+        for (std::uint32_t link = head; link != kNone; link = next_link_[link])
+          prefetch_candidate(link / 2, other_end(edges_[link / 2], slot_a));
+      } else {
+        model = options_.exact_costs ? select(cluster, edge)
+                                     : selector_.refit(cluster, candidate.type());
+        merged_ = cluster.stats(4);
+      }
+    };
+    pool_.run(2, jobs);
     const std::uint32_t node = next_node();
 
     Merge record;
@@ -613,9 +673,9 @@ class HierarchyBuilder::Impl {
     // The merged cluster lives in a's slot; b's is released.
     release_stats(slot_b);
     if (record.face_count == 2)
-      store_pair(slot_a, edge_id, std::move(merged));
+      store_pair(slot_a, edge_id, std::move(merged_));
     else
-      store_stats(slot_a, std::move(merged));
+      store_stats(slot_a, std::move(merged_));
     Slot& kept = slots_[slot_a];
     kept.faces = record.face_count;
     kept.triangles += slots_[slot_b].triangles;
@@ -635,7 +695,7 @@ class HierarchyBuilder::Impl {
       const std::uint32_t id = link / 2;
       const double bound = lazy_ ? queued_bound(edges_[id]) : 0;
       if (bound > 0)
-        queue_.update({bound, false, PrimitiveType::Plane, id});
+        requeue({bound, false, PrimitiveType::Plane, id});
       else
         batch_.push_back({0, false, PrimitiveType::Plane, id});
     }
@@ -643,10 +703,11 @@ class HierarchyBuilder::Impl {
       batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
     };
     pool_.run(batch_.size(), evaluate_batch);
+    for (const QueuedCandidate& evaluated : batch_) queue_.prefetch_node(evaluated.id);
     for (QueuedCandidate& evaluated : batch_) {
       if (evaluated.cost == 0)
         evaluated.set_degree(merged_degree(edges_[evaluated.id].a, edges_[evaluated.id].b));
-      queue_.update(evaluated);
+      requeue(evaluated);
     }
     evaluations_ += batch_.size();
   }
@@ -657,6 +718,7 @@ class HierarchyBuilder::Impl {
     auto release = [](auto& vector) { std::decay_t<decltype(vector)>().swap(vector); };
     release(stats_);
     release(free_stats_);
+    release(pair_cache_);
     release(slots_);
     release(next_link_);
     release(edges_);
@@ -664,6 +726,7 @@ class HierarchyBuilder::Impl {
     release(free_combined_shared_);
     queue_.clear();
     release(tied_);
+    release(queued_pairs_);
     release(next_face_);
     release(face_list_head_);
     release(face_list_tail_);
@@ -701,8 +764,14 @@ class HierarchyBuilder::Impl {
   std::vector<Scratch> scratch_;  // per thread of pool_
   std::unique_ptr<DualGraph> graph_;
   std::vector<ClusterStats> stats_;  // merged clusters' statistics, pooled
-  std::uint32_t newest_pair_key_ = kNone;  // see store_pair()
-  ClusterStats newest_pair_;
+  // Statistics of recent pairs by key (kPairTag | dual edge), direct-mapped: see store_pair().
+  // Written between batches only.
+  static constexpr std::uint32_t kCachedPairs = 1024;
+  struct CachedPair {
+    std::uint32_t key = kNone;
+    ClusterStats stats;
+  };
+  std::vector<CachedPair> pair_cache_ = std::vector<CachedPair>(kCachedPairs);
   std::vector<std::uint32_t> free_stats_;  // unused entries of stats_
   std::vector<Slot> slots_;                // per input face
   // Adjacency as intrusive lists: link 2 id + side is edge id on the list of the slot of its
@@ -715,6 +784,8 @@ class HierarchyBuilder::Impl {
   std::uint32_t current_stamp_ = 0;  // see Slot::stamp
   std::vector<std::size_t> tied_;  // settle_tie()'s queue positions
   std::vector<QueuedCandidate> batch_;  // the candidates merge() evaluates
+  std::vector<NodePair> queued_pairs_;  // per edge: see ComesFirst
+  ClusterStats merged_;                 // merge()'s new statistics
   CandidateQueue queue_;
   std::vector<std::uint32_t> next_face_, face_list_head_, face_list_tail_;  // exact_costs only
   std::uint32_t total_merges_ = 0;
