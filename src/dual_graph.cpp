@@ -262,6 +262,18 @@ double DualGraph::triangle_area(std::uint32_t t) const {
                    .norm();
 }
 
+void DualGraph::prefetch_face(std::uint32_t f) const {
+  __builtin_prefetch(&first_triangle_[f]);
+  // Most faces are one triangle, and face f's is then triangle f when all are.
+  if (first_triangle_.size() == mesh_->triangles.size() + 1)
+    __builtin_prefetch(&mesh_->triangles[f]);
+}
+
+void DualGraph::prefetch_face_corners(std::uint32_t f) const {
+  for (std::uint32_t t = first_triangle_[f]; t < first_triangle_[f + 1]; ++t)
+    for (std::uint32_t v : mesh_->triangles[t]) __builtin_prefetch(&positions_[v]);
+}
+
 std::array<double, 3> DualGraph::corner_weights(std::uint32_t t) const {
   return corner_weights(t, weights_ == VertexWeights::Area ? triangle_area(t) : 0.0);
 }

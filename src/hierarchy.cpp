@@ -611,14 +611,21 @@ class HierarchyBuilder::Impl {
   }
 
   // Asks for the cache lines the evaluation of candidate `id` with the cluster in `slot` reads
-  // most: that cluster's statistics if stored, and the mesh edges between the two clusters.
+  // most: that cluster's statistics if stored (its triangles if a face), the mesh edges between
+  // the two clusters, the candidate's place in the queue.
   void prefetch_candidate(std::uint32_t id, std::uint32_t slot) const {
     const std::uint32_t index = slots_[slot].stats;
-    if (index != kNone && !(index & kPairTag)) {
-      const char* stats = reinterpret_cast<const char*>(&stats_[index]);
+    auto prefetch_stats = [](const ClusterStats& stats) {
+      const char* bytes = reinterpret_cast<const char*>(&stats);
       for (std::size_t offset = 0; offset < sizeof(ClusterStats); offset += 64)
-        __builtin_prefetch(stats + offset);
-    }
+        __builtin_prefetch(bytes + offset);
+    };
+    if (index == kNone)
+      graph_->prefetch_face(slot);
+    else if (!(index & kPairTag))
+      prefetch_stats(stats_[index]);
+    else if (pair_cache_[index % kCachedPairs].key == index)
+      prefetch_stats(pair_cache_[index % kCachedPairs].stats);
     queue_.prefetch(id);
     const std::uint32_t pooled = edges_[id].combined_shared;
     if (pooled == kNone)
@@ -698,6 +705,12 @@ class HierarchyBuilder::Impl {
         requeue({bound, false, PrimitiveType::Plane, id});
       else
         batch_.push_back({0, false, PrimitiveType::Plane, id});
+    }
+    // The faces' corners, now that their triangles have arrived.
+    for (const QueuedCandidate& queued : batch_) {
+      const LiveEdge& e = edges_[queued.id];
+      const std::uint32_t other = e.a == slot_a ? e.b : e.a;
+      if (slots_[other].stats == kNone) graph_->prefetch_face_corners(other);
     }
     auto evaluate_batch = [&](std::size_t i, unsigned thread) {
       batch_[i] = evaluate(batch_[i].id, scratch_[thread]);

@@ -83,6 +83,11 @@ class DualGraph {
   std::array<double, 3> corner_weights(std::uint32_t t) const;
   /// The same, with the triangle's area (triangle_area(t)) already known.
   std::array<double, 3> corner_weights(std::uint32_t t, double area) const;
+  /// Cache hints for a coming face_stats(f): prefetch_face() asks for the face's triangles,
+  /// prefetch_face_corners(), a while later, for their corners' positions (it reads the
+  /// triangles).
+  void prefetch_face(std::uint32_t f) const;
+  void prefetch_face_corners(std::uint32_t f) const;
   /// Statistics of input face f alone (its triangles and the edges between them), centred: about
   /// the weighted centroid of its corners (first moments zero). With `with_samples`, its corners
   /// in ClusterStats::samples too (for the torus). With max_degree 2 the moments of degree 3 and 4

@@ -56,9 +56,11 @@ struct HierarchyOptions {
   /// (Euclidean distance to the same fitted primitive), as the paper's prototype computed it.
   /// Cost O(|A| + |B|) per candidate instead of O(1): for comparison only.
   bool exact_costs = false;
-  /// Threads for the parallel parts (the statistics of every face and the first evaluation of
-  /// every candidate); 0 uses all hardware threads. The tree is the same, bit for bit, for any
-  /// number of threads.
+  /// Threads for the parallel parts: the first evaluation of every candidate, and at each merge
+  /// the new cluster's candidates and its own fit (helper threads spin between merges, then
+  /// sleep once the loop ends); 0 uses all hardware threads. The tree is the same, bit for bit,
+  /// for any number of threads. On a machine already loaded by other processes one thread can
+  /// be the fastest.
   unsigned threads = 0;
   /// Candidate evaluation scheme (exact_costs forces Eager: Euclidean errors of algebraic fits
   /// are not minima, so no bound holds).
