@@ -3,21 +3,321 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
+#include <span>
+#include <tuple>
+#include <utility>
+
+#include "parallel.hpp"
 
 namespace primseg {
 namespace {
 
-// One directed side of a mesh edge: triangle t traverses it from `from` to `to`.
-struct EdgeSide {
-  std::uint32_t low, high;  // vertex ids, low < high
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+// Side c of a triangle runs from its corner c to corner c + 1 (mod 3).
+std::uint32_t side_end(const Triangle& tri, unsigned c) {
+  return tri[c == 2 ? 0 : c + 1];
+}
+
+// Sorts [begin, end) stably: by insertion when tiny (as nearly all ranges are here).
+template <typename Iterator, typename Less>
+void stable_sort_small(Iterator begin, Iterator end, Less less) {
+  if (end - begin > 32) {
+    std::stable_sort(begin, end, less);
+    return;
+  }
+  for (Iterator i = begin; i != end; ++i) {
+    auto value = std::move(*i);
+    Iterator hole = i;
+    for (; hole != begin && less(value, *std::prev(hole)); --hole)
+      *hole = std::move(*std::prev(hole));
+    *hole = std::move(value);
+  }
+}
+
+// A side of a triangle (joining two distinct vertices) filed under the lower vertex of its edge.
+struct Side {
+  std::uint32_t high;  // the edge's higher vertex
   std::uint32_t triangle;
-  bool forward;  // traversed low → high
+  std::uint8_t corner;  // the side runs from this corner of the triangle
+  bool forward;         // from the lower vertex to the higher
 };
 
-struct TriangleLink {
-  std::uint32_t first, second;  // triangles
-  std::uint32_t low, high;      // the shared edge
+// The sides bucketed by the lower vertex of their edge, each bucket sorted by (high, triangle):
+// the order of a comparison sort of all sides by (low, high, triangle). (A triangle with two sides
+// on one edge is degenerate; which of the two comes first does not matter.)
+struct SideBuckets {
+  std::vector<std::size_t> offsets;  // bucket v is sides[offsets[v], offsets[v + 1])
+  std::vector<Side> sides;
+};
+
+SideBuckets bucket_sides(const Mesh& mesh) {
+  // Vertex ids are dense: two stable counting sorts, by the higher vertex then by the lower, sort
+  // in linear time. Their writes land anywhere (vertices need not be numbered near their
+  // triangles), so their addresses are fetched a few sides ahead, and the cursors that give the
+  // addresses before that (those of every vertex of the triangle: the cheapest superset).
+  constexpr std::size_t kAhead = 8;
+  const std::size_t vertex_count = mesh.vertex_count();
+  std::vector<std::size_t> high_cursor(vertex_count + 1, 0), low_cursor(vertex_count + 1, 0);
+  for (const Triangle& tri : mesh.triangles)
+    for (unsigned c = 0; c < 3; ++c) {
+      const std::uint32_t from = tri[c], to = side_end(tri, c);
+      if (from == to) continue;
+      ++high_cursor[std::max(from, to)];
+      ++low_cursor[std::min(from, to)];
+    }
+  // Exclusive prefix sums: bucket starts, the last entry the total.
+  auto starts = [](std::vector<std::size_t>& counts) {
+    std::size_t total = 0;
+    for (std::size_t& count : counts) total += std::exchange(count, total);
+  };
+  starts(high_cursor);
+  starts(low_cursor);
+  SideBuckets buckets;
+  buckets.offsets = low_cursor;
+  const std::vector<std::size_t> high_offsets = high_cursor;
+
+  // `high` of these holds the lower vertex.
+  std::vector<Side> by_high(high_offsets.back());
+  const std::uint32_t triangle_count = mesh.triangle_count();
+  for (std::uint32_t t = 0; t < triangle_count; ++t) {
+    if (t + 2 * kAhead < triangle_count)
+      for (std::uint32_t v : mesh.triangles[t + 2 * kAhead]) __builtin_prefetch(&high_cursor[v]);
+    if (t + kAhead < triangle_count)
+      for (std::uint32_t v : mesh.triangles[t + kAhead])
+        __builtin_prefetch(by_high.data() + high_cursor[v]);
+    const Triangle& tri = mesh.triangles[t];
+    for (unsigned c = 0; c < 3; ++c) {
+      const std::uint32_t from = tri[c], to = side_end(tri, c);
+      if (from != to)
+        by_high[high_cursor[std::max(from, to)]++] = {std::min(from, to), t,
+                                                      static_cast<std::uint8_t>(c), from < to};
+    }
+  }
+  std::vector<std::size_t>().swap(high_cursor);
+
+  buckets.sides.resize(by_high.size());
+  for (std::uint32_t high = 0; high < vertex_count; ++high)
+    for (std::size_t s = high_offsets[high]; s < high_offsets[high + 1]; ++s) {
+      if (s + 2 * kAhead < by_high.size())
+        __builtin_prefetch(&low_cursor[by_high[s + 2 * kAhead].high]);
+      if (s + kAhead < by_high.size())
+        __builtin_prefetch(buckets.sides.data() + low_cursor[by_high[s + kAhead].high]);
+      const Side& side = by_high[s];
+      buckets.sides[low_cursor[side.high]++] = {high, side.triangle, side.corner, side.forward};
+    }
+  return buckets;
+}
+
+// What lies across the sides of each triangle: up to three slots, in increasing order of their
+// edge (as mesh edges sorted by (low, high)), each a side of the triangle and another triangle.
+// Across a manifold edge (two sides of distinct triangles) each names the other; on any other
+// edge the distinct triangles form the chain of dual_graph.hpp, each naming the next (the last
+// names none). So a slot naming a higher triangle is a dual link, and a slot naming a lower one
+// a manifold edge seen from above. Slots and flags share one record so that building them
+// touches one cache line per triangle.
+struct TriangleSlots {
+  std::array<std::uint32_t, 3> other;
+  // Bits 0-1: number of slots. Slot k at bits 4k + 2 to 4k + 5: its side (2 bits), whether its
+  // edge is manifold, and then whether the two triangles traverse it in the same direction (one
+  // must flip). Bit 14: the triangle has a side on a boundary or non-manifold edge.
+  std::uint16_t bits;
+
+  unsigned count() const { return bits & 3u; }
+  unsigned side(unsigned k) const { return (bits >> (4 * k + 2)) & 3u; }
+  bool manifold(unsigned k) const { return (bits >> (4 * k + 4)) & 1u; }
+  bool same_direction(unsigned k) const { return (bits >> (4 * k + 5)) & 1u; }
+  bool open() const { return (bits >> 14) & 1u; }
+
+  void add(std::uint32_t triangle, unsigned side, bool manifold, bool same_direction) {
+    const unsigned k = count();
+    other[k] = triangle;
+    bits = static_cast<std::uint16_t>(
+        bits + 1 +
+        ((side | unsigned{manifold} << 2 | unsigned{same_direction} << 3) << (4 * k + 2)));
+  }
+  void set_open() { bits |= 1u << 14; }
+};
+
+struct Links {
+  std::vector<TriangleSlots> slots;  // by triangle
+  // Per range of triangles (chunk_begin of link_triangles): the links from its triangles, and
+  // those of them inside an input face.
+  std::vector<std::size_t> count, internal;
+};
+
+Links link_triangles(const Mesh& mesh, const SideBuckets& buckets,
+                     const std::vector<std::uint32_t>& chunk_begin) {
+  Links links;
+  std::vector<TriangleSlots>& slots = links.slots;
+  slots.resize(mesh.triangle_count());
+  links.count.assign(chunk_begin.size() - 1, 0);
+  links.internal.assign(chunk_begin.size() - 1, 0);
+  const bool polygons = mesh.face_count() != mesh.triangle_count();
+  auto count = [&](std::uint32_t a, std::uint32_t b) {
+    const auto chunk = static_cast<std::size_t>(
+        std::upper_bound(chunk_begin.begin() + 1, chunk_begin.end() - 1, a) -
+        (chunk_begin.begin() + 1));
+    ++links.count[chunk];
+    if (polygons && mesh.face_of_triangle[a] == mesh.face_of_triangle[b]) ++links.internal[chunk];
+  };
+  const std::vector<Side>& sides = buckets.sides;
+  for (std::size_t low = 0; low + 1 < buckets.offsets.size(); ++low) {
+    const std::size_t bucket_end = buckets.offsets[low + 1];
+    for (std::size_t begin = buckets.offsets[low]; begin < bucket_end;) {
+      // The triangles' slots are anywhere: fetched a few sides ahead.
+      if (begin + 8 < sides.size()) __builtin_prefetch(&slots[sides[begin + 8].triangle]);
+      std::size_t end = begin + 1;
+      while (end < bucket_end && sides[end].high == sides[begin].high) ++end;
+      const Side& a = sides[begin];
+      if (end - begin == 2 && a.triangle != sides[begin + 1].triangle) {
+        const Side& b = sides[begin + 1];
+        // Consistent neighbours traverse their shared edge in opposite directions.
+        const bool same = a.forward == b.forward;
+        slots[a.triangle].add(b.triangle, a.corner, true, same);
+        slots[b.triangle].add(a.triangle, b.corner, true, same);
+        count(a.triangle, b.triangle);
+      } else {
+        for (std::size_t s = begin; s < end; ++s) {
+          slots[sides[s].triangle].set_open();
+          if (s + 1 < end && sides[s].triangle != sides[s + 1].triangle) {
+            slots[sides[s].triangle].add(sides[s + 1].triangle, sides[s].corner, false, false);
+            count(sides[s].triangle, sides[s + 1].triangle);
+          }
+        }
+      }
+      begin = end;
+    }
+  }
+  return links;
+}
+
+// The dual edges of ranges of faces, each face's links in the order (other face, edge, lower
+// triangle): the edges come sorted by face pair, and the links of one pair add in increasing edge
+// order, as they would after a stable sort of all links in edge order.
+class FaceLinks {
+ public:
+  FaceLinks(const Mesh& mesh, std::span<const Eigen::Vector3d> positions,
+            std::span<const std::uint8_t> flipped, std::span<const std::uint32_t> first_triangle,
+            std::span<const TriangleSlots> neighbours)
+      : triangles_(mesh.triangles),
+        face_of_triangle_(mesh.face_of_triangle),
+        positions_(positions),
+        flipped_(flipped),
+        first_triangle_(first_triangle),
+        neighbours_(neighbours),
+        polygons_(mesh.face_count() != mesh.triangle_count()) {}
+
+  /// Appends the dual edges of faces [face_begin, face_end) to `edges`, the links inside them
+  /// to `internal`.
+  void add(std::uint32_t face_begin, std::uint32_t face_end, std::vector<DualEdge>& edges,
+           std::vector<std::pair<std::uint32_t, EdgeStats>>& internal) const {
+    // In blocks, so that the random reads of a block can be issued before they are needed.
+    constexpr std::size_t kBlock = 256;
+    std::vector<Link> block;
+    block.reserve(kBlock);
+    for (std::uint32_t f = face_begin; f < face_end; ++f) {
+      const std::size_t face_links = block.size();
+      for (std::uint32_t t = first_triangle_[f]; t < first_triangle_[f + 1]; ++t) {
+        const TriangleSlots& slots = neighbours_[t];
+        const Triangle& tri = triangles_[t];
+        for (std::uint32_t v : tri) __builtin_prefetch(&positions_[v]);
+        for (unsigned k = 0; k < slots.count(); ++k) {
+          const std::uint32_t other = slots.other[k];
+          if (other < t) continue;  // a manifold edge seen from above
+          __builtin_prefetch(&triangles_[other]);
+          __builtin_prefetch(&flipped_[other]);
+          const std::uint32_t from = tri[slots.side(k)], to = side_end(tri, slots.side(k));
+          block.push_back({f, polygons_ ? face_of_triangle_[other] : other, std::min(from, to),
+                           std::max(from, to), t, other});
+        }
+      }
+      if (block.size() - face_links > 1)
+        stable_sort_small(block.begin() + static_cast<std::ptrdiff_t>(face_links), block.end(),
+                          [](const Link& a, const Link& b) {
+                            return std::tie(a.other_face, a.low, a.high, a.first) <
+                                   std::tie(b.other_face, b.low, b.high, b.first);
+                          });
+      if (block.size() >= kBlock) add_block(block, edges, internal);
+    }
+    add_block(block, edges, internal);
+  }
+
+ private:
+  struct Link {
+    std::uint32_t face, other_face;  // of the lower and the higher triangle
+    std::uint32_t low, high;         // the shared edge
+    std::uint32_t first, second;     // triangles, first < second
+    std::uint32_t opposite = kNone;  // the vertex of the second off the edge
+    bool angled = false;             // both normals nonzero, and a vertex off the edge
+    bool concave = false;
+    double y = 0, x = 0;  // the signed dihedral angle is ±atan2(y, x), − if concave
+  };
+
+  Eigen::Vector3d oriented_normal(std::uint32_t t) const {
+    const Triangle& tri = triangles_[t];
+    const Eigen::Vector3d n =
+        (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
+    return flipped_[t] ? Eigen::Vector3d(-n) : n;
+  }
+
+  void add_block(std::vector<Link>& block, std::vector<DualEdge>& edges,
+                 std::vector<std::pair<std::uint32_t, EdgeStats>>& internal) const {
+    std::uint32_t normal_of = kNone;
+    Eigen::Vector3d n1 = Eigen::Vector3d::Zero();
+    bool n1_nonzero = false;
+    // The random reads first, in a loop short enough for many of them to be in flight at once.
+    for (Link& link : block) {
+      for (std::uint32_t v : triangles_[link.second])
+        if (v != link.low && v != link.high) link.opposite = v;
+      if (link.opposite != kNone) __builtin_prefetch(&positions_[link.opposite]);
+    }
+    for (Link& link : block) {
+      if (link.first != normal_of) {
+        normal_of = link.first;
+        n1 = oriented_normal(link.first);
+        n1_nonzero = n1.squaredNorm() > 0;
+      }
+      if (link.opposite == kNone || !n1_nonzero) continue;
+      const Eigen::Vector3d n2 = oriented_normal(link.second);
+      if (!(n2.squaredNorm() > 0)) continue;
+      link.angled = true;
+      link.y = n1.cross(n2).norm();
+      link.x = n1.dot(n2);
+      link.concave = (positions_[link.opposite] - positions_[link.low]).dot(n1) > 0;
+    }
+    for (const Link& link : block) {
+      double beta = 0;
+      // atan2 keeps full precision near 0 where acos of the dot product would not.
+      if (link.angled) beta = std::atan2(link.y, link.x);
+      if (link.concave) beta = -beta;
+      const Eigen::Vector3d edge = positions_[link.high] - positions_[link.low];
+      if (link.other_face == link.face) {
+        internal.push_back({link.face, {}});
+        internal.back().second.add_edge(edge, beta);
+      } else if (!edges.empty() && edges.back().first == link.face &&
+                 edges.back().second == link.other_face) {
+        EdgeStats stats;
+        stats.add_edge(edge, beta);
+        edges.back().shared += stats;
+      } else {
+        edges.push_back({link.face, link.other_face, {}});
+        edges.back().shared.add_edge(edge, beta);
+      }
+    }
+    block.clear();
+  }
+
+  // Spans rather than references to vectors: one indirection less on every access.
+  std::span<const Triangle> triangles_;
+  std::span<const std::uint32_t> face_of_triangle_;
+  std::span<const Eigen::Vector3d> positions_;
+  std::span<const std::uint8_t> flipped_;
+  std::span<const std::uint32_t> first_triangle_;
+  std::span<const TriangleSlots> neighbours_;
+  bool polygons_;
 };
 
 class UnionFind {
@@ -31,6 +331,15 @@ class UnionFind {
     a = find(a);
     b = find(b);
     if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+  /// The set of each element, the sets numbered by their lowest element; `count` is set to the
+  /// number of sets. Consumes the structure: the labels overwrite the parents.
+  std::vector<std::uint32_t> labels(std::uint32_t& count) && {
+    // Every parent is lower than its child, hence labelled before it, with the label of the set.
+    count = 0;
+    for (std::uint32_t x = 0; x < parent_.size(); ++x)
+      parent_[x] = parent_[x] == x ? count++ : parent_[parent_[x]];
+    return std::move(parent_);
   }
 
  private:
@@ -61,9 +370,44 @@ Primitive WorkingFrame::to_input(const Primitive& working) const {
   return p;
 }
 
-WorkingFrame working_frame_for(const Mesh& mesh) {
+namespace {
+
+WorkingFrame frame_of_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   WorkingFrame frame;
-  if (mesh.triangles.empty()) return frame;
+  // Halving each bound before adding cannot overflow and stays exact for normal numbers.
+  frame.center = lo * 0.5 + hi * 0.5;
+  const double extent = (hi - frame.center).cwiseMax(frame.center - lo).maxCoeff();
+  if (extent > 0) std::frexp(extent, &frame.exponent);
+  return frame;
+}
+
+// working_frame_for(mesh), given the valences: the used vertices in index order rather than
+// corner by corner, which reads the positions once and in order. The bounds are the same unless
+// a bound is zero and both signed zeros occur on its axis: then the first in corner order is the
+// bound.
+WorkingFrame working_frame_of_used(const Mesh& mesh, const std::vector<std::uint32_t>& valence) {
+  if (mesh.triangles.empty()) return {};
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  std::array<unsigned, 3> zero_signs{};  // bit 0: +0 seen, bit 1: -0 seen
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (valence[v] == 0) continue;
+    for (int a = 0; a < 3; ++a) {
+      const double x = mesh.positions[v][a];
+      lo[a] = std::min(lo[a], x);
+      hi[a] = std::max(hi[a], x);
+      if (x == 0) zero_signs[a] |= std::signbit(x) ? 2u : 1u;
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+    if ((lo[a] == 0 || hi[a] == 0) && zero_signs[a] == 3) return working_frame_for(mesh);
+  return frame_of_box(lo, hi);
+}
+
+}  // namespace
+
+WorkingFrame working_frame_for(const Mesh& mesh) {
+  if (mesh.triangles.empty()) return {};
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (const Triangle& t : mesh.triangles)
@@ -72,186 +416,146 @@ WorkingFrame working_frame_for(const Mesh& mesh) {
         lo[a] = std::min(lo[a], mesh.positions[v][a]);
         hi[a] = std::max(hi[a], mesh.positions[v][a]);
       }
-  // Halving each bound before adding cannot overflow and stays exact for normal numbers.
-  frame.center = lo * 0.5 + hi * 0.5;
-  const double extent = (hi - frame.center).cwiseMax(frame.center - lo).maxCoeff();
-  if (extent > 0) std::frexp(extent, &frame.exponent);
-  return frame;
+  return frame_of_box(lo, hi);
 }
 
-DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights)
-    : mesh_(&mesh), weights_(weights), frame_(working_frame_for(mesh)) {
+DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
+    : mesh_(&mesh), weights_(weights) {
+  threads = detail::thread_count(threads);
   const std::uint32_t triangle_count = mesh.triangle_count();
   const std::uint32_t face_count = mesh.face_count();
 
+  valence_.assign(mesh.positions.size(), 0);
+  for (const Triangle& t : mesh.triangles)
+    for (std::uint32_t v : t) ++valence_[v];
+  frame_ = working_frame_of_used(mesh, valence_);
+
   positions_.resize(mesh.positions.size());
-  for (std::size_t v = 0; v < positions_.size(); ++v)
-    positions_[v] = frame_.to_working(mesh.positions[v]);
+  // A product by a power of two rounds once, as ldexp does, when the power is a double.
+  const double scale = std::ldexp(1.0, -frame_.exponent);
+  if (scale > 0 && std::isfinite(scale)) {
+    for (std::size_t v = 0; v < positions_.size(); ++v)
+      for (int a = 0; a < 3; ++a)
+        positions_[v][a] = (mesh.positions[v][a] - frame_.center[a]) * scale;
+  } else {
+    for (std::size_t v = 0; v < positions_.size(); ++v)
+      positions_[v] = frame_.to_working(mesh.positions[v]);
+  }
 
   first_triangle_.assign(face_count + 1, 0);
   for (std::uint32_t f : mesh.face_of_triangle) ++first_triangle_[f + 1];
   std::partial_sum(first_triangle_.begin(), first_triangle_.end(), first_triangle_.begin());
 
-  valence_.assign(mesh.positions.size(), 0);
-  for (const Triangle& t : mesh.triangles)
-    for (std::uint32_t v : t) ++valence_[v];
-
-  // Mesh edges with their triangles, sorted so that each edge's sides are adjacent.
-  std::vector<EdgeSide> sides;
-  sides.reserve(3 * std::size_t{triangle_count});
-  for (std::uint32_t t = 0; t < triangle_count; ++t)
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t from = mesh.triangles[t][c], to = mesh.triangles[t][(c + 1) % 3];
-      if (from == to) continue;
-      sides.push_back({std::min(from, to), std::max(from, to), t, from < to});
-    }
-  std::sort(sides.begin(), sides.end(), [](const EdgeSide& a, const EdgeSide& b) {
-    if (a.low != b.low) return a.low < b.low;
-    if (a.high != b.high) return a.high < b.high;
-    if (a.triangle != b.triangle) return a.triangle < b.triangle;
-    return a.forward < b.forward;
-  });
-
-  // Links between consecutive triangles on each edge, and the manifold edges that orient.
-  std::vector<TriangleLink> links;
-  links.reserve(sides.size() / 2 + 1);
-  std::vector<std::uint32_t> orient_offsets(triangle_count + 1, 0);
-  std::vector<std::pair<std::uint32_t, std::uint8_t>> orient_neighbours;  // (triangle, must flip)
-  std::vector<std::uint8_t> open_triangle(triangle_count, 0);
-  struct OrientLink {
-    std::uint32_t a, b;
-    std::uint8_t flip;
+  // Ranges of faces for threads (see below), and the triangles they start at.
+  const std::size_t chunk_count = std::min<std::size_t>(threads, face_count / 16384 + 1);
+  auto chunk_face = [&](std::size_t chunk) {
+    return static_cast<std::uint32_t>(face_count * chunk / chunk_count);
   };
-  std::vector<OrientLink> orient_links;
-  for (std::size_t begin = 0; begin < sides.size();) {
-    std::size_t end = begin + 1;
-    while (end < sides.size() && sides[end].low == sides[begin].low &&
-           sides[end].high == sides[begin].high)
-      ++end;
-    const std::size_t k = end - begin;
-    if (k == 2 && sides[begin].triangle != sides[begin + 1].triangle) {
-      // Consistent neighbours traverse their shared edge in opposite directions.
-      orient_links.push_back(
-          {sides[begin].triangle, sides[begin + 1].triangle,
-           static_cast<std::uint8_t>(sides[begin].forward == sides[begin + 1].forward)});
-    } else {
-      for (std::size_t s = begin; s < end; ++s) open_triangle[sides[s].triangle] = 1;
-    }
-    for (std::size_t s = begin; s + 1 < end; ++s)
-      if (sides[s].triangle != sides[s + 1].triangle)
-        links.push_back(
-            {sides[s].triangle, sides[s + 1].triangle, sides[begin].low, sides[begin].high});
-    begin = end;
-  }
-  std::vector<EdgeSide>().swap(sides);
+  std::vector<std::uint32_t> chunk_begin(chunk_count + 1);
+  for (std::size_t chunk = 0; chunk <= chunk_count; ++chunk)
+    chunk_begin[chunk] = first_triangle_[chunk_face(chunk)];
+  Links links = link_triangles(mesh, bucket_sides(mesh), chunk_begin);
+  const std::vector<TriangleSlots>& neighbours = links.slots;
 
-  // Orientation: breadth-first over manifold edges from the lowest unvisited triangle.
-  for (const OrientLink& l : orient_links) {
-    ++orient_offsets[l.a + 1];
-    ++orient_offsets[l.b + 1];
-  }
-  std::partial_sum(orient_offsets.begin(), orient_offsets.end(), orient_offsets.begin());
-  orient_neighbours.resize(orient_offsets.back());
-  {
-    std::vector<std::uint32_t> fill(orient_offsets.begin(), orient_offsets.end() - 1);
-    for (const OrientLink& l : orient_links) {
-      orient_neighbours[fill[l.a]++] = {l.b, l.flip};
-      orient_neighbours[fill[l.b]++] = {l.a, l.flip};
-    }
-  }
+  // Orientation: breadth-first over manifold edges from the lowest unvisited triangle, the edges
+  // of a triangle in increasing order (on a non-orientable component the order decides the flips).
   flipped_.assign(triangle_count, 0);
-  std::vector<std::uint32_t> orient_component(triangle_count, UINT32_MAX);
-  std::vector<std::uint32_t> queue;
-  std::vector<std::uint8_t> component_open;
-  for (std::uint32_t seed = 0; seed < triangle_count; ++seed) {
-    if (orient_component[seed] != UINT32_MAX) continue;
-    const auto component = static_cast<std::uint32_t>(component_open.size());
-    component_open.push_back(0);
-    orient_component[seed] = component;
-    queue.assign(1, seed);
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const std::uint32_t t = queue[head];
-      component_open[component] |= open_triangle[t];
-      for (std::uint32_t n = orient_offsets[t]; n < orient_offsets[t + 1]; ++n) {
-        const auto [other, flip] = orient_neighbours[n];
-        const std::uint8_t wanted = flipped_[t] ^ flip;
-        if (orient_component[other] == UINT32_MAX) {
-          orient_component[other] = component;
-          flipped_[other] = wanted;
-          queue.push_back(other);
-        } else if (flipped_[other] != wanted) {
-          component_open[component] = 1;  // not orientable (a Möbius band): no inside
+  {
+    std::vector<std::uint32_t> orient_component(triangle_count, kNone);
+    std::vector<std::uint32_t> queue(triangle_count);  // every triangle enters it once
+    std::vector<std::uint8_t> component_open;
+    std::size_t queued = 0;
+    for (std::uint32_t seed = 0; seed < triangle_count; ++seed) {
+      if (orient_component[seed] != kNone) continue;
+      const auto component = static_cast<std::uint32_t>(component_open.size());
+      component_open.push_back(0);
+      orient_component[seed] = component;
+      queue[queued++] = seed;
+      for (std::size_t head = queued - 1; head < queued; ++head) {
+        if (head + 4 < queued) {
+          const TriangleSlots& ahead = neighbours[queue[head + 4]];
+          for (unsigned k = 0; k < ahead.count(); ++k) {
+            __builtin_prefetch(&orient_component[ahead.other[k]]);
+            __builtin_prefetch(&flipped_[ahead.other[k]]);
+          }
+        }
+        if (head + 8 < queued) __builtin_prefetch(&neighbours[queue[head + 8]]);
+        const std::uint32_t t = queue[head];
+        const TriangleSlots& slots = neighbours[t];
+        if (slots.open()) component_open[component] = 1;
+        for (unsigned k = 0; k < slots.count(); ++k) {
+          if (!slots.manifold(k)) continue;
+          const std::uint32_t other = slots.other[k];
+          const std::uint8_t wanted = flipped_[t] ^ std::uint8_t{slots.same_direction(k)};
+          if (orient_component[other] == kNone) {
+            orient_component[other] = component;
+            flipped_[other] = wanted;
+            queue[queued++] = other;
+          } else if (flipped_[other] != wanted) {
+            component_open[component] = 1;  // not orientable (a Möbius band): no inside
+          }
         }
       }
     }
-  }
-  // Closed components face outward: flip those of negative signed volume.
-  std::vector<double> volume(component_open.size(), 0.0);
-  for (std::uint32_t t = 0; t < triangle_count; ++t) {
-    const Triangle& tri = mesh.triangles[t];
-    const double v = positions_[tri[0]].dot(positions_[tri[1]].cross(positions_[tri[2]]));
-    volume[orient_component[t]] += flipped_[t] ? -v : v;
-  }
-  for (std::uint32_t t = 0; t < triangle_count; ++t) {
-    const std::uint32_t c = orient_component[t];
-    if (!component_open[c] && volume[c] < 0) flipped_[t] ^= 1;
-  }
-
-  // Signed dihedral angles of the links.
-  auto oriented_normal = [&](std::uint32_t t) {
-    const Triangle& tri = mesh.triangles[t];
-    const Eigen::Vector3d n =
-        (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
-    return flipped_[t] ? Eigen::Vector3d(-n) : n;
-  };
-  std::vector<DualEdge> records;
-  records.reserve(links.size());
-  for (const TriangleLink& link : links) {
-    const Eigen::Vector3d n1 = oriented_normal(link.first), n2 = oriented_normal(link.second);
-    const Eigen::Vector3d edge = positions_[link.high] - positions_[link.low];
-    double beta = 0;
-    std::uint32_t opposite = UINT32_MAX;
-    for (std::uint32_t v : mesh.triangles[link.second])
-      if (v != link.low && v != link.high) opposite = v;
-    if (opposite != UINT32_MAX && n1.squaredNorm() > 0 && n2.squaredNorm() > 0) {
-      // atan2 keeps full precision near 0 where acos of the dot product would not.
-      beta = std::atan2(n1.cross(n2).norm(), n1.dot(n2));
-      if ((positions_[opposite] - positions_[link.low]).dot(n1) > 0) beta = -beta;
+    std::vector<std::uint32_t>().swap(queue);
+    // Closed components face outward: flip those of negative signed volume. The components of
+    // the dual graph are those of the orientation joined across the other links and within
+    // polygon faces; numbered by their lowest member, as the orientation components are by their
+    // lowest triangle, they are numbered by their lowest face.
+    std::vector<double> volume(component_open.size(), 0.0);
+    UnionFind joined(component_open.size());
+    const bool polygons = face_count != triangle_count;
+    for (std::uint32_t t = 0; t < triangle_count; ++t) {
+      if (t + 16 < triangle_count)
+        for (std::uint32_t u : mesh.triangles[t + 16]) __builtin_prefetch(&positions_[u]);
+      const Triangle& tri = mesh.triangles[t];
+      const double v = positions_[tri[0]].dot(positions_[tri[1]].cross(positions_[tri[2]]));
+      volume[orient_component[t]] += flipped_[t] ? -v : v;
+      const TriangleSlots& slots = neighbours[t];
+      for (unsigned k = 0; k < slots.count(); ++k)
+        if (!slots.manifold(k)) joined.unite(orient_component[t], orient_component[slots.other[k]]);
+      if (polygons && t > 0 && mesh.face_of_triangle[t] == mesh.face_of_triangle[t - 1])
+        joined.unite(orient_component[t], orient_component[t - 1]);
     }
-    EdgeStats stats;
-    stats.add_edge(edge, beta);
-    const std::uint32_t fa = mesh.face_of_triangle[link.first];
-    const std::uint32_t fb = mesh.face_of_triangle[link.second];
-    if (fa == fb)
-      internal_edges_.push_back({fa, stats});
-    else
-      records.push_back({std::min(fa, fb), std::max(fa, fb), stats});
-  }
-  std::vector<TriangleLink>().swap(links);
-
-  auto by_faces = [](const DualEdge& a, const DualEdge& b) {
-    return a.first != b.first ? a.first < b.first : a.second < b.second;
-  };
-  // Stable: the tensor sums below then add in a fixed order.
-  std::stable_sort(records.begin(), records.end(), by_faces);
-  for (const DualEdge& r : records) {
-    if (!edges_.empty() && edges_.back().first == r.first && edges_.back().second == r.second) {
-      edges_.back().shared += r.shared;
-    } else {
-      edges_.push_back(r);
+    for (std::uint32_t t = 0; t < triangle_count; ++t) {
+      const std::uint32_t c = orient_component[t];
+      if (!component_open[c] && volume[c] < 0) flipped_[t] ^= 1;
     }
+    const std::vector<std::uint32_t> label = std::move(joined).labels(component_count_);
+    component_of_face_.resize(face_count);
+    for (std::uint32_t f = 0; f < face_count; ++f)
+      component_of_face_[f] = label[orient_component[first_triangle_[f]]];
   }
-  std::stable_sort(internal_edges_.begin(), internal_edges_.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
 
-  UnionFind components(face_count);
-  for (const DualEdge& e : edges_) components.unite(e.first, e.second);
-  component_of_face_.resize(face_count);
-  std::vector<std::uint32_t> number(face_count, UINT32_MAX);
-  for (std::uint32_t f = 0; f < face_count; ++f) {
-    const std::uint32_t root = components.find(f);
-    if (number[root] == UINT32_MAX) number[root] = component_count_++;
-    component_of_face_[f] = number[root];
+  // The dual edges: faces are independent, so ranges of them go to threads, their results
+  // concatenated in order.
+  const std::size_t external =
+      std::accumulate(links.count.begin(), links.count.end(), std::size_t{0}) -
+      std::accumulate(links.internal.begin(), links.internal.end(), std::size_t{0});
+  edges_.reserve(external);
+  internal_edges_.reserve(
+      std::accumulate(links.internal.begin(), links.internal.end(), std::size_t{0}));
+  const FaceLinks face_links(mesh, positions_, flipped_, first_triangle_, neighbours);
+  std::vector<std::vector<DualEdge>> later_edges(chunk_count - 1);
+  std::vector<std::vector<std::pair<std::uint32_t, EdgeStats>>> later_internal(chunk_count - 1);
+  detail::parallel_for_threads(
+      chunk_count, static_cast<unsigned>(chunk_count), [&](std::size_t chunk, unsigned) {
+        std::vector<DualEdge>& edges = chunk == 0 ? edges_ : later_edges[chunk - 1];
+        std::vector<std::pair<std::uint32_t, EdgeStats>>& internal =
+            chunk == 0 ? internal_edges_ : later_internal[chunk - 1];
+        if (chunk > 0) {
+          edges.reserve(links.count[chunk] - links.internal[chunk]);
+          internal.reserve(links.internal[chunk]);
+        }
+        face_links.add(chunk_face(chunk), chunk_face(chunk + 1), edges, internal);
+      });
+  std::vector<TriangleSlots>().swap(links.slots);
+  for (std::size_t chunk = 0; chunk + 1 < chunk_count; ++chunk) {
+    edges_.insert(edges_.end(), later_edges[chunk].begin(), later_edges[chunk].end());
+    std::vector<DualEdge>().swap(later_edges[chunk]);
+    internal_edges_.insert(internal_edges_.end(), later_internal[chunk].begin(),
+                           later_internal[chunk].end());
+    std::vector<std::pair<std::uint32_t, EdgeStats>>().swap(later_internal[chunk]);
   }
 }
 

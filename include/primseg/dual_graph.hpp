@@ -57,8 +57,11 @@ struct DualEdge {
 /// connected to the others. Orientation propagates only across manifold edges.
 class DualGraph {
  public:
-  /// Builds the graph of `mesh`, which must outlive it (the graph refers to it). O(T log T).
-  DualGraph(const Mesh& mesh, VertexWeights weights);
+  /// Builds the graph of `mesh`, which must outlive it (the graph refers to it). Linear in T but
+  /// for sorting the links of each face (O(T log T) at worst). `threads` as
+  /// HierarchyOptions::threads: 0 uses all hardware threads; the graph is the same, bit for bit,
+  /// for any number.
+  DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads = 0);
 
   const Mesh& mesh() const { return *mesh_; }
   const WorkingFrame& frame() const { return frame_; }
