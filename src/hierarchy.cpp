@@ -149,7 +149,7 @@ Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
     throw InvalidInputError("a hierarchy of " + std::to_string(f) + " faces needs " +
                             std::to_string(f - 1) + " merges, not " +
                             std::to_string(merges_.size()));
-  if (!graph_) graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights);
+  if (!graph_) graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, options_.threads);
   parents_.assign(2 * std::size_t{f} - 1, kNone);
   for (std::uint32_t i = 0; i < merges_.size(); ++i) {
     const Merge& m = merges_[i];
@@ -219,7 +219,7 @@ class HierarchyBuilder::Impl {
         queue_(0, ComesFirst{&queued_pairs_}) {
     if (!mesh_) throw InvalidInputError("no mesh");
     mesh_->validate();
-    graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights);
+    graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, options_.threads);
     const std::uint32_t f = mesh_->face_count();
     // Statistics are stored for clusters of three faces or more only (at most F / 3 live at
     // once); a single face's or a pair's are recomputed when needed (see store_pair()).
