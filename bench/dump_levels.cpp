@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
       for (const char* variant : {"cad", "uniform", "noisy"}) {
         primseg::ShapeOptions options;
         options.tessellation = std::string(variant) == "cad" ? primseg::Tessellation::Cad
-                                                            : primseg::Tessellation::Uniform;
+                                                             : primseg::Tessellation::Uniform;
         if (std::string(variant) == "noisy") options.noise = 0.002;
         options.random_motion = true;
         const primseg::GroundTruthShape generated = primseg::make_shape(shape, options);

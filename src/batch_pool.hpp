@@ -62,11 +62,9 @@ class BatchPool {
     const std::uint32_t batch = ++batch_number_;
     Batch& b = batches_[batch % batches_.size()];
     b.job.store(&job, std::memory_order_relaxed);
-    b.invoke.store(
-        [](void* context, std::size_t i, unsigned thread) {
-          (*static_cast<Job*>(context))(i, thread);
-        },
-        std::memory_order_relaxed);
+    b.invoke.store([](void* context, std::size_t i,
+                      unsigned thread) { (*static_cast<Job*>(context))(i, thread); },
+                   std::memory_order_relaxed);
     b.count.store(count, std::memory_order_relaxed);
     b.done.store(0, std::memory_order_relaxed);
     cursor_.store(std::uint64_t{batch} << 32, std::memory_order_release);

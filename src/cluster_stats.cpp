@@ -90,15 +90,14 @@ constexpr std::array<TranslationTerm, count> make_centred_terms() {
     if (!is_first_moment(term.source) && n < count) terms[n++] = term;
   return terms;
 }
-constexpr auto kCentredTerms =
-    make_centred_terms<count_centred_terms(kTranslationTerms.size())>();
+constexpr auto kCentredTerms = make_centred_terms<count_centred_terms(kTranslationTerms.size())>();
 constexpr std::size_t kCentredTermsUpToDegree2 = count_centred_terms(kTermsUpToDegree2);
 
 template <const auto& terms, std::size_t... n>
 inline void apply_translation_terms(std::index_sequence<n...>, const double* shift,
                                     const double* source, double* target) {
-  ((target[terms[n].target] += terms[n].coefficient * shift[terms[n].shift] *
-                               source[terms[n].source]),
+  ((target[terms[n].target] +=
+    terms[n].coefficient * shift[terms[n].shift] * source[terms[n].source]),
    ...);
 }
 
@@ -182,17 +181,17 @@ Moments Moments::translated(const Eigen::Vector3d& new_origin, int max_degree) c
   double* target = result.values_.data();
   const bool centred = values_[1] == 0 && values_[2] == 0 && values_[3] == 0;
   if (centred && max_degree >= 4)
-    apply_translation_terms<kCentredTerms>(std::make_index_sequence<kCentredTerms.size()>(),
-                                           shift, source, target);
+    apply_translation_terms<kCentredTerms>(std::make_index_sequence<kCentredTerms.size()>(), shift,
+                                           source, target);
   else if (centred)
     apply_translation_terms<kCentredTerms>(std::make_index_sequence<kCentredTermsUpToDegree2>(),
                                            shift, source, target);
   else if (max_degree >= 4)
-    apply_translation_terms<kTranslationTerms>(
-        std::make_index_sequence<kTranslationTerms.size()>(), shift, source, target);
-  else
-    apply_translation_terms<kTranslationTerms>(std::make_index_sequence<kTermsUpToDegree2>(),
+    apply_translation_terms<kTranslationTerms>(std::make_index_sequence<kTranslationTerms.size()>(),
                                                shift, source, target);
+  else
+    apply_translation_terms<kTranslationTerms>(std::make_index_sequence<kTermsUpToDegree2>(), shift,
+                                               source, target);
   return result;
 }
 

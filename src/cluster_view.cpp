@@ -130,7 +130,8 @@ const ClusterView::RadialMoments& ClusterView::radial_moments() const {
     const double w = m.weight(), trace = s.trace(), dd = d.squaredNorm();
     const Eigen::Vector3d sd = s * d;
     sum.third += part.third + 2 * sd + trace * d + (w * dd) * d;
-    sum.fourth += part.fourth + 4 * d.dot(part.third) + 2 * dd * trace + 4 * d.dot(sd) + w * dd * dd;
+    sum.fourth +=
+        part.fourth + 4 * d.dot(part.third) + 2 * dd * trace + 4 * d.dot(sd) + w * dd * dd;
   }
   return sum;
 }

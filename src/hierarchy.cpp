@@ -59,7 +59,8 @@ static_assert(kPrimitiveTypeCount <= 8);
 
 // 16 bytes: the builder keeps one per dual edge.
 struct LiveEdge {
-  std::uint32_t a, b;  // slots of the two clusters (see HierarchyBuilder::Impl); a = kNone once dead
+  std::uint32_t a,
+      b;  // slots of the two clusters (see HierarchyBuilder::Impl); a = kNone once dead
   // The mesh edges between the two clusters are those of the input dual edge with this id until
   // two edges to a common neighbour are combined; then their sum lives in a pool at this index.
   std::uint32_t combined_shared = kNone;
@@ -99,9 +100,9 @@ using CandidateQueue = detail::IndexedHeap<QueuedCandidate, ComesFirst>;
 struct Slot {
   std::uint32_t node;   // the cluster's node id; kNone once merged into another slot
   std::uint32_t stats;  // index into the pool of statistics; kNone: a face; kPairTag | edge: a pair
-  std::uint32_t faces;      // input faces in the cluster
-  std::uint32_t triangles;  // triangles in the cluster
-  std::uint32_t min_face;   // its lowest input face (orders the trailing merges)
+  std::uint32_t faces;  // input faces in the cluster
+  std::uint32_t triangles;   // triangles in the cluster
+  std::uint32_t min_face;    // its lowest input face (orders the trailing merges)
   std::uint32_t first_link;  // head of its adjacency list; kNone if empty
   std::uint32_t marker;      // merge(): the kept edge to this neighbour, else kNone
   std::uint32_t stamp;       // merged_degree(): the last count this neighbour was counted in
@@ -227,8 +228,9 @@ class HierarchyBuilder::Impl {
     merges_.reserve(f - 1);
     slots_.resize(f);
     for (std::uint32_t face = 0; face < f; ++face)
-      slots_[face] = {face, kNone, 1, graph_->first_triangle(face + 1) - graph_->first_triangle(face),
-                      face, kNone, kNone, 0};
+      slots_[face] = {
+          face, kNone, 1,     graph_->first_triangle(face + 1) - graph_->first_triangle(face),
+          face, kNone, kNone, 0};
     if (options_.exact_costs) {
       next_face_.assign(f, kNone);
       face_list_head_.resize(f);
@@ -271,8 +273,7 @@ class HierarchyBuilder::Impl {
     queued_pairs_.resize(edges_.size());
     for (std::size_t id = 0; id < edges_.size(); ++id)
       queued_pairs_[id] = {dual_edges[id].first, dual_edges[id].second};  // faces: first < second
-    queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()),
-                            ComesFirst{&queued_pairs_});
+    queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{&queued_pairs_});
     queue_.assign(candidates);
     total_merges_ = f - graph_->component_count();
   }
@@ -456,7 +457,7 @@ class HierarchyBuilder::Impl {
   // Part 0 of a union must be read before part 1: its statistics stay in place while part 1's are
   // read.
   const ClusterStats& stats_of(std::uint32_t slot, Scratch& scratch, int part,
-                              int max_degree) const {
+                               int max_degree) const {
     if (part == 0) scratch.pinned.fill(kNone);
     const std::uint32_t index = slots_[slot].stats;
     ClusterStats& stats = scratch.clusters[part];
@@ -789,13 +790,13 @@ class HierarchyBuilder::Impl {
   std::vector<Slot> slots_;                // per input face
   // Adjacency as intrusive lists: link 2 id + side is edge id on the list of the slot of its
   // a (side 0) or b (side 1) cluster, from Slot::first_link. Dead edges are unlinked lazily.
-  std::vector<std::uint32_t> next_link_;   // per link
+  std::vector<std::uint32_t> next_link_;  // per link
   std::vector<LiveEdge> edges_;
   std::vector<EdgeStats> combined_shared_;  // see LiveEdge::combined_shared
   std::vector<std::uint32_t> free_combined_shared_;
   std::vector<Merge> merges_;
-  std::uint32_t current_stamp_ = 0;  // see Slot::stamp
-  std::vector<std::size_t> tied_;  // settle_tie()'s queue positions
+  std::uint32_t current_stamp_ = 0;     // see Slot::stamp
+  std::vector<std::size_t> tied_;       // settle_tie()'s queue positions
   std::vector<QueuedCandidate> batch_;  // the candidates merge() evaluates
   std::vector<NodePair> queued_pairs_;  // per edge: see ComesFirst
   ClusterStats merged_;                 // merge()'s new statistics

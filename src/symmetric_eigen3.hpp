@@ -70,19 +70,19 @@ namespace eigen3_detail {
 // The scaled, shifted matrix and its isolated eigenvalue (see the top of this file).
 struct IsolatedRoot {
   enum Kind { kNotFinite, kZero, kScalar, kFound } kind = kFound;
-  double scale = 0;  // max |a_ij|
-  double mean = 0;   // mean eigenvalue of a / scale
-  double p = 0;      // sqrt(Σ (λ − mean)² / 6) of a / scale
-  Eigen::Matrix3d b;                 // a / scale − mean I
-  bool low = false;                  // the isolated eigenvalue is the smallest, else the largest
-  double x = 0;                      // its root of 4x³ − 3x = r, positive: ±2p x is b's eigenvalue
+  double scale = 0;   // max |a_ij|
+  double mean = 0;    // mean eigenvalue of a / scale
+  double p = 0;       // sqrt(Σ (λ − mean)² / 6) of a / scale
+  Eigen::Matrix3d b;  // a / scale − mean I
+  bool low = false;   // the isolated eigenvalue is the smallest, else the largest
+  double x = 0;       // its root of 4x³ − 3x = r, positive: ±2p x is b's eigenvalue
   double shifted() const { return 2 * p * (low ? -x : x); }
 };
 
 inline IsolatedRoot isolated_root(const Eigen::Matrix3d& a) {
   IsolatedRoot root;
-  root.scale = std::max({std::abs(a(0, 0)), std::abs(a(1, 1)), std::abs(a(2, 2)),
-                         std::abs(a(0, 1)), std::abs(a(0, 2)), std::abs(a(1, 2))});
+  root.scale = std::max({std::abs(a(0, 0)), std::abs(a(1, 1)), std::abs(a(2, 2)), std::abs(a(0, 1)),
+                         std::abs(a(0, 2)), std::abs(a(1, 2))});
   // (std::max passes a NaN over: the sum of the entries does not.)
   if (!std::isfinite(root.scale + a(0, 0) + a(1, 1) + a(2, 2) + a(0, 1) + a(0, 2) + a(1, 2))) {
     root.kind = IsolatedRoot::kNotFinite;
@@ -226,6 +226,5 @@ inline Eigenpair dominant_eigenpair(const Eigen::Matrix3d& a) {
   const int k = std::abs(all.values(0)) > std::abs(all.values(2)) ? 0 : 2;
   return {all.values(k), all.vectors.col(k)};
 }
-
 
 }  // namespace primseg::detail

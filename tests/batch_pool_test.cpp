@@ -36,7 +36,8 @@ TEST(BatchPool, ManySmallBatchesInARow) {
   for (int batch = 0; batch < 200000; ++batch) {
     auto job = [&](std::size_t i, unsigned) { results[i] = double(batch) * double(i); };
     pool.run(results.size(), job);
-    for (std::size_t i = 0; i < results.size(); ++i) ASSERT_EQ(results[i], double(batch) * double(i));
+    for (std::size_t i = 0; i < results.size(); ++i)
+      ASSERT_EQ(results[i], double(batch) * double(i));
     total += results[5];
   }
   EXPECT_GT(total, 0);

@@ -100,8 +100,9 @@ TEST(ClusterView, UnionQuantitiesEqualDirectSumsOverTheUnionsPoints) {
         return y * y.squaredNorm();
       }),
                   1e-12 * scale * radius, "radial third");
-      EXPECT_NEAR(radial.fourth,
-                  corners.sum([](const Eigen::Vector3d& y) { return y.squaredNorm() * y.squaredNorm(); }),
+      EXPECT_NEAR(radial.fourth, corners.sum([](const Eigen::Vector3d& y) {
+        return y.squaredNorm() * y.squaredNorm();
+      }),
                   1e-12 * scale * radius * radius);
       for (int axes = 0; axes < 4; ++axes) {
         const Eigen::Vector3d axis =
@@ -122,8 +123,8 @@ TEST(ClusterView, UnionQuantitiesEqualDirectSumsOverTheUnionsPoints) {
       }
       EXPECT_EQ(view.triangle_count(), stats_a.triangle_count + stats_b.triangle_count);
       EXPECT_DOUBLE_EQ(view.area(), stats_a.area + stats_b.area);
-      Eigen::Matrix3d tensor = stats_a.edges.tensor_matrix() + stats_b.edges.tensor_matrix() +
-                               shared.tensor_matrix();
+      Eigen::Matrix3d tensor =
+          stats_a.edges.tensor_matrix() + stats_b.edges.tensor_matrix() + shared.tensor_matrix();
       expect_near(view.edge_tensor(), tensor, 1e-14, "edge tensor");
 
       // The view's whole statistics equal the old way of forming them (merge, then centre), and
@@ -134,16 +135,17 @@ TEST(ClusterView, UnionQuantitiesEqualDirectSumsOverTheUnionsPoints) {
       const ClusterStats& formed = view.stats();
       for (int n = 0; n < Moments::kCount; ++n)
         EXPECT_NEAR(formed.moments.values()[n], merged.moments.values()[n],
-                    1e-12 * scale * (1 + radius * radius)) << n;
+                    1e-12 * scale * (1 + radius * radius))
+            << n;
       expect_near(formed.normal_position, merged.normal_position, 1e-13 * view.area(),
                   "normal position");
       const ClusterView single(formed);
       expect_near(single.second_moment(), view.second_moment(), 1e-13 * scale, "single view");
-      const Eigen::Matrix3d q = Eigen::Matrix3d::Identity() - Eigen::Vector3d::UnitZ() *
-                                                                  Eigen::Vector3d::UnitZ().transpose();
+      const Eigen::Matrix3d q = Eigen::Matrix3d::Identity() -
+                                Eigen::Vector3d::UnitZ() * Eigen::Vector3d::UnitZ().transpose();
       const Eigen::Vector3d point = view.centroid() + Eigen::Vector3d(0.3, -0.2, 0.1);
-      EXPECT_NEAR(view.normal_alignment(q, point, 0.7),
-                  merged.normal_alignment(q, point, 0.7), 1e-12);
+      EXPECT_NEAR(view.normal_alignment(q, point, 0.7), merged.normal_alignment(q, point, 0.7),
+                  1e-12);
       EXPECT_NEAR(single.normal_alignment(q, point, 0.7), merged.normal_alignment(q, point, 0.7),
                   1e-12);
       // With degree 2 only, the moments up to degree 2 are the same bits and the rest zero.

@@ -40,7 +40,8 @@ std::vector<Merge> naive_greedy(const Mesh& mesh, const HierarchyOptions& option
     std::uint32_t degree = 0;  // merged degree when evaluated, for a zero cost
   };
   std::vector<Edge> edges;
-  for (const DualEdge& e : graph.edges()) edges.push_back({e.first, e.second, e.shared, true, false, {}, 0});
+  for (const DualEdge& e : graph.edges())
+    edges.push_back({e.first, e.second, e.shared, true, false, {}, 0});
   std::vector<Merge> merges;
   for (std::uint32_t next = graph.face_count();; ++next) {
     auto merged_degree = [&](const Edge& of) {
@@ -158,8 +159,8 @@ TEST(GreedyReference, CleanMeshesSettleTheirZeroCostTiesAsTheNaiveGreedyOrder) {
       options.random_motion = true;
       options.seed = seed++;
       const Mesh mesh = make_shape(name, options).mesh;
-      expect_naive_greedy(mesh, std::string(name) +
-                                    (tessellation == Tessellation::Cad ? " cad" : " uniform"));
+      expect_naive_greedy(
+          mesh, std::string(name) + (tessellation == Tessellation::Cad ? " cad" : " uniform"));
     }
 }
 

@@ -19,8 +19,7 @@ Eigensystem<2> eigensystem_of(const Eigen::Matrix2d& c) {
   double cosine = 1, sine = 0;
   if (c(0, 1) != 0) {
     const double zeta = (c(1, 1) - c(0, 0)) / (2 * c(0, 1));
-    const double tangent =
-        (zeta >= 0 ? 1.0 : -1.0) / (std::abs(zeta) + std::sqrt(1 + zeta * zeta));
+    const double tangent = (zeta >= 0 ? 1.0 : -1.0) / (std::abs(zeta) + std::sqrt(1 + zeta * zeta));
     cosine = 1 / std::sqrt(1 + tangent * tangent);
     sine = tangent * cosine;
   }

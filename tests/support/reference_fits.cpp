@@ -162,8 +162,8 @@ ReferenceModel reference_model(const ClusterStats& centred, const HierarchyOptio
     if (fit.valid) {
       if (fit.error <= zero_level) fit.error = 0;
       fit.cost = fit.error * options.type_penalty[static_cast<int>(type)];
-      const bool better_exact = found && fit.cost == 0 && model.cost == 0 &&
-                                fit.normal_alignment > best_alignment + 1e-6;
+      const bool better_exact =
+          found && fit.cost == 0 && model.cost == 0 && fit.normal_alignment > best_alignment + 1e-6;
       if (!found || fit.cost < model.cost || better_exact) {
         model.type = type;
         model.cost = fit.cost;
