@@ -718,12 +718,46 @@ class HierarchyBuilder::Impl {
     };
     pool_.run(batch_.size(), evaluate_batch);
     for (const QueuedCandidate& evaluated : batch_) queue_.prefetch_node(evaluated.id);
+    bool zero_cost = false;
+    for (const QueuedCandidate& evaluated : batch_) zero_cost = zero_cost || evaluated.cost == 0;
+    if (zero_cost) mark_neighbours(slot_a);
     for (QueuedCandidate& evaluated : batch_) {
       if (evaluated.cost == 0)
-        evaluated.set_degree(merged_degree(edges_[evaluated.id].a, edges_[evaluated.id].b));
+        evaluated.set_degree(degree_with_marked(slot_a, other_end(edges_[evaluated.id], slot_a)));
       requeue(evaluated);
     }
     evaluations_ += batch_.size();
+  }
+
+  // Stamps the neighbours of the cluster in `slot` (for degree_with_marked()) and remembers
+  // their number.
+  void mark_neighbours(std::uint32_t slot) {
+    ++current_stamp_;
+    marked_degree_ = 0;
+    for (std::uint32_t link = slots_[slot].first_link; link != kNone; link = next_link_[link]) {
+      slots_[other_end(edges_[link / 2], slot)].stamp = current_stamp_;
+      ++marked_degree_;
+    }
+  }
+
+  // merged_degree(marked, other) for `other` a neighbour of the cluster whose neighbours
+  // mark_neighbours() just stamped: |adj(m) \ {o}| + |adj(o) \ {m}| − |adj(m) ∩ adj(o)|, in
+  // O(deg o) instead of O(deg m + deg o) (a large flat region next to single faces gets all its
+  // candidates at zero cost, each needing its degree). Unlinks o's dead edges on the way.
+  std::uint32_t degree_with_marked(std::uint32_t marked, std::uint32_t other) {
+    std::uint32_t degree = marked_degree_ - 1;
+    std::uint32_t* link = &slots_[other].first_link;
+    while (*link != kNone) {
+      const LiveEdge& e = edges_[*link / 2];
+      if (!e.alive()) {
+        *link = next_link_[*link];
+        continue;
+      }
+      link = &next_link_[*link];
+      const std::uint32_t neighbour = other_end(e, other);
+      if (neighbour != marked && slots_[neighbour].stamp != current_stamp_) ++degree;
+    }
+    return degree;
   }
 
   // What only the merge loop needs (about two thirds of the peak memory) is freed before the
@@ -796,6 +830,7 @@ class HierarchyBuilder::Impl {
   std::vector<std::uint32_t> free_combined_shared_;
   std::vector<Merge> merges_;
   std::uint32_t current_stamp_ = 0;     // see Slot::stamp
+  std::uint32_t marked_degree_ = 0;     // see mark_neighbours()
   std::vector<std::size_t> tied_;       // settle_tie()'s queue positions
   std::vector<QueuedCandidate> batch_;  // the candidates merge() evaluates
   std::vector<NodePair> queued_pairs_;  // per edge: see ComesFirst
