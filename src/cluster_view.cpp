@@ -121,7 +121,8 @@ Eigen::Matrix3d ClusterView::edge_tensor() const {
 
 const ClusterView::RadialMoments& ClusterView::radial_moments() const {
   if (radial_) return *radial_;
-  RadialMoments& sum = radial_.emplace();
+  radial_ = RadialMoments{Eigen::Vector3d::Zero(), 0.0};
+  RadialMoments& sum = *radial_;
   for (int p = 0; p < part_count_; ++p) {
     const Moments& m = parts_[p]->moments;
     const RadialMoments part = radial_of(m.values());

@@ -46,9 +46,11 @@ class ClusterView {
   Eigen::Matrix3d edge_tensor() const;
 
   /// Σ w y |y|² (shape 3) and Σ w |y|⁴: the radial moments a sphere fit needs.
+  /// (No default member initialisers: std::optional<RadialMoments> below is instantiated inside
+  /// this class, where clang would not yet see them and would find it not constructible.)
   struct RadialMoments {
-    Eigen::Vector3d third = Eigen::Vector3d::Zero();
-    double fourth = 0;
+    Eigen::Vector3d third;
+    double fourth;
   };
   /// (Computed on first use, then kept.)
   const RadialMoments& radial_moments() const;
