@@ -18,6 +18,7 @@ Command add_denoise_command(CLI::App& app) {
     bool bilateral = false;
     double max_move = DenoiseOptions{}.max_move_edge_lengths;
     double min_crease_angle = DenoiseOptions{}.min_crease_angle_degrees;
+    int relabel_passes = DenoiseOptions{}.relabel_passes;
     unsigned threads = 0;
     LevelOptions level;
   };
@@ -57,6 +58,12 @@ Command add_denoise_command(CLI::App& app) {
       ->add_option("--min-crease-angle", o->min_crease_angle,
                    "Primitives meeting at a smaller angle (degrees) are averaged, not intersected")
       ->capture_default_str();
+  denoise
+      ->add_option("--relabel-passes", o->relabel_passes,
+                   "Passes moving each face to the neighbouring cluster whose refitted primitive "
+                   "its corners are nearest to, before snapping (0: keep the hierarchy's labels)")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
   denoise->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
       ->capture_default_str();
   denoise->add_option("--threads", o->threads, "Threads for the hierarchy (0: all cores)")
@@ -69,6 +76,7 @@ Command add_denoise_command(CLI::App& app) {
             options.smoothing_steps = o->smoothing_steps;
             if (o->bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
             options.min_crease_angle_degrees = o->min_crease_angle;
+            options.relabel_passes = o->relabel_passes;
             options.hierarchy.primitives = parse_primitives(o->primitives);
             options.hierarchy.threads = o->threads;
             validate(options);

@@ -865,7 +865,7 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
   // denoise, skeleton, distance.
 
   const char* denoise_doc =
-      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
 denoise(V, F, *, ...) -> numpy.ndarray
 denoise(hierarchy, *, ...) -> numpy.ndarray
 
@@ -881,7 +881,8 @@ later rounds use its primitives and weights).
 Level: k (count or "auto"), tolerance or relative_tolerance as in Hierarchy.cut, the CLI's
 --clusters and --tolerance; none: 0.1% of the diagonal.
 stylize: --stylize (each vertex onto its own cluster's primitive); max_move: --max-move (in mean
-incident edge lengths); min_crease_angle: --min-crease-angle (degrees); smoothing_steps:
+incident edge lengths); min_crease_angle: --min-crease-angle (degrees); relabel_passes:
+--relabel-passes (faces moved to the nearest refitted neighbouring primitive); smoothing_steps:
 --smooth (Taubin steps on the copy that is segmented); bilateral: --bilateral (that copy
 smoothed by bilateral normal filtering instead, which keeps edges sharp); primitives (default plane, cylinder, sphere) and weights (default "area"): as in
 segment. The GIL is released while it works.
@@ -891,17 +892,22 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       [](const py::object& first, const py::object& faces, ClusterCount k,
          std::optional<double> tolerance, std::optional<double> relative_tolerance, int iterations,
          int smoothing_steps, bool bilateral, bool stylize, double max_move,
-         double min_crease_angle, const py::object& primitives, const py::object& weights,
-         unsigned threads, bool return_rounds) -> py::object {
+         double min_crease_angle, int relabel_passes, const py::object& primitives,
+         const py::object& weights, unsigned threads, bool return_rounds) -> py::object {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
         if (given && !faces.is_none())
           throw InvalidInputError("denoise(hierarchy) takes no F (give the level as k=...)");
+        if (relabel_passes < 0 || relabel_passes > 100)
+          throw InvalidInputError(
+              "relabel_passes must be between 0 and 100 (the CLI's range), not " +
+              std::to_string(relabel_passes));
         DenoiseOptions options;
         options.mode = stylize ? SnapMode::NearestIncident : SnapMode::AllIncident;
         options.max_move_edge_lengths = max_move;
         options.min_crease_angle_degrees = min_crease_angle;
+        options.relabel_passes = relabel_passes;
         options.smoothing_steps = smoothing_steps;
         if (bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
         options.hierarchy = tool_hierarchy_options("denoise", given, primitives, weights, threads,
@@ -948,19 +954,22 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       py::arg("bilateral") = false, py::arg("stylize") = false,
       py::arg("max_move") = DenoiseOptions{}.max_move_edge_lengths,
       py::arg("min_crease_angle") = DenoiseOptions{}.min_crease_angle_degrees,
+      py::arg("relabel_passes") = DenoiseOptions{}.relabel_passes,
       py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
       py::arg("return_rounds") = false,
-      join_docs({denoise_doc, cpp_doc("denoise.hpp", doc::denoise__file),
-                 cpp_doc("DenoiseOptions::max_move_edge_lengths",
-                         doc::denoise__DenoiseOptions__max_move_edge_lengths),
-                 cpp_doc("DenoiseOptions::min_crease_angle_degrees",
-                         doc::denoise__DenoiseOptions__min_crease_angle_degrees),
-                 cpp_doc("DenoiseOptions::smoothing_steps",
-                         doc::denoise__DenoiseOptions__smoothing_steps),
-                 cpp_doc("DenoiseOptions::bilateral_smoothing",
-                         doc::denoise__DenoiseOptions__bilateral_smoothing),
-                 cpp_doc("SnapMode", doc::denoise__SnapMode),
-                 cpp_doc("SnapReport", doc::denoise__SnapReport)})
+      join_docs(
+          {denoise_doc, cpp_doc("denoise.hpp", doc::denoise__file),
+           cpp_doc("DenoiseOptions::max_move_edge_lengths",
+                   doc::denoise__DenoiseOptions__max_move_edge_lengths),
+           cpp_doc("DenoiseOptions::min_crease_angle_degrees",
+                   doc::denoise__DenoiseOptions__min_crease_angle_degrees),
+           cpp_doc("DenoiseOptions::relabel_passes", doc::denoise__DenoiseOptions__relabel_passes),
+           cpp_doc("DenoiseOptions::smoothing_steps",
+                   doc::denoise__DenoiseOptions__smoothing_steps),
+           cpp_doc("DenoiseOptions::bilateral_smoothing",
+                   doc::denoise__DenoiseOptions__bilateral_smoothing),
+           cpp_doc("SnapMode", doc::denoise__SnapMode),
+           cpp_doc("SnapReport", doc::denoise__SnapReport)})
           .c_str());
 
   py::class_<PySkeleton>(

@@ -161,6 +161,9 @@ def test_denoise_argument_errors():
     for bad in (0, -1, 101):
         with pytest.raises(ValueError, match="iterations must be between 1 and 100"):
             primseg.denoise(mesh, iterations=bad)
+    for bad in (-1, 101):
+        with pytest.raises(ValueError, match="relabel_passes must be between 0 and 100"):
+            primseg.denoise(mesh, relabel_passes=bad)
     for option in ({"max_move": 0.0}, {"max_move": float("nan")}, {"min_crease_angle": 90.0},
                    {"min_crease_angle": -1.0}, {"smoothing_steps": -1}):
         with pytest.raises(ValueError):

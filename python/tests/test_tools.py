@@ -46,7 +46,8 @@ def man_skeleton(man):
      (("--clusters", "12", "--stylize", "--primitives", "plane"),
       {"k": 12, "stylize": True, "primitives": "plane"}),
      (("--clusters", "30", "--max-move", "1.5", "--min-crease-angle", "25"),
-      {"k": 30, "max_move": 1.5, "min_crease_angle": 25.0})])
+      {"k": 30, "max_move": 1.5, "min_crease_angle": 25.0}),
+     (("--clusters", "30", "--relabel-passes", "0"), {"k": 30, "relabel_passes": 0})])
 def test_denoise_matches_the_cli(cli, noisy_fandisk, tmp_path, cli_options, python_options):
     run_cli(cli, "denoise", noisy_fandisk, *cli_options, "-o", tmp_path / "out.off",
             "--json", tmp_path / "summary.json", "--quiet")

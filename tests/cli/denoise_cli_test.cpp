@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "primseg/denoise.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/shape_generator.hpp"
 #include "support/test_support.hpp"
@@ -115,6 +116,36 @@ TEST(CliDenoise, BilateralSmoothingOfTheSegmentedCopy) {
       primseg({"denoise", q(f.noisy), "--clusters 6 --bilateral --smooth 5 -o", q(out)}, &output),
       1);
   EXPECT_NE(output.find("--bilateral"), std::string::npos) << output;
+}
+
+// --relabel-passes reaches DenoiseOptions::relabel_passes: the CLI's output is the library's, bit
+// for bit, with the hierarchy's own labels (0) and with the default passes.
+TEST(CliDenoise, RelabelPassesAreTheLibrarysOption) {
+  const Files f = noisy_box();
+  auto library = [&](int relabel_passes) {
+    DenoiseOptions options;
+    options.relabel_passes = relabel_passes;
+    Denoiser denoiser(read_mesh(f.noisy), options);
+    denoiser.iterate(level_by_count(8));
+    return denoiser.mesh().positions;
+  };
+  for (const int passes : {0, 2}) {
+    const fs::path out = f.dir / ("relabel" + std::to_string(passes) + ".ply");
+    std::string output;
+    ASSERT_EQ(primseg({"denoise", q(f.noisy), "--clusters 8 -q --relabel-passes",
+                       std::to_string(passes), "-o", q(out)},
+                      &output),
+              0)
+        << output;
+    EXPECT_EQ(read_mesh(out).positions, library(passes)) << passes;
+  }
+  EXPECT_NE(library(0), library(2));  // the option changes something on this mesh
+  std::string output;
+  EXPECT_EQ(
+      primseg({"denoise", q(f.noisy), "--clusters 8 --relabel-passes -1 -o", q(f.dir / "x.off")},
+              &output),
+      1);
+  EXPECT_NE(output.find("--relabel-passes"), std::string::npos) << output;
 }
 
 TEST(CliDenoise, BadUsageFailsWithAMessage) {
