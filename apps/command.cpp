@@ -89,7 +89,11 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
 
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
                   Clock::time_point cut_start) {
-  ChosenLevel level = cut(hierarchy, options.level);
+  report_level(hierarchy, options, cut(hierarchy, options.level), std::move(summary), cut_start);
+}
+
+void report_level(const Hierarchy& hierarchy, const LevelOptions& options, ChosenLevel level,
+                  nlohmann::json summary, Clock::time_point cut_start) {
   Segmentation& segmentation = level.segmentation;
   std::vector<ClusterReport> reports;
   nlohmann::json refinement;
@@ -117,6 +121,11 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohm
     for (const LevelCandidate& c : level.automatic->candidates)
       candidates.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
     summary["level"]["candidates"] = std::move(candidates);
+    if (level.by_noise) {
+      summary["level"]["rule"] = "noise";
+      summary["level"]["noise_estimate"] = level.by_noise->noise;
+      summary["level"]["noise_tolerance"] = level.by_noise->tolerance;
+    }
   } else if (options.level.clusters)
     summary["level"]["requested_clusters"] = *parse_cluster_count(*options.level.clusters);
   else

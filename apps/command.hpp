@@ -67,5 +67,8 @@ void add_level_options(CLI::App& command, LevelOptions& options);
 /// Cuts the chosen level and writes its outputs (and the tree when asked).
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
                   Clock::time_point cut_start);
+/// The same for a level the command has already cut.
+void report_level(const Hierarchy& hierarchy, const LevelOptions& options, ChosenLevel level,
+                  nlohmann::json summary, Clock::time_point cut_start);
 
 }  // namespace primseg::cli

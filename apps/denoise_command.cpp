@@ -19,6 +19,7 @@ Command add_denoise_command(CLI::App& app) {
     double max_move = DenoiseOptions{}.max_move_edge_lengths;
     double min_crease_angle = DenoiseOptions{}.min_crease_angle_degrees;
     int relabel_passes = DenoiseOptions{}.relabel_passes;
+    std::optional<double> noise_factor;
     unsigned threads = 0;
     LevelOptions level;
   };
@@ -64,6 +65,10 @@ Command add_denoise_command(CLI::App& app) {
                    "its corners are nearest to, before snapping (0: keep the hierarchy's labels)")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
+  denoise->add_option("--noise-factor", o->noise_factor,
+                      "With --clusters auto and no jump in the error curve: clusters within this "
+                      "multiple of the estimated noise (default: 1.2, 0.8 with --smooth, 0.4 with "
+                      "--bilateral)");
   denoise->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
       ->capture_default_str();
   denoise->add_option("--threads", o->threads, "Threads for the hierarchy (0: all cores)")
@@ -77,6 +82,7 @@ Command add_denoise_command(CLI::App& app) {
             if (o->bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
             options.min_crease_angle_degrees = o->min_crease_angle;
             options.relabel_passes = o->relabel_passes;
+            options.noise_tolerance_factor = o->noise_factor;
             options.hierarchy.primitives = parse_primitives(o->primitives);
             options.hierarchy.threads = o->threads;
             validate(options);
@@ -86,13 +92,28 @@ Command add_denoise_command(CLI::App& app) {
             Mesh mesh = read_mesh(o->mesh_path);
             validate_level(o->level.level, mesh.face_count());
             Denoiser denoiser(std::move(mesh), options);
+            const bool automatic =
+                o->level.level.clusters && !parse_cluster_count(*o->level.level.clusters);
             std::unique_ptr<Hierarchy> hierarchy;
+            ChosenLevel level;
             nlohmann::json rounds = nlohmann::json::array();
             for (int i = 0; i < o->iterations; ++i) {
               hierarchy = std::make_unique<Hierarchy>(
                   build_hierarchy(denoiser.segmented_mesh(), options.hierarchy));
-              const SnapReport r =
-                  denoiser.snap(*hierarchy, cut(*hierarchy, o->level.level).segmentation);
+              if (automatic) {
+                // Denoising's own automatic level: under noise, a multiple of the noise.
+                DenoiseLevel chosen = denoiser.automatic_level(*hierarchy);
+                level = {std::move(chosen.segmentation), std::move(chosen.automatic), std::nullopt};
+                if (chosen.by_noise) level.by_noise = {chosen.noise, chosen.tolerance};
+              } else {
+                level = cut(*hierarchy, o->level.level);
+              }
+              const SnapReport r = denoiser.snap(*hierarchy, level.segmentation);
+              if (level.by_noise && !o->level.quiet)
+                std::printf(
+                    "round %d: no jump in the error curve; level by noise: estimate %.6g, "
+                    "clusters within RMS %.6g\n",
+                    i + 1, level.by_noise->noise, level.by_noise->tolerance);
               rounds.push_back({{"clusters", r.clusters},
                                 {"boundary_vertices", r.boundary_vertices},
                                 {"moved", r.moved},
@@ -118,7 +139,7 @@ Command add_denoise_command(CLI::App& app) {
                                   {"rounds", rounds}};
             summary["timing"] = {{"denoise_seconds", seconds_since(start)}};
             // The per-level outputs describe the segmentation the last round snapped onto.
-            report_level(*hierarchy, o->level, summary, Clock::now());
+            report_level(*hierarchy, o->level, std::move(level), summary, Clock::now());
           }};
 }
 

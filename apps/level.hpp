@@ -29,6 +29,12 @@ void validate_level(const LevelChoice& level, std::uint32_t face_count);
 struct ChosenLevel {
   Segmentation segmentation;
   std::optional<AutoLevel> automatic;
+  // denoise --clusters auto without a jump: the level is the tolerance cut at a multiple of the
+  // noise estimate (Denoiser::automatic_level), both in input units.
+  struct ByNoise {
+    double noise = 0, tolerance = 0;
+  };
+  std::optional<ByNoise> by_noise;
 };
 
 /// The segmentation for a level choice; with neither option, the default tolerance below.

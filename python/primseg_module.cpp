@@ -865,7 +865,7 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
   // denoise, skeleton, distance.
 
   const char* denoise_doc =
-      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, noise_tolerance_factor=None, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
 denoise(V, F, *, ...) -> numpy.ndarray
 denoise(hierarchy, *, ...) -> numpy.ndarray
 
@@ -879,7 +879,9 @@ The input is a Mesh, arrays V and F (as segment takes them), or a Hierarchy: its
 then snaps onto that tree's level without building it again (smoothing_steps must be 0, and the
 later rounds use its primitives and weights).
 Level: k (count or "auto"), tolerance or relative_tolerance as in Hierarchy.cut, the CLI's
---clusters and --tolerance; none: 0.1% of the diagonal.
+--clusters and --tolerance; none: 0.1% of the diagonal. k="auto" is denoising's automatic level
+(Denoiser::automatic_level): a jump of the error curve, else the clusters within a multiple of
+the estimated noise (noise_tolerance_factor: None for the default of the segmented copy).
 stylize: --stylize (each vertex onto its own cluster's primitive); max_move: --max-move (in mean
 incident edge lengths); min_crease_angle: --min-crease-angle (degrees); relabel_passes:
 --relabel-passes (faces moved to the nearest refitted neighbouring primitive); smoothing_steps:
@@ -892,8 +894,9 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       [](const py::object& first, const py::object& faces, ClusterCount k,
          std::optional<double> tolerance, std::optional<double> relative_tolerance, int iterations,
          int smoothing_steps, bool bilateral, bool stylize, double max_move,
-         double min_crease_angle, int relabel_passes, const py::object& primitives,
-         const py::object& weights, unsigned threads, bool return_rounds) -> py::object {
+         double min_crease_angle, int relabel_passes, std::optional<double> noise_tolerance_factor,
+         const py::object& primitives, const py::object& weights, unsigned threads,
+         bool return_rounds) -> py::object {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
@@ -908,6 +911,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         options.max_move_edge_lengths = max_move;
         options.min_crease_angle_degrees = min_crease_angle;
         options.relabel_passes = relabel_passes;
+        options.noise_tolerance_factor = noise_tolerance_factor;
         options.smoothing_steps = smoothing_steps;
         if (bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
         options.hierarchy = tool_hierarchy_options("denoise", given, primitives, weights, threads,
@@ -938,7 +942,11 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
                 round == 0 && given ? given->hierarchy
                                     : std::make_shared<const Hierarchy>(build_hierarchy(
                                           denoiser.segmented_mesh(), options.hierarchy));
-            reports.push_back(denoiser.snap(*hierarchy, cut_level(*hierarchy, level)));
+            // k="auto": denoising's own automatic level, as `primseg denoise --clusters auto`.
+            const bool automatic = level.k && std::holds_alternative<std::string>(*level.k);
+            reports.push_back(denoiser.snap(
+                *hierarchy, automatic ? denoiser.automatic_level(*hierarchy).segmentation
+                                      : cut_level(*hierarchy, level)));
           }
           positions = denoiser.mesh().positions;
         }
@@ -955,8 +963,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       py::arg("max_move") = DenoiseOptions{}.max_move_edge_lengths,
       py::arg("min_crease_angle") = DenoiseOptions{}.min_crease_angle_degrees,
       py::arg("relabel_passes") = DenoiseOptions{}.relabel_passes,
-      py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
-      py::arg("return_rounds") = false,
+      py::arg("noise_tolerance_factor") = py::none(), py::arg("primitives") = py::none(),
+      py::arg("weights") = py::none(), py::arg("threads") = 0u, py::arg("return_rounds") = false,
       join_docs(
           {denoise_doc, cpp_doc("denoise.hpp", doc::denoise__file),
            cpp_doc("DenoiseOptions::max_move_edge_lengths",

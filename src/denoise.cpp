@@ -221,6 +221,9 @@ void validate(const DenoiseOptions& options) {
     if (options.smoothing_steps > 0)
       throw InvalidInputError("denoise: choose Taubin or bilateral smoothing, not both");
   }
+  if (options.noise_tolerance_factor &&
+      !(*options.noise_tolerance_factor > 0 && std::isfinite(*options.noise_tolerance_factor)))
+    throw InvalidInputError("denoise: the noise tolerance factor must be a positive number");
   if (options.relabel_passes < 0)
     throw InvalidInputError("denoise: the relabelling passes must be a non-negative count");
   if (options.max_solver_steps < 1)
@@ -293,6 +296,42 @@ std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
     positions.swap(next);
   }
   return segmented;
+}
+
+double estimate_noise(const Mesh& mesh, const BilateralSmoothingOptions& options) {
+  const Mesh smoothed = bilateral_smooth(mesh, options);
+  // Over the vertices of triangles only: an unused vertex does not move and is no sample.
+  std::vector<char> used(mesh.vertex_count(), 0);
+  for (const Triangle& t : mesh.triangles)
+    for (const std::uint32_t v : t) used[v] = 1;
+  double sum = 0;
+  std::uint32_t count = 0;
+  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    if (!used[v]) continue;
+    sum += (to_eigen(mesh.positions[v]) - to_eigen(smoothed.positions[v])).squaredNorm();
+    ++count;
+  }
+  return count > 0 ? std::sqrt(sum / count) : 0.0;
+}
+
+double Denoiser::noise_tolerance_factor() const {
+  if (options_.noise_tolerance_factor) return *options_.noise_tolerance_factor;
+  if (options_.bilateral_smoothing) return 0.4;
+  return options_.smoothing_steps > 0 ? 0.8 : 1.2;
+}
+
+DenoiseLevel Denoiser::automatic_level(const Hierarchy& hierarchy) const {
+  DenoiseLevel level;
+  level.automatic = choose_level(hierarchy);
+  level.noise = estimate_noise(mesh_);
+  level.by_noise = level.automatic.rule != AutoLevelRule::Jump;
+  if (level.by_noise) {
+    level.tolerance = noise_tolerance_factor() * level.noise;
+    level.segmentation = cut_by_tolerance(hierarchy, level.tolerance);
+  } else {
+    level.segmentation = cut_by_count(hierarchy, level.automatic.clusters);
+  }
+  return level;
 }
 
 SnapReport Denoiser::iterate(const LevelSelector& level) {

@@ -165,7 +165,8 @@ def test_denoise_argument_errors():
         with pytest.raises(ValueError, match="relabel_passes must be between 0 and 100"):
             primseg.denoise(mesh, relabel_passes=bad)
     for option in ({"max_move": 0.0}, {"max_move": float("nan")}, {"min_crease_angle": 90.0},
-                   {"min_crease_angle": -1.0}, {"smoothing_steps": -1}):
+                   {"min_crease_angle": -1.0}, {"smoothing_steps": -1},
+                   {"k": "auto", "noise_tolerance_factor": 0.0}):
         with pytest.raises(ValueError):
             primseg.denoise(mesh, **option)
     with pytest.raises(ValueError, match="unknown primitive 'ellipsoid'"):

@@ -47,7 +47,8 @@ def man_skeleton(man):
       {"k": 12, "stylize": True, "primitives": "plane"}),
      (("--clusters", "30", "--max-move", "1.5", "--min-crease-angle", "25"),
       {"k": 30, "max_move": 1.5, "min_crease_angle": 25.0}),
-     (("--clusters", "30", "--relabel-passes", "0"), {"k": 30, "relabel_passes": 0})])
+     (("--clusters", "30", "--relabel-passes", "0"), {"k": 30, "relabel_passes": 0}),
+     (("--clusters", "auto", "--noise-factor", "2"), {"k": "auto", "noise_tolerance_factor": 2.0})])
 def test_denoise_matches_the_cli(cli, noisy_fandisk, tmp_path, cli_options, python_options):
     run_cli(cli, "denoise", noisy_fandisk, *cli_options, "-o", tmp_path / "out.off",
             "--json", tmp_path / "summary.json", "--quiet")
@@ -59,6 +60,27 @@ def test_denoise_matches_the_cli(cli, noisy_fandisk, tmp_path, cli_options, pyth
     np.testing.assert_array_equal(V, expected)  # bit for bit
     assert rounds == summary["denoise"]["rounds"]
     assert not np.array_equal(V, mesh.V)
+
+
+def test_denoise_auto_level_is_a_multiple_of_the_estimated_noise(cli, noisy_fandisk, tmp_path):
+    """fandisk's error curve has no jump: `denoise --clusters auto` keeps the clusters within a
+    multiple of the noise, estimated by how far bilateral smoothing moves the vertices."""
+    levels = {}
+    for factor in (None, "0.8"):
+        options = ("--noise-factor", factor) if factor else ()
+        run_cli(cli, "denoise", noisy_fandisk, "--clusters", "auto", *options, "-o",
+                tmp_path / "out.off", "--json", tmp_path / "summary.json", "--quiet")
+        levels[factor] = json.loads((tmp_path / "summary.json").read_text())["level"]
+    default, finer = levels[None], levels["0.8"]
+    assert default["rule"] == "noise" and finer["rule"] == "noise"
+    assert default["requested_clusters"] == "auto"
+    # Isotropic noise of 0.1% of the diagonal: about that much along the normals.
+    diagonal = primseg.read_mesh(noisy_fandisk).bounding_box_diagonal
+    assert 0.7e-3 * diagonal < default["noise_estimate"] < 1.5e-3 * diagonal
+    assert finer["noise_estimate"] == default["noise_estimate"]
+    assert default["noise_tolerance"] == pytest.approx(1.2 * default["noise_estimate"], rel=1e-15)
+    assert finer["noise_tolerance"] == pytest.approx(0.8 * finer["noise_estimate"], rel=1e-15)
+    assert finer["clusters"] > default["clusters"]  # a smaller tolerance cuts finer
 
 
 def test_denoise_from_arrays_and_from_a_hierarchy(noisy_fandisk):

@@ -146,6 +146,12 @@ TEST(CliDenoise, RelabelPassesAreTheLibrarysOption) {
               &output),
       1);
   EXPECT_NE(output.find("--relabel-passes"), std::string::npos) << output;
+  EXPECT_EQ(
+      primseg({"denoise", q(f.noisy), "--clusters auto --noise-factor 0 -o", q(f.dir / "x.off")},
+              &output),
+      1);
+  EXPECT_NE(output.find("noise tolerance factor must be a positive number"), std::string::npos)
+      << output;
 }
 
 TEST(CliDenoise, BadUsageFailsWithAMessage) {

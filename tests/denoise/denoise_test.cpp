@@ -244,6 +244,40 @@ TEST(Denoise, NearlyParallelPrimitivesAreAveragedNotIntersected) {
   EXPECT_GT(unguarded_move, 20 * sigma);
 }
 
+// Bilateral smoothing removes the noise and little else: how far it moves the vertices measures
+// the noise's standard deviation along the normals (Gaussian, as make_shape adds it).
+TEST(Denoise, NoiseEstimateIsTheNoiseAlongTheNormals) {
+  for (const char* name : {"box", "capped_cylinder", "box_with_hole"}) {
+    const NoisyShape shape = noisy_shape(name, 0.004, 0.04);
+    const double estimate = estimate_noise(shape.noisy.mesh);
+    std::printf("%s: sigma %.4g, estimate %.4g; noise-free %.3g\n", name, shape.sigma, estimate,
+                estimate_noise(shape.clean.mesh));
+    EXPECT_GE(estimate, 0.85 * shape.sigma) << name;  // measured 0.95-0.96
+    EXPECT_LE(estimate, 1.1 * shape.sigma) << name;
+  }
+  // A noise-free box: only the vertex update's round-off and its edges move.
+  const NoisyShape box = noisy_shape("box", 0.004, 0.04);
+  EXPECT_LE(estimate_noise(box.clean.mesh), 0.01 * box.sigma);
+}
+
+// With a jump in the error curve (a noisy box: six planes) the automatic level is the jump's,
+// the true six faces, and denoising is as good as at K = 6.
+TEST(Denoise, AutomaticLevelKeepsAJumpOfTheErrorCurve) {
+  const NoisyShape box = noisy_shape("box", 0.004, 0.04);
+  Denoiser denoiser(box.noisy.mesh);
+  DenoiseLevel level;
+  denoiser.iterate([&](const Hierarchy& hierarchy) {
+    level = denoiser.automatic_level(hierarchy);
+    EXPECT_EQ(level.segmentation.labels, cut_by_count(hierarchy, 6).labels);
+    return level.segmentation;
+  });
+  EXPECT_FALSE(level.by_noise);
+  EXPECT_EQ(level.automatic.rule, AutoLevelRule::Jump);
+  EXPECT_EQ(level.segmentation.cluster_count(), 6u);
+  EXPECT_EQ(denoiser.mesh().positions, denoise(box.noisy.mesh, level_by_count(6)).positions);
+  EXPECT_EQ(denoiser.noise_tolerance_factor(), 1.2);  // the mesh segmented as it is
+}
+
 TEST(Denoise, IsDeterministic) {
   const NoisyShape box = noisy_shape("box", 0.004, 0.06);
   const Mesh first = denoise(box.noisy.mesh, level_by_count(6), {}, 2);
@@ -263,6 +297,12 @@ TEST(Denoise, RejectsBadOptionsAndAMismatchedHierarchy) {
   options = {};
   options.hierarchy.primitives.clear();
   EXPECT_THROW(Denoiser(box.noisy.mesh, options), InvalidInputError);
+  for (const double factor : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(),
+                              std::numeric_limits<double>::infinity()}) {
+    options = {};
+    options.noise_tolerance_factor = factor;
+    EXPECT_THROW(Denoiser(box.noisy.mesh, options), InvalidInputError) << factor;
+  }
 
   Denoiser denoiser(box.noisy.mesh);
   const Hierarchy other = build_hierarchy(noisy_shape("box", 0.004, 0.2).noisy.mesh);
