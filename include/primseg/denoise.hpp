@@ -158,7 +158,8 @@ class Denoiser {
   /// segmentation's fallback, is too coarse to denoise with: on fandisk with 0.3% noise and
   /// bilateral filtering, RMS 3.8x lower against 2.3x at the knee; on mech-holes-shark 2.1x
   /// against 0.4x. `hierarchy` is one built on segmented_mesh() (or on a mesh with its
-  /// connectivity).
+  /// connectivity). In NearestIncident mode (stylization, which wants few clusters) the level is
+  /// always choose_level()'s.
   DenoiseLevel automatic_level(const Hierarchy& hierarchy) const;
 
   /// The factor automatic_level() uses: DenoiseOptions::noise_tolerance_factor, or its default

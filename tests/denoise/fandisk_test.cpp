@@ -98,6 +98,19 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     EXPECT_EQ(testing::inverted_triangles(noisy, denoiser.mesh()), 0u);
     EXPECT_LT(after.rms * 3.5, before.rms);  // measured 3.8x
   }
+  {
+    // Stylization keeps the segmentation's automatic level: the knee, few clusters.
+    DenoiseOptions options = bilateral_options();
+    options.mode = SnapMode::NearestIncident;
+    Denoiser denoiser(noisy, options);
+    denoiser.iterate([&](const Hierarchy& hierarchy) {
+      const DenoiseLevel chosen = denoiser.automatic_level(hierarchy);
+      EXPECT_FALSE(chosen.by_noise);
+      EXPECT_EQ(chosen.segmentation.labels,
+                cut_by_count(hierarchy, choose_level(hierarchy).clusters).labels);
+      return chosen.segmentation;
+    });
+  }
   // The target is 5x. Measured: 3.5x (bilateral smoothing, K = 40), 2.7x (5 Taubin
   // steps, K = 60); without smoothing, noise fragments the segmentation into small planes and the
   // gain is at most 1.8x. Snapping the same noisy vertices onto the clean mesh's segmentation
