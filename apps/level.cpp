@@ -42,15 +42,15 @@ void validate_level(const LevelChoice& level, std::uint32_t face_count) {
 ChosenLevel cut(const Hierarchy& hierarchy, const LevelChoice& level) {
   if (level.clusters) {
     if (const auto count = parse_cluster_count(*level.clusters))
-      return {cut_by_count(hierarchy, *count), std::nullopt};
+      return {cut_by_count(hierarchy, *count), std::nullopt, std::nullopt};
     AutoLevel automatic = choose_level(hierarchy);
     Segmentation segmentation = cut_by_count(hierarchy, automatic.clusters);
-    return {std::move(segmentation), std::move(automatic)};
+    return {std::move(segmentation), std::move(automatic), std::nullopt};
   }
   const std::string tolerance = level.tolerance.value_or(kDefaultTolerance);
   return {cut_by_tolerance(hierarchy,
                            parse_tolerance(tolerance, bounding_box_diagonal(hierarchy.mesh()))),
-          std::nullopt};
+          std::nullopt, std::nullopt};
 }
 
 }  // namespace primseg::cli
