@@ -116,13 +116,12 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, Chose
   if (!refinement.is_null()) summary["level"]["refinement"] = std::move(refinement);
   if (level.automatic) {
     summary["level"]["requested_clusters"] = "auto";
-    summary["level"]["rule"] = to_string(level.automatic->rule);
+    summary["level"]["rule"] = level.by_noise ? "noise" : to_string(level.automatic->rule);
     nlohmann::json candidates = nlohmann::json::array();
     for (const LevelCandidate& c : level.automatic->candidates)
       candidates.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
     summary["level"]["candidates"] = std::move(candidates);
     if (level.by_noise) {
-      summary["level"]["rule"] = "noise";
       summary["level"]["noise_estimate"] = level.by_noise->noise;
       summary["level"]["noise_tolerance"] = level.by_noise->tolerance;
     }

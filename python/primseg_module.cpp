@@ -936,14 +936,14 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         {
           py::gil_scoped_release release;
           Denoiser denoiser(*mesh, options);
+          // k="auto": denoising's own automatic level, as `primseg denoise --clusters auto`.
+          const bool automatic = level.k && std::holds_alternative<std::string>(*level.k);
           for (int round = 0; round < iterations; ++round) {
             // As `primseg denoise`: each round segments the previous round's result.
             const std::shared_ptr<const Hierarchy> hierarchy =
                 round == 0 && given ? given->hierarchy
                                     : std::make_shared<const Hierarchy>(build_hierarchy(
                                           denoiser.segmented_mesh(), options.hierarchy));
-            // k="auto": denoising's own automatic level, as `primseg denoise --clusters auto`.
-            const bool automatic = level.k && std::holds_alternative<std::string>(*level.k);
             reports.push_back(denoiser.snap(
                 *hierarchy, automatic ? denoiser.automatic_level(*hierarchy).segmentation
                                       : cut_level(*hierarchy, level)));
@@ -972,6 +972,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
            cpp_doc("DenoiseOptions::min_crease_angle_degrees",
                    doc::denoise__DenoiseOptions__min_crease_angle_degrees),
            cpp_doc("DenoiseOptions::relabel_passes", doc::denoise__DenoiseOptions__relabel_passes),
+           cpp_doc("DenoiseOptions::noise_tolerance_factor",
+                   doc::denoise__DenoiseOptions__noise_tolerance_factor),
            cpp_doc("DenoiseOptions::smoothing_steps",
                    doc::denoise__DenoiseOptions__smoothing_steps),
            cpp_doc("DenoiseOptions::bilateral_smoothing",

@@ -323,11 +323,12 @@ double Denoiser::noise_tolerance_factor() const {
 DenoiseLevel Denoiser::automatic_level(const Hierarchy& hierarchy) const {
   DenoiseLevel level;
   level.automatic = choose_level(hierarchy);
-  level.noise = estimate_noise(mesh_);
   // Stylization wants few clusters: the segmentation's own level.
   level.by_noise =
       options_.mode == SnapMode::AllIncident && level.automatic.rule != AutoLevelRule::Jump;
   if (level.by_noise) {
+    // Only here: the estimate smooths the whole mesh once more.
+    level.noise = estimate_noise(mesh_);
     level.tolerance = noise_tolerance_factor() * level.noise;
     level.segmentation = cut_by_tolerance(hierarchy, level.tolerance);
   } else {

@@ -113,7 +113,7 @@ struct DenoiseLevel {
   AutoLevel automatic;
   /// True when the noise rule chose (no significant jump): the tolerance cut below.
   bool by_noise = false;
-  double noise = 0;      ///< estimate_noise() of the mesh being denoised, input units
+  double noise = 0;  ///< estimate_noise() of the mesh being denoised, input units (by_noise only)
   double tolerance = 0;  ///< noise × the tolerance factor, input units (by_noise only)
 };
 
