@@ -141,8 +141,7 @@ Eigen::Vector3d Moments::centroid() const {
                        values_[0];
 }
 
-void Moments::add_point(const Eigen::Vector3d& x, double w, int max_degree) {
-  const Eigen::Vector3d d = x - origin_;
+void Moments::add_offset(const Eigen::Vector3d& d, double w, int max_degree) {
   double px[5], py[5], pz[5];
   px[0] = py[0] = pz[0] = 1;
   for (int p = 1; p <= 4; ++p) {
@@ -243,6 +242,60 @@ void ClusterStats::merge(const ClusterStats& other, const EdgeStats& shared_edge
   area += other.area;
   triangle_count += other.triangle_count;
   samples.merge(other.samples);
+}
+
+bool FaceCorners::unite(const FaceCorners& a, const FaceCorners& b, const EdgeStats& shared,
+                        FaceCorners& united) {
+  if (a.triangle_count + b.triangle_count > kMaxTriangles) return false;
+  const double wa = a.weight, wb = b.weight, w = wa + wb;
+  const Eigen::Vector3d gap = b.centroid - a.centroid;
+  // The parts' centroids from the union's, as ClusterView's (exact when a weight is zero).
+  Eigen::Vector3d shift_a = Eigen::Vector3d::Zero(), shift_b = gap;
+  united.centroid = a.centroid;
+  united.second_moment = a.second_moment + b.second_moment;
+  if (w > 0) {
+    united.centroid = a.centroid + (wb / w) * gap;
+    shift_a = -(wb / w) * gap;
+    shift_b = (wa / w) * gap;
+    united.second_moment += (wa * wb / w) * gap * gap.transpose();
+  }
+  united.triangle_count = 0;
+  for (const auto& [part, shift] : {std::pair(&a, shift_a), std::pair(&b, shift_b)}) {
+    for (std::uint32_t t = 0; t < part->triangle_count; ++t, ++united.triangle_count) {
+      const std::uint32_t to = united.triangle_count;
+      for (int k = 0; k < 3; ++k) {
+        united.offsets[3 * to + k] = part->offsets[3 * t + k] + shift;
+        united.weights[3 * to + k] = part->weights[3 * t + k];
+      }
+      united.area_normals[to] = part->area_normals[t];
+      united.areas[to] = part->areas[t];
+      united.triangle_offsets[to] = part->triangle_offsets[t] + shift;
+    }
+  }
+  united.weight = w;
+  united.normal_sum = a.normal_sum + b.normal_sum;
+  united.normal_position = a.normal_position + shift_a * a.normal_sum.transpose() +
+                           b.normal_position + shift_b * b.normal_sum.transpose();
+  united.area = a.area + b.area;
+  united.edges = a.edges;
+  united.edges += b.edges;
+  united.edges += shared;
+  return true;
+}
+
+void ClusterStats::add(const FaceCorners& face, int max_degree) {
+  const Eigen::Vector3d shift = face.centroid - moments.origin();
+  for (std::uint32_t k = 0; k < face.corner_count(); ++k)
+    moments.add_offset(face.offsets[k] + shift, face.weights[k], max_degree);
+  normal_position += face.normal_position + shift * face.normal_sum.transpose();
+  for (std::uint32_t t = 0; t < face.triangle_count; ++t)
+    if (face.areas[t] > 0)
+      face_planes.add_face(face.area_normals[t] / face.areas[t], face.areas[t],
+                           face.triangle_offsets[t] + shift);
+  edges += face.edges;
+  normal_sum += face.normal_sum;
+  area += face.area;
+  triangle_count += face.triangle_count;
 }
 
 ClusterStats ClusterStats::translated(const Eigen::Vector3d& new_origin, int max_degree) const {

@@ -10,6 +10,8 @@
 //   Σ w (a·y)⁴      = h + 4 (a·δ) a·v + 6 (a·δ)² aᵀSa + w (a·δ)⁴
 // with the part's S = Σ w y_p y_pᵀ, t = Σ w y_p |y_p|², f = Σ w |y_p|⁴, v = Σ w y_p (a·y_p)²,
 // g = Σ w |y_p|² (a·y_p)², h = Σ w (a·y_p)⁴: contractions of its degree-3 and -4 moments.
+// A single face given by its corners (FaceCorners) is summed directly instead, corner by corner,
+// with y = (corner − its centroid) + δ: a few corners cost less than the 35 moments.
 #include "primseg/cluster_view.hpp"
 
 #include "symmetric_eigen3.hpp"
@@ -71,7 +73,7 @@ ClusterView::AxialMoments axial_of(const std::array<double, Moments::kCount>& m,
 }  // namespace
 
 ClusterView::ClusterView(const ClusterStats& centred)
-    : parts_{&centred, nullptr},
+    : parts_{centred, centred},
       part_count_(1),
       weight_(centred.moments.weight()),
       centroid_(centred.moments.origin()),
@@ -80,26 +82,26 @@ ClusterView::ClusterView(const ClusterStats& centred)
       area_(centred.area),
       normal_sum_(centred.normal_sum) {}
 
-ClusterView::ClusterView(const ClusterStats& a, const ClusterStats& b, const EdgeStats& shared)
-    : parts_{&a, &b},
+ClusterView::ClusterView(ClusterPart a, ClusterPart b, const EdgeStats& shared)
+    : parts_{a, b},
       part_count_(2),
       shared_(&shared),
-      weight_(a.moments.weight() + b.moments.weight()),
-      triangle_count_(a.triangle_count + b.triangle_count),
-      area_(a.area + b.area),
-      normal_sum_(a.normal_sum + b.normal_sum) {
-  const double wa = a.moments.weight(), wb = b.moments.weight();
-  const Eigen::Vector3d gap = b.moments.origin() - a.moments.origin();
-  second_moment_ = second_moment_of(a.moments.values()) + second_moment_of(b.moments.values());
+      weight_(a.weight() + b.weight()),
+      triangle_count_(a.triangle_count() + b.triangle_count()),
+      area_(a.area() + b.area()),
+      normal_sum_(a.normal_sum() + b.normal_sum()) {
+  const double wa = a.weight(), wb = b.weight();
+  const Eigen::Vector3d gap = b.centroid() - a.centroid();
+  second_moment_ = a.second_moment() + b.second_moment();
   if (weight_ > 0) {
     // Exact when either weight is zero; the parts' centroids are δ_a = −wb/w gap and
     // δ_b = wa/w gap from the union's.
-    centroid_ = a.moments.origin() + (wb / weight_) * gap;
+    centroid_ = a.centroid() + (wb / weight_) * gap;
     shifts_[0] = -(wb / weight_) * gap;
     shifts_[1] = (wa / weight_) * gap;
     second_moment_ += (wa * wb / weight_) * gap * gap.transpose();
   } else {
-    centroid_ = a.moments.origin();
+    centroid_ = a.centroid();
   }
 }
 
@@ -112,9 +114,9 @@ const ClusterView::Eigenpair& ClusterView::smallest_eigenpair() const {
 }
 
 Eigen::Matrix3d ClusterView::edge_tensor() const {
-  if (part_count_ == 1) return parts_[0]->edges.tensor_matrix();
-  EdgeStats sum = parts_[0]->edges;
-  sum += parts_[1]->edges;
+  if (part_count_ == 1) return parts_[0].edges().tensor_matrix();
+  EdgeStats sum = parts_[0].edges();
+  sum += parts_[1].edges();
   sum += *shared_;
   return sum.tensor_matrix();
 }
@@ -124,9 +126,18 @@ const ClusterView::RadialMoments& ClusterView::radial_moments() const {
   radial_ = RadialMoments{Eigen::Vector3d::Zero(), 0.0};
   RadialMoments& sum = *radial_;
   for (int p = 0; p < part_count_; ++p) {
-    const Moments& m = parts_[p]->moments;
-    const RadialMoments part = radial_of(m.values());
     const Eigen::Vector3d& d = shifts_[p];
+    if (const FaceCorners* face = parts_[p].face()) {
+      for (std::uint32_t k = 0; k < face->corner_count(); ++k) {
+        const Eigen::Vector3d y = face->offsets[k] + d;
+        const double w = face->weights[k], yy = y.squaredNorm();
+        sum.third += (w * yy) * y;
+        sum.fourth += w * yy * yy;
+      }
+      continue;
+    }
+    const Moments& m = parts_[p].stats()->moments;
+    const RadialMoments part = radial_of(m.values());
     const Eigen::Matrix3d s = second_moment_of(m.values());
     const double w = m.weight(), trace = s.trace(), dd = d.squaredNorm();
     const Eigen::Vector3d sd = s * d;
@@ -140,9 +151,19 @@ const ClusterView::RadialMoments& ClusterView::radial_moments() const {
 ClusterView::AxialMoments ClusterView::axial_moments(const Eigen::Vector3d& axis) const {
   AxialMoments sum;
   for (int p = 0; p < part_count_; ++p) {
-    const Moments& m = parts_[p]->moments;
-    const AxialMoments part = axial_of(m.values(), axis);
     const Eigen::Vector3d& d = shifts_[p];
+    if (const FaceCorners* face = parts_[p].face()) {
+      for (std::uint32_t k = 0; k < face->corner_count(); ++k) {
+        const Eigen::Vector3d y = face->offsets[k] + d;
+        const double w = face->weights[k], ay = axis.dot(y), way2 = w * ay * ay;
+        sum.third += way2 * y;
+        sum.mixed += way2 * y.squaredNorm();
+        sum.fourth += way2 * ay * ay;
+      }
+      continue;
+    }
+    const Moments& m = parts_[p].stats()->moments;
+    const AxialMoments part = axial_of(m.values(), axis);
     if (d.isZero(0)) {
       sum.third += part.third;
       sum.mixed += part.mixed;
@@ -169,11 +190,11 @@ double ClusterView::normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vect
   // Σ A n · Q (c − p) over the triangles = tr(Q Σ (c − o)(A n)ᵀ) − (Σ A n)ᵀ Q (p − o), with each
   // part's Σ (c − o_p)(A n)ᵀ moved to the view's centroid by δ_p (Σ A n)ᵀ.
   if (!normal_position_) {
-    Eigen::Matrix3d& sum = normal_position_.emplace(parts_[0]->normal_position);
-    sum.noalias() += shifts_[0] * parts_[0]->normal_sum.transpose();
+    Eigen::Matrix3d& sum = normal_position_.emplace(parts_[0].normal_position());
+    sum.noalias() += shifts_[0] * parts_[0].normal_sum().transpose();
     for (int p = 1; p < part_count_; ++p) {
-      sum += parts_[p]->normal_position;
-      sum.noalias() += shifts_[p] * parts_[p]->normal_sum.transpose();
+      sum += parts_[p].normal_position();
+      sum.noalias() += shifts_[p] * parts_[p].normal_sum().transpose();
     }
   }
   // tr(Q N) = Σ_ij Q_ij N_ji.
@@ -183,15 +204,26 @@ double ClusterView::normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vect
 }
 
 const ClusterStats& ClusterView::stats() const {
-  if (part_count_ == 1) return *parts_[0];
+  if (part_count_ == 1) return *parts_[0].stats();
   if (!union_stats_) union_stats_ = stats(4);
   return *union_stats_;
 }
 
 ClusterStats ClusterView::stats(int max_degree) const {
-  if (part_count_ == 1) return parts_[0]->translated(centroid_, max_degree);
-  ClusterStats result = parts_[0]->translated(centroid_, max_degree);
-  result.merge(*parts_[1], *shared_, max_degree);
+  if (part_count_ == 1) return parts_[0].stats()->translated(centroid_, max_degree);
+  ClusterStats result;
+  if (const ClusterStats* first = parts_[0].stats()) {
+    result = first->translated(centroid_, max_degree);
+  } else {
+    result.moments = Moments(centroid_);
+    result.add(*parts_[0].face(), max_degree);
+  }
+  if (const ClusterStats* second = parts_[1].stats()) {
+    result.merge(*second, *shared_, max_degree);
+  } else {
+    result.add(*parts_[1].face(), max_degree);
+    result.edges += *shared_;
+  }
   // About its centroid by construction: the first moments are round-off.
   result.moments.discard_first_moments();
   return result;

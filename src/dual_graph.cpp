@@ -589,6 +589,64 @@ std::array<double, 3> DualGraph::corner_weights(std::uint32_t t, double area) co
   return {area / 3, area / 3, area / 3};
 }
 
+bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
+  const std::uint32_t begin = first_triangle_[f], end = first_triangle_[f + 1];
+  if (end - begin > FaceCorners::kMaxTriangles) return false;
+  // As face_stats(): area vectors and weights first, then everything about the weighted centroid.
+  Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
+  double weight = 0;
+  corners.triangle_count = end - begin;
+  for (std::uint32_t t = begin; t < end; ++t) {
+    const Triangle& tri = mesh_->triangles[t];
+    Eigen::Vector3d normal =
+        (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
+    if (flipped_[t]) normal = -normal;
+    const std::uint32_t i = t - begin;
+    corners.areas[i] = 0.5 * normal.norm();
+    corners.area_normals[i] = 0.5 * normal;
+    const std::array<double, 3> w = corner_weights(t, corners.areas[i]);
+    for (int k = 0; k < 3; ++k) {
+      corners.weights[3 * i + k] = w[k];
+      weighted_sum += w[k] * positions_[tri[k]];
+      weight += w[k];
+    }
+  }
+  const Triangle& first = mesh_->triangles[begin];
+  corners.centroid =
+      weight > 0 ? Eigen::Vector3d(weighted_sum / weight)
+                 : Eigen::Vector3d(
+                       (positions_[first[0]] + positions_[first[1]] + positions_[first[2]]) / 3);
+  corners.weight = 0;
+  corners.second_moment.setZero();
+  corners.normal_sum.setZero();
+  corners.normal_position.setZero();
+  corners.area = 0;
+  for (std::uint32_t t = begin; t < end; ++t) {
+    const Triangle& tri = mesh_->triangles[t];
+    const std::uint32_t i = t - begin;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d y = positions_[tri[k]] - corners.centroid;
+      const double w = corners.weights[3 * i + k];
+      corners.offsets[3 * i + k] = y;
+      corners.weight += w;
+      corners.second_moment.noalias() += (w * y) * y.transpose();
+    }
+    const Eigen::Vector3d centroid =
+        (positions_[tri[0]] + positions_[tri[1]] + positions_[tri[2]]) / 3;
+    corners.triangle_offsets[i] = centroid - corners.centroid;
+    corners.normal_position += corners.triangle_offsets[i] * corners.area_normals[i].transpose();
+    corners.normal_sum += corners.area_normals[i];
+    corners.area += corners.areas[i];
+  }
+  corners.edges = {};
+  if (end - begin == 1) return true;  // no edge inside a triangle
+  auto it =
+      std::lower_bound(internal_edges_.begin(), internal_edges_.end(), f,
+                       [](const auto& entry, std::uint32_t face) { return entry.first < face; });
+  for (; it != internal_edges_.end() && it->first == f; ++it) corners.edges += it->second;
+  return true;
+}
+
 ClusterStats DualGraph::face_stats(std::uint32_t f, bool with_samples, int max_degree) const {
   ClusterStats stats;
   face_stats(f, stats, with_samples, max_degree);

@@ -113,14 +113,18 @@ static_assert(sizeof(Slot) == 32);
 // kept from one evaluation to the next so that their storage is reused.
 struct Scratch {
   ClusterStats clusters[2];
-  ClusterStats faces[2];  // of a pair
+  ClusterStats faces[2];                            // of a pair
+  FaceCorners cluster_corners[2], face_corners[2];  // the same for faces by their corners
 
-  // Statistics of recently read faces by face id, direct-mapped: the first evaluation reads a
-  // face once per edge, with its edges to higher faces in a row, and a face next to a growing
-  // cluster is read again at each of the cluster's merges.
+  // Recently read faces by face id, direct-mapped: the first evaluation reads a face once per
+  // edge, with its edges to higher faces in a row, and a face next to a growing cluster is read
+  // again at each of the cluster's merges. An entry holds the face's corners, or its statistics
+  // (with moments up to cached_degree) when it has too many triangles or samples are needed.
   static constexpr std::uint32_t kCachedFaces = 64;
   std::array<std::uint32_t, kCachedFaces> cached_face;
+  std::array<bool, kCachedFaces> cached_by_corners;
   std::array<int, kCachedFaces> cached_degree;
+  std::array<FaceCorners, kCachedFaces> cached_corners;
   std::array<ClusterStats, kCachedFaces> cached_stats;
   // Entries an evaluation is still reading, not to be evicted (kNone: none).
   std::array<std::uint32_t, 2> pinned;
@@ -254,6 +258,7 @@ class HierarchyBuilder::Impl {
         slots_[face].first_link = link;
       }
     lazy_ = options_.evaluation != CandidateEvaluation::Eager && !options_.exact_costs;
+    by_corners_ = !selector_.needs_samples();
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
     // Every candidate's cost and first degree is independent of the others: all in parallel.
     // In chunks of consecutive edges: those of a face to its higher neighbours follow each other,
@@ -451,25 +456,36 @@ class HierarchyBuilder::Impl {
     e.a = e.b = kNone;
   }
 
-  // A live cluster's centred statistics: stored for a merged cluster of three faces or more,
-  // computed into `scratch` for a face or a pair of faces, with the moments up to `max_degree`
-  // (2 for a candidate only a plane can fit: see ModelSelector::moment_degree()).
-  // Part 0 of a union must be read before part 1: its statistics stay in place while part 1's are
-  // read.
-  const ClusterStats& stats_of(std::uint32_t slot, Scratch& scratch, int part,
-                               int max_degree) const {
+  // A live cluster as a part of a union: its centred statistics, stored for a merged cluster of
+  // three faces or more, computed into `scratch` for a pair of faces (with the moments up to
+  // `max_degree`: 2 for a candidate only a plane can fit, see ModelSelector::moment_degree()); a
+  // single face by its corners (or its statistics: see face_part()).
+  // Part 0 of a union must be read before part 1: it stays in place while part 1 is read.
+  ClusterPart part_of(std::uint32_t slot, Scratch& scratch, int part, int max_degree) const {
     if (part == 0) scratch.pinned.fill(kNone);
     const std::uint32_t index = slots_[slot].stats;
-    ClusterStats& stats = scratch.clusters[part];
-    if (index == kNone) return face_stats(slot, max_degree, scratch, part, stats);
+    if (index == kNone)
+      return face_part(slot, max_degree, scratch, part, scratch.clusters[part],
+                       scratch.cluster_corners[part]);
     if (index & kPairTag) {
-      const CachedPair& cached = pair_cache_[index % kCachedPairs];
-      if (cached.key == index) return cached.stats;
+      const bool by_corners = pair_by_corners(slots_[slot].triangles);
+      if (!by_corners) {
+        const CachedPair& cached = pair_cache_[index % kCachedPairs];
+        if (cached.key == index) return cached.stats;
+      }
       // The same union, by the same operations, as when the pair merged.
       const DualEdge& e = graph_->edges()[index & ~kPairTag];
       const std::array<std::uint32_t, 2> pinned = scratch.pinned;
-      const ClusterStats& first = face_stats(e.first, max_degree, scratch, 1, scratch.faces[0]);
-      const ClusterStats& second = face_stats(e.second, max_degree, scratch, 1, scratch.faces[1]);
+      const ClusterPart first =
+          face_part(e.first, max_degree, scratch, 1, scratch.faces[0], scratch.face_corners[0]);
+      const ClusterPart second =
+          face_part(e.second, max_degree, scratch, 1, scratch.faces[1], scratch.face_corners[1]);
+      if (by_corners) {
+        FaceCorners::unite(*first.face(), *second.face(), e.shared, scratch.cluster_corners[part]);
+        scratch.pinned = pinned;
+        return scratch.cluster_corners[part];
+      }
+      ClusterStats& stats = scratch.clusters[part];
       stats = ClusterView(first, second, e.shared).stats(max_degree);
       scratch.pinned = pinned;
       return stats;
@@ -477,32 +493,50 @@ class HierarchyBuilder::Impl {
     return stats_[index];
   }
 
-  // A face's statistics (moments up to max_degree at least) from the scratch's cache, read into
-  // `fallback` instead when its entry is pinned; pins the entry used in pinned[pin].
-  const ClusterStats& face_stats(std::uint32_t face, int max_degree, Scratch& scratch, int pin,
-                                 ClusterStats& fallback) const {
+  // A face from the scratch's cache, read into a fallback instead when its entry is pinned; pins
+  // the entry used in pinned[pin]. By its corners unless it has too many triangles or a type
+  // needs samples; then its statistics, with moments up to max_degree at least.
+  ClusterPart face_part(std::uint32_t face, int max_degree, Scratch& scratch, int pin,
+                        ClusterStats& fallback_stats, FaceCorners& fallback_corners) const {
     const std::uint32_t entry = face % Scratch::kCachedFaces;
     if (std::find(scratch.pinned.begin(), scratch.pinned.end(), entry) != scratch.pinned.end()) {
-      graph_->face_stats(face, fallback, selector_.needs_samples(), max_degree);
-      return fallback;
+      if (by_corners_ && graph_->face_corners(face, fallback_corners)) return fallback_corners;
+      graph_->face_stats(face, fallback_stats, selector_.needs_samples(), max_degree);
+      return fallback_stats;
     }
     scratch.pinned[pin] = entry;
-    if (scratch.cached_face[entry] != face || scratch.cached_degree[entry] < max_degree) {
-      graph_->face_stats(face, scratch.cached_stats[entry], selector_.needs_samples(), max_degree);
+    if (scratch.cached_face[entry] != face ||
+        (!scratch.cached_by_corners[entry] && scratch.cached_degree[entry] < max_degree)) {
       scratch.cached_face[entry] = face;
-      scratch.cached_degree[entry] = max_degree;
+      scratch.cached_by_corners[entry] =
+          by_corners_ && graph_->face_corners(face, scratch.cached_corners[entry]);
+      if (!scratch.cached_by_corners[entry]) {
+        graph_->face_stats(face, scratch.cached_stats[entry], selector_.needs_samples(),
+                           max_degree);
+        scratch.cached_degree[entry] = max_degree;
+      }
     }
+    if (scratch.cached_by_corners[entry]) return scratch.cached_corners[entry];
     return scratch.cached_stats[entry];
   }
 
   // Pairs of faces are most of the merged clusters alive at once (all of them at the peak on a
-  // subdivided mesh, 40% on a scan): recomputing theirs from the two faces saves their 568 bytes
-  // each. The most recent pairs' are kept in a small cache (they are next to the clusters that
-  // grow): most reads of a pair's statistics hit it.
-  void store_pair(std::uint32_t slot, std::uint32_t edge_id, ClusterStats&& stats) {
+  // subdivided mesh, 40% on a scan): reading them from their two faces saves their statistics'
+  // 568 bytes each. A pair is read by its corners when they are few (see pair_by_corners());
+  // else the most recent pairs' statistics are kept in a small cache (they are next to the
+  // clusters that grow): most reads of them hit it.
+  // Whether a pair of faces of this many triangles is read by its corners (then it keeps no
+  // statistics at all: uniting the faces' corners is cheap).
+  bool pair_by_corners(std::uint32_t triangles) const {
+    return by_corners_ && triangles <= FaceCorners::kMaxTriangles;
+  }
+
+  void store_pair(std::uint32_t slot, std::uint32_t edge_id, std::uint32_t triangles,
+                  ClusterStats&& stats) {
     release_stats(slot);
     const std::uint32_t key = kPairTag | edge_id;
     slots_[slot].stats = key;
+    if (pair_by_corners(triangles)) return;
     CachedPair& entry = pair_cache_[key % kCachedPairs];
     entry.key = key;
     entry.stats = std::move(stats);
@@ -553,8 +587,8 @@ class HierarchyBuilder::Impl {
   QueuedCandidate evaluate(std::uint32_t id, Scratch& scratch) {
     LiveEdge& e = edges_[id];
     const int degree = selector_.moment_degree(slots_[e.a].triangles + slots_[e.b].triangles);
-    const ClusterStats& a = stats_of(e.a, scratch, 0, degree);  // (part 0 first)
-    const ClusterStats& b = stats_of(e.b, scratch, 1, degree);
+    const ClusterPart a = part_of(e.a, scratch, 0, degree);  // (part 0 first)
+    const ClusterPart b = part_of(e.b, scratch, 1, degree);
     const ClusterView cluster(a, b, shared_edges(id));
     const detail::SelectedModel model = select(cluster, e);
     if (lazy_) e.raise_cost_bound(model.superset_cost_bound);
@@ -568,12 +602,12 @@ class HierarchyBuilder::Impl {
   // factor 2 covers round-off.
   double queued_bound(const LiveEdge& e) {
     if (!(e.cost_bound > 0)) return 0;
-    const Moments& a = stats_of(e.a, scratch_[0], 0, 2).moments;
-    const Moments& b = stats_of(e.b, scratch_[0], 1, 2).moments;
+    const ClusterPart a = part_of(e.a, scratch_[0], 0, 2);
+    const ClusterPart b = part_of(e.b, scratch_[0], 1, 2);
     const double wa = a.weight(), wb = b.weight();
     if (!(wa > 0) || !(wb > 0)) return 0;
     const double spread = a.second_moment().trace() + b.second_moment().trace() +
-                          wa * wb / (wa + wb) * (a.origin() - b.origin()).squaredNorm();
+                          wa * wb / (wa + wb) * (a.centroid() - b.centroid()).squaredNorm();
     return e.cost_bound > 2 * max_penalty_ * options_.zero_cost_tolerance * spread ? e.cost_bound
                                                                                    : 0.0;
   }
@@ -641,11 +675,13 @@ class HierarchyBuilder::Impl {
     const LiveEdge edge = edges_[edge_id];
     const std::uint32_t slot_a = edge.a, slot_b = edge.b;
     const std::uint32_t a = slots_[slot_a].node, b = slots_[slot_b].node;
+    const std::uint32_t faces = slots_[slot_a].faces + slots_[slot_b].faces;
+    const std::uint32_t triangles = slots_[slot_a].triangles + slots_[slot_b].triangles;
     // A copy: combining edges in relink() may move the pool it is in.
     const EdgeStats shared = shared_edges(edge_id);
-    const ClusterStats& stats_a = stats_of(slot_a, scratch_[0], 0, 4);  // (part 0 first)
-    const ClusterStats& stats_b = stats_of(slot_b, scratch_[0], 1, 4);
-    const ClusterView cluster(stats_a, stats_b, shared);
+    const ClusterPart part_a = part_of(slot_a, scratch_[0], 0, 4);  // (part 0 first)
+    const ClusterPart part_b = part_of(slot_b, scratch_[0], 1, 4);
+    const ClusterView cluster(part_a, part_b, shared);
     // Two independent jobs, on two threads when there are: the new cluster's edges, and its fit
     // and statistics. (The type is known: only its fit is needed, and it has the candidate's cost
     // exactly.)
@@ -661,7 +697,7 @@ class HierarchyBuilder::Impl {
       } else {
         model = options_.exact_costs ? select(cluster, edge)
                                      : selector_.refit(cluster, candidate.type());
-        merged_ = cluster.stats(4);
+        if (!(faces == 2 && pair_by_corners(triangles))) merged_ = cluster.stats(4);
       }
     };
     pool_.run(2, jobs);
@@ -673,7 +709,7 @@ class HierarchyBuilder::Impl {
     record.cost = model.cost;
     record.error = model.fit.error;
     record.weight = cluster.weight();
-    record.face_count = slots_[slot_a].faces + slots_[slot_b].faces;
+    record.face_count = faces;
     record.primitive = graph_->frame().to_input(model.fit.primitive);
     merges_.push_back(record);
     max_cost_ = std::max(max_cost_, model.cost);
@@ -681,7 +717,7 @@ class HierarchyBuilder::Impl {
     // The merged cluster lives in a's slot; b's is released.
     release_stats(slot_b);
     if (record.face_count == 2)
-      store_pair(slot_a, edge_id, std::move(merged_));
+      store_pair(slot_a, edge_id, triangles, std::move(merged_));
     else
       store_stats(slot_a, std::move(merged_));
     Slot& kept = slots_[slot_a];
@@ -789,7 +825,7 @@ class HierarchyBuilder::Impl {
     std::sort(roots.begin(), roots.end());
     const double cost = max_cost_ > 0 ? 2 * max_cost_ : 1.0;
     std::uint32_t joined = slots_[roots.front().second].node;
-    double weight = stats_of(roots.front().second, scratch_[0], 0, 2).moments.weight();
+    double weight = part_of(roots.front().second, scratch_[0], 0, 2).weight();
     std::uint32_t faces = slots_[roots.front().second].faces;
     for (std::size_t i = 1; i < roots.size(); ++i) {
       const std::uint32_t slot = roots[i].second, other = slots_[slot].node;
@@ -797,7 +833,7 @@ class HierarchyBuilder::Impl {
       record.first = std::min(joined, other);
       record.second = std::max(joined, other);
       record.cost = cost;
-      record.weight = weight += stats_of(slot, scratch_[0], 0, 2).moments.weight();
+      record.weight = weight += part_of(slot, scratch_[0], 0, 2).weight();
       record.face_count = faces += slots_[slot].faces;
       record.trailing = true;
       joined = next_node();
@@ -841,6 +877,7 @@ class HierarchyBuilder::Impl {
   double max_cost_ = 0;
   std::uint64_t evaluations_ = 0;
   bool lazy_ = false;
+  bool by_corners_ = false;  // faces are read by their corners (see face_part())
   double max_penalty_ = 0;
 };
 

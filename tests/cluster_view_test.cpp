@@ -60,6 +60,92 @@ void expect_near(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double tole
   EXPECT_LE((a - b).cwiseAbs().maxCoeff(), tolerance) << what << "\n" << a << "\nvs\n" << b;
 }
 
+// Every quantity of `view`, the union of the faces a and b and the mesh edges `shared` between
+// them (plus `inner` inside the parts beyond their faces' own edges), against direct sums over the
+// union's corners; its whole statistics against the old way of forming them (merge, then centre).
+void expect_union_of(const ClusterView& view, const DualGraph& graph,
+                     const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b,
+                     const EdgeStats& shared, const EdgeStats& inner, int trial) {
+  std::vector<std::uint32_t> both = a;
+  both.insert(both.end(), b.begin(), b.end());
+  const ClusterStats stats_a = stats_of(graph, a), stats_b = stats_of(graph, b);
+  const Corners corners(graph, both);
+  const double scale = corners.sum([](const Eigen::Vector3d& y) { return y.squaredNorm(); });
+
+  EXPECT_NEAR(view.weight(), corners.sum([](const Eigen::Vector3d&) { return 1.0; }),
+              1e-12 * view.weight());
+  expect_near(view.centroid(), corners.centroid(), 1e-13, "centroid");
+  expect_near(view.second_moment(), corners.sum([](const Eigen::Vector3d& y) -> Eigen::Matrix3d {
+    return y * y.transpose();
+  }),
+              1e-12 * scale, "second moment");
+  const ClusterView::RadialMoments& radial = view.radial_moments();
+  const double radius = std::sqrt(scale / view.weight());
+  expect_near(radial.third, corners.sum([](const Eigen::Vector3d& y) -> Eigen::Vector3d {
+    return y * y.squaredNorm();
+  }),
+              1e-12 * scale * radius, "radial third");
+  EXPECT_NEAR(radial.fourth, corners.sum([](const Eigen::Vector3d& y) {
+    return y.squaredNorm() * y.squaredNorm();
+  }),
+              1e-12 * scale * radius * radius);
+  for (int axes = 0; axes < 4; ++axes) {
+    const Eigen::Vector3d axis =
+        Eigen::Vector3d(std::cos(axes + trial), std::sin(2.0 * axes), 0.3 * axes - 0.5)
+            .normalized();
+    const ClusterView::AxialMoments axial = view.axial_moments(axis);
+    expect_near(axial.third, corners.sum([&](const Eigen::Vector3d& y) -> Eigen::Vector3d {
+      return y * std::pow(axis.dot(y), 2);
+    }),
+                1e-12 * scale * radius, "axial third");
+    EXPECT_NEAR(axial.mixed, corners.sum([&](const Eigen::Vector3d& y) {
+      return y.squaredNorm() * std::pow(axis.dot(y), 2);
+    }),
+                1e-12 * scale * radius * radius);
+    EXPECT_NEAR(axial.fourth,
+                corners.sum([&](const Eigen::Vector3d& y) { return std::pow(axis.dot(y), 4); }),
+                1e-12 * scale * radius * radius);
+  }
+  EXPECT_EQ(view.triangle_count(), stats_a.triangle_count + stats_b.triangle_count);
+  EXPECT_NEAR(view.area(), stats_a.area + stats_b.area, 1e-15 * view.area());
+  const Eigen::Matrix3d tensor = stats_a.edges.tensor_matrix() + stats_b.edges.tensor_matrix() +
+                                 shared.tensor_matrix() + inner.tensor_matrix();
+  expect_near(view.edge_tensor(), tensor, 1e-14, "edge tensor");
+
+  // The view's whole statistics equal the old way of forming them (merge, then centre), and
+  // the single view of them gives the same quantities.
+  ClusterStats merged = stats_a;
+  merged.merge(stats_b, shared);
+  merged.edges += inner;
+  merged = merged.centred();
+  const ClusterStats& formed = view.stats();
+  for (int n = 0; n < Moments::kCount; ++n)
+    EXPECT_NEAR(formed.moments.values()[n], merged.moments.values()[n],
+                1e-12 * scale * (1 + radius * radius))
+        << n;
+  expect_near(formed.normal_position, merged.normal_position, 1e-13 * view.area(),
+              "normal position");
+  expect_near(formed.face_planes.normal_normal_matrix(), merged.face_planes.normal_normal_matrix(),
+              1e-13 * view.area(), "face planes");
+  EXPECT_NEAR(formed.face_planes.offset_square, merged.face_planes.offset_square,
+              1e-12 * view.area());
+  expect_near(formed.edges.tensor_matrix(), tensor, 1e-14, "formed edge tensor");
+  const ClusterView single(formed);
+  expect_near(single.second_moment(), view.second_moment(), 1e-13 * scale, "single view");
+  const Eigen::Matrix3d q =
+      Eigen::Matrix3d::Identity() - Eigen::Vector3d::UnitZ() * Eigen::Vector3d::UnitZ().transpose();
+  const Eigen::Vector3d point = view.centroid() + Eigen::Vector3d(0.3, -0.2, 0.1);
+  EXPECT_NEAR(view.normal_alignment(q, point, 0.7), merged.normal_alignment(q, point, 0.7), 1e-12);
+  EXPECT_NEAR(single.normal_alignment(q, point, 0.7), merged.normal_alignment(q, point, 0.7),
+              1e-12);
+  // With degree 2 only, the moments up to degree 2 are the same bits and the rest zero.
+  const ClusterStats low = view.stats(2);
+  for (int n = 0; n < Moments::kCount; ++n)
+    EXPECT_EQ(low.moments.values()[n],
+              n < Moments::kCountUpToDegree2 ? formed.moments.values()[n] : 0.0)
+        << n;
+}
+
 TEST(ClusterView, UnionQuantitiesEqualDirectSumsOverTheUnionsPoints) {
   ShapeOptions options;
   options.tessellation = Tessellation::Uniform;
@@ -77,83 +163,56 @@ TEST(ClusterView, UnionQuantitiesEqualDirectSumsOverTheUnionsPoints) {
       const std::size_t na = 1 + trial * 37, nb = 1 + trial * 11;
       const std::vector<std::uint32_t> a(all.begin(), all.begin() + na);
       const std::vector<std::uint32_t> b(all.begin() + na, all.begin() + na + nb);
-      std::vector<std::uint32_t> both = a;
-      both.insert(both.end(), b.begin(), b.end());
       const ClusterStats stats_a = stats_of(graph, a), stats_b = stats_of(graph, b);
       EdgeStats shared;
       shared.add_edge(Eigen::Vector3d(0.1, 0.2, 0.3), 0.4);
-      const ClusterView view(stats_a, stats_b, shared);
-      const Corners corners(graph, both);
-      const double scale = corners.sum([](const Eigen::Vector3d& y) { return y.squaredNorm(); });
+      expect_union_of(ClusterView(stats_a, stats_b, shared), graph, a, b, shared, {}, trial);
+    }
+  }
+}
 
-      EXPECT_NEAR(view.weight(), corners.sum([](const Eigen::Vector3d&) { return 1.0; }),
-                  1e-12 * view.weight());
-      expect_near(view.centroid(), corners.centroid(), 1e-13, "centroid");
-      expect_near(view.second_moment(),
-                  corners.sum([](const Eigen::Vector3d& y) -> Eigen::Matrix3d {
-                    return y * y.transpose();
-                  }),
-                  1e-12 * scale, "second moment");
-      const ClusterView::RadialMoments& radial = view.radial_moments();
-      const double radius = std::sqrt(scale / view.weight());
-      expect_near(radial.third, corners.sum([](const Eigen::Vector3d& y) -> Eigen::Vector3d {
-        return y * y.squaredNorm();
-      }),
-                  1e-12 * scale * radius, "radial third");
-      EXPECT_NEAR(radial.fourth, corners.sum([](const Eigen::Vector3d& y) {
-        return y.squaredNorm() * y.squaredNorm();
-      }),
-                  1e-12 * scale * radius * radius);
-      for (int axes = 0; axes < 4; ++axes) {
-        const Eigen::Vector3d axis =
-            Eigen::Vector3d(std::cos(axes + trial), std::sin(2.0 * axes), 0.3 * axes - 0.5)
-                .normalized();
-        const ClusterView::AxialMoments axial = view.axial_moments(axis);
-        expect_near(axial.third, corners.sum([&](const Eigen::Vector3d& y) -> Eigen::Vector3d {
-          return y * std::pow(axis.dot(y), 2);
-        }),
-                    1e-12 * scale * radius, "axial third");
-        EXPECT_NEAR(axial.mixed, corners.sum([&](const Eigen::Vector3d& y) {
-          return y.squaredNorm() * std::pow(axis.dot(y), 2);
-        }),
-                    1e-12 * scale * radius * radius);
-        EXPECT_NEAR(axial.fourth,
-                    corners.sum([&](const Eigen::Vector3d& y) { return std::pow(axis.dot(y), 4); }),
-                    1e-12 * scale * radius * radius);
-      }
-      EXPECT_EQ(view.triangle_count(), stats_a.triangle_count + stats_b.triangle_count);
-      EXPECT_DOUBLE_EQ(view.area(), stats_a.area + stats_b.area);
-      Eigen::Matrix3d tensor =
-          stats_a.edges.tensor_matrix() + stats_b.edges.tensor_matrix() + shared.tensor_matrix();
-      expect_near(view.edge_tensor(), tensor, 1e-14, "edge tensor");
+// The merge loop reads single faces and pairs of faces by their corners: a view with such parts
+// gives the same quantities as with their statistics, in either order and against either kind.
+TEST(ClusterView, FacesAndPairsByTheirCornersGiveTheUnionsQuantities) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.noise = 0.003;
+  options.random_motion = true;
+  const GroundTruthShape shape = make_shape("box_with_dome", options);
+  for (VertexWeights weights : {VertexWeights::Area, VertexWeights::Uniform}) {
+    const DualGraph graph(shape.mesh, weights);
+    std::mt19937_64 rng(7);
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<std::uint32_t> all(graph.face_count());
+      std::iota(all.begin(), all.end(), 0u);
+      std::shuffle(all.begin(), all.end(), rng);
+      const std::uint32_t f = all[0], g = all[1], h = all[2];
+      const std::vector<std::uint32_t> cluster(all.begin() + 3, all.begin() + 3 + 5 * trial + 1);
+      const ClusterStats stats = stats_of(graph, cluster);
+      FaceCorners face_f, face_g, face_h, pair;
+      ASSERT_TRUE(graph.face_corners(f, face_f));
+      ASSERT_TRUE(graph.face_corners(g, face_g));
+      ASSERT_TRUE(graph.face_corners(h, face_h));
+      EdgeStats shared, inner;
+      shared.add_edge(Eigen::Vector3d(0.1, 0.2, 0.3), 0.4);
+      inner.add_edge(Eigen::Vector3d(-0.2, 0.1, 0.05), -0.3);
+      ASSERT_TRUE(FaceCorners::unite(face_f, face_g, inner, pair));
+      EXPECT_EQ(pair.triangle_count, 2u);
 
-      // The view's whole statistics equal the old way of forming them (merge, then centre), and
-      // the single view of them gives the same quantities.
-      ClusterStats merged = stats_a;
-      merged.merge(stats_b, shared);
-      merged = merged.centred();
-      const ClusterStats& formed = view.stats();
-      for (int n = 0; n < Moments::kCount; ++n)
-        EXPECT_NEAR(formed.moments.values()[n], merged.moments.values()[n],
-                    1e-12 * scale * (1 + radius * radius))
-            << n;
-      expect_near(formed.normal_position, merged.normal_position, 1e-13 * view.area(),
-                  "normal position");
-      const ClusterView single(formed);
-      expect_near(single.second_moment(), view.second_moment(), 1e-13 * scale, "single view");
-      const Eigen::Matrix3d q = Eigen::Matrix3d::Identity() -
-                                Eigen::Vector3d::UnitZ() * Eigen::Vector3d::UnitZ().transpose();
-      const Eigen::Vector3d point = view.centroid() + Eigen::Vector3d(0.3, -0.2, 0.1);
-      EXPECT_NEAR(view.normal_alignment(q, point, 0.7), merged.normal_alignment(q, point, 0.7),
-                  1e-12);
-      EXPECT_NEAR(single.normal_alignment(q, point, 0.7), merged.normal_alignment(q, point, 0.7),
-                  1e-12);
-      // With degree 2 only, the moments up to degree 2 are the same bits and the rest zero.
-      const ClusterStats low = view.stats(2);
-      for (int n = 0; n < Moments::kCount; ++n)
-        EXPECT_EQ(low.moments.values()[n],
-                  n < Moments::kCountUpToDegree2 ? formed.moments.values()[n] : 0.0)
-            << n;
+      expect_union_of(ClusterView(stats, face_h, shared), graph, cluster, {h}, shared, {}, trial);
+      expect_union_of(ClusterView(face_h, stats, shared), graph, {h}, cluster, shared, {}, trial);
+      expect_union_of(ClusterView(face_f, face_h, shared), graph, {f}, {h}, shared, {}, trial);
+      expect_union_of(ClusterView(pair, stats, shared), graph, {f, g}, cluster, shared, inner,
+                      trial);
+      expect_union_of(ClusterView(stats, pair, shared), graph, cluster, {f, g}, shared, inner,
+                      trial);
+      expect_union_of(ClusterView(pair, face_h, shared), graph, {f, g}, {h}, shared, inner, trial);
+      // Past the limit, no union.
+      FaceCorners three, four, five;
+      ASSERT_TRUE(FaceCorners::unite(pair, face_h, {}, three));
+      ASSERT_TRUE(FaceCorners::unite(three, face_f, {}, four));
+      EXPECT_EQ(four.triangle_count, FaceCorners::kMaxTriangles);
+      EXPECT_FALSE(FaceCorners::unite(four, face_g, {}, five));
     }
   }
 }
@@ -168,6 +227,42 @@ TEST(ClusterView, FaceStatisticsAreCentred) {
     EXPECT_EQ(stats.moments.at(0, 0, 1), 0);
     const Corners corners(graph, {f});
     EXPECT_LE((stats.moments.origin() - corners.centroid()).norm(), 1e-15);
+    // Its corners, about the same origin, add up to the same statistics.
+    FaceCorners face;
+    ASSERT_TRUE(graph.face_corners(f, face));
+    EXPECT_EQ(face.centroid, stats.moments.origin());
+    ClusterStats from_corners;
+    from_corners.moments = Moments(face.centroid);
+    from_corners.add(face);
+    for (int n = 0; n < Moments::kCount; ++n)
+      EXPECT_NEAR(from_corners.moments.values()[n], stats.moments.values()[n], 1e-16) << n;
+    expect_near(from_corners.normal_position, stats.normal_position, 1e-16, "normal position");
+    expect_near(from_corners.normal_sum, stats.normal_sum, 0, "normal sum");
+    EXPECT_EQ(from_corners.area, stats.area);
+    EXPECT_EQ(from_corners.triangle_count, 1u);
+  }
+}
+
+// Polygon faces: up to FaceCorners::kMaxTriangles triangles by their corners, with the edges
+// between their own triangles; larger ones only by their statistics.
+TEST(ClusterView, PolygonFacesByTheirCorners) {
+  std::vector<Vec3> positions;
+  for (int i = 0; i < 8; ++i)
+    positions.push_back({std::cos(0.8 * i), std::sin(0.8 * i), 0.1 * std::sin(2.1 * i)});
+  // A quad (2 triangles), a hexagon (4) and an octagon (6) sharing the same ring of vertices.
+  const Mesh mesh = Mesh::from_polygons(positions, {0, 4, 10, 18},
+                                        {0, 1, 2, 3, 0, 1, 2, 3, 4, 5, 0, 1, 2, 3, 4, 5, 6, 7});
+  const DualGraph graph(mesh, VertexWeights::Area);
+  for (std::uint32_t f = 0; f < 3; ++f) {
+    FaceCorners face;
+    const std::uint32_t triangles = graph.first_triangle(f + 1) - graph.first_triangle(f);
+    ASSERT_EQ(graph.face_corners(f, face), triangles <= FaceCorners::kMaxTriangles) << f;
+    if (triangles > FaceCorners::kMaxTriangles) continue;
+    const ClusterStats stats = graph.face_stats(f);
+    EXPECT_EQ(face.triangle_count, triangles);
+    expect_near(face.edges.tensor_matrix(), stats.edges.tensor_matrix(), 0, "inner edges");
+    EXPECT_GT(face.edges.tensor_matrix().cwiseAbs().maxCoeff(), 0) << f;
+    expect_near(face.second_moment, stats.moments.second_moment(), 1e-15, "second moment");
   }
 }
 

@@ -5,6 +5,8 @@
 // bookkeeping of adjacency and shared edges, the caches and the parallel evaluation together.
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <map>
 #include <set>
 
@@ -26,11 +28,18 @@ std::vector<Merge> naive_greedy(const Mesh& mesh, const HierarchyOptions& option
   const DualGraph graph(mesh, options.weights);
   const detail::ModelSelector selector(options);
   std::vector<ClusterStats> stats;
+  // A cluster that is still one face or a pair is read by its corners, as the builder reads it.
+  std::vector<std::optional<FaceCorners>> corners(graph.face_count());
   std::vector<std::uint32_t> node;
   for (std::uint32_t f = 0; f < graph.face_count(); ++f) {
     stats.push_back(graph.face_stats(f));
+    if (FaceCorners c; !selector.needs_samples() && graph.face_corners(f, c)) corners[f] = c;
     node.push_back(f);
   }
+  auto part = [&](std::uint32_t cluster) -> ClusterPart {
+    if (corners[cluster]) return *corners[cluster];
+    return stats[cluster];
+  };
   struct Edge {
     std::uint32_t a, b;  // clusters (by their first face), in the builder's order
     EdgeStats shared;
@@ -61,7 +70,7 @@ std::vector<Merge> naive_greedy(const Mesh& mesh, const HierarchyOptions& option
     };
     for (Edge& e : edges)
       if (e.alive && !e.evaluated) {
-        e.model = selector.select(ClusterView(stats[e.a], stats[e.b], e.shared));
+        e.model = selector.select(ClusterView(part(e.a), part(e.b), e.shared));
         e.degree = e.model.cost == 0 ? merged_degree(e) : 0;
         e.evaluated = true;
       }
@@ -90,7 +99,16 @@ std::vector<Merge> naive_greedy(const Mesh& mesh, const HierarchyOptions& option
     record.error = best->model.fit.error;
     record.primitive = graph.frame().to_input(best->model.fit.primitive);
     merges.push_back(record);
-    stats[a] = ClusterView(stats[a], stats[b], best->shared).stats();
+    // A pair of faces (two leaves) is read by its corners too, while they are few.
+    const bool leaves = node[a] < graph.face_count() && node[b] < graph.face_count();
+    FaceCorners united;
+    if (leaves && corners[a] && corners[b] &&
+        FaceCorners::unite(*corners[a], *corners[b], best->shared, united)) {
+      corners[a] = united;
+    } else {
+      stats[a] = ClusterView(part(a), part(b), best->shared).stats();
+      corners[a].reset();
+    }
     node[a] = next;
     best->alive = false;
     // a's edges first, then b's: an edge of b to a neighbour a already has is summed into a's.

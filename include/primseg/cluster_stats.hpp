@@ -41,7 +41,11 @@ class Moments {
   Eigen::Vector3d centroid() const;
 
   /// Adds the point x with weight w (to the moments up to max_degree: 2 or 4).
-  void add_point(const Eigen::Vector3d& x, double w, int max_degree = 4);
+  void add_point(const Eigen::Vector3d& x, double w, int max_degree = 4) {
+    add_offset(x - origin_, w, max_degree);
+  }
+  /// Adds the point origin() + d with weight w.
+  void add_offset(const Eigen::Vector3d& d, double w, int max_degree = 4);
   /// Sets the first moments to zero: for moments about a centroid the caller computed, whose
   /// first moments are only round-off (the centroid then is the origin exactly).
   void discard_first_moments() { values_[1] = values_[2] = values_[3] = 0; }
@@ -139,6 +143,45 @@ struct SampleReservoir {
   static double priority_of(std::uint64_t corner_id, double weight);
 };
 
+/// A small cluster, one input face or a pair of adjacent faces of at most kMaxTriangles triangles
+/// in all, by its weighted corners (working frame), for the merge loop: a candidate that unites a
+/// cluster with a face or a pair reads these few corners directly, which costs far less than
+/// forming their 35 moments and translating them (most candidates of a scan have a single face
+/// on one side, and pairs are most of the merged clusters alive at once). The same quantities as
+/// the cluster's ClusterStats, about its weighted centroid. Filled by DualGraph::face_corners and
+/// unite(); it carries no samples (the torus reads ClusterStats).
+struct FaceCorners {
+  static constexpr std::uint32_t kMaxTriangles = 4;
+  std::uint32_t triangle_count = 0;
+  /// The weighted centroid of the corners (the first triangle's centroid if they weigh nothing).
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  /// Corner positions − centroid, three per triangle; the first 3 triangle_count are set.
+  std::array<Eigen::Vector3d, 3 * kMaxTriangles> offsets;
+  /// Their weights w.
+  std::array<double, 3 * kMaxTriangles> weights{};
+  /// Per triangle: area × unit normal (consistently oriented), area, and centroid − centroid.
+  std::array<Eigen::Vector3d, kMaxTriangles> area_normals;
+  std::array<double, kMaxTriangles> areas{};
+  std::array<Eigen::Vector3d, kMaxTriangles> triangle_offsets;
+  /// Σ w.
+  double weight = 0;
+  /// Σ w y yᵀ with y = corner − centroid, shape (3, 3).
+  Eigen::Matrix3d second_moment = Eigen::Matrix3d::Zero();
+  /// As in ClusterStats, about the centroid.
+  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d normal_position = Eigen::Matrix3d::Zero();
+  double area = 0;
+  /// The mesh edges between the cluster's own triangles.
+  EdgeStats edges;
+
+  std::uint32_t corner_count() const { return 3 * triangle_count; }
+  /// The union of two disjoint small clusters and the mesh edges between them into `united`,
+  /// about their weighted centroid (as ClusterView places it). False, with `united` unspecified,
+  /// when they have more than kMaxTriangles triangles in all.
+  static bool unite(const FaceCorners& a, const FaceCorners& b, const EdgeStats& shared,
+                    FaceCorners& united);
+};
+
 /// Everything a primitive fit needs to know about a cluster; all sums over its triangles, so the
 /// statistics of a union are the sums of its parts (plus the tensor of the edges between them).
 struct ClusterStats {
@@ -164,6 +207,9 @@ struct ClusterStats {
   /// Adds other (which must not share triangles with this) and the edges between the two. With
   /// max_degree 2 the moments of degree 3 and 4 are left zero (see Moments::translated).
   void merge(const ClusterStats& other, const EdgeStats& shared_edges, int max_degree = 4);
+  /// Adds a single face given by its corners (not sharing triangles with this), without the edges
+  /// between the two; samples are not added. Moments up to max_degree, as merge().
+  void add(const FaceCorners& face, int max_degree = 4);
   /// The same statistics about another origin (moments up to max_degree).
   ClusterStats translated(const Eigen::Vector3d& new_origin, int max_degree = 4) const;
   /// The same statistics about the centroid (what the fitters take).

@@ -13,6 +13,44 @@
 
 namespace primseg {
 
+/// One side of a ClusterView: a cluster's statistics centred at its centroid
+/// (ClusterStats::centred()), or a single face by its corners. Refers to it: it must outlive the
+/// views made of it.
+class ClusterPart {
+ public:
+  ClusterPart(const ClusterStats& centred) : stats_(&centred) {}  // NOLINT: implicit on purpose
+  ClusterPart(const FaceCorners& face) : face_(&face) {}          // NOLINT: implicit on purpose
+
+  /// The statistics, or null for a face by its corners.
+  const ClusterStats* stats() const { return stats_; }
+  /// The face's corners, or null for statistics.
+  const FaceCorners* face() const { return face_; }
+
+  double weight() const { return stats_ ? stats_->moments.weight() : face_->weight; }
+  const Eigen::Vector3d& centroid() const {
+    return stats_ ? stats_->moments.origin() : face_->centroid;
+  }
+  /// Σ w y yᵀ about centroid(), shape (3, 3).
+  Eigen::Matrix3d second_moment() const {
+    return stats_ ? stats_->moments.second_moment() : face_->second_moment;
+  }
+  std::uint32_t triangle_count() const {
+    return stats_ ? stats_->triangle_count : face_->triangle_count;
+  }
+  double area() const { return stats_ ? stats_->area : face_->area; }
+  const Eigen::Vector3d& normal_sum() const {
+    return stats_ ? stats_->normal_sum : face_->normal_sum;
+  }
+  const Eigen::Matrix3d& normal_position() const {
+    return stats_ ? stats_->normal_position : face_->normal_position;
+  }
+  const EdgeStats& edges() const { return stats_ ? stats_->edges : face_->edges; }
+
+ private:
+  const ClusterStats* stats_ = nullptr;
+  const FaceCorners* face_ = nullptr;
+};
+
 /// A cluster's statistics as the fitters read them. Points y are relative to centroid(), in the
 /// working frame; Σ runs over the weighted triangle corners of the cluster.
 ///
@@ -22,9 +60,9 @@ class ClusterView {
  public:
   /// One cluster, with statistics centred at its centroid.
   explicit ClusterView(const ClusterStats& centred);
-  /// The union of two disjoint clusters with centred statistics; `shared` holds the mesh edges
-  /// between them.
-  ClusterView(const ClusterStats& a, const ClusterStats& b, const EdgeStats& shared);
+  /// The union of two disjoint clusters (centred statistics or single faces' corners); `shared`
+  /// holds the mesh edges between them.
+  ClusterView(ClusterPart a, ClusterPart b, const EdgeStats& shared);
 
   /// Σ w.
   double weight() const { return weight_; }
@@ -79,7 +117,7 @@ class ClusterView {
 
  private:
   // The parts, with the shift from their centroid to the view's: y = y_part + shift.
-  const ClusterStats* parts_[2] = {nullptr, nullptr};
+  ClusterPart parts_[2];
   Eigen::Vector3d shifts_[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   int part_count_ = 0;
   const EdgeStats* shared_ = nullptr;

@@ -98,6 +98,9 @@ class DualGraph {
   ClusterStats face_stats(std::uint32_t f, bool with_samples = false, int max_degree = 4) const;
   /// The same into `stats` (whatever it held before), reusing its storage.
   void face_stats(std::uint32_t f, ClusterStats& stats, bool with_samples, int max_degree) const;
+  /// Input face f by its corners, about the same origin as face_stats(f). False, with `corners`
+  /// unspecified, when f has more than FaceCorners::kMaxTriangles triangles.
+  bool face_corners(std::uint32_t f, FaceCorners& corners) const;
 
  private:
   const Mesh* mesh_;
