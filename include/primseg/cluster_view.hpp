@@ -14,12 +14,13 @@
 namespace primseg {
 
 /// One side of a ClusterView: a cluster's statistics centred at its centroid
-/// (ClusterStats::centred()), or a single face by its corners. Refers to it: it must outlive the
-/// views made of it.
+/// (ClusterStats::centred()), or a face or a pair of faces by its corners (FaceCorners). Refers
+/// to it: it must outlive the views made of it.
 class ClusterPart {
  public:
-  ClusterPart(const ClusterStats& centred) : stats_(&centred) {}  // NOLINT: implicit on purpose
-  ClusterPart(const FaceCorners& face) : face_(&face) {}          // NOLINT: implicit on purpose
+  // Implicit, so that a view is made of either kind alike: ClusterView(stats, face, shared).
+  ClusterPart(const ClusterStats& centred) : stats_(&centred) {}
+  ClusterPart(const FaceCorners& face) : face_(&face) {}
 
   /// The statistics, or null for a face by its corners.
   const ClusterStats* stats() const { return stats_; }
