@@ -125,6 +125,31 @@ inline IsolatedRoot isolated_root(const Eigen::Matrix3d& a) {
   return root;
 }
 
+// The unit eigenvector of the smaller of the two eigenvalues of the symmetric b whose
+// eigenvectors are orthogonal to the unit eigenvector `first`: from the 2x2 problem in the plane
+// orthogonal to it, which is well conditioned however close those two eigenvalues are.
+inline Eigen::Vector3d smaller_orthogonal_eigenvector(const Eigen::Matrix3d& b,
+                                                      const Eigen::Vector3d& first) {
+  // Basis (u, v) of the plane, matrix [[buu, buv], [buv, bvv]].
+  const Eigen::Vector3d u = eigen3_detail::any_orthogonal(first);
+  const Eigen::Vector3d v = first.cross(u);
+  const Eigen::Vector3d bu = b * u, bv = b * v;
+  const double buu = u.dot(bu), bvv = v.dot(bv), buv = u.dot(bv);
+  // Eigenvector of the smaller eigenvalue μ = (buu + bvv)/2 − h: (buv, μ − buu) or
+  // (μ − bvv, buv), the longer one (they are parallel); for a multiple of the identity, u.
+  const double half_gap = 0.5 * (buu - bvv);
+  const double h = std::sqrt(half_gap * half_gap + buv * buv);
+  const double mu = 0.5 * (buu + bvv) - h;
+  double cu = buv, cv = mu - buu;
+  if (std::abs(mu - bvv) > std::abs(cv)) {
+    cu = mu - bvv;
+    cv = buv;
+  }
+  const double length2 = cu * cu + cv * cv;
+  if (!(length2 > 0)) return u;
+  return (cu * u + cv * v) * (1 / std::sqrt(length2));
+}
+
 // The full decomposition from the isolated root.
 inline SymmetricEigen3 complete(const Eigen::Matrix3d& a, const IsolatedRoot& root) {
   SymmetricEigen3 result;
@@ -142,26 +167,8 @@ inline SymmetricEigen3 complete(const Eigen::Matrix3d& a, const IsolatedRoot& ro
     case IsolatedRoot::kFound:
       break;
   }
-  const Eigen::Matrix3d& b = root.b;
-  const Eigen::Vector3d first = eigenvector_of(b, root.shifted());
-  // The 2x2 problem in the plane orthogonal to it: basis (u, v), matrix [[buu, buv], [buv, bvv]].
-  const Eigen::Vector3d u = eigen3_detail::any_orthogonal(first);
-  const Eigen::Vector3d v = first.cross(u);
-  const Eigen::Vector3d bu = b * u, bv = b * v;
-  const double buu = u.dot(bu), bvv = v.dot(bv), buv = u.dot(bv);
-  // Eigenvector of the smaller eigenvalue μ = (buu + bvv)/2 − h: (buv, μ − buu) or
-  // (μ − bvv, buv), the longer one (they are parallel); for a multiple of the identity, u.
-  const double half_gap = 0.5 * (buu - bvv);
-  const double h = std::sqrt(half_gap * half_gap + buv * buv);
-  const double mu = 0.5 * (buu + bvv) - h;
-  double cu = buv, cv = mu - buu;
-  if (std::abs(mu - bvv) > std::abs(cv)) {
-    cu = mu - bvv;
-    cv = buv;
-  }
-  const double length2 = cu * cu + cv * cv;
-  Eigen::Vector3d second = u;
-  if (length2 > 0) second = (cu * u + cv * v) * (1 / std::sqrt(length2));
+  const Eigen::Vector3d first = eigenvector_of(root.b, root.shifted());
+  const Eigen::Vector3d second = smaller_orthogonal_eigenvector(root.b, first);
   result.vectors.col(0) = first;
   result.vectors.col(1) = second;
   result.vectors.col(2) = first.cross(second);
@@ -195,14 +202,17 @@ struct Eigenpair {
 };
 
 /// The smallest eigenvalue of the symmetric matrix a and its eigenvector: the first column of
-/// symmetric_eigen3(a), at about half its cost when that eigenvalue is the isolated one.
+/// symmetric_eigen3(a) (but where round-off would order two nearly equal eigenvalues the other
+/// way), at about half its cost: the isolated eigenvalue's vector when it is the smallest, else
+/// the smaller one of the 2x2 problem orthogonal to it.
 inline Eigenpair smallest_eigenpair(const Eigen::Matrix3d& a) {
   const eigen3_detail::IsolatedRoot root = eigen3_detail::isolated_root(a);
-  if (root.kind != eigen3_detail::IsolatedRoot::kFound || !root.low) {
+  if (root.kind != eigen3_detail::IsolatedRoot::kFound) {
     const SymmetricEigen3 all = eigen3_detail::complete(a, root);
     return {all.values(0), all.vectors.col(0)};
   }
-  const Eigen::Vector3d v = eigen3_detail::eigenvector_of(root.b, root.shifted());
+  Eigen::Vector3d v = eigen3_detail::eigenvector_of(root.b, root.shifted());
+  if (!root.low) v = eigen3_detail::smaller_orthogonal_eigenvector(root.b, v);
   return {v.dot(a * v), v};
 }
 
