@@ -45,18 +45,19 @@ ModelSelector::ModelSelector(const HierarchyOptions& options) : options_(options
   }
 }
 
-SelectedModel ModelSelector::finish(PrimitiveFit fit, double zero_level,
-                                    const ExactError* exact) const {
+double ModelSelector::finish(PrimitiveFit& fit, double zero_level, const ExactError* exact) const {
   if (exact) fit.error = (*exact)(fit.primitive);
   if (fit.error <= zero_level) fit.error = 0;
-  const double cost = fit.error * options_.type_penalty[static_cast<int>(fit.primitive.type)];
-  return {std::move(fit), cost};
+  return fit.error * options_.type_penalty[static_cast<int>(fit.primitive.type)];
 }
 
 SelectedModel ModelSelector::refit(const ClusterView& cluster, PrimitiveType chosen) const {
   // A chosen type's fit was valid, or the type is the plane fallback, which always is.
-  return finish(fitter_for(chosen).fit(cluster),
-                options_.zero_cost_tolerance * cluster.second_moment().trace(), nullptr);
+  SelectedModel model;
+  model.fit = fitter_for(chosen).fit(cluster);
+  model.cost =
+      finish(model.fit, options_.zero_cost_tolerance * cluster.second_moment().trace(), nullptr);
+  return model;
 }
 
 SelectedModel ModelSelector::select(const ClusterView& cluster, const ExactError* exact) const {
@@ -80,23 +81,27 @@ SelectedModel ModelSelector::select(const ClusterView& cluster, const ExactError
     PrimitiveFit fit = fitter->fit(cluster, error_to_beat);
     if (lazy) bound = std::min(bound, fit.superset_error_bound * penalty);
     if (!fit.valid || !std::isfinite(fit.error)) continue;
-    SelectedModel candidate = finish(std::move(fit), zero_level, exact);
+    const double cost = finish(fit, zero_level, exact);
     // Exact fits tie at cost 0: the vertices of a coarse tessellation lie exactly on several
     // surfaces (a band between two circles lies on a cone, a sphere and tori), but the face
     // normals follow only the true one. Among exact fits the better normal agreement wins;
     // other ties keep the earlier (simpler) type.
     const bool better_exact =
-        found && candidate.cost == 0 && best.cost == 0 &&
-        candidate.fit.normal_alignment > best.fit.normal_alignment + kAlignmentTieMargin;
-    if (!found || candidate.cost < best.cost || better_exact) {
-      best = candidate;
+        found && cost == 0 && best.cost == 0 &&
+        fit.normal_alignment > best.fit.normal_alignment + kAlignmentTieMargin;
+    if (!found || cost < best.cost || better_exact) {
+      best.fit = fit;
+      best.cost = cost;
       found = true;
     }
     // Costs are never negative: nothing after an exact fit whose normals agree everywhere (a
     // flat plane) can win, so the richer fits need not run (most candidates in flat regions).
     if (found && best.cost == 0 && best.fit.normal_alignment >= 1 - kAlignmentTieMargin) break;
   }
-  if (!found) best = finish(fitter_for(PrimitiveType::Plane).fit(cluster), zero_level, exact);
+  if (!found) {
+    best.fit = fitter_for(PrimitiveType::Plane).fit(cluster);
+    best.cost = finish(best.fit, zero_level, exact);
+  }
   if (lazy && best.cost > 0 && bound > 0) {
     // Round-off in the fits is of order 1e-16 of the spread; the margin keeps the bound below
     // every computed cost of a superset.

@@ -47,8 +47,8 @@ class ModelSelector {
   }
 
  private:
-  // The fit's error, exact if asked, zero-snapped, and its cost.
-  SelectedModel finish(PrimitiveFit fit, double zero_level, const ExactError* exact) const;
+  // Makes the fit's error exact if asked, and zero-snapped; returns its cost.
+  double finish(PrimitiveFit& fit, double zero_level, const ExactError* exact) const;
 
   std::vector<const PrimitiveFitter*> fitters_;  // ascending type
   std::uint32_t min_curved_triangles_ = UINT32_MAX;
