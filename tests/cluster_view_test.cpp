@@ -11,6 +11,7 @@
 
 #include "primseg/dual_graph.hpp"
 #include "primseg/shape_generator.hpp"
+#include "support/test_support.hpp"
 
 namespace primseg {
 namespace {
@@ -146,20 +147,22 @@ void expect_union_of(const ClusterView& view, const DualGraph& graph,
         << n;
 }
 
+// The faces of the graph in a random order.
+std::vector<std::uint32_t> shuffled_faces(const DualGraph& graph, std::mt19937_64& rng) {
+  std::vector<std::uint32_t> all(graph.face_count());
+  std::iota(all.begin(), all.end(), 0u);
+  std::shuffle(all.begin(), all.end(), rng);
+  return all;
+}
+
 TEST(ClusterView, UnionQuantitiesEqualDirectSumsOverTheUnionsPoints) {
-  ShapeOptions options;
-  options.tessellation = Tessellation::Uniform;
-  options.noise = 0.003;
-  options.random_motion = true;
-  const GroundTruthShape shape = make_shape("cylinder_with_sphere_cap", options);
+  const Mesh mesh = testing::noisy_uniform_shape("cylinder_with_sphere_cap");
   for (VertexWeights weights : {VertexWeights::Area, VertexWeights::Uniform}) {
-    const DualGraph graph(shape.mesh, weights);
+    const DualGraph graph(mesh, weights);
     std::mt19937_64 rng(3);
     // Two disjoint random sets of faces (adjacency does not matter for the moments).
     for (int trial = 0; trial < 20; ++trial) {
-      std::vector<std::uint32_t> all(graph.face_count());
-      std::iota(all.begin(), all.end(), 0u);
-      std::shuffle(all.begin(), all.end(), rng);
+      const std::vector<std::uint32_t> all = shuffled_faces(graph, rng);
       const std::size_t na = 1 + trial * 37, nb = 1 + trial * 11;
       const std::vector<std::uint32_t> a(all.begin(), all.begin() + na);
       const std::vector<std::uint32_t> b(all.begin() + na, all.begin() + na + nb);
@@ -174,18 +177,12 @@ TEST(ClusterView, UnionQuantitiesEqualDirectSumsOverTheUnionsPoints) {
 // The merge loop reads single faces and pairs of faces by their corners: a view with such parts
 // gives the same quantities as with their statistics, in either order and against either kind.
 TEST(ClusterView, FacesAndPairsByTheirCornersGiveTheUnionsQuantities) {
-  ShapeOptions options;
-  options.tessellation = Tessellation::Uniform;
-  options.noise = 0.003;
-  options.random_motion = true;
-  const GroundTruthShape shape = make_shape("box_with_dome", options);
+  const Mesh mesh = testing::noisy_uniform_shape("box_with_dome");
   for (VertexWeights weights : {VertexWeights::Area, VertexWeights::Uniform}) {
-    const DualGraph graph(shape.mesh, weights);
+    const DualGraph graph(mesh, weights);
     std::mt19937_64 rng(7);
     for (int trial = 0; trial < 20; ++trial) {
-      std::vector<std::uint32_t> all(graph.face_count());
-      std::iota(all.begin(), all.end(), 0u);
-      std::shuffle(all.begin(), all.end(), rng);
+      const std::vector<std::uint32_t> all = shuffled_faces(graph, rng);
       const std::uint32_t f = all[0], g = all[1], h = all[2];
       const std::vector<std::uint32_t> cluster(all.begin() + 3, all.begin() + 3 + 5 * trial + 1);
       const ClusterStats stats = stats_of(graph, cluster);

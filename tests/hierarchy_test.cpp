@@ -176,13 +176,9 @@ TEST(Hierarchy, ComponentsAreJoinedOnlyByTrailingMergesCostedAboveAll) {
 }
 
 TEST(Hierarchy, SameInputGivesTheSameTreeBitForBit) {
-  ShapeOptions options;
-  options.tessellation = Tessellation::Uniform;
-  options.noise = 0.003;
-  options.random_motion = true;
-  const GroundTruthShape shape = make_shape("box_with_dome", options);
-  const std::string first = serialize_tree(build_hierarchy(shape.mesh));
-  const std::string second = serialize_tree(build_hierarchy(shape.mesh));
+  const Mesh mesh = testing::noisy_uniform_shape("box_with_dome");
+  const std::string first = serialize_tree(build_hierarchy(mesh));
+  const std::string second = serialize_tree(build_hierarchy(mesh));
   EXPECT_EQ(first, second);
 }
 

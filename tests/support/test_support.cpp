@@ -12,6 +12,8 @@
 #include <limits>
 #include <mutex>
 
+#include "primseg/shape_generator.hpp"
+
 namespace primseg::testing {
 
 std::filesystem::path cgal_mesh(const std::string& name) {
@@ -85,6 +87,14 @@ void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation,
 }  // namespace primseg::testing
 
 namespace primseg::testing {
+
+Mesh noisy_uniform_shape(const std::string& name) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.noise = 0.003;
+  options.random_motion = true;
+  return make_shape(name, options).mesh;
+}
 
 ClusterStats whole_mesh_stats(const DualGraph& graph) {
   ClusterStats stats = graph.face_stats(0, true);

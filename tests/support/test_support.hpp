@@ -62,6 +62,10 @@ Mesh grid_mesh(int rows, int cols, Surface&& p, bool alternate = false) {
   return Mesh::from_triangles(std::move(positions), std::move(triangles));
 }
 
+/// A generated shape (shape_generator.hpp) in its Uniform tessellation with random vertex motion
+/// and Gaussian noise of 0.3% of its size along the normals: a small scan-like input.
+Mesh noisy_uniform_shape(const std::string& name);
+
 /// Statistics of the whole mesh as one cluster, accumulated face by face and edge by edge the way
 /// the engine does (corner samples included), with moments centred at the centroid.
 ClusterStats whole_mesh_stats(const DualGraph& graph);
