@@ -2,12 +2,14 @@
 // adjacent clusters at every step and merges the cheapest gives the same tree, bit for bit, on
 // small noisy meshes and on clean ones, whose flat and exactly curved regions tie at cost zero
 // in large numbers (settled by the merged degree, then node ids). This guards the queue, the
-// bookkeeping of adjacency and shared edges, the caches and the parallel evaluation together.
+// bookkeeping of adjacency and shared edges, the caches and the parallel evaluation together, and
+// the reading of faces and pairs by their corners or their statistics (polygon faces, tori).
 #include <gtest/gtest.h>
 
-#include <optional>
-
+#include <cmath>
 #include <map>
+#include <optional>
+#include <random>
 #include <set>
 
 #include "model_selection.hpp"
@@ -32,7 +34,7 @@ std::vector<Merge> naive_greedy(const Mesh& mesh, const HierarchyOptions& option
   std::vector<std::optional<FaceCorners>> corners(graph.face_count());
   std::vector<std::uint32_t> node;
   for (std::uint32_t f = 0; f < graph.face_count(); ++f) {
-    stats.push_back(graph.face_stats(f));
+    stats.push_back(graph.face_stats(f, selector.needs_samples()));
     if (FaceCorners c; !selector.needs_samples() && graph.face_corners(f, c)) corners[f] = c;
     node.push_back(f);
   }
@@ -133,10 +135,13 @@ std::vector<Merge> naive_greedy(const Mesh& mesh, const HierarchyOptions& option
   return merges;
 }
 
-void expect_naive_greedy(const Mesh& mesh, const std::string& what) {
+void expect_naive_greedy(
+    const Mesh& mesh, const std::string& what,
+    const std::vector<PrimitiveType>& primitives = HierarchyOptions{}.primitives) {
   for (unsigned threads : {1u, 2u}) {
     HierarchyOptions options;
     options.threads = threads;
+    options.primitives = primitives;
     const Hierarchy tree = build_hierarchy(mesh, options);
     const std::vector<Merge> naive = naive_greedy(mesh, options);
     ASSERT_EQ(naive.size() + tree.component_count() - 1, tree.merges().size()) << what;
@@ -180,6 +185,63 @@ TEST(GreedyReference, CleanMeshesSettleTheirZeroCostTiesAsTheNaiveGreedyOrder) {
       expect_naive_greedy(
           mesh, std::string(name) + (tessellation == Tessellation::Cad ? " cad" : " uniform"));
     }
+}
+
+// Polygon faces: quads (two triangles, read by their corners, and pairs of them too), hexagons
+// (four triangles: a face by its corners, its pairs by their statistics) and octagons (six: by
+// their statistics), on a noisy curved sheet; and with the torus enabled, which reads every
+// cluster by its statistics (samples).
+TEST(GreedyReference, PolygonMeshesMergeInTheNaiveGreedyOrder) {
+  const int n = 14;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0, 0.01);
+  std::vector<Vec3> positions;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j)
+      positions.push_back(
+          {0.1 * i, 0.1 * j, 0.3 * std::sin(0.25 * i) * std::cos(0.2 * j) + noise(rng)});
+  auto id = [&](int i, int j) { return static_cast<std::uint32_t>(i * (n + 1) + j); };
+  std::vector<std::uint32_t> offsets{0}, vertices;
+  std::vector<bool> used(n * n, false);
+  auto add_face = [&](std::initializer_list<std::pair<int, int>> corners,
+                      std::initializer_list<std::pair<int, int>> cells) {
+    for (auto [i, j] : corners) vertices.push_back(id(i, j));
+    offsets.push_back(static_cast<std::uint32_t>(vertices.size()));
+    for (auto [i, j] : cells) used[i * n + j] = true;
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      if (used[i * n + j]) continue;
+      const bool fits_2x2 = i + 1 < n && j + 1 < n && !used[(i + 1) * n + j] &&
+                            !used[i * n + j + 1] && !used[(i + 1) * n + j + 1];
+      if (i % 6 == 0 && j % 6 == 0 && fits_2x2)
+        add_face({{i, j},
+                  {i + 1, j},
+                  {i + 2, j},
+                  {i + 2, j + 1},
+                  {i + 2, j + 2},
+                  {i + 1, j + 2},
+                  {i, j + 2},
+                  {i, j + 1}},
+                 {{i, j}, {i + 1, j}, {i, j + 1}, {i + 1, j + 1}});
+      else if (i % 4 == 1 && j % 5 == 2 && i + 1 < n && !used[(i + 1) * n + j])
+        add_face({{i, j}, {i + 1, j}, {i + 2, j}, {i + 2, j + 1}, {i + 1, j + 1}, {i, j + 1}},
+                 {{i, j}, {i + 1, j}});
+      else
+        add_face({{i, j}, {i + 1, j}, {i + 1, j + 1}, {i, j + 1}}, {{i, j}});
+    }
+  const Mesh mesh = Mesh::from_polygons(positions, offsets, vertices);
+  std::size_t hexagons = 0, octagons = 0;
+  for (std::size_t f = 0; f + 1 < offsets.size(); ++f) {
+    hexagons += offsets[f + 1] - offsets[f] == 6;
+    octagons += offsets[f + 1] - offsets[f] == 8;
+  }
+  ASSERT_GT(hexagons, 3u);
+  ASSERT_GT(octagons, 3u);
+  expect_naive_greedy(mesh, "polygon sheet");
+  expect_naive_greedy(
+      mesh, "polygon sheet with tori",
+      {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere, PrimitiveType::Torus});
 }
 
 }  // namespace
