@@ -520,17 +520,17 @@ class HierarchyBuilder::Impl {
     return scratch.cached_stats[entry];
   }
 
-  // Pairs of faces are most of the merged clusters alive at once (all of them at the peak on a
-  // subdivided mesh, 40% on a scan): reading them from their two faces saves their statistics'
-  // 568 bytes each. A pair is read by its corners when they are few (see pair_by_corners());
-  // else the most recent pairs' statistics are kept in a small cache (they are next to the
-  // clusters that grow): most reads of them hit it.
   // Whether a pair of faces of this many triangles is read by its corners (then it keeps no
   // statistics at all: uniting the faces' corners is cheap).
   bool pair_by_corners(std::uint32_t triangles) const {
     return by_corners_ && triangles <= FaceCorners::kMaxTriangles;
   }
 
+  // Pairs of faces are most of the merged clusters alive at once (all of them at the peak on a
+  // subdivided mesh, 40% on a scan): reading them from their two faces saves their statistics'
+  // 568 bytes each. A pair is read by its corners when they are few (see pair_by_corners());
+  // else the most recent pairs' statistics are kept in a small cache (they are next to the
+  // clusters that grow): most reads of them hit it.
   void store_pair(std::uint32_t slot, std::uint32_t edge_id, std::uint32_t triangles,
                   ClusterStats&& stats) {
     release_stats(slot);
