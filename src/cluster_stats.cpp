@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "union_placement.hpp"
+
 namespace primseg {
 namespace {
 
@@ -247,18 +249,13 @@ void ClusterStats::merge(const ClusterStats& other, const EdgeStats& shared_edge
 bool FaceCorners::unite(const FaceCorners& a, const FaceCorners& b, const EdgeStats& shared,
                         FaceCorners& united) {
   if (a.triangle_count + b.triangle_count > kMaxTriangles) return false;
-  const double wa = a.weight, wb = b.weight, w = wa + wb;
-  const Eigen::Vector3d gap = b.centroid - a.centroid;
-  // The parts' centroids from the union's, as ClusterView's (exact when a weight is zero).
-  Eigen::Vector3d shift_a = Eigen::Vector3d::Zero(), shift_b = gap;
-  united.centroid = a.centroid;
+  const double w = a.weight + b.weight;
+  const detail::UnionPlacement placement =
+      detail::place_union(a.weight, a.centroid, b.weight, b.centroid, w);
+  const Eigen::Vector3d &shift_a = placement.shift_a, &shift_b = placement.shift_b;
+  united.centroid = placement.centroid;
   united.second_moment = a.second_moment + b.second_moment;
-  if (w > 0) {
-    united.centroid = a.centroid + (wb / w) * gap;
-    shift_a = -(wb / w) * gap;
-    shift_b = (wa / w) * gap;
-    united.second_moment += (wa * wb / w) * gap * gap.transpose();
-  }
+  united.second_moment += placement.second_moment_gain;
   united.triangle_count = 0;
   for (const auto& [part, shift] : {std::pair(&a, shift_a), std::pair(&b, shift_b)}) {
     for (std::uint32_t t = 0; t < part->triangle_count; ++t, ++united.triangle_count) {

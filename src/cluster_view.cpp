@@ -15,6 +15,7 @@
 #include "primseg/cluster_view.hpp"
 
 #include "symmetric_eigen3.hpp"
+#include "union_placement.hpp"
 
 namespace primseg {
 namespace {
@@ -90,19 +91,13 @@ ClusterView::ClusterView(ClusterPart a, ClusterPart b, const EdgeStats& shared)
       triangle_count_(a.triangle_count() + b.triangle_count()),
       area_(a.area() + b.area()),
       normal_sum_(a.normal_sum() + b.normal_sum()) {
-  const double wa = a.weight(), wb = b.weight();
-  const Eigen::Vector3d gap = b.centroid() - a.centroid();
+  const detail::UnionPlacement placement =
+      detail::place_union(a.weight(), a.centroid(), b.weight(), b.centroid(), weight_);
+  centroid_ = placement.centroid;
+  shifts_[0] = placement.shift_a;
+  shifts_[1] = placement.shift_b;
   second_moment_ = a.second_moment() + b.second_moment();
-  if (weight_ > 0) {
-    // Exact when either weight is zero; the parts' centroids are δ_a = −wb/w gap and
-    // δ_b = wa/w gap from the union's.
-    centroid_ = a.centroid() + (wb / weight_) * gap;
-    shifts_[0] = -(wb / weight_) * gap;
-    shifts_[1] = (wa / weight_) * gap;
-    second_moment_ += (wa * wb / weight_) * gap * gap.transpose();
-  } else {
-    centroid_ = a.centroid();
-  }
+  second_moment_ += placement.second_moment_gain;
 }
 
 const ClusterView::Eigenpair& ClusterView::smallest_eigenpair() const {

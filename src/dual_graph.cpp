@@ -197,6 +197,17 @@ Links link_triangles(const Mesh& mesh, const SideBuckets& buckets,
 // The dual edges of ranges of faces, each face's links in the order (other face, edge, lower
 // triangle): the edges come sorted by face pair, and the links of one pair add in increasing edge
 // order, as they would after a stable sort of all links in edge order.
+// Triangle t's normal, oriented (negated where the orientation was flipped), of length twice its
+// area.
+inline Eigen::Vector3d oriented_normal(std::span<const Triangle> triangles,
+                                       std::span<const Eigen::Vector3d> positions,
+                                       std::span<const std::uint8_t> flipped, std::uint32_t t) {
+  const Triangle& tri = triangles[t];
+  const Eigen::Vector3d n =
+      (positions[tri[1]] - positions[tri[0]]).cross(positions[tri[2]] - positions[tri[0]]);
+  return flipped[t] ? Eigen::Vector3d(-n) : n;
+}
+
 class FaceLinks {
  public:
   FaceLinks(const Mesh& mesh, std::span<const Eigen::Vector3d> positions,
@@ -257,10 +268,7 @@ class FaceLinks {
   };
 
   Eigen::Vector3d oriented_normal(std::uint32_t t) const {
-    const Triangle& tri = triangles_[t];
-    const Eigen::Vector3d n =
-        (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
-    return flipped_[t] ? Eigen::Vector3d(-n) : n;
+    return primseg::oriented_normal(triangles_, positions_, flipped_, t);
   }
 
   void add_block(std::vector<Link>& block, std::vector<DualEdge>& edges,
@@ -589,6 +597,27 @@ std::array<double, 3> DualGraph::corner_weights(std::uint32_t t, double area) co
   return {area / 3, area / 3, area / 3};
 }
 
+inline Eigen::Vector3d DualGraph::triangle_centroid(std::uint32_t t) const {
+  const Triangle& tri = mesh_->triangles[t];
+  return (positions_[tri[0]] + positions_[tri[1]] + positions_[tri[2]]) / 3;
+}
+
+inline Eigen::Vector3d DualGraph::face_origin(std::uint32_t f, const Eigen::Vector3d& weighted_sum,
+                                              double weight) const {
+  if (weight > 0) return weighted_sum / weight;
+  return triangle_centroid(first_triangle_[f]);
+}
+
+inline EdgeStats DualGraph::internal_edges_of(std::uint32_t f) const {
+  EdgeStats edges;
+  if (first_triangle_[f + 1] - first_triangle_[f] <= 1) return edges;  // none inside a triangle
+  auto it =
+      std::lower_bound(internal_edges_.begin(), internal_edges_.end(), f,
+                       [](const auto& entry, std::uint32_t face) { return entry.first < face; });
+  for (; it != internal_edges_.end() && it->first == f; ++it) edges += it->second;
+  return edges;
+}
+
 bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
   const std::uint32_t begin = first_triangle_[f], end = first_triangle_[f + 1];
   if (end - begin > FaceCorners::kMaxTriangles) return false;
@@ -598,10 +627,8 @@ bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
   corners.triangle_count = end - begin;
   for (std::uint32_t t = begin; t < end; ++t) {
     const Triangle& tri = mesh_->triangles[t];
-    Eigen::Vector3d normal =
-        (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
-    if (flipped_[t]) normal = -normal;
     const std::uint32_t i = t - begin;
+    const Eigen::Vector3d normal = oriented_normal(mesh_->triangles, positions_, flipped_, t);
     corners.areas[i] = 0.5 * normal.norm();
     corners.area_normals[i] = 0.5 * normal;
     const std::array<double, 3> w = corner_weights(t, corners.areas[i]);
@@ -611,12 +638,8 @@ bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
       weight += w[k];
     }
   }
-  const Triangle& first = mesh_->triangles[begin];
-  corners.centroid =
-      weight > 0 ? Eigen::Vector3d(weighted_sum / weight)
-                 : Eigen::Vector3d(
-                       (positions_[first[0]] + positions_[first[1]] + positions_[first[2]]) / 3);
-  corners.weight = 0;
+  corners.centroid = face_origin(f, weighted_sum, weight);
+  corners.weight = weight;
   corners.second_moment.setZero();
   corners.normal_sum.setZero();
   corners.normal_position.setZero();
@@ -626,24 +649,15 @@ bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
     const std::uint32_t i = t - begin;
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d y = positions_[tri[k]] - corners.centroid;
-      const double w = corners.weights[3 * i + k];
       corners.offsets[3 * i + k] = y;
-      corners.weight += w;
-      corners.second_moment.noalias() += (w * y) * y.transpose();
+      corners.second_moment.noalias() += (corners.weights[3 * i + k] * y) * y.transpose();
     }
-    const Eigen::Vector3d centroid =
-        (positions_[tri[0]] + positions_[tri[1]] + positions_[tri[2]]) / 3;
-    corners.triangle_offsets[i] = centroid - corners.centroid;
+    corners.triangle_offsets[i] = triangle_centroid(t) - corners.centroid;
     corners.normal_position += corners.triangle_offsets[i] * corners.area_normals[i].transpose();
     corners.normal_sum += corners.area_normals[i];
     corners.area += corners.areas[i];
   }
-  corners.edges = {};
-  if (end - begin == 1) return true;  // no edge inside a triangle
-  auto it =
-      std::lower_bound(internal_edges_.begin(), internal_edges_.end(), f,
-                       [](const auto& entry, std::uint32_t face) { return entry.first < face; });
-  for (; it != internal_edges_.end() && it->first == f; ++it) corners.edges += it->second;
+  corners.edges = internal_edges_of(f);
   return true;
 }
 
@@ -676,23 +690,15 @@ void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_sampl
   for (std::uint32_t t = begin; t < end; ++t) {
     const Triangle& tri = mesh_->triangles[t];
     Corners& c = corners[t - begin];
-    c.normal =
-        (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
-    if (flipped_[t]) c.normal = -c.normal;
+    c.normal = oriented_normal(mesh_->triangles, positions_, flipped_, t);
     c.weights = corner_weights(t, 0.5 * c.normal.norm());
     for (int k = 0; k < 3; ++k) {
       weighted_sum += c.weights[k] * positions_[tri[k]];
       weight += c.weights[k];
     }
   }
-  if (weight > 0) {
-    stats.moments = Moments(weighted_sum / weight);
-  } else {
-    const Triangle& first = mesh_->triangles[begin];
-    stats.moments =
-        Moments((positions_[first[0]] + positions_[first[1]] + positions_[first[2]]) / 3);
-  }
-  stats.edges = {};
+  stats.moments = Moments(face_origin(f, weighted_sum, weight));
+  stats.edges = internal_edges_of(f);
   stats.normal_sum.setZero();
   stats.normal_position.setZero();
   stats.face_planes = {};
@@ -705,8 +711,7 @@ void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_sampl
     for (int k = 0; k < 3; ++k)
       stats.moments.add_point(positions_[tri[k]], c.weights[k], max_degree);
     const Eigen::Vector3d& n = c.normal;
-    const Eigen::Vector3d centroid =
-        (positions_[tri[0]] + positions_[tri[1]] + positions_[tri[2]]) / 3;
+    const Eigen::Vector3d centroid = triangle_centroid(t);
     stats.normal_position += (centroid - stats.moments.origin()) * (0.5 * n).transpose();
     stats.normal_sum += 0.5 * n;
     const double area = 0.5 * n.norm();
@@ -723,10 +728,6 @@ void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_sampl
     stats.area += area;
     ++stats.triangle_count;
   }
-  auto it =
-      std::lower_bound(internal_edges_.begin(), internal_edges_.end(), f,
-                       [](const auto& entry, std::uint32_t face) { return entry.first < face; });
-  for (; it != internal_edges_.end() && it->first == f; ++it) stats.edges += it->second;
   stats.moments.discard_first_moments();
 }
 

@@ -500,8 +500,7 @@ class HierarchyBuilder::Impl {
                         ClusterStats& fallback_stats, FaceCorners& fallback_corners) const {
     const std::uint32_t entry = face % Scratch::kCachedFaces;
     if (std::find(scratch.pinned.begin(), scratch.pinned.end(), entry) != scratch.pinned.end()) {
-      if (by_corners_ && graph_->face_corners(face, fallback_corners)) return fallback_corners;
-      graph_->face_stats(face, fallback_stats, selector_.needs_samples(), max_degree);
+      if (read_face(face, max_degree, fallback_stats, fallback_corners)) return fallback_corners;
       return fallback_stats;
     }
     scratch.pinned[pin] = entry;
@@ -509,15 +508,20 @@ class HierarchyBuilder::Impl {
         (!scratch.cached_by_corners[entry] && scratch.cached_degree[entry] < max_degree)) {
       scratch.cached_face[entry] = face;
       scratch.cached_by_corners[entry] =
-          by_corners_ && graph_->face_corners(face, scratch.cached_corners[entry]);
-      if (!scratch.cached_by_corners[entry]) {
-        graph_->face_stats(face, scratch.cached_stats[entry], selector_.needs_samples(),
-                           max_degree);
-        scratch.cached_degree[entry] = max_degree;
-      }
+          read_face(face, max_degree, scratch.cached_stats[entry], scratch.cached_corners[entry]);
+      scratch.cached_degree[entry] = max_degree;
     }
     if (scratch.cached_by_corners[entry]) return scratch.cached_corners[entry];
     return scratch.cached_stats[entry];
+  }
+
+  // Reads a face into `corners` (true), or into `stats` (moments up to max_degree) when its
+  // corners do not apply.
+  bool read_face(std::uint32_t face, int max_degree, ClusterStats& stats,
+                 FaceCorners& corners) const {
+    if (by_corners_ && graph_->face_corners(face, corners)) return true;
+    graph_->face_stats(face, stats, selector_.needs_samples(), max_degree);
+    return false;
   }
 
   // Whether a pair of faces of this many triangles is read by its corners (then it keeps no

@@ -103,6 +103,14 @@ class DualGraph {
   bool face_corners(std::uint32_t f, FaceCorners& corners) const;
 
  private:
+  // What face_stats() and face_corners() share: triangle t's centroid; the origin of face f's
+  // statistics (its corners' weighted centroid from their weighted sum, or its first triangle's
+  // centroid when they weigh nothing); the mesh edges between f's own triangles.
+  Eigen::Vector3d triangle_centroid(std::uint32_t t) const;
+  Eigen::Vector3d face_origin(std::uint32_t f, const Eigen::Vector3d& weighted_sum,
+                              double weight) const;
+  EdgeStats internal_edges_of(std::uint32_t f) const;
+
   const Mesh* mesh_;
   VertexWeights weights_;
   WorkingFrame frame_;
