@@ -189,7 +189,7 @@ Result process(const Item& item, const BatchOptions& o, const HierarchyOptions& 
   }
   try {
     check_file_limits(item.input, o.limits);
-    auto mesh = std::make_shared<const Mesh>(read_mesh(item.input));
+    auto mesh = std::make_shared<const Mesh>(read_geometry(item.input));
     result.faces = mesh->face_count();
     check_mesh_limits(*mesh, fs::file_size(item.input), o.limits);
     validate_level(o.level, mesh->face_count());

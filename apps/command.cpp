@@ -15,6 +15,16 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+Mesh read_geometry(const std::filesystem::path& path) {
+  Mesh mesh = read_mesh(path);
+  try {
+    check_geometric_range(mesh);
+  } catch (const InvalidInputError& error) {
+    throw InvalidInputError(path.string() + ": " + error.what());
+  }
+  return mesh;
+}
+
 std::vector<PrimitiveType> parse_primitives(const std::string& list) {
   std::vector<PrimitiveType> types;
   std::size_t begin = 0;

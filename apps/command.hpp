@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "level.hpp"
 #include "outputs.hpp"
 #include "primseg/hierarchy.hpp"
+#include "primseg/mesh.hpp"
 
 namespace primseg::cli {
 
@@ -34,6 +36,10 @@ Command add_view_command(CLI::App& app);
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start);
+
+/// read_mesh(), then check_geometric_range(), whose message gets the file's name: the commands
+/// that compute geometry read their meshes through this (`info` reads any finite coordinates).
+Mesh read_geometry(const std::filesystem::path& path);
 
 /// Parses "plane,sphere,cylinder" into types that have a fitter; throws InvalidInputError
 /// naming the unknown one and the available ones.

@@ -40,7 +40,7 @@ Command add_deform_command(CLI::App& app) {
             if (!(std::isfinite(o->band) && o->band >= 0))
               throw InvalidInputError("--band: must be a finite number >= 0");
             mesh_format_from_path(o->output);  // an unknown extension fails before any work
-            const Mesh mesh = read_mesh(o->mesh_path);
+            const Mesh mesh = read_geometry(o->mesh_path);
             const Skeleton skeleton = read_skeleton_file(o->skeleton_path);
             const std::vector<JointRotation> pose = read_pose_file(o->pose_path);
             if (skeleton.face_labels.size() != mesh.face_count())

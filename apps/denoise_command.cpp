@@ -89,7 +89,7 @@ Command add_denoise_command(CLI::App& app) {
             validate_output_files(o->level.files);
             mesh_format_from_path(o->output_path);  // an unknown extension fails before any work
             const auto start = Clock::now();
-            Mesh mesh = read_mesh(o->mesh_path);
+            Mesh mesh = read_geometry(o->mesh_path);
             validate_level(o->level.level, mesh.face_count());
             Denoiser denoiser(std::move(mesh), options);
             const bool automatic =

@@ -56,8 +56,8 @@ Command add_distance_command(CLI::App& app) {
             if (o->density) options.density = *o->density;
             options.seed = o->seed;
             options.threads = o->threads;
-            const Mesh a = read_mesh(o->first);
-            const Mesh b = read_mesh(o->second);
+            const Mesh a = read_geometry(o->first);
+            const Mesh b = read_geometry(o->second);
             const auto start = Clock::now();
             const MeshDistance d = mesh_distance(a, b, options);
             const double seconds = seconds_since(start);

@@ -50,7 +50,7 @@ Command add_segment_command(CLI::App& app) {
         validate_output_files(o->level.files);
         check_file_limits(o->mesh_path, o->limits);
         const auto read_start = Clock::now();
-        auto mesh = std::make_shared<const Mesh>(read_mesh(o->mesh_path));
+        auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path));
         const double read_seconds = seconds_since(read_start);
         check_mesh_limits(*mesh, std::filesystem::file_size(o->mesh_path), o->limits);
         validate_level(o->level.level, mesh->face_count());

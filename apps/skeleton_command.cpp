@@ -51,7 +51,7 @@ Command add_skeleton_command(CLI::App& app) {
             validate(options);
             if (!(std::isfinite(o->band) && o->band >= 0))
               throw InvalidInputError("--band: must be a finite number >= 0");
-            auto mesh = std::make_shared<const Mesh>(read_mesh(o->mesh_path));
+            auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path));
             validate_level(o->level, mesh->face_count());
             const auto build_start = Clock::now();
             HierarchyBuilder builder(mesh, options);

@@ -321,7 +321,7 @@ Command add_view_command(CLI::App& app) {
         options.primitives = parse_primitives(o->primitives);
         options.threads = o->threads;
         validate(options);
-        auto mesh = std::make_shared<const Mesh>(read_mesh(o->mesh_path));
+        auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path));
         if (!(std::isfinite(o->band) && o->band >= 0))
           throw InvalidInputError("--band: must be a finite number >= 0");
         if (o->clusters) validate_level({o->clusters, std::nullopt}, mesh->face_count());

@@ -46,6 +46,7 @@ void validate(const BilateralSmoothingOptions& options) {
 Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options) {
   validate(options);
   mesh.validate();
+  check_geometric_range(mesh);
   Mesh smoothed = mesh;
   const std::uint32_t face_count = mesh.triangle_count();
   if (face_count == 0) return smoothed;

@@ -68,10 +68,12 @@ Eigen::Vector3d surface_normal(const Primitive& primitive, const Eigen::Vector3d
 
 // The point nearest to x (approximately, for curved primitives) among the minimisers of the sum
 // of squared distances to `primitives`: Gauss–Newton on the tangent planes at the closest points,
-// each step the minimum-norm solution of the truncated normal equations.
+// each step the minimum-norm solution of the truncated normal equations. It stops when a step is
+// at round-off against |y| + `length`, a length of the neighbourhood (so that the result does not
+// depend on the units).
 Eigen::Vector3d least_squares_point(const Eigen::Vector3d& x,
                                     const std::vector<const Primitive*>& primitives,
-                                    double eigenvalue_ratio, int max_steps) {
+                                    double eigenvalue_ratio, int max_steps, double length) {
   if (primitives.size() == 1) return to_eigen(primitives[0]->closest_point(to_vec3(x)));
   Eigen::Vector3d y = x;
   for (int step = 0; step < max_steps; ++step) {
@@ -94,7 +96,7 @@ Eigen::Vector3d least_squares_point(const Eigen::Vector3d& x,
         delta += u * (u.dot(right_side) / values(k));
       }
     y += delta;
-    if (!(delta.norm() > 1e-14 * (1 + y.norm()))) break;
+    if (!(delta.norm() > 1e-14 * (length + y.norm()))) break;
   }
   return y;
 }
@@ -141,6 +143,9 @@ double signed_distance(PrimitiveType type, const Eigen::VectorXd& q, const Eigen
 // Gauss-Newton refinement of a sphere or cylinder on weighted points (geometric distances), each
 // step the minimum-norm least-squares solution (the parametrisation has free directions: a
 // cylinder's point along its axis, its axis length). nullopt when it does not lower the error.
+// It runs without units (lengths over the start's radius, weights over their sum), so that the
+// result does not depend on the input's units: the axis is a direction, its derivatives are taken
+// with the same step as the lengths', and the singular value threshold compares them.
 std::optional<Primitive> refine_curved(const Primitive& start,
                                        const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<double>& weights) {
@@ -148,24 +153,31 @@ std::optional<Primitive> refine_curved(const Primitive& start,
   const Eigen::Index k = sphere ? 4 : 7;
   const auto m = static_cast<Eigen::Index>(points.size());
   if (m < 2 * k || !(start.radius > 0)) return std::nullopt;
-  Eigen::VectorXd q(k);
-  q.head<3>() = to_eigen(start.point);
-  if (sphere) {
-    q(3) = start.radius;
-  } else {
-    q.segment<3>(3) = to_eigen(start.axis);
-    q(6) = start.radius;
+  const Eigen::Vector3d origin = to_eigen(start.point);
+  const double length = start.radius;
+  double total_weight = 0;
+  for (const double w : weights) total_weight += w;
+  if (!(total_weight > 0) || !std::isfinite(total_weight)) return std::nullopt;
+  std::vector<Eigen::Vector3d> scaled(points.size());
+  std::vector<double> root_weights(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    scaled[i] = (points[i] - origin) / length;
+    root_weights[i] = std::sqrt(weights[i] / total_weight);
   }
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(k);  // point (0: the start's), axis, radius (1)
+  if (!sphere) q.segment<3>(3) = to_eigen(start.axis);
+  q(k - 1) = 1;
   auto residuals = [&](const Eigen::VectorXd& params) {
     Eigen::VectorXd r(m);
     for (Eigen::Index i = 0; i < m; ++i)
-      r(i) = std::sqrt(weights[i]) * signed_distance(start.type, params, points[i]);
+      r(i) = root_weights[i] * signed_distance(start.type, params, scaled[i]);
     return r;
   };
   Eigen::VectorXd r = residuals(q);
   const double initial = r.squaredNorm();
+  if (!std::isfinite(initial)) return std::nullopt;
   double error = initial;
-  const double step = 1e-7 * start.radius;
+  constexpr double step = 1e-7;
   for (int iteration = 0; iteration < 15; ++iteration) {
     Eigen::MatrixXd jacobian(m, k);
     for (Eigen::Index j = 0; j < k; ++j) {
@@ -174,6 +186,7 @@ std::optional<Primitive> refine_curved(const Primitive& start,
       minus(j) -= step;
       jacobian.col(j) = (residuals(plus) - residuals(minus)) / (2 * step);
     }
+    if (!jacobian.allFinite()) break;  // Eigen's SVD reads out of its arrays on a NaN
     // Singular values below 1e-9 of the largest are the free directions: no step along them.
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinU | Eigen::ComputeThinV);
     svd.setThreshold(1e-9);
@@ -193,13 +206,11 @@ std::optional<Primitive> refine_curved(const Primitive& start,
   }
   if (!(error < initial)) return std::nullopt;
   Primitive refined = start;
-  refined.point = to_vec3(q.head<3>());
-  if (sphere) {
-    refined.radius = q(3);
-  } else {
+  refined.point = to_vec3(origin + length * q.head<3>());
+  refined.radius = length * q(k - 1);
+  if (!sphere) {
     const Eigen::Vector3d axis = q.segment<3>(3).normalized();
     refined.axis = to_vec3(axis.dot(to_eigen(start.axis)) < 0 ? Eigen::Vector3d(-axis) : axis);
-    refined.radius = q(6);
   }
   if (!(refined.radius > 0) || !std::isfinite(refined.radius)) return std::nullopt;
   return refined;
@@ -243,6 +254,7 @@ Denoiser::Denoiser(Mesh mesh, DenoiseOptions options)
     : mesh_(std::move(mesh)), options_(std::move(options)) {
   validate(options_);
   mesh_.validate();
+  check_geometric_range(mesh_);
   const std::uint32_t n = mesh_.vertex_count();
   input_normals_.reserve(mesh_.triangles.size());
   std::vector<double> edge_sum(n, 0);
@@ -544,8 +556,8 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
       for (std::size_t count = most; count >= fewest; --count) {
         chosen.clear();
         for (std::size_t i = 0; i < count; ++i) chosen.push_back(&primitives[clusters[i]]);
-        const Eigen::Vector3d target =
-            least_squares_point(x, chosen, eigenvalue_ratio, options_.max_solver_steps);
+        const Eigen::Vector3d target = least_squares_point(
+            x, chosen, eigenvalue_ratio, options_.max_solver_steps, local_edge_length_[v]);
         if (!target.allFinite() || (bounded && (target - x).norm() > bound) ||
             !keeps_orientation(v, target))
           continue;

@@ -224,6 +224,7 @@ class HierarchyBuilder::Impl {
         queue_(0, ComesFirst{&queued_pairs_}) {
     if (!mesh_) throw InvalidInputError("no mesh");
     mesh_->validate();
+    check_geometric_range(*mesh_);
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, options_.threads);
     const std::uint32_t f = mesh_->face_count();
     // Statistics are stored for clusters of three faces or more only (at most F / 3 live at

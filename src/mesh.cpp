@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <utility>
@@ -336,6 +337,37 @@ double bounding_box_diagonal(const Mesh& mesh) {
   }
   const double dx = high[0] - low[0], dy = high[1] - low[1], dz = high[2] - low[2];
   return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+void check_geometric_range(const Mesh& mesh) {
+  auto formatted = [](double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", x);
+    return std::string(text);
+  };
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+    for (const double x : mesh.positions[v])
+      if (!(std::abs(x) <= kMaxCoordinateMagnitude))
+        invalid("vertex " + std::to_string(v) + " has a coordinate of magnitude " +
+                formatted(std::abs(x)) + ", above the " + formatted(kMaxCoordinateMagnitude) +
+                " that primseg computes with");
+  // The extent of the triangles' corners (those of a valid mesh's faces); indices out of range
+  // are left to the caller's own checks.
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  Vec3 low{kInfinity, kInfinity, kInfinity}, high{-kInfinity, -kInfinity, -kInfinity};
+  for (const Triangle& t : mesh.triangles)
+    for (const std::uint32_t v : t)
+      if (v < mesh.positions.size())
+        for (int axis = 0; axis < 3; ++axis) {
+          low[axis] = std::min(low[axis], mesh.positions[v][axis]);
+          high[axis] = std::max(high[axis], mesh.positions[v][axis]);
+        }
+  double extent = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    if (low[axis] <= high[axis]) extent = std::max(extent, high[axis] - low[axis]);
+  if (extent > 0 && extent < kMinPositiveExtent)
+    invalid("the mesh spans " + formatted(extent) + " units, below the " +
+            formatted(kMinPositiveExtent) + " that primseg computes with");
 }
 
 }  // namespace primseg

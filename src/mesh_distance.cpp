@@ -313,10 +313,14 @@ OneSidedDistance measure(const Mesh& from, const TriangleBvh& to, const Distance
 
 OneSidedDistance one_sided_distance(const Mesh& from, const Mesh& to,
                                     const DistanceOptions& options) {
+  check_geometric_range(from);
+  check_geometric_range(to);
   return measure(from, TriangleBvh(to), options);
 }
 
 MeshDistance mesh_distance(const Mesh& a, const Mesh& b, const DistanceOptions& options) {
+  check_geometric_range(a);
+  check_geometric_range(b);
   MeshDistance result;
   result.a_to_b = measure(a, TriangleBvh(b), options);
   result.b_to_a = measure(b, TriangleBvh(a), options);

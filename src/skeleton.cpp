@@ -121,7 +121,8 @@ void describe_bones(const Mesh& mesh, std::span<const std::uint32_t> labels,
       axis = normalized(primitives[c].axis);
     } else {
       Eigen::Matrix3d moment = second[c];
-      if (!(moment.norm() > 0)) {  // zero-area cluster: its vertices' spread
+      // (Not norm(): squaring the entries, fourth powers of lengths, can underflow.)
+      if (!(moment.cwiseAbs().maxCoeff() > 0)) {  // zero-area cluster: its vertices' spread
         moment.setZero();
         for (const std::uint32_t v : cluster_vertices[c]) {
           const Vec3 d = mesh.positions[v] - centroid[c];

@@ -177,6 +177,7 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
   }
   try {
     mesh->validate();
+    check_geometric_range(*mesh);
   } catch (const Error& e) {
     r.fail(std::string("invalid mesh: ") + e.what());
   }

@@ -63,4 +63,21 @@ struct Mesh {
 /// Axis-aligned bounding box diagonal length of the vertices used by some face (0 for no faces).
 double bounding_box_diagonal(const Mesh& mesh);
 
+/// Largest coordinate magnitude the geometric operations accept (input units). Some of them work
+/// in input units with fourth powers of lengths (area-weighted second moments) and their squares:
+/// those stay normal doubles from kMinPositiveExtent to here, so that results do not depend on the
+/// units (scaling a mesh by a power of two scales every result exactly).
+inline constexpr double kMaxCoordinateMagnitude = 1e32;
+/// Smallest extent (largest side of the bounding box of the triangles' corners, input units) the
+/// geometric operations accept, other than 0 (every face collapsed to one point): see
+/// kMaxCoordinateMagnitude.
+inline constexpr double kMinPositiveExtent = 1e-32;
+
+/// Throws InvalidInputError naming the problem when a valid mesh's coordinates are outside the
+/// range the geometric operations compute with in input units (hierarchy, denoising, smoothing,
+/// distances): a coordinate of magnitude above kMaxCoordinateMagnitude, or a positive extent
+/// below kMinPositiveExtent. Reading and writing meshes accept every finite coordinate; this is
+/// checked where the geometry starts.
+void check_geometric_range(const Mesh& mesh);
+
 }  // namespace primseg

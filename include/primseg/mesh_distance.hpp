@@ -75,9 +75,9 @@ struct MeshDistance {
   double diagonal = 0;
 };
 
-/// Compares two meshes. Throws InvalidInputError when either has no triangle of positive area,
-/// or for options out of range (zero samples, a negative or non-finite density, a density that
-/// asks for more than 10⁹ samples).
+/// Compares two meshes. Throws InvalidInputError when either has no triangle of positive area or
+/// coordinates outside check_geometric_range()'s range, or for options out of range (zero
+/// samples, a negative or non-finite density, a density that asks for more than 10⁹ samples).
 MeshDistance mesh_distance(const Mesh& a, const Mesh& b, const DistanceOptions& options = {});
 
 /// One side only: samples on `from`, distances to `to`.

@@ -68,6 +68,18 @@ def test_bad_arrays_raise_value_error(name, entry_point):
         assert isinstance(raised.value, primseg.InvalidInputError)
 
 
+@pytest.mark.parametrize("entry_point", [name for name in ENTRY_POINTS if name != "Mesh"])
+def test_coordinates_outside_the_supported_range_raise_value_error(entry_point):
+    # A Mesh holds any finite coordinates; the geometry refuses what it cannot compute with.
+    far = V_OK.copy()
+    far[2, 1] = 1e40
+    primseg.Mesh(far, F_OK)
+    with pytest.raises(primseg.InvalidInputError, match=r"vertex 2 has a coordinate of magnitude 1e\+40"):
+        ENTRY_POINTS[entry_point](far, F_OK)
+    with pytest.raises(primseg.InvalidInputError, match=r"the mesh spans 1e-40 units, below the 1e-32"):
+        ENTRY_POINTS[entry_point](V_OK * 1e-40, F_OK)
+
+
 def test_segment_argument_errors(fandisk):
     mesh = primseg.read_mesh(fandisk)
     with pytest.raises(ValueError, match="segment.V, F.: F is missing"):

@@ -708,6 +708,8 @@ TEST(Cli, BadMeshFilesAreRejectedWithAMessage) {
   write_file(dir / "nofaces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
   write_file(dir / "garbage.stl", std::string(40, '\x01'));
   write_file(dir / "huge.off", "OFF\n3 4000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  write_file(dir / "far.off", "OFF\n3 1 0\n0 0 0\n1e40 0 0\n0 1 0\n3 0 1 2\n");
+  write_file(dir / "speck.off", "OFF\n3 1 0\n0 0 0\n1e-40 0 0\n0 1e-40 0\n3 0 1 2\n");
   fs::create_directories(dir / "directory.off");
 
   const std::vector<BadCase> cases = {
@@ -722,6 +724,13 @@ TEST(Cli, BadMeshFilesAreRejectedWithAMessage) {
       {"no faces (OBJ)", "segment " + dir.q("nofaces.obj"), {"no faces"}},
       {"face count beyond the file", "segment " + dir.q("huge.off"), {"huge.off"}},
       {"garbage STL", "segment " + dir.q("garbage.stl"), {"garbage.stl"}},
+      {"coordinate beyond the range", "segment " + dir.q("far.off"), {"1e+40", "1e+32"}},
+      {"extent below the range",
+       "denoise " + dir.q("speck.off") + " --clusters 1 -o " + dir.q("out.off"),
+       {"spans 1e-40", "1e-32"}},
+      {"distance beyond the range",
+       "distance " + dir.q("far.off") + " " + dir.q("box.off"),
+       {"1e+40"}},
       {"directory as mesh", "segment " + dir.q("directory.off"), {"directory.off"}},
       {"info on a missing file", "info " + dir.q("missing.off"), {"missing.off"}},
       {"info on a truncated file", "info " + dir.q("truncated.ply"), {"truncated.ply"}},
