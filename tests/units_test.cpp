@@ -1,8 +1,9 @@
 // Results do not depend on the units. Scaling a mesh by a power of two is exact in floating point,
-// so every result must follow it exactly: the same tree, the same labels, and every length of every
-// primitive, denoised position, bone and distance scaled by the same factor, bit for bit. An
-// absolute constant anywhere in a computation (a step, a threshold, an epsilon) breaks this.
-// Coordinates outside the range the geometry computes with are rejected with a message.
+// so every result must follow it exactly: the same tree, the same labels (refined borders
+// included), the same skin weights, and every length of every primitive, denoised or posed
+// position, bone and distance scaled by the same factor, bit for bit. An absolute constant
+// anywhere in a computation (a step, a threshold, an epsilon) breaks this. Coordinates outside
+// the range the geometry computes with are rejected with a message.
 
 #include <gtest/gtest.h>
 
@@ -15,8 +16,10 @@
 #include "primseg/error.hpp"
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh_distance.hpp"
+#include "primseg/refine.hpp"
 #include "primseg/shape_generator.hpp"
 #include "primseg/skeleton.hpp"
+#include "primseg/skinning.hpp"
 
 namespace primseg {
 namespace {
@@ -95,6 +98,16 @@ TEST_P(Units, ScalingByAPowerOfTwoScalesEveryResultExactly) {
     EXPECT_EQ(reports[c].rms, factor * unit_reports[c].rms) << what;
   }
 
+  // Boundary refinement of a finer level.
+  const RefinedLevel unit_refined = refine_boundaries(unit_tree, cut_by_count(unit_tree, 20));
+  const RefinedLevel refined = refine_boundaries(tree, cut_by_count(tree, 20));
+  EXPECT_GT(unit_refined.moved_faces, 0u);
+  EXPECT_EQ(refined.segmentation.labels, unit_refined.segmentation.labels);
+  ASSERT_EQ(refined.reports.size(), unit_refined.reports.size());
+  for (std::size_t c = 0; c < refined.reports.size(); ++c)
+    expect_same_primitive(unit_refined.reports[c].primitive, refined.reports[c].primitive, factor,
+                          "refined cluster " + std::to_string(c));
+
   // Denoising, plain at the true level and bilateral at the automatic one.
   for (const bool bilateral : {false, true}) {
     SCOPED_TRACE(bilateral ? "bilateral, auto" : "plain, true level");
@@ -132,6 +145,21 @@ TEST_P(Units, ScalingByAPowerOfTwoScalesEveryResultExactly) {
   for (std::size_t j = 0; j < skeleton.joints.size(); ++j)
     expect_scaled(unit_skeleton.joints[j].position, skeleton.joints[j].position, factor,
                   "joint " + std::to_string(j));
+  // Skin weights are unitless; a pose moves the vertices by scaled amounts.
+  const SkinWeights unit_weights = compute_skin_weights(unit.noisy, unit_skeleton);
+  const SkinWeights weights = compute_skin_weights(noisy, skeleton);
+  EXPECT_EQ(weights.bones, unit_weights.bones);
+  EXPECT_EQ(weights.weights, unit_weights.weights);
+  const std::vector<JointRotation> pose = {{0, {0, 0, 1}, 0.5}};
+  const Mesh unit_posed = deform(unit.noisy, unit_skeleton, pose);
+  const Mesh posed = deform(noisy, skeleton, pose);
+  std::uint32_t posed_moved = 0;
+  for (std::uint32_t v = 0; v < noisy.vertex_count(); ++v) {
+    expect_scaled(unit_posed.positions[v], posed.positions[v], factor,
+                  "posed vertex " + std::to_string(v));
+    posed_moved += posed.positions[v] != noisy.positions[v];
+  }
+  EXPECT_GT(posed_moved, 0u);
 
   // Metro-style distances.
   DistanceOptions measure;
