@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "command.hpp"
+#include "primseg/error.hpp"
 #include "primseg/mesh_info.hpp"
 #include "primseg/mesh_io.hpp"
 
@@ -13,7 +14,8 @@ Command add_info_command(CLI::App& app) {
   info->add_option("MESH", *path, "Input mesh")->required();
 
   return {info, [path] {
-            const MeshInfo i = describe_mesh(read_mesh(*path));
+            const Mesh mesh = read_mesh(*path);
+            const MeshInfo i = describe_mesh(mesh);
             std::printf("%s\n", path->c_str());
             std::printf("  vertices            %u (%u isolated)\n", i.vertices,
                         i.isolated_vertices);
@@ -27,6 +29,12 @@ Command add_info_command(CLI::App& app) {
             std::printf("  bounding box        [%g %g %g] - [%g %g %g], diagonal %g\n",
                         i.bbox_min[0], i.bbox_min[1], i.bbox_min[2], i.bbox_max[0], i.bbox_max[1],
                         i.bbox_max[2], i.bbox_diagonal);
+            // Reported, not refused: info is where a user finds out why the others refuse.
+            try {
+              check_geometric_range(mesh);
+            } catch (const InvalidInputError& error) {
+              std::printf("  out of range        %s\n", error.what());
+            }
           }};
 }
 

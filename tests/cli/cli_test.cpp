@@ -662,6 +662,19 @@ TEST(Cli, InfoPrintsFandiskCounts) {
   }
   EXPECT_TRUE(vertices) << r.output;
   EXPECT_TRUE(faces) << r.output;
+  EXPECT_EQ(r.output.find("out of range"), std::string::npos) << r.output;
+}
+
+TEST(Cli, InfoReportsCoordinatesTheOtherCommandsRefuse) {
+  TempDir dir("info-range");
+  write_file(dir / "far.off", "OFF\n3 1 0\n0 0 0\n1e40 0 0\n0 1 0\n3 0 1 2\n");
+  const CliRun info = run("info " + dir.q("far.off"));
+  ASSERT_EXIT_OK(info);
+  EXPECT_NE(info.output.find("out of range        vertex 1 has a coordinate of magnitude 1e+40"),
+            std::string::npos)
+      << info.output;
+  const CliRun segment = run("segment " + dir.q("far.off") + " --quiet");
+  EXPECT_EQ(segment.status, 1) << segment.output;
 }
 
 // ---------------------------------------------------------------------------------------------
