@@ -323,18 +323,29 @@ void Mesh::validate() const {
   }
 }
 
-double bounding_box_diagonal(const Mesh& mesh) {
-  if (mesh.polygon_vertices.empty()) return 0.0;
-  Vec3 low{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-           std::numeric_limits<double>::infinity()};
-  Vec3 high{-low[0], -low[1], -low[2]};
-  for (std::uint32_t vertex : mesh.polygon_vertices) {
+namespace {
+
+// Axis-aligned bounds of the vertices used by some face (indices out of range skipped, for the
+// callers that take meshes unvalidated); low > high on every axis when there are none.
+std::pair<Vec3, Vec3> face_vertex_bounds(const Mesh& mesh) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  Vec3 low{kInfinity, kInfinity, kInfinity}, high{-kInfinity, -kInfinity, -kInfinity};
+  for (const std::uint32_t vertex : mesh.polygon_vertices) {
+    if (vertex >= mesh.positions.size()) continue;
     const Vec3& p = mesh.positions[vertex];
     for (int axis = 0; axis < 3; ++axis) {
       low[axis] = std::min(low[axis], p[axis]);
       high[axis] = std::max(high[axis], p[axis]);
     }
   }
+  return {low, high};
+}
+
+}  // namespace
+
+double bounding_box_diagonal(const Mesh& mesh) {
+  if (mesh.polygon_vertices.empty()) return 0.0;
+  const auto [low, high] = face_vertex_bounds(mesh);
   const double dx = high[0] - low[0], dy = high[1] - low[1], dz = high[2] - low[2];
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
@@ -351,17 +362,7 @@ void check_geometric_range(const Mesh& mesh) {
         invalid("vertex " + std::to_string(v) + " has a coordinate of magnitude " +
                 formatted(std::abs(x)) + ", above the " + formatted(kMaxCoordinateMagnitude) +
                 " that primseg computes with");
-  // The extent of the triangles' corners (those of a valid mesh's faces); indices out of range
-  // are left to the caller's own checks.
-  constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  Vec3 low{kInfinity, kInfinity, kInfinity}, high{-kInfinity, -kInfinity, -kInfinity};
-  for (const Triangle& t : mesh.triangles)
-    for (const std::uint32_t v : t)
-      if (v < mesh.positions.size())
-        for (int axis = 0; axis < 3; ++axis) {
-          low[axis] = std::min(low[axis], mesh.positions[v][axis]);
-          high[axis] = std::max(high[axis], mesh.positions[v][axis]);
-        }
+  const auto [low, high] = face_vertex_bounds(mesh);
   double extent = 0;
   for (int axis = 0; axis < 3; ++axis)
     if (low[axis] <= high[axis]) extent = std::max(extent, high[axis] - low[axis]);

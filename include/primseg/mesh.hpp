@@ -68,8 +68,8 @@ double bounding_box_diagonal(const Mesh& mesh);
 /// those stay normal doubles from kMinPositiveExtent to here, so that results do not depend on the
 /// units (scaling a mesh by a power of two scales every result exactly).
 inline constexpr double kMaxCoordinateMagnitude = 1e32;
-/// Smallest extent (largest side of the bounding box of the triangles' corners, input units) the
-/// geometric operations accept, other than 0 (every face collapsed to one point): see
+/// Smallest extent (largest side of the bounding box of the vertices used by some face, input
+/// units) the geometric operations accept, other than 0 (every face collapsed to one point): see
 /// kMaxCoordinateMagnitude.
 inline constexpr double kMinPositiveExtent = 1e-32;
 
