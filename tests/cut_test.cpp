@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <set>
+#include <vector>
 
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
@@ -22,8 +23,15 @@ TEST(Cut, EveryCountFromOneToFGivesThatManyClustersOrderedByArea) {
     ASSERT_EQ(seg.cluster_count(), k);
     EXPECT_EQ(std::set<std::uint32_t>(seg.labels.begin(), seg.labels.end()).size(), k);
     const auto reports = describe_clusters(h, seg);
-    for (std::size_t c = 1; c < reports.size(); ++c)
+    // Equal areas (the block's triangles come in congruent pairs) by their lowest face.
+    std::vector<std::uint32_t> lowest_face(k, h.face_count());
+    for (std::uint32_t f = h.face_count(); f-- > 0;) lowest_face[seg.labels[f]] = f;
+    for (std::size_t c = 1; c < reports.size(); ++c) {
       EXPECT_GE(reports[c - 1].area, reports[c].area);
+      if (reports[c - 1].area == reports[c].area) {
+        EXPECT_LT(lowest_face[c - 1], lowest_face[c]) << "k " << k << ", clusters " << c - 1;
+      }
+    }
     std::uint32_t faces = 0;
     for (const auto& r : reports) faces += r.face_count;
     EXPECT_EQ(faces, h.face_count());
@@ -50,6 +58,10 @@ TEST(Cut, ToleranceKeepsNodesWhoseRmsEstimateFits) {
     previous = seg.cluster_count();
   }
   EXPECT_EQ(cut_by_tolerance(h, 1e3).cluster_count(), 1u);
+  // "Within the tolerance" includes it: a node whose estimate equals it is kept.
+  const std::uint32_t root = h.node_count() - 1;
+  EXPECT_EQ(cut_by_tolerance(h, h.rms_estimate(root)).cluster_count(), 1u);
+  EXPECT_GT(cut_by_tolerance(h, std::nextafter(h.rms_estimate(root), 0.0)).cluster_count(), 1u);
   EXPECT_THROW(cut_by_tolerance(h, -1), InvalidInputError);
 }
 

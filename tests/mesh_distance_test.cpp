@@ -102,6 +102,14 @@ TEST(MeshDistance, OneSidedFiguresOfAnOverhangMatchTheirIntegrals) {
   EXPECT_NEAR(d.b_to_a.rms, std::sqrt(1.0 / 6), 0.005);
   EXPECT_EQ(d.b_to_a.max, 1);
   EXPECT_EQ(d.hausdorff, 1);
+  // Symmetric figures are the larger side's (Metro's convention), in either order.
+  EXPECT_EQ(d.mean, d.b_to_a.mean);
+  EXPECT_EQ(d.rms, d.b_to_a.rms);
+  const MeshDistance swapped = mesh_distance(rectangle(2, 0), rectangle(1, 0));
+  EXPECT_EQ(swapped.mean, swapped.a_to_b.mean);
+  EXPECT_EQ(swapped.rms, swapped.a_to_b.rms);
+  EXPECT_EQ(swapped.hausdorff, 1);
+  EXPECT_NEAR(d.diagonal, std::sqrt(5.0), 1e-12);  // of both meshes' bounding box
 }
 
 TEST(MeshDistance, SameBitsForAnyThreadCountAndDensityCountsSamples) {

@@ -75,11 +75,15 @@ TEST(RefineBoundaries, LeavesExactSegmentationsAlone) {
   EXPECT_EQ(refined.segmentation.labels, cut.labels);
 }
 
-TEST(RefineBoundaries, PutsAMisplacedBorderFaceBack) {
+// A box of six exact planes, uniformly tessellated: its level of 6 is the truth.
+Hierarchy uniform_box_hierarchy() {
   ShapeOptions options;
   options.tessellation = Tessellation::Uniform;
-  const GroundTruthShape shape = make_shape("box", options);
-  const Hierarchy h = build_hierarchy(shape.mesh);
+  return build_hierarchy(make_shape("box", options).mesh);
+}
+
+TEST(RefineBoundaries, PutsAMisplacedBorderFaceBack) {
+  const Hierarchy h = uniform_box_hierarchy();
   Segmentation cut = cut_by_count(h, 6);
   const std::vector<std::uint32_t> truth = cut.labels;
   // Hand a face in the middle of a border of cluster 0 to its neighbour; both stay connected.
@@ -106,6 +110,27 @@ TEST(RefineBoundaries, PutsAMisplacedBorderFaceBack) {
   const RefinedLevel refined = refine_boundaries(h, cut);
   EXPECT_EQ(refined.segmentation.labels, truth);
   EXPECT_GE(refined.moved_faces, 1u);
+}
+
+TEST(RefineBoundaries, AClusterWhoseFacesAllFitNeighboursBetterKeepsOne) {
+  const Hierarchy h = uniform_box_hierarchy();
+  Segmentation cut = cut_by_count(h, 6);
+  // A seventh cluster of two faces across a box edge: its plane fits neither, and each face lies
+  // exactly on its old side's plane, so both want to go back.
+  const DualEdge* across = nullptr;
+  for (const DualEdge& e : h.graph().edges())
+    if (cut.labels[e.first] != cut.labels[e.second]) {
+      across = &e;
+      break;
+    }
+  ASSERT_NE(across, nullptr);
+  cut.labels[across->first] = cut.labels[across->second] = 6;
+  cut.nodes.push_back(across->first);  // a leaf: the fit starts from that face's plane
+  const RefinedLevel refined = refine_boundaries(h, cut);
+  ASSERT_EQ(refined.reports.size(), 7u);
+  EXPECT_EQ(refined.moved_faces, 1u);
+  for (const ClusterReport& r : refined.reports) EXPECT_GT(r.face_count, 0u);
+  for (int c : components(h, refined.segmentation.labels, 7)) EXPECT_EQ(c, 1);
 }
 
 TEST(RefineBoundaries, RejectsBadInput) {

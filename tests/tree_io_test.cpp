@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <string>
+
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
 #include "primseg/shape_generator.hpp"
@@ -54,6 +58,59 @@ TEST(TreeIo, CorruptTruncatedAndForeignFilesGiveClearErrors) {
                ParseError);
   EXPECT_THROW(deserialize_tree(std::string()), ParseError);
   EXPECT_THROW(read_tree("/nonexistent/primseg.tree"), IoError);
+}
+
+// The checksum guards against accidents, not against a writer that gets the content wrong: every
+// content check must hold behind a valid checksum too (FNV-1a 64, as docs/tree-format.md says).
+std::string with_checksum(std::string body) {
+  std::uint64_t hash = 14695981039346656037ull;
+  for (const char c : body) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 1099511628211ull;
+  }
+  for (int i = 0; i < 8; ++i) body.push_back(static_cast<char>((hash >> (8 * i)) & 0xff));
+  return body;
+}
+
+void expect_parse_error(const std::string& bytes, const std::string& message) {
+  try {
+    deserialize_tree(bytes, "x.tree");
+    ADD_FAILURE() << "accepted; expected an error containing \"" << message << "\"";
+  } catch (const ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("x.tree"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TreeIo, BadContentIsRejectedBehindAValidChecksum) {
+  const std::string bytes = serialize_tree(sample_hierarchy());
+  const std::string body = bytes.substr(0, bytes.size() - 8);
+  ASSERT_EQ(with_checksum(body), bytes);  // the test's checksum is the format's
+  // Offsets from docs/tree-format.md: magic 8, version u32, weights u8, exact_costs u8, n u8,
+  // then the n types.
+  constexpr std::size_t kVersion = 8, kWeights = 12, kFirstType = 15;
+
+  std::string version = body;
+  version[kVersion] = 2;
+  expect_parse_error(with_checksum(version), "version 2 is not supported");
+
+  std::string weights = body;
+  weights[kWeights] = 2;
+  expect_parse_error(with_checksum(weights), "unknown vertex weighting 2");
+
+  std::string type = body;
+  type[kFirstType] = 9;
+  expect_parse_error(with_checksum(type), "unknown primitive type 9");
+
+  expect_parse_error(with_checksum(body + "extra"), "unexpected data after the merges");
+  expect_parse_error(with_checksum(body.substr(0, body.size() - 1)), "exceeds the file size");
+
+  // The last merge (110 bytes before the checksum) names its second child as its first.
+  std::string self_merge = body;
+  const std::size_t last = body.size() - 110;
+  std::copy_n(body.begin() + static_cast<std::ptrdiff_t>(last), 4,
+              self_merge.begin() + static_cast<std::ptrdiff_t>(last + 4));
+  expect_parse_error(with_checksum(self_merge), "invalid tree");
 }
 
 }  // namespace

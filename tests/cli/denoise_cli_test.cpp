@@ -7,8 +7,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "primseg/denoise.hpp"
+#include "primseg/mesh_distance.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/shape_generator.hpp"
 #include "support/test_support.hpp"
@@ -154,6 +156,35 @@ TEST(CliDenoise, RelabelPassesAreTheLibrarysOption) {
       << output;
 }
 
+TEST(CliDenoise, SnappingOptionsAreTheLibrarys) {
+  const Files f = noisy_box();
+  auto library = [&](const DenoiseOptions& options) {
+    Denoiser denoiser(read_mesh(f.noisy), options);
+    denoiser.iterate(level_by_count(8));
+    return denoiser.mesh().positions;
+  };
+  const auto defaults = library({});
+  struct Case {
+    std::string flag;
+    DenoiseOptions options;
+  };
+  std::vector<Case> cases(2);
+  cases[0].flag = "--max-move 0.25";
+  cases[0].options.max_move_edge_lengths = 0.25;
+  cases[1].flag = "--min-crease-angle 0";
+  cases[1].options.min_crease_angle_degrees = 0;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.flag);
+    const fs::path out = f.dir / "snapped.ply";
+    std::string output;
+    ASSERT_EQ(primseg({"denoise", q(f.noisy), "--clusters 8 -q", c.flag, "-o", q(out)}, &output), 0)
+        << output;
+    const auto expected = library(c.options);
+    EXPECT_EQ(read_mesh(out).positions, expected);
+    EXPECT_NE(expected, defaults);  // the option changes something on this mesh
+  }
+}
+
 TEST(CliDenoise, BadUsageFailsWithAMessage) {
   const Files f = noisy_box();
   std::string output;
@@ -178,6 +209,28 @@ TEST(CliDistance, PrintsATableAndIsReproducible) {
             0);
   EXPECT_NE(first.find("symmetric"), std::string::npos) << first;
   EXPECT_EQ(first, second);
+
+  // --seed draws other samples: the library's figures for that seed.
+  for (const std::uint64_t seed : {1u, 7u}) {
+    std::string output;
+    ASSERT_EQ(primseg({"distance", q(f.noisy), q(f.clean), "--samples 20000 --json - --seed",
+                       std::to_string(seed)},
+                      &output),
+              0)
+        << output;
+    DistanceOptions options;
+    options.samples = 20000;
+    options.seed = seed;
+    const MeshDistance expected = mesh_distance(read_mesh(f.noisy), read_mesh(f.clean), options);
+    const nlohmann::json json = nlohmann::json::parse(output);
+    EXPECT_EQ(json["a_to_b"]["rms"].get<double>(), expected.a_to_b.rms) << seed;
+    EXPECT_EQ(json["b_to_a"]["mean"].get<double>(), expected.b_to_a.mean) << seed;
+  }
+  EXPECT_NE(distance_json(f.noisy, f.clean)["a_to_b"]["rms"].get<double>(), [&] {
+    std::string output;
+    primseg({"distance", q(f.noisy), q(f.clean), "--samples 50000 --json - --seed 7"}, &output);
+    return nlohmann::json::parse(output)["a_to_b"]["rms"].get<double>();
+  }());
 }
 
 }  // namespace

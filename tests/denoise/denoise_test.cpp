@@ -8,7 +8,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "denoise_test_support.hpp"
 #include "marching_tetrahedra.hpp"
@@ -303,6 +306,39 @@ TEST(Denoise, RejectsBadOptionsAndAMismatchedHierarchy) {
     options.noise_tolerance_factor = factor;
     EXPECT_THROW(Denoiser(box.noisy.mesh, options), InvalidInputError) << factor;
   }
+  // Every rule of validate(DenoiseOptions), each on its own, and the smallest valid values.
+  const std::vector<std::pair<const char*, std::function<void(DenoiseOptions&)>>> invalid = {
+      {"outlier threshold -1", [](DenoiseOptions& o) { o.refit_outlier_threshold = -1; }},
+      {"outlier threshold NaN",
+       [](DenoiseOptions& o) {
+         o.refit_outlier_threshold = std::numeric_limits<double>::quiet_NaN();
+       }},
+      {"smoothing steps -1", [](DenoiseOptions& o) { o.smoothing_steps = -1; }},
+      {"Taubin and bilateral",
+       [](DenoiseOptions& o) {
+         o.smoothing_steps = 1;
+         o.bilateral_smoothing = BilateralSmoothingOptions{};
+       }},
+      {"relabel passes -1", [](DenoiseOptions& o) { o.relabel_passes = -1; }},
+      {"solver steps 0", [](DenoiseOptions& o) { o.max_solver_steps = 0; }},
+      {"max move NaN",
+       [](DenoiseOptions& o) {
+         o.max_move_edge_lengths = std::numeric_limits<double>::quiet_NaN();
+       }},
+      {"crease angle -1", [](DenoiseOptions& o) { o.min_crease_angle_degrees = -1; }},
+  };
+  for (const auto& [name, change] : invalid) {
+    options = {};
+    change(options);
+    EXPECT_THROW(validate(options), InvalidInputError) << name;
+  }
+  options = {};
+  options.max_solver_steps = 1;
+  options.relabel_passes = 0;
+  options.smoothing_steps = 0;
+  options.refit_outlier_threshold = 0;
+  options.min_crease_angle_degrees = 0;
+  EXPECT_NO_THROW(validate(options));
 
   Denoiser denoiser(box.noisy.mesh);
   const Hierarchy other = build_hierarchy(noisy_shape("box", 0.004, 0.2).noisy.mesh);

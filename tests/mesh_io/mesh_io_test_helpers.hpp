@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
+#include <numbers>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "primseg/error.hpp"
@@ -41,6 +44,18 @@ std::string expect_error(std::string_view bytes, MeshFormat format, std::string_
     ADD_FAILURE() << "wrong exception type: " << error.what();
   }
   return {};
+}
+
+/// One face: the regular n-gon inscribed in the unit circle of the xy plane, counter-clockwise.
+inline Mesh regular_polygon(std::uint32_t n) {
+  std::vector<Vec3> positions;
+  std::vector<std::uint32_t> loop;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const double angle = 2 * std::numbers::pi * i / n;
+    positions.push_back({std::cos(angle), std::sin(angle), 0.0});
+    loop.push_back(i);
+  }
+  return Mesh::from_polygons(std::move(positions), {0, n}, std::move(loop));
 }
 
 /// MeshWriteOptions without designated initializers (which warn about the fields left out).

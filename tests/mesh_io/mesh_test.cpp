@@ -76,6 +76,17 @@ TEST(MeshFromPolygons, ConcaveLShapedHexagonGivesFourTrianglesInsideIt) {
   expect_tiles_polygon({{1, 1, 0}, {1, 2, 0}, {0, 2, 0}, {0, 0, 0}, {2, 0, 0}, {2, 1, 0}}, 3.0);
 }
 
+TEST(MeshFromPolygons, FlatVerticesNeverMakeDegenerateTriangles) {
+  // A square with a vertex in the middle of every side, starting at one of them: clipping a flat
+  // vertex would make a triangle of zero area (expect_tiles_polygon wants every area positive).
+  expect_tiles_polygon(
+      {{1, 0, 0}, {2, 0, 0}, {2, 1, 0}, {2, 2, 0}, {1, 2, 0}, {0, 2, 0}, {0, 1, 0}, {0, 0, 0}},
+      4.0);
+  // The same with three vertices on one side.
+  expect_tiles_polygon(
+      {{0.5, 0, 0}, {1, 0, 0}, {1.5, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {0, 0, 0}}, 4.0);
+}
+
 TEST(MeshFromPolygons, CombWithManyReflexVerticesIsTiled) {
   // A comb: a base strip 0 <= y <= 1 with n teeth up to y = 3 between notches.
   const int teeth = 25;
@@ -161,14 +172,7 @@ TEST(MeshFromPolygons, DegenerateAndDuplicateFacesAreKept) {
 
 TEST(MeshFromPolygons, LargeConvexPolygonIsFast) {
   const std::uint32_t n = 20000;
-  std::vector<Vec3> positions;
-  std::vector<std::uint32_t> loop;
-  for (std::uint32_t i = 0; i < n; ++i) {
-    const double angle = 2 * std::numbers::pi * i / n;
-    positions.push_back({std::cos(angle), std::sin(angle), 0.0});
-    loop.push_back(i);
-  }
-  const Mesh mesh = Mesh::from_polygons(positions, {0, n}, loop);
+  const Mesh mesh = mesh_io_test::regular_polygon(n);
   EXPECT_EQ(mesh.triangle_count(), n - 2);
 }
 

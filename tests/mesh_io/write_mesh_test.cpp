@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <numbers>
@@ -114,6 +115,47 @@ TEST_F(WriteMeshTest, StlRoundTrips) {
 
   // Out of float range: refused rather than written as inf.
   EXPECT_THROW(write_mesh(directory_ / "m.stl", mesh), InvalidInputError);
+}
+
+TEST_F(WriteMeshTest, StlNormalsAreUnitOrZeroForADegenerateTriangle) {
+  // A right triangle in z = 0 and a degenerate one (three collinear points): the first's normal
+  // is +z, the second's has no direction and is written as zeros, never as NaN.
+  const Mesh mesh = Mesh::from_triangles(
+      {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}}, {{0, 1, 2}, {3, 4, 5}});
+  write_mesh(directory_ / "a.stl", mesh, write_options({}, {}, false));
+  const std::string text = read_bytes(directory_ / "a.stl");
+  EXPECT_NE(text.find("facet normal 0 0 1\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("facet normal 0 0 0\n"), std::string::npos) << text;
+  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+
+  write_mesh(directory_ / "b.stl", mesh);
+  const std::string bytes = read_bytes(directory_ / "b.stl");
+  ASSERT_EQ(bytes.size(), 84u + 2 * 50u);
+  auto normal_component = [&](int triangle, int axis) {
+    float value;
+    std::memcpy(&value, bytes.data() + 84 + 50 * triangle + 4 * axis, 4);
+    return value;
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_EQ(normal_component(0, axis), axis == 2 ? 1.0f : 0.0f);
+    EXPECT_EQ(normal_component(1, axis), 0.0f);
+  }
+}
+
+TEST_F(WriteMeshTest, PlyListLengthsAreBytesUpTo255Vertices) {
+  // uchar lengths, what most PLY readers expect, whenever every face fits; uint beyond.
+  for (const std::uint32_t n : {255u, 256u}) {
+    const Mesh mesh = mesh_io_test::regular_polygon(n);
+    for (const bool binary : {true, false}) {
+      SCOPED_TRACE(std::to_string(n) + (binary ? " binary" : " ascii"));
+      write_mesh(directory_ / "p.ply", mesh, write_options({}, {}, binary));
+      const std::string text = read_bytes(directory_ / "p.ply");
+      const std::string expected = n <= 255 ? "property list uchar int vertex_indices\n"
+                                            : "property list uint int vertex_indices\n";
+      EXPECT_NE(text.find(expected), std::string::npos) << text.substr(0, 300);
+      expect_same_polygon_mesh(mesh, read_mesh(directory_ / "p.ply"));
+    }
+  }
 }
 
 TEST_F(WriteMeshTest, PlyFaceColoursFromGroups) {

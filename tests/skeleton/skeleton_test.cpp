@@ -222,6 +222,25 @@ TEST(Skinning, WeightsAreAPartitionOfUnityBlendedOnlyNearJoints) {
     EXPECT_NEAR(sum, 1, 1e-12);
     blended += weights.bones_of(v).size() > 1;
   }
+  // Inside a cluster each neighbour's weight, (1 − s(d / band)) / 2, is below 1/2 off the
+  // boundary, and the own bone's is the largest (below 1/2 only near several boundaries).
+  std::vector<std::set<std::uint32_t>> clusters_of(s.figure.mesh.vertex_count());
+  for (std::uint32_t f = 0; f < s.figure.mesh.face_count(); ++f)
+    for (const std::uint32_t v : s.figure.mesh.triangles[f])
+      clusters_of[v].insert(s.skeleton.face_labels[f]);
+  for (std::uint32_t v = 0; v < weights.vertex_count(); ++v) {
+    if (clusters_of[v].size() != 1) continue;
+    const std::uint32_t own = *clusters_of[v].begin();
+    const auto bones = weights.bones_of(v);
+    const auto w = weights.weights_of(v);
+    const std::size_t largest = std::max_element(w.begin(), w.end()) - w.begin();
+    EXPECT_EQ(bones[largest], own) << "vertex " << v;
+    for (std::size_t i = 0; i < bones.size(); ++i) {
+      if (bones[i] != own) {
+        EXPECT_LT(w[i], 0.5) << "vertex " << v;
+      }
+    }
+  }
   // Only a band near each of the 7 joints blends: a minority of the vertices.
   EXPECT_GT(blended, 0u);
   EXPECT_LT(blended, weights.vertex_count() / 2);
@@ -383,6 +402,34 @@ TEST(Skeleton, AnIsolatedClusterGetsAVirtualJointAtEachEnd) {
   ASSERT_EQ(one.joints.size(), 2u);
   for (const Joint& joint : one.joints) EXPECT_EQ(joint.kind, JointKind::Virtual);
   EXPECT_GT(distance(one.joints[0].position, one.joints[1].position), 1.0);
+}
+
+TEST(Skeleton, ABoneOfAPlaneRunsAlongItsLongestExtent) {
+  // A flat strip 1 wide and 10 long along y, tilted 30 degrees about y, fitted as a plane: the
+  // bone follows the strip's length, through its middle, with its ends at the strip's ends.
+  const double tilt = std::numbers::pi / 6;
+  const Mesh strip = testing::grid_mesh(
+      4, 40,
+      [&](double u, double v) {
+        return Vec3{u * std::cos(tilt), 10 * v, u * std::sin(tilt)};
+      },
+      /*alternate=*/true);
+  Primitive plane;
+  plane.type = PrimitiveType::Plane;
+  plane.axis = {-std::sin(tilt), 0, std::cos(tilt)};
+  plane.point = {0, 0, 0};
+  const Skeleton skeleton =
+      extract_skeleton(strip, std::vector<std::uint32_t>(strip.face_count(), 0), {&plane, 1});
+  ASSERT_EQ(skeleton.bones.size(), 1u);
+  const Bone& bone = skeleton.bones[0];
+  EXPECT_NEAR(bone.axis[0], 0, 1e-12);
+  EXPECT_NEAR(bone.axis[1], 1, 1e-12);
+  EXPECT_NEAR(bone.axis[2], 0, 1e-12);
+  EXPECT_NEAR(bone.point[0], 0.5 * std::cos(tilt), 1e-12);
+  EXPECT_NEAR(bone.point[2], 0.5 * std::sin(tilt), 1e-12);
+  EXPECT_NEAR(bone.area, 10, 1e-12);
+  ASSERT_EQ(skeleton.joints.size(), 2u);
+  EXPECT_NEAR(distance(skeleton.joints[0].position, skeleton.joints[1].position), 10, 1e-9);
 }
 
 TEST(Skeleton, BadInputIsRejected) {
