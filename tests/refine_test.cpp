@@ -73,6 +73,15 @@ TEST(RefineBoundaries, LeavesExactSegmentationsAlone) {
   const RefinedLevel refined = refine_boundaries(h, cut);
   EXPECT_EQ(refined.moved_faces, 0u);
   EXPECT_EQ(refined.segmentation.labels, cut.labels);
+  // Finer levels split exact surfaces: a face fits its own cluster and its neighbour exactly,
+  // and a move must improve, so none moves (and no cluster is emptied).
+  const Hierarchy boss = build_hierarchy(make_shape("box_with_boss").mesh);
+  for (const std::uint32_t k : {boss.face_count() / 2, boss.face_count()}) {
+    const Segmentation fine = cut_by_count(boss, k);
+    const RefinedLevel same = refine_boundaries(boss, fine);
+    EXPECT_EQ(same.moved_faces, 0u) << k;
+    EXPECT_EQ(same.segmentation.labels, fine.labels) << k;
+  }
 }
 
 // A box of six exact planes, uniformly tessellated: its level of 6 is the truth.

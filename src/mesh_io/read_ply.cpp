@@ -1,4 +1,5 @@
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -62,7 +63,10 @@ std::string describe_value(double value) {
   if (value == std::floor(value) && std::fabs(value) < 1e18) {
     return std::to_string(static_cast<long long>(value));
   }
-  return std::to_string(value);
+  // Shortest round-trip form: 1.5, not 1.500000 (and not 0.000000 for 1e-9).
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+  return std::string(text, end);
 }
 
 /// Where a face error is reported: a line of the ascii body or an offset of the binary one.
@@ -460,8 +464,11 @@ class PlyReader {
   void add_index(double value, std::uint64_t record, const ErrorSite& site) {
     std::uint64_t index = 0;
     if (!to_index(value, vertex_count_, index)) {
+      const bool whole = value == std::floor(value);
       site.fail("face " + std::to_string(record) + " has vertex index " + describe_value(value) +
-                ", outside [0, " + std::to_string(vertex_count_) + ")");
+                (whole || !std::isfinite(value)
+                     ? ", outside [0, " + std::to_string(vertex_count_) + ")"
+                     : ", not a whole number"));
     }
     soup_.vertices.push_back(static_cast<std::uint32_t>(index));
   }

@@ -288,6 +288,24 @@ TEST(Denoise, IsDeterministic) {
   EXPECT_EQ(first.positions, second.positions);
 }
 
+TEST(Denoise, TaubinStepsOnTheSegmentedCopyDoNotShrinkTheShape) {
+  // λ = 0.5, μ = −0.53 pass the lowest frequencies (a sphere's size), slightly amplified, where
+  // Laplacian steps or μ = −λ would shrink it: the copy's sphere stays a sphere of about the size.
+  ShapeOptions shape;
+  shape.tessellation = Tessellation::Uniform;
+  const GroundTruthShape sphere = make_shape("sphere", shape);
+  const Primitive& truth = sphere.regions[0];
+  DenoiseOptions options;
+  options.smoothing_steps = 20;
+  const Mesh copy = *Denoiser(sphere.mesh, options).segmented_mesh();
+  double mean_radius = 0;
+  for (const Vec3& p : copy.positions)
+    mean_radius += std::hypot(p[0] - truth.point[0], p[1] - truth.point[1], p[2] - truth.point[2]);
+  mean_radius /= static_cast<double>(copy.vertex_count());
+  EXPECT_GE(mean_radius, truth.radius);
+  EXPECT_LE(mean_radius, 1.01 * truth.radius);
+}
+
 TEST(Denoise, RejectsBadOptionsAndAMismatchedHierarchy) {
   const NoisyShape box = noisy_shape("box", 0.004, 0.1);
   EXPECT_THROW(denoise(box.noisy.mesh, level_by_count(6), {}, 0), InvalidInputError);

@@ -314,6 +314,16 @@ TEST(ReadPly, AsciiErrors) {
                            {"a.ply", "line 11", "'O'"});
   expect_error<InvalidInputError>(header + "0 0 0\n1 0 0\n0 nan 0\n3 0 1 2\n", MeshFormat::Ply,
                                   "a.ply", {"a.ply", "line 12", "vertex 2", "'nan'"});
+  // Lists may be stored as floats; their values must still be whole numbers.
+  const std::string float_lists =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list float float vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n";
+  EXPECT_EQ(parse(float_lists + "3 0 1 2\n", MeshFormat::Ply).face_count(), 1u);
+  expect_error<ParseError>(float_lists + "3 0 1.5 2\n", MeshFormat::Ply, "a.ply",
+                           {"a.ply", "line 13", "vertex index 1.5, not a whole number"});
+  expect_error<ParseError>(float_lists + "3.5 0 1 2\n", MeshFormat::Ply, "a.ply",
+                           {"a.ply", "line 13", "invalid list length 3.5 "});
 }
 
 TEST(ReadPly, HeaderErrors) {

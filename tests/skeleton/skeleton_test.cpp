@@ -262,6 +262,27 @@ TEST(Skinning, WeightsAreAPartitionOfUnityBlendedOnlyNearJoints) {
   EXPECT_GT(boundary, 0u);
 }
 
+TEST(Skinning, WideBandsOverlappingAtShortBonesStillPartitionUnity) {
+  // A band of 10 bone radii reaches across whole limb segments, so vertices sit in the bands of
+  // several boundaries at once: the neighbours' shares are scaled down, never the own one below 0.
+  const FigureSkeleton& s = figure_skeleton();
+  SkinningOptions options;
+  options.band = 10;
+  const SkinWeights weights = compute_skin_weights(s.figure.mesh, s.skeleton, options);
+  std::size_t three_or_more = 0;
+  for (std::uint32_t v = 0; v < weights.vertex_count(); ++v) {
+    double sum = 0;
+    for (const double w : weights.weights_of(v)) {
+      EXPECT_GT(w, 0) << "vertex " << v;
+      EXPECT_LE(w, 1) << "vertex " << v;
+      sum += w;
+    }
+    EXPECT_NEAR(sum, 1, 1e-12) << "vertex " << v;
+    three_or_more += weights.bones_of(v).size() >= 3;
+  }
+  EXPECT_GT(three_or_more, 0u);
+}
+
 // Rotating the right elbow by 90 degrees about the normal of the arm's plane.
 TEST(Skinning, ElbowRotationMovesTheForearmRigidlyAndLeavesTheTorsoStill) {
   const FigureSkeleton& s = figure_skeleton();
