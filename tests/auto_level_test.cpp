@@ -75,8 +75,16 @@ TEST(AutoLevel, ExactPlaneCylinderSphereShapesGetTheirTrueCount) {
   for (const std::string name : {"box", "slanted_box", "capped_cylinder", "sphere", "box_with_hole",
                                  "box_with_dome", "stepped_block"}) {
     const GroundTruthShape shape = make_shape(name);
-    const AutoLevel level = choose_level(build_hierarchy(shape.mesh));
+    const Hierarchy h = build_hierarchy(shape.mesh);
+    const AutoLevel level = choose_level(h);
     EXPECT_EQ(level.clusters, shape.regions.size()) << name;
+    // "At least min_score": a threshold equal to the chosen jump's score still keeps it.
+    if (level.rule != AutoLevelRule::Jump) continue;
+    AutoLevelOptions exactly;
+    for (const LevelCandidate& c : level.candidates)
+      if (c.clusters == level.clusters) exactly.min_score = c.score;
+    ASSERT_GT(exactly.min_score, 2.0) << name;
+    EXPECT_EQ(choose_level(h, exactly).clusters, level.clusters) << name;
   }
 }
 
