@@ -93,7 +93,8 @@ std::optional<std::uint32_t> curve_knee(const std::vector<ErrorCurvePoint>& curv
     knee = found;
     count = std::min(x.size(), std::max<std::size_t>(3 * knee + 1, kMinKneeRange));
   }
-  if (knee >= count || knee + 2 >= count) return std::nullopt;
+  // A knee needs finer levels after it (knee == count: no split was tried at all).
+  if (knee + 2 >= count) return std::nullopt;
   // Significant only if the curve falls by at least min_score down to the knee, and the coarse
   // line is at least min_score times steeper than the fine one: a curve that only wavers (one
   // noisy sphere) or falls evenly has a best split too, but no bend.
