@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../src/file_io.hpp"
 #include "command.hpp"
 #include "primseg/error.hpp"
 
@@ -65,6 +66,8 @@ int run(int argc, char** argv) {
 }  // namespace primseg::cli
 
 int main(int argc, char** argv) {
+  // Ctrl-C leaves every output whole or absent (see the function).
+  primseg::detail::defer_termination_during_writes();
   try {
     return primseg::cli::run(argc, argv);
   } catch (const primseg::Error& e) {

@@ -1,13 +1,18 @@
 #include "file_io.hpp"
 
 #include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 
 #include "primseg/error.hpp"
@@ -69,6 +74,41 @@ FileImage read_file(const std::filesystem::path& path) {
 
 namespace {
 
+// Writes between naming a temporary file and renaming it (all threads), and a termination signal
+// that arrived meanwhile: see defer_termination_during_writes().
+std::atomic<int> writes_naming_files{0};
+volatile std::sig_atomic_t deferred_signal = 0;
+static_assert(std::atomic<int>::is_always_lock_free, "used from a signal handler");
+
+[[noreturn]] void terminate_by(int signal_number) {
+  std::signal(signal_number, SIG_DFL);
+  // Inside its own handler the signal is blocked: unblock it so that raising it terminates now.
+  sigset_t only;
+  sigemptyset(&only);
+  sigaddset(&only, signal_number);
+  ::pthread_sigmask(SIG_UNBLOCK, &only, nullptr);
+  std::raise(signal_number);
+  std::_Exit(128 + signal_number);  // not reached: the default action terminates
+}
+
+extern "C" void defer_or_terminate(int signal_number) {
+  deferred_signal = signal_number;
+  if (writes_naming_files.load() == 0) terminate_by(signal_number);
+}
+
+// Marks a write that has (or will have) a named temporary file until it is renamed or removed.
+class NamedTemporaryScope {
+ public:
+  NamedTemporaryScope() { ++writes_naming_files; }
+  ~NamedTemporaryScope() {
+    // A signal arriving after the decrement sees no write and terminates by itself; one arriving
+    // before it was deferred and is raised here by the last write to finish.
+    if (--writes_naming_files == 0 && deferred_signal != 0) terminate_by(deferred_signal);
+  }
+  NamedTemporaryScope(const NamedTemporaryScope&) = delete;
+  NamedTemporaryScope& operator=(const NamedTemporaryScope&) = delete;
+};
+
 /// Writes all bytes to fd and flushes them to disk; false with errno set on failure.
 bool write_all(int fd, std::string_view bytes) {
   std::size_t written = 0;
@@ -99,7 +139,8 @@ std::filesystem::path temporary_name_for(const std::filesystem::path& path) {
 
 }  // namespace
 
-void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
+                           const std::function<void()>& while_named) {
   std::filesystem::path directory = path.parent_path();
   if (directory.empty()) directory = ".";
   // An unnamed file (O_TMPFILE) vanishes by itself if the process is killed while writing: only
@@ -107,6 +148,7 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
   // O_TMPFILE get a named temporary file from the start.
   const int fd = ::open(directory.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
   const std::filesystem::path temporary = temporary_name_for(path);
+  std::optional<NamedTemporaryScope> named_temporary;
   if (fd >= 0) {
     if (!write_all(fd, bytes)) {
       const int error_number = errno;
@@ -114,6 +156,7 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
       io_failure(path, "write", error_number);
     }
     const std::string self = "/proc/self/fd/" + std::to_string(fd);
+    named_temporary.emplace();
     if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, temporary.c_str(), AT_SYMLINK_FOLLOW) != 0) {
       const int error_number = errno;
       ::close(fd);
@@ -121,6 +164,7 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
     }
     ::close(fd);
   } else {
+    named_temporary.emplace();
     const int named = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (named < 0) io_failure(path, "create a temporary file for", errno);
     const bool written = write_all(named, bytes);
@@ -130,10 +174,24 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
       io_failure(path, "write", written ? errno : error_number);
     }
   }
+  if (while_named) while_named();
   if (::rename(temporary.c_str(), path.c_str()) != 0) {
     const int error_number = errno;
     ::unlink(temporary.c_str());
     io_failure(path, "rename a temporary file onto", error_number);
+  }
+}
+
+void defer_termination_during_writes() {
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction current {};
+    if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler != SIG_DFL)
+      continue;
+    struct sigaction action {};
+    action.sa_handler = defer_or_terminate;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESTART;
+    ::sigaction(signal_number, &action, nullptr);
   }
 }
 

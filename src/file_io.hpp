@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string_view>
 
@@ -31,6 +32,17 @@ FileImage read_file(const std::filesystem::path& path);
 /// filesystem lacks it), then names it and renames it over the target: readers see the old file
 /// or the complete new one, never a partial write, and a process killed while writing leaves
 /// nothing behind. Throws IoError.
-void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+/// `while_named`, if set, runs once the temporary file has its name and before the rename (for
+/// tests of what an interruption there leaves).
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
+                           const std::function<void()>& while_named = {});
+
+/// For programs (the CLI's main()), not for a library user's process: installs handlers for
+/// SIGINT, SIGTERM and SIGHUP that leave their default action (termination) immediate, except
+/// while write_file_atomically() is between naming its temporary file and renaming it, in any
+/// thread; a signal arriving then terminates the process as soon as no such write is left, so an
+/// interrupted run leaves each output whole or absent, never a temporary file. Signals whose
+/// action is not the default (ignored, e.g. under nohup) are left alone.
+void defer_termination_during_writes();
 
 }  // namespace primseg::detail
