@@ -10,10 +10,8 @@
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <set>
-#include <sstream>
 #include <string>
 
 #include "support/test_support.hpp"
@@ -28,13 +26,6 @@ std::set<std::string> names_in(const fs::path& directory) {
   for (const auto& entry : fs::directory_iterator(directory))
     names.insert(entry.path().filename().string());
   return names;
-}
-
-std::string contents_of(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream contents;
-  contents << file.rdbuf();
-  return contents.str();
 }
 
 // Runs `body` in a child process, which exits with status 3 if body returns; the wait status.
@@ -66,7 +57,7 @@ TEST(WriteFileAtomically, AnInterruptWhileTheFileIsNamedWaitsForTheRename) {
   });
   EXPECT_TRUE(terminated_by(status, SIGINT)) << "wait status " << status;
   EXPECT_EQ(names_in(dir), std::set<std::string>{"out.txt"});
-  EXPECT_EQ(contents_of(target), "complete contents");
+  EXPECT_EQ(testing::file_contents(target), "complete contents");
   fs::remove_all(dir);
 }
 

@@ -464,11 +464,10 @@ class PlyReader {
   void add_index(double value, std::uint64_t record, const ErrorSite& site) {
     std::uint64_t index = 0;
     if (!to_index(value, vertex_count_, index)) {
-      const bool whole = value == std::floor(value);
+      const bool fractional = std::isfinite(value) && value != std::floor(value);
       site.fail("face " + std::to_string(record) + " has vertex index " + describe_value(value) +
-                (whole || !std::isfinite(value)
-                     ? ", outside [0, " + std::to_string(vertex_count_) + ")"
-                     : ", not a whole number"));
+                (fractional ? ", not a whole number"
+                            : ", outside [0, " + std::to_string(vertex_count_) + ")"));
     }
     soup_.vertices.push_back(static_cast<std::uint32_t>(index));
   }

@@ -84,13 +84,6 @@ class TempDir {
   fs::path path_;
 };
 
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 void write_file(const fs::path& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
   out << bytes;
@@ -100,7 +93,7 @@ void write_file(const fs::path& path, const std::string& bytes) {
 // every line terminated by '\n', nothing else.
 std::vector<std::uint32_t> read_labels(const fs::path& path) {
   std::vector<std::uint32_t> labels;
-  const std::string text = read_file(path);
+  const std::string text = testing::file_contents(path);
   EXPECT_FALSE(text.empty()) << path;
   if (!text.empty()) {
     EXPECT_EQ(text.back(), '\n') << path << ": last line not terminated";
@@ -121,7 +114,7 @@ std::vector<std::uint32_t> read_labels(const fs::path& path) {
 }
 
 json read_json(const fs::path& path) {
-  const std::string text = read_file(path);
+  const std::string text = testing::file_contents(path);
   json parsed = json::parse(text, nullptr, /*allow_exceptions=*/false);
   EXPECT_FALSE(parsed.is_discarded()) << path << " is not valid JSON:\n" << text.substr(0, 400);
   return parsed;
@@ -187,7 +180,7 @@ bool clusters_connected(const Mesh& mesh, const std::vector<std::uint32_t>& labe
 // uchar red/green/blue face properties).
 std::vector<std::array<std::uint8_t, 3>> ply_face_colors(const fs::path& path, std::size_t vertices,
                                                          std::size_t faces) {
-  const std::string bytes = read_file(path);
+  const std::string bytes = testing::file_contents(path);
   const std::size_t header_end = bytes.find("end_header\n");
   EXPECT_NE(header_end, std::string::npos);
   if (header_end == std::string::npos) return {};
@@ -382,7 +375,7 @@ TEST(Cli, SegmentBoxWithHoleWritesEveryOutputAndRecoversGroundTruth) {
   const CliRun obj =
       run("segment " + dir.q("in.off") + " --clusters 7 --quiet --colored " + dir.q("c.obj"));
   ASSERT_EXIT_OK(obj);
-  std::istringstream lines(read_file(dir / "c.obj"));
+  std::istringstream lines(testing::file_contents(dir / "c.obj"));
   std::string line;
   int groups = 0;
   std::size_t faces_in_obj = 0;
@@ -503,7 +496,8 @@ TEST(Cli, CutFromTreeReproducesSegmentAtEveryLevel) {
     EXPECT_EQ(cj["clusters"], sj["clusters"]);
     EXPECT_EQ(cj["clusters"].size(), distinct_count(s));
     EXPECT_EQ(cj["mesh"].value("faces", 0u), f);
-    EXPECT_EQ(read_file(dir / "c.ply"), read_file(dir / "s.ply")) << "coloured meshes differ";
+    EXPECT_EQ(testing::file_contents(dir / "c.ply"), testing::file_contents(dir / "s.ply"))
+        << "coloured meshes differ";
     if (level.rfind("--clusters ", 0) == 0) {
       const auto k = std::stoul(level.substr(11));
       expect_valid_labels(c, f, k);
@@ -566,9 +560,9 @@ TEST(Cli, TreeFilesAreByteIdenticalAcrossRunsAndLabelsScaleInvariant) {
                      " --clusters 12 --labels " + dir.q("a.txt") + " --json " + dir.q("a.json")));
   ASSERT_EXIT_OK(run("segment " + dir.q("in.ply") + " --quiet --tree " + dir.q("b.tree") +
                      " --clusters 12 --labels " + dir.q("b.txt")));
-  const std::string a = read_file(dir / "a.tree");
+  const std::string a = testing::file_contents(dir / "a.tree");
   ASSERT_FALSE(a.empty());
-  EXPECT_TRUE(a == read_file(dir / "b.tree")) << "two runs wrote different tree files";
+  EXPECT_TRUE(a == testing::file_contents(dir / "b.tree")) << "two runs wrote different tree files";
   const std::vector<std::uint32_t> reference = read_labels(dir / "a.txt");
   EXPECT_EQ(read_labels(dir / "b.txt"), reference);
   expect_valid_labels(reference, f, 12);
@@ -710,10 +704,10 @@ TEST(Cli, BadMeshFilesAreRejectedWithAMessage) {
   const Mesh box = make_shape("box").mesh;
   write_mesh(dir / "box.off", box);
   write_mesh(dir / "box.ply", box);
-  write_file(dir / "mesh.xyz", read_file(dir / "box.off"));
+  write_file(dir / "mesh.xyz", testing::file_contents(dir / "box.off"));
   write_file(dir / "empty.off", "");
   write_file(dir / "empty.ply", "");
-  const std::string ply = read_file(dir / "box.ply");
+  const std::string ply = testing::file_contents(dir / "box.ply");
   write_file(dir / "truncated.ply", ply.substr(0, ply.size() - 7));
   write_file(dir / "nan.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n");
   write_file(dir / "range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
@@ -775,7 +769,7 @@ TEST(Cli, ClustersAutoFindsTheRegionsAndReportsCandidatesAndTheCurve) {
   EXPECT_TRUE(listed);
 
   // The curve: a header, then k = 1..F in order; one cluster per face fits exactly.
-  std::istringstream lines(read_file(dir / "curve.csv"));
+  std::istringstream lines(testing::file_contents(dir / "curve.csv"));
   std::string line;
   std::getline(lines, line);
   EXPECT_EQ(line, "k,rms");
@@ -907,7 +901,7 @@ TEST(Cli, BadTreeFilesAreRejectedWithAMessage) {
   const Mesh mesh = make_shape("capped_cylinder").mesh;
   write_mesh(dir / "in.off", mesh);
   ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --tree " + dir.q("t.tree")));
-  const std::string tree = read_file(dir / "t.tree");
+  const std::string tree = testing::file_contents(dir / "t.tree");
   ASSERT_GT(tree.size(), 100u);
   std::string flipped = tree;
   flipped[flipped.size() / 2] = static_cast<char>(flipped[flipped.size() / 2] ^ 0x10);
@@ -1270,8 +1264,8 @@ TEST(Cli, ThreadCountDoesNotChangeTheTree) {
   for (const char* threads : {"1", "2", "3"})
     ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --threads " + threads + " --tree " +
                        dir.q(std::string("t") + threads + ".tree")));
-  EXPECT_EQ(read_file(dir / "t1.tree"), read_file(dir / "t2.tree"));
-  EXPECT_EQ(read_file(dir / "t1.tree"), read_file(dir / "t3.tree"));
+  EXPECT_EQ(testing::file_contents(dir / "t1.tree"), testing::file_contents(dir / "t2.tree"));
+  EXPECT_EQ(testing::file_contents(dir / "t1.tree"), testing::file_contents(dir / "t3.tree"));
 }
 
 TEST(Cli, LinkageIsAValidScipyLinkageMatrixOfTheWholeTree) {
@@ -1282,7 +1276,7 @@ TEST(Cli, LinkageIsAValidScipyLinkageMatrixOfTheWholeTree) {
                      dir.q("t.tree") + " --linkage " + dir.q("z.txt")));
   ASSERT_EXIT_OK(
       run("cut " + dir.q("t.tree") + " --quiet --clusters 3 --linkage " + dir.q("z2.txt")));
-  EXPECT_EQ(read_file(dir / "z.txt"), read_file(dir / "z2.txt"));
+  EXPECT_EQ(testing::file_contents(dir / "z.txt"), testing::file_contents(dir / "z2.txt"));
   // SciPy's rules (scipy.cluster.hierarchy.is_valid_linkage): n − 1 rows; row i joins two
   // existing clusters (< n + i), each used once; the size is the sum of the children's sizes.
   const std::uint32_t n = shape.mesh.face_count();

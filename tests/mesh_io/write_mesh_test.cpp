@@ -10,7 +10,6 @@
 #include <limits>
 #include <numbers>
 #include <set>
-#include <sstream>
 #include <string>
 
 #include "mesh_io_test_helpers.hpp"
@@ -20,13 +19,6 @@ namespace primseg {
 namespace {
 
 using mesh_io_test::write_options;
-
-std::string read_bytes(const std::filesystem::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream contents;
-  contents << file.rdbuf();
-  return contents.str();
-}
 
 /// Coordinates chosen to break any printing that is not shortest-round-trip: thirds, tenths,
 /// extremes, a subnormal, negative zero.
@@ -108,7 +100,7 @@ TEST_F(WriteMeshTest, StlRoundTrips) {
   }
   const Mesh floats = Mesh::from_polygons(positions, mesh.polygon_offsets, mesh.polygon_vertices);
   write_mesh(directory_ / "f.stl", floats);
-  const std::string bytes = read_bytes(directory_ / "f.stl");
+  const std::string bytes = testing::file_contents(directory_ / "f.stl");
   ASSERT_EQ(bytes.size(), 84u + 50u * floats.triangle_count());
   EXPECT_NE(bytes.substr(0, 5), "solid");
   expect_same_triangle_soup(floats, read_mesh(directory_ / "f.stl"));
@@ -123,13 +115,13 @@ TEST_F(WriteMeshTest, StlNormalsAreUnitOrZeroForADegenerateTriangle) {
   const Mesh mesh = Mesh::from_triangles(
       {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}}, {{0, 1, 2}, {3, 4, 5}});
   write_mesh(directory_ / "a.stl", mesh, write_options({}, {}, false));
-  const std::string text = read_bytes(directory_ / "a.stl");
+  const std::string text = testing::file_contents(directory_ / "a.stl");
   EXPECT_NE(text.find("facet normal 0 0 1\n"), std::string::npos) << text;
   EXPECT_NE(text.find("facet normal 0 0 0\n"), std::string::npos) << text;
   EXPECT_EQ(text.find("nan"), std::string::npos) << text;
 
   write_mesh(directory_ / "b.stl", mesh);
-  const std::string bytes = read_bytes(directory_ / "b.stl");
+  const std::string bytes = testing::file_contents(directory_ / "b.stl");
   ASSERT_EQ(bytes.size(), 84u + 2 * 50u);
   auto normal_component = [&](int triangle, int axis) {
     float value;
@@ -149,7 +141,7 @@ TEST_F(WriteMeshTest, PlyListLengthsAreBytesUpTo255Vertices) {
     for (const bool binary : {true, false}) {
       SCOPED_TRACE(std::to_string(n) + (binary ? " binary" : " ascii"));
       write_mesh(directory_ / "p.ply", mesh, write_options({}, {}, binary));
-      const std::string text = read_bytes(directory_ / "p.ply");
+      const std::string text = testing::file_contents(directory_ / "p.ply");
       const std::string expected = n <= 255 ? "property list uchar int vertex_indices\n"
                                             : "property list uint int vertex_indices\n";
       EXPECT_NE(text.find(expected), std::string::npos) << text.substr(0, 300);
@@ -164,7 +156,7 @@ TEST_F(WriteMeshTest, PlyFaceColoursFromGroups) {
   const std::vector<std::array<std::uint8_t, 3>> colors{{1, 2, 3}, {4, 5, 6}, {7, 8, 9}};
   const std::filesystem::path path = directory_ / "c.ply";
   write_mesh(path, mesh, write_options(groups, colors));
-  const std::string bytes = read_bytes(path);
+  const std::string bytes = testing::file_contents(path);
   const std::string header_end = "end_header\n";
   const std::size_t body = bytes.find(header_end) + header_end.size();
   EXPECT_NE(bytes.substr(0, body).find("property uchar red\nproperty uchar green\n"
@@ -187,7 +179,7 @@ TEST_F(WriteMeshTest, PlyFaceColoursFromGroups) {
   write_mesh(directory_ / "a.ply", mesh, write_options(groups, {}, false));
   expect_same_polygon_mesh(mesh, read_mesh(directory_ / "a.ply"));
   const auto palette = distinct_colors(3);
-  const std::string text = read_bytes(directory_ / "a.ply");
+  const std::string text = testing::file_contents(directory_ / "a.ply");
   const std::string last_face = "5 0 2 4 5 3 " + std::to_string(palette[2][0]) + " " +
                                 std::to_string(palette[2][1]) + " " +
                                 std::to_string(palette[2][2]) + "\n";
@@ -198,7 +190,7 @@ TEST_F(WriteMeshTest, ObjGroupsAndOffColours) {
   const Mesh mesh = awkward_mesh();
   const std::vector<std::uint32_t> groups{5, 1, 5};
   write_mesh(directory_ / "g.obj", mesh, write_options(groups));
-  const std::string obj = read_bytes(directory_ / "g.obj");
+  const std::string obj = testing::file_contents(directory_ / "g.obj");
   const std::size_t group_1 =
       obj.find("g cluster_1\nf 3 2 4 5\ng cluster_5\nf 1 2 3\nf 1 3 5 6 4\n");
   EXPECT_NE(group_1, std::string::npos) << obj;
@@ -206,7 +198,7 @@ TEST_F(WriteMeshTest, ObjGroupsAndOffColours) {
 
   const std::vector<std::array<std::uint8_t, 3>> colors(6, {10, 20, 30});
   write_mesh(directory_ / "c.off", mesh, write_options(groups, colors));
-  const std::string off = read_bytes(directory_ / "c.off");
+  const std::string off = testing::file_contents(directory_ / "c.off");
   EXPECT_TRUE(off.ends_with("3 0 1 2 10 20 30\n4 2 1 3 4 10 20 30\n5 0 2 4 5 3 10 20 30\n")) << off;
   expect_same_polygon_mesh(mesh, read_mesh(directory_ / "c.off"));
 }

@@ -20,13 +20,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // A temp directory holding the stick figure as figure.off (its paths need no shell quoting).
 class SkeletonCli : public ::testing::Test {
  protected:
@@ -51,7 +44,7 @@ class SkeletonCli : public ::testing::Test {
             &output),
         0)
         << output;
-    return json::parse(slurp(path("skeleton.json")));
+    return json::parse(testing::file_contents(path("skeleton.json")));
   }
   // The joint nearest a point.
   static std::uint32_t nearest_joint(const json& skeleton, const Vec3& p) {
@@ -92,7 +85,7 @@ TEST_F(SkeletonCli, WritesTheSkeletonAndSkinWeights) {
       EXPECT_TRUE(bone.contains(key)) << key;
 
   // One line per vertex: "bone weight" pairs summing to 1.
-  std::istringstream lines(slurp(path("weights.txt")));
+  std::istringstream lines(testing::file_contents(path("weights.txt")));
   std::string line;
   std::uint32_t rows = 0;
   while (std::getline(lines, line)) {
@@ -114,7 +107,7 @@ TEST_F(SkeletonCli, DefaultPrimitivesAreCylindersOnly) {
   ASSERT_EQ(
       run("skeleton " + path("figure.off") + " --clusters 12 -q -o " + path("s.json"), &output), 0)
       << output;
-  const json s = json::parse(slurp(path("s.json")));
+  const json s = json::parse(testing::file_contents(path("s.json")));
   EXPECT_EQ(s["primitives"], "cylinder");
   EXPECT_EQ(s["bones"].size(), 12u);
 }
@@ -126,13 +119,13 @@ TEST_F(SkeletonCli, AutomaticLevelIsTheOneSegmentChooses) {
                 &output),
             0)
       << output;
-  const json segmented = json::parse(slurp(path("seg.json")));
+  const json segmented = json::parse(testing::file_contents(path("seg.json")));
   ASSERT_EQ(run("skeleton " + path("figure.off") +
                     " --clusters auto --primitives cylinder,sphere -q -o " + path("auto.json"),
                 &output),
             0)
       << output;
-  const json s = json::parse(slurp(path("auto.json")));
+  const json s = json::parse(testing::file_contents(path("auto.json")));
   EXPECT_EQ(s["requested_clusters"], "auto");
   EXPECT_EQ(s["cluster_count"], segmented["level"]["clusters"]);
   EXPECT_EQ(s["bones"].size(), s["cluster_count"].get<std::size_t>());
@@ -151,7 +144,7 @@ TEST_F(SkeletonCli, DeformRotatesTheForearmAndLeavesTheRestInPlace) {
                 &output),
             0)
       << output;
-  EXPECT_EQ(slurp(path("posed.png")).substr(0, 4), "\x89PNG");
+  EXPECT_EQ(testing::file_contents(path("posed.png")).substr(0, 4), "\x89PNG");
   const Mesh posed = read_mesh(path("posed.ply"));
   ASSERT_EQ(posed.vertex_count(), figure_.mesh.vertex_count());
   double moved = 0;
@@ -199,7 +192,7 @@ TEST_F(SkeletonCli, BadInputGivesAClearError) {
   EXPECT_NE(output.find("was made from a mesh of"), std::string::npos) << output;
 
   // A truncated skeleton file.
-  const std::string text = slurp(path("skeleton.json"));
+  const std::string text = testing::file_contents(path("skeleton.json"));
   std::ofstream(path("skeleton.json")) << text.substr(0, text.size() / 2);
   EXPECT_EQ(deform_with(R"({"rotations": []})", &output), 1);
   EXPECT_NE(output.find("not valid JSON"), std::string::npos) << output;

@@ -21,6 +21,9 @@ std::filesystem::path temp_directory(const std::string& tag);
 /// Path of the primseg executable built with the tests.
 std::filesystem::path cli_path();
 
+/// The whole contents of a file, bytes as they are (empty if it cannot be read).
+std::string file_contents(const std::filesystem::path& path);
+
 /// Runs a shell command, returns its exit status; stdout+stderr go to *output if given.
 int run_command(const std::string& command, std::string* output = nullptr);
 
