@@ -142,6 +142,75 @@ TEST(RefineBoundaries, AClusterWhoseFacesAllFitNeighboursBetterKeepsOne) {
   for (int c : components(h, refined.segmentation.labels, 7)) EXPECT_EQ(c, 1);
 }
 
+TEST(RefineBoundaries, AMoveThatWouldSplitAClusterIsUndone) {
+  const Hierarchy h = uniform_box_hierarchy();
+  Segmentation cut = cut_by_count(h, 6);
+  const std::uint32_t f_count = h.face_count();
+  std::vector<std::vector<std::uint32_t>> neighbours(f_count);
+  for (const DualEdge& e : h.graph().edges()) {
+    neighbours[e.first].push_back(e.second);
+    neighbours[e.second].push_back(e.first);
+  }
+  // A lollipop of cluster 0 on a neighbouring side of the box: a stick of faces from the shared
+  // edge to a blob (a face and every face sharing a vertex with it). Every face of it lies
+  // exactly on its side's plane, so each border face of it fits the neighbour far better; but
+  // the blob's middle face touches no other cluster, and moving the rest would cut it off.
+  constexpr std::uint32_t kFar = UINT32_MAX;
+  std::uint32_t side = kFar;  // the first cluster found next to cluster 0
+  for (const DualEdge& e : h.graph().edges())
+    if ((cut.labels[e.first] == 0) != (cut.labels[e.second] == 0)) {
+      side = cut.labels[cut.labels[e.first] == 0 ? e.second : e.first];
+      break;
+    }
+  ASSERT_NE(side, kFar);
+  // Breadth-first distances from cluster 0 into that side give the stick.
+  std::vector<std::uint32_t> distance(f_count, kFar), previous(f_count, kFar);
+  std::vector<std::uint32_t> frontier;
+  for (std::uint32_t f = 0; f < f_count; ++f)
+    if (cut.labels[f] == 0) distance[f] = 0, frontier.push_back(f);
+  for (std::size_t i = 0; i < frontier.size(); ++i)
+    for (std::uint32_t g : neighbours[frontier[i]])
+      if (distance[g] == kFar && cut.labels[g] == side) {
+        distance[g] = distance[frontier[i]] + 1, previous[g] = frontier[i];
+        frontier.push_back(g);
+      }
+  // The blob's middle face: 5 steps in, with every face around its corners on the same side.
+  const Mesh& mesh = h.mesh();
+  auto shares_a_vertex = [&](std::uint32_t f, std::uint32_t g) {
+    for (std::uint32_t a : mesh.polygon(f))
+      for (std::uint32_t b : mesh.polygon(g))
+        if (a == b) return true;
+    return false;
+  };
+  std::uint32_t middle = kFar;
+  std::vector<std::uint32_t> blob;
+  for (std::uint32_t f = 0; f < f_count && middle == kFar; ++f) {
+    if (distance[f] != 5) continue;
+    blob.clear();
+    bool inside = true;
+    for (std::uint32_t g = 0; g < f_count; ++g)
+      if (shares_a_vertex(f, g)) {
+        blob.push_back(g);
+        inside = inside && cut.labels[g] == side && distance[g] >= 3;
+      }
+    if (inside) middle = f;
+  }
+  ASSERT_NE(middle, kFar);
+  for (std::uint32_t g : blob) cut.labels[g] = 0;
+  for (std::uint32_t f = previous[middle]; distance[f] > 0; f = previous[f]) cut.labels[f] = 0;
+  for (int c : components(h, cut.labels, 6)) ASSERT_EQ(c, 1);
+
+  // Connected after every pass, not only at the end (a later pass could have moved the cut-off
+  // face too): the moves around the middle face are undone, so it stays.
+  for (const std::uint32_t passes : {1u, 5u}) {
+    BoundaryRefinementOptions options;
+    options.max_passes = passes;
+    const RefinedLevel refined = refine_boundaries(h, cut, options);
+    for (int c : components(h, refined.segmentation.labels, 6)) EXPECT_EQ(c, 1) << passes;
+    EXPECT_EQ(refined.segmentation.labels[middle], 0u) << passes;
+  }
+}
+
 TEST(RefineBoundaries, RejectsBadInput) {
   const Hierarchy h = build_hierarchy(make_shape("box").mesh);
   Segmentation cut = cut_by_count(h, 6);
