@@ -1,6 +1,7 @@
 #include "primseg/refine.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -13,6 +14,10 @@ namespace primseg {
 namespace {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+// How far above the cut's total error (over the corners) refinement may take it: passes trade a
+// little of it for borders the corners cannot see (measured on the generated CAD-tessellated
+// shapes: a chamfered cylinder's borders move right while its corner error rises by 0.1%).
+constexpr double kAllowedErrorRise = 0.05;
 
 // Dual-graph neighbours of every face, as offsets into one array.
 struct Adjacency {
@@ -30,31 +35,86 @@ struct Adjacency {
   }
 };
 
-// Connected components of each cluster (edge-connected through the dual graph).
-std::vector<std::uint32_t> component_counts(const Adjacency& adjacency,
-                                            const std::vector<std::uint32_t>& labels,
-                                            std::uint32_t clusters) {
-  std::vector<std::uint32_t> count(clusters, 0);
-  std::vector<char> seen(labels.size(), 0);
-  std::vector<std::uint32_t> stack;
-  for (std::uint32_t start = 0; start < labels.size(); ++start) {
-    if (seen[start]) continue;
-    ++count[labels[start]];
-    seen[start] = 1;
-    stack.push_back(start);
-    while (!stack.empty()) {
-      const std::uint32_t f = stack.back();
-      stack.pop_back();
-      for (std::uint32_t i = adjacency.offset[f]; i < adjacency.offset[f + 1]; ++i) {
-        const std::uint32_t g = adjacency.neighbour[i];
-        if (!seen[g] && labels[g] == labels[f]) {
-          seen[g] = 1;
-          stack.push_back(g);
+// Connected components (edge-connected through the dual graph) of the clusters of a labelling.
+struct Components {
+  std::vector<std::uint32_t> of_face;  // component of each face
+  std::vector<std::uint32_t> size;     // faces of each component, in order of lowest face
+  std::vector<std::uint32_t> count;    // components of each cluster
+
+  Components(const Adjacency& adjacency, const std::vector<std::uint32_t>& labels,
+             std::uint32_t clusters)
+      : of_face(labels.size(), kNone), count(clusters, 0) {
+    std::vector<std::uint32_t> stack;
+    for (std::uint32_t start = 0; start < labels.size(); ++start) {
+      if (of_face[start] != kNone) continue;
+      const auto id = static_cast<std::uint32_t>(size.size());
+      size.push_back(0);
+      ++count[labels[start]];
+      of_face[start] = id;
+      stack.push_back(start);
+      while (!stack.empty()) {
+        const std::uint32_t f = stack.back();
+        stack.pop_back();
+        ++size[id];
+        for (std::uint32_t i = adjacency.offset[f]; i < adjacency.offset[f + 1]; ++i) {
+          const std::uint32_t g = adjacency.neighbour[i];
+          if (of_face[g] == kNone && labels[g] == labels[f]) {
+            of_face[g] = id;
+            stack.push_back(g);
+          }
         }
       }
     }
   }
-  return count;
+};
+
+// Undoes the moves of a pass that split a cluster, until no cluster has more components than at
+// the start (`initial`). A cluster that was connected keeps its largest piece (ties: the one
+// with the lowest face); the moves next to its other pieces are undone, layer by layer, which
+// reconnects them through the faces that had left, and leaves the moves elsewhere on its border.
+// After kLayers layers, or for a cluster that was not connected to begin with, every move into
+// or out of a split cluster is undone, which at worst restores the connected start of the pass.
+void undo_splitting_moves(const Adjacency& adjacency, const std::vector<std::uint32_t>& initial,
+                          std::vector<std::uint32_t>& moves,
+                          const std::vector<std::uint32_t>& origin,
+                          std::vector<std::uint32_t>& labels) {
+  constexpr int kLayers = 16;
+  const auto k = static_cast<std::uint32_t>(initial.size());
+  for (int layer = 0;; ++layer) {
+    const Components components(adjacency, labels, k);
+    std::vector<char> split(k, 0);
+    bool any = false;
+    for (std::uint32_t c = 0; c < k; ++c)
+      if (components.count[c] > initial[c]) split[c] = 1, any = true;
+    if (!any) return;
+    // The piece each split cluster keeps, if it keeps one.
+    std::vector<std::uint32_t> kept_piece(k, kNone);
+    if (layer < kLayers)
+      for (std::uint32_t f = 0; f < labels.size(); ++f) {
+        const std::uint32_t c = labels[f], piece = components.of_face[f];
+        if (split[c] && initial[c] == 1 &&
+            (kept_piece[c] == kNone || components.size[piece] > components.size[kept_piece[c]]))
+          kept_piece[c] = piece;
+      }
+    auto cut_off_next_to = [&](std::uint32_t f, std::uint32_t c) {
+      for (std::uint32_t i = adjacency.offset[f]; i < adjacency.offset[f + 1]; ++i) {
+        const std::uint32_t g = adjacency.neighbour[i];
+        if (labels[g] == c && components.of_face[g] != kept_piece[c]) return true;
+      }
+      return false;
+    };
+    std::vector<std::uint32_t> kept;
+    for (std::uint32_t f : moves) {
+      const std::uint32_t from = origin[f], to = labels[f];
+      const bool undo = (split[from] && (kept_piece[from] == kNone || cut_off_next_to(f, from))) ||
+                        (split[to] && kept_piece[to] == kNone);
+      if (undo)
+        labels[f] = from;
+      else
+        kept.push_back(f);
+    }
+    moves = std::move(kept);
+  }
 }
 
 // ∫ d² over face f's triangles (working frame), by the edge-midpoint rule.
@@ -73,6 +133,22 @@ double face_error(const Hierarchy& hierarchy, std::uint32_t f, const Primitive& 
     }
     sum += graph.triangle_area(t) * squares / 3;
   }
+  return sum;
+}
+
+// Σ w d² of every cluster to its reported primitive, over the triangle corners weighted as in
+// the hierarchy: the error the reports' RMS values measure.
+double total_squared_error(const Hierarchy& hierarchy, const std::vector<std::uint32_t>& labels,
+                           const std::vector<ClusterReport>& reports) {
+  const Mesh& mesh = hierarchy.mesh();
+  std::vector<double> weight(reports.size(), 0);
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::array<double, 3> w = hierarchy.graph().corner_weights(t);
+    weight[labels[mesh.face_of_triangle[t]]] += w[0] + w[1] + w[2];
+  }
+  double sum = 0;
+  for (std::size_t c = 0; c < reports.size(); ++c)
+    sum += reports[c].rms * reports[c].rms * weight[c];
   return sum;
 }
 
@@ -98,9 +174,10 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
   result.segmentation = segmentation;
   std::vector<std::uint32_t>& labels = result.segmentation.labels;
   result.reports = describe_clusters(hierarchy, result.segmentation, options.describe);
-  const std::vector<std::uint32_t> initial_components = component_counts(adjacency, labels, k);
+  const std::vector<std::uint32_t> initial_components = Components(adjacency, labels, k).count;
   std::vector<std::uint32_t> sizes(k, 0);
   for (std::uint32_t label : labels) ++sizes[label];
+  const double cut_error = total_squared_error(hierarchy, labels, result.reports);
 
   for (std::uint32_t pass = 0; pass < options.max_passes; ++pass) {
     std::vector<Primitive> working(k);
@@ -130,33 +207,29 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
         ++leaving[labels[f]];
         moves.push_back(f);
       }
+    const std::vector<std::uint32_t> labels_before = labels;
     std::vector<std::uint32_t> origin(f_count);
     for (std::uint32_t f : moves) origin[f] = labels[f], labels[f] = target[f];
-    // Undo every move touching a cluster that split, until none does (at worst all moves are
-    // undone, which restores the connected start of the pass).
-    for (;;) {
-      const std::vector<std::uint32_t> components = component_counts(adjacency, labels, k);
-      std::vector<char> split(k, 0);
-      bool any = false;
-      for (std::uint32_t c = 0; c < k; ++c)
-        if (components[c] > initial_components[c]) split[c] = 1, any = true;
-      if (!any) break;
-      std::vector<std::uint32_t> kept;
-      for (std::uint32_t f : moves) {
-        if (split[origin[f]] || split[labels[f]])
-          labels[f] = origin[f];
-        else
-          kept.push_back(f);
-      }
-      moves = std::move(kept);
-    }
+    undo_splitting_moves(adjacency, initial_components, moves, origin, labels);
     if (moves.empty()) break;
+    std::vector<Primitive> start(k);
+    for (std::uint32_t c = 0; c < k; ++c) start[c] = result.reports[c].primitive;
+    std::vector<ClusterReport> refitted =
+        describe_clusters(hierarchy, result.segmentation, start, options.describe);
+    // A face is judged over its flat triangles, which see what its corners cannot (the faces of
+    // a CAD fan have all their corners on feature curves, on both surfaces), but which a curved
+    // primitive misses by the tessellation's sagitta: the faces of an exact cylinder can look
+    // closer to the plane it turns into. So a pass stops the refinement if it leaves the clusters'
+    // total error over the corners (what the tree and the reports measure) more than
+    // kAllowedErrorRise above the cut's.
+    if (total_squared_error(hierarchy, labels, refitted) > (1 + kAllowedErrorRise) * cut_error) {
+      labels = labels_before;
+      break;
+    }
+    result.reports = std::move(refitted);
     for (std::uint32_t f : moves) --sizes[origin[f]], ++sizes[labels[f]];
     result.moved_faces += static_cast<std::uint32_t>(moves.size());
     ++result.passes;
-    std::vector<Primitive> start(k);
-    for (std::uint32_t c = 0; c < k; ++c) start[c] = result.reports[c].primitive;
-    result.reports = describe_clusters(hierarchy, result.segmentation, start, options.describe);
   }
   // Reported as the tree's fit of the node each cluster grew from, not the previous pass's.
   for (ClusterReport& r : result.reports) r.algebraic = hierarchy.primitive(r.node);

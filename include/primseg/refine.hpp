@@ -4,7 +4,7 @@
 /// cluster whose primitive fits them better, primitives are refitted, and this repeats. Greedy
 /// merging decides a border once, early, from small clusters; the final primitives know better.
 /// Only border faces are examined (the paper found full Lloyd iterations costly for little
-/// gain), and a move that would split a cluster is undone, so clusters stay connected.
+/// gain), and the moves that would split a cluster are undone, so clusters stay connected.
 
 #include <cstdint>
 #include <vector>
@@ -38,10 +38,16 @@ struct RefinedLevel {
 
 /// Refines the borders of a cut. A face's error to a primitive is the integral of the squared
 /// distance over its triangles (three-point edge-midpoint rule: exact for planes). Moves are
-/// decided for all border faces against the labels at the start of the pass (the result does
-/// not depend on face order), no cluster loses all its faces, and every cluster keeps its number
-/// of connected components. Deterministic. Throws InvalidInputError for a segmentation of
-/// another mesh or a non-positive improvement factor.
+/// decided for all border faces against the labels at the start of the pass, no cluster loses
+/// all its faces, and every cluster keeps its number of connected components: where the moves
+/// of a pass would cut a piece off a connected cluster, its largest piece stays (ties: the one
+/// with the lowest face) and the moves next to the others are undone, layer by layer, until
+/// they are reconnected; the cluster's other moves stand. A pass that leaves the clusters'
+/// total error over their corners (Σ w d², what ClusterReport::rms measures) more than 5% above
+/// the cut's is undone and ends the refinement: over its flat triangles, a face of an exact but
+/// coarsely tessellated cylinder can look closer to a plane it meets at a shallow crease.
+/// Deterministic. Throws InvalidInputError for a segmentation of another mesh or a non-positive
+/// improvement factor.
 RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& segmentation,
                                const BoundaryRefinementOptions& options = {});
 
