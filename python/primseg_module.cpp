@@ -28,6 +28,7 @@
 #include "primseg/mesh_distance.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
+#include "primseg/refine.hpp"
 #include "primseg/skeleton.hpp"
 #include "primseg/skinning.hpp"
 #include "primseg/tree_io.hpp"
@@ -292,6 +293,33 @@ Segmentation cut_level(const Hierarchy& hierarchy, const LevelArguments& level) 
   if (level.tolerance) return cut_by_tolerance(hierarchy, *level.tolerance);
   const double fraction = level.relative_tolerance.value_or(kDefaultRelativeTolerance);
   return cut_by_tolerance(hierarchy, fraction * bounding_box_diagonal(hierarchy.mesh()));
+}
+
+// The CLI's limit on --refine.
+constexpr std::int64_t kMaxRefinePasses = 1000;
+const char* kRefineArgument =
+    R"(refine: up to this many passes of boundary refinement after the cut (the CLI's --refine N;
+  0: none): border faces move to the adjacent cluster whose primitive fits them at least twice
+  better, and the primitives are refitted. Raises InvalidInputError (a ValueError) outside
+  0..1000.)";
+
+// The level, refined by up to `refine` boundary passes (0: as cut), with its cluster reports when
+// `reports` is given: what the CLI's --refine N writes.
+Segmentation refined_level(const Hierarchy& hierarchy, const LevelArguments& level,
+                           std::int64_t refine, std::vector<ClusterReport>* reports) {
+  if (refine < 0 || refine > kMaxRefinePasses)
+    throw InvalidInputError("refine must be a number of passes in [0, " +
+                            std::to_string(kMaxRefinePasses) + "], not " + std::to_string(refine));
+  Segmentation segmentation = cut_level(hierarchy, level);
+  if (refine == 0) {
+    if (reports) *reports = describe_clusters(hierarchy, segmentation);
+    return segmentation;
+  }
+  BoundaryRefinementOptions options;
+  options.max_passes = static_cast<std::uint32_t>(refine);
+  RefinedLevel refined = refine_boundaries(hierarchy, segmentation, options);
+  if (reports) *reports = std::move(refined.reports);
+  return std::move(refined.segmentation);
 }
 
 py::list vector_list(const Vec3& v) {
@@ -760,51 +788,54 @@ coordinates, index out of range, no faces) or bad options.)";
       .def(
           "cut",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
-             std::optional<double> relative_tolerance) {
+             std::optional<double> relative_tolerance, std::int64_t refine) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             Segmentation segmentation;
             {
               py::gil_scoped_release release;
-              segmentation = cut_level(*self.hierarchy, level);
+              segmentation = refined_level(*self.hierarchy, level, refine, nullptr);
             }
             const py::ssize_t faces = static_cast<py::ssize_t>(segmentation.labels.size());
             return adopt<std::int32_t>(std::move(segmentation.labels), {faces});
           },
           py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
-          py::arg("relative_tolerance") = py::none(),
-          join_docs({R"(cut(k=None, *, tolerance=None, relative_tolerance=None) -> numpy.ndarray
+          py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
+          join_docs(
+              {R"(cut(k=None, *, tolerance=None, relative_tolerance=None, refine=0) -> numpy.ndarray
 
 The cluster of each input face, int32 (F,), values 0..K-1 numbered by decreasing area: the same
 labels as the CLI's --labels.)",
-                     kLevelArguments, cpp_doc("cut_by_count", doc::cut__cut_by_count),
-                     cpp_doc("cut_by_tolerance", doc::cut__cut_by_tolerance)})
+               kLevelArguments, kRefineArgument, cpp_doc("cut_by_count", doc::cut__cut_by_count),
+               cpp_doc("cut_by_tolerance", doc::cut__cut_by_tolerance),
+               cpp_doc("refine_boundaries", doc::refine__refine_boundaries)})
               .c_str())
       .def(
           "clusters",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
-             std::optional<double> relative_tolerance) {
+             std::optional<double> relative_tolerance, std::int64_t refine) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterReport> reports;
             {
               py::gil_scoped_release release;
-              reports = describe_clusters(*self.hierarchy, cut_level(*self.hierarchy, level));
+              refined_level(*self.hierarchy, level, refine, &reports);
             }
             py::list clusters;
             for (const ClusterReport& report : reports) clusters.append(cluster_dict(report));
             return clusters;
           },
           py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
-          py::arg("relative_tolerance") = py::none(),
-          join_docs({R"(clusters(k=None, *, tolerance=None, relative_tolerance=None) -> list of dict
+          py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
+          join_docs(
+              {R"(clusters(k=None, *, tolerance=None, relative_tolerance=None, refine=0) -> list of dict
 
 One dict per cluster, in label order, with the keys and values of the CLI's --json "clusters":
 id, type ("plane", "cylinder", "sphere"), faces (count), area, rms, max, and params (input
 units: plane {normal, point}, sphere {center, radius}, cylinder {axis, point, radius}; vectors
 as lists). json.dumps() takes it as it is.)",
-                     kLevelArguments, cpp_doc("ClusterReport", doc::cut__ClusterReport),
-                     cpp_doc("ClusterReport::rms", doc::cut__ClusterReport__rms),
-                     cpp_doc("ClusterReport::max", doc::cut__ClusterReport__max),
-                     cpp_doc("named_parameters", doc::primitive__named_parameters)})
+               kLevelArguments, kRefineArgument, cpp_doc("ClusterReport", doc::cut__ClusterReport),
+               cpp_doc("ClusterReport::rms", doc::cut__ClusterReport__rms),
+               cpp_doc("ClusterReport::max", doc::cut__ClusterReport__max),
+               cpp_doc("named_parameters", doc::primitive__named_parameters)})
               .c_str())
       .def(
           "linkage",

@@ -20,7 +20,9 @@ def fandisk_tree(fandisk):
     [((), {}), (("--clusters", "30"), {"k": 30}), (("--clusters", "1"), {"k": 1}),
      (("--clusters", "auto"), {"k": "auto"}),
      (("--tolerance", "0.05%"), {"relative_tolerance": 0.0005}),
-     (("--tolerance", "0.002"), {"tolerance": 0.002})])
+     (("--tolerance", "0.002"), {"tolerance": 0.002}),
+     (("--clusters", "30", "--refine", "5"), {"k": 30, "refine": 5}),
+     (("--tolerance", "0.05%", "--refine", "2"), {"relative_tolerance": 0.0005, "refine": 2})])
 def test_labels_and_clusters_match_the_cli(cli, fandisk, fandisk_tree, tmp_path, cli_level, python_level):
     run_cli(cli, "segment", fandisk, *cli_level, "--labels", tmp_path / "l.txt",
             "--json", tmp_path / "c.json", "--quiet")
@@ -30,6 +32,18 @@ def test_labels_and_clusters_match_the_cli(cli, fandisk, fandisk_tree, tmp_path,
     np.testing.assert_array_equal(labels, expected)
     # Same keys, same numbers, bit for bit (JSON doubles round-trip).
     assert fandisk_tree.clusters(**python_level) == json.loads((tmp_path / "c.json").read_text())["clusters"]
+
+
+def test_refinement_moves_border_faces_and_checks_its_pass_count(fandisk_tree):
+    cut = fandisk_tree.cut(30)
+    refined = fandisk_tree.cut(30, refine=5)
+    assert 0 < np.count_nonzero(refined != cut) < cut.size // 10
+    np.testing.assert_array_equal(fandisk_tree.cut(30, refine=0), cut)
+    for passes in (-1, 1001):
+        with pytest.raises(ValueError, match="refine"):
+            fandisk_tree.cut(30, refine=passes)
+        with pytest.raises(ValueError, match="refine"):
+            fandisk_tree.clusters(30, refine=passes)
 
 
 def test_linkage_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path):
