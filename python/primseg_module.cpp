@@ -111,13 +111,13 @@ std::string entry(const char* name, py::ssize_t row, py::ssize_t column) {
 }
 
 template <typename T>
-std::vector<Vec3> read_vertices(const ArrayView& a) {
+std::vector<Vec3> read_vertices(const ArrayView& a, const char* name = "V") {
   std::vector<Vec3> positions(static_cast<std::size_t>(a.rows));
   for (py::ssize_t i = 0; i < a.rows; ++i)
     for (py::ssize_t j = 0; j < 3; ++j) {
       const double value = static_cast<double>(element<T>(a, i, j));
       if (!std::isfinite(value))
-        throw InvalidInputError(entry("V", i, j) + " is " + std::to_string(value) +
+        throw InvalidInputError(entry(name, i, j) + " is " + std::to_string(value) +
                                 ": coordinates must be finite");
       positions[i][j] = value;
     }
@@ -320,6 +320,42 @@ Segmentation refined_level(const Hierarchy& hierarchy, const LevelArguments& lev
   RefinedLevel refined = refine_boundaries(hierarchy, segmentation, options);
   if (reports) *reports = std::move(refined.reports);
   return std::move(refined.segmentation);
+}
+
+// write_mesh's `positions`: (n, 3) finite floats for the n vertices of `mesh`.
+std::vector<Vec3> replacement_positions(const py::handle& object, const Mesh& mesh) {
+  py::object owner;
+  const ArrayView a = view_n_by_3(object, "positions", "float32 or float64", true, owner);
+  if (static_cast<std::size_t>(a.rows) != mesh.vertex_count())
+    throw InvalidInputError("positions has " + std::to_string(a.rows) + " rows for " +
+                            std::to_string(mesh.vertex_count()) + " vertices");
+  return a.itemsize == 4 ? read_vertices<float>(a, "positions")
+                         : read_vertices<double>(a, "positions");
+}
+
+// write_mesh's `labels`: one non-negative integer per input face (polygon) of `mesh`.
+std::vector<std::uint32_t> face_labels(const py::handle& object, const Mesh& mesh) {
+  const py::module_ numpy = py::module_::import("numpy");
+  const py::array array = py::isinstance<py::array>(object)
+                              ? py::reinterpret_borrow<py::array>(object)
+                              : py::array(numpy.attr("asarray")(object));
+  const char kind = array.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throw InvalidInputError("labels must be an array of integers, not " +
+                            py::repr(array.dtype().attr("name")).cast<std::string>());
+  if (array.ndim() != 1 || static_cast<std::size_t>(array.shape(0)) != mesh.face_count())
+    throw InvalidInputError("labels must have one entry per face: shape (" +
+                            std::to_string(mesh.face_count()) + ",)");
+  const py::array_t<std::int64_t> values(numpy.attr("asarray")(array, "int64"));
+  std::vector<std::uint32_t> labels(mesh.face_count());
+  for (std::size_t f = 0; f < labels.size(); ++f) {
+    const std::int64_t label = values.at(static_cast<py::ssize_t>(f));
+    if (label < 0 || label > std::numeric_limits<std::uint32_t>::max() - 1)
+      throw InvalidInputError("labels[" + std::to_string(f) + "] = " + std::to_string(label) +
+                              " is not a cluster id (0 .. 2^32 - 2)");
+    labels[f] = static_cast<std::uint32_t>(label);
+  }
+  return labels;
 }
 
 py::list vector_list(const Vec3& v) {
@@ -738,6 +774,46 @@ faces.)",
                  cpp_doc("read_mesh", doc::mesh_io__read_mesh)})
           .c_str());
 
+  m.def(
+      "write_mesh",
+      [](const std::filesystem::path& path, const py::object& first, const py::object& faces,
+         const py::object& positions, const py::object& labels, bool binary) {
+        std::shared_ptr<const Mesh> mesh =
+            py::isinstance<PyHierarchy>(first)
+                ? first.cast<const PyHierarchy&>().hierarchy->shared_mesh()
+                : mesh_argument("write_mesh", first, faces);
+        Mesh moved;
+        if (!positions.is_none()) {
+          moved = *mesh;
+          moved.positions = replacement_positions(positions, *mesh);
+        }
+        const std::vector<std::uint32_t> groups =
+            labels.is_none() ? std::vector<std::uint32_t>{} : face_labels(labels, *mesh);
+        MeshWriteOptions options;
+        options.face_groups = groups;
+        options.binary = binary;
+        py::gil_scoped_release release;
+        write_mesh(path, positions.is_none() ? *mesh : moved, options);
+      },
+      py::arg("path"), py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(),
+      py::arg("positions") = py::none(), py::arg("labels") = py::none(), py::arg("binary") = true,
+      join_docs(
+          {R"(write_mesh(path, mesh, *, positions=None, labels=None, binary=True)
+write_mesh(path, V, F, *, ...)
+
+Writes a Mesh (its input polygons), a Hierarchy's mesh, or arrays V (n, 3) and F (m, 3), in the
+format of the extension (.off .obj .ply .stl), through a temporary file renamed into place.
+positions: (n, 3) float new positions of the same vertices (what denoise() and
+Skeleton.deform() return), written with the mesh's faces: the CLI's denoise and deform outputs.
+labels: one non-negative integer per face (per input polygon, like cut()'s), written as face
+colours (PLY, OFF) or groups (OBJ), like the CLI's --colored; STL has neither.
+binary: PLY and STL binary (little-endian) or ASCII.
+Raises InvalidInputError (a ValueError) for an unknown extension or bad arrays, IoError (an
+OSError) when the file cannot be written.)",
+           cpp_doc("write_mesh", doc::mesh_io__write_mesh),
+           cpp_doc("MeshWriteOptions::face_groups", doc::mesh_io__MeshWriteOptions__face_groups)})
+          .c_str());
+
   const char* segment_doc =
       R"(segment(mesh, *, primitives=("plane", "cylinder", "sphere"), weights="area", threads=0, exact_costs=False, eager=False) -> Hierarchy
 segment(V, F, *, ...) -> Hierarchy
@@ -836,6 +912,28 @@ as lists). json.dumps() takes it as it is.)",
                cpp_doc("ClusterReport::rms", doc::cut__ClusterReport__rms),
                cpp_doc("ClusterReport::max", doc::cut__ClusterReport__max),
                cpp_doc("named_parameters", doc::primitive__named_parameters)})
+              .c_str())
+      .def(
+          "error_curve",
+          [](const PyHierarchy& self) {
+            std::vector<ErrorCurvePoint> points;
+            {
+              py::gil_scoped_release release;
+              points = error_curve(*self.hierarchy);
+            }
+            std::vector<std::array<double, 2>> rows(points.size());
+            for (std::size_t i = 0; i < points.size(); ++i)
+              rows[i] = {static_cast<double>(points[i].clusters), points[i].rms};
+            const py::ssize_t count = static_cast<py::ssize_t>(rows.size());
+            return adopt<double>(std::move(rows), {count, 2});
+          },
+          join_docs({R"(error_curve() -> numpy.ndarray
+
+The RMS distance estimate of every level, float64 (F - C + 1, 2): rows (K, rms) for K from the
+number of components C to F, in input units; the CLI's --curve CSV. To plot and choose a level
+by eye: plt.semilogy(*curve.T).)",
+                     cpp_doc("error_curve", doc::auto_level__error_curve),
+                     cpp_doc("ErrorCurvePoint::rms", doc::auto_level__ErrorCurvePoint__rms)})
               .c_str())
       .def(
           "linkage",

@@ -54,6 +54,10 @@ for name, level in [("0.1% of the diagonal (the CLI's default)", {}),
     print(f"{name}: {tree.cut(**level).max() + 1} clusters")
 assert labels.shape == (mesh.face_count,) and labels.max() == 29
 
+curve = tree.error_curve()  # (K, rms) for every K, to plot and pick a level by eye
+print("RMS of the levels of 10, 30 and 100 clusters:", curve[[9, 29, 99], 1])
+assert np.array_equal(curve[:, 0], np.arange(1, mesh.face_count + 1))
+
 # %% [markdown]
 # ## What each cluster is
 # One dict per cluster, as in the CLI's JSON: fitted primitive, parameters, exact RMS and maximum
@@ -135,6 +139,13 @@ for name, d in [("noisy", before), ("denoised", after)]:
           " of the diagonal")
 assert clean_V.shape == mesh.V.shape and clean_V.dtype == np.float64
 assert after["symmetric"]["rms"] < 0.6 * before["symmetric"]["rms"]
+
+# Saved with the mesh's faces, as `primseg denoise -o` saves it; and the 30 clusters as colours.
+folder = tree_path.parent
+primseg.write_mesh(folder / "fandisk-denoised.ply", mesh, positions=clean_V)
+primseg.write_mesh(folder / "fandisk-clusters.ply", mesh, labels=labels)
+assert np.array_equal(primseg.read_mesh(folder / "fandisk-denoised.ply").V, clean_V)
+print("wrote", ", ".join(p.name for p in sorted(folder.glob("*.ply"))))
 
 # %% [markdown]
 # ## A skeleton, and a pose

@@ -91,3 +91,63 @@ def test_strided_and_byte_swapped_arrays_are_read_as_given():
 def test_lists_are_accepted():
     mesh = primseg.Mesh([[0.0, 0, 0], [1.0, 0, 0], [0.0, 1, 0]], [[0, 1, 2]])
     assert mesh.face_count == 1
+
+
+@pytest.mark.parametrize("extension, binary", [(".off", True), (".obj", True), (".ply", True),
+                                               (".ply", False), (".stl", True), (".stl", False)])
+def test_write_mesh_round_trips(fandisk, tmp_path, extension, binary):
+    mesh = primseg.read_mesh(fandisk)
+    path = tmp_path / f"copy{extension}"
+    primseg.write_mesh(path, mesh, binary=binary)
+    copy = primseg.read_mesh(path)
+    if extension == ".stl":  # float32 triangle soup, welded again on reading
+        assert copy.face_count == mesh.face_count
+        np.testing.assert_allclose(np.sort(copy.V, axis=0), np.sort(mesh.V, axis=0), atol=1e-6)
+    else:
+        np.testing.assert_array_equal(copy.V, mesh.V)
+        np.testing.assert_array_equal(copy.F, mesh.F)
+
+
+def test_write_mesh_keeps_polygons_and_takes_new_positions(tmp_path):
+    path = tmp_path / "quad_and_triangle.off"
+    path.write_text("OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n4 0 1 2 3\n3 1 4 2\n")
+    mesh = primseg.read_mesh(path)
+    moved = mesh.V + [0, 0, 0.5]
+    primseg.write_mesh(tmp_path / "moved.off", mesh, positions=moved.astype(np.float32))
+    lines = (tmp_path / "moved.off").read_text().split("\n")
+    assert lines[:2] == ["OFF", "5 2 0"] and lines[7:9] == ["4 0 1 2 3", "3 1 4 2"]
+    np.testing.assert_array_equal(primseg.read_mesh(tmp_path / "moved.off").V, moved)
+    np.testing.assert_array_equal(mesh.V[:, 2], 0)  # the Mesh itself is unchanged
+
+
+def test_write_mesh_from_arrays_and_from_a_hierarchy(fandisk, tmp_path):
+    mesh = primseg.read_mesh(fandisk)
+    primseg.write_mesh(tmp_path / "arrays.ply", mesh.V, mesh.F)
+    primseg.write_mesh(tmp_path / "tree.ply", primseg.segment(mesh))
+    primseg.write_mesh(tmp_path / "mesh.ply", mesh)
+    data = (tmp_path / "mesh.ply").read_bytes()
+    assert (tmp_path / "arrays.ply").read_bytes() == data == (tmp_path / "tree.ply").read_bytes()
+
+
+def test_write_mesh_rejects_bad_arguments(fandisk, tmp_path):
+    mesh = primseg.read_mesh(fandisk)
+    out = tmp_path / "out.ply"
+    cases = [
+        (dict(positions=mesh.V[:-1]), "positions has 6474 rows for 6475 vertices"),
+        (dict(positions=np.where(np.arange(6475)[:, None] == 7, np.nan, mesh.V)),
+         r"positions\[7, 0\] is nan"),
+        (dict(positions=mesh.V.astype(np.int64)), "positions must be an array of float32 or float64"),
+        (dict(labels=np.zeros(mesh.face_count, dtype=np.float64)), "labels must be an array of integers"),
+        (dict(labels=np.zeros(3, dtype=np.int32)), r"one entry per face: shape \(12946,\)"),
+        (dict(labels=np.full(mesh.face_count, -1)), r"labels\[0\] = -1 is not a cluster id"),
+    ]
+    for keywords, message in cases:
+        with pytest.raises(ValueError, match=message):
+            primseg.write_mesh(out, mesh, **keywords)
+    with pytest.raises(ValueError, match="extension"):
+        primseg.write_mesh(tmp_path / "out.xyz", mesh)
+    with pytest.raises(OSError):
+        primseg.write_mesh(tmp_path / "missing" / "out.ply", mesh)
+    with pytest.raises(ValueError, match="F is missing"):
+        primseg.write_mesh(out, mesh.V)
+    assert not out.exists()

@@ -188,3 +188,13 @@ def test_polygon_file_labels_match_the_cli(cli, tmp_path):
     np.testing.assert_array_equal(labels, np.loadtxt(tmp_path / "l.txt"))
     assert same_partition(labels, [0] * len(quads) + [1, 2])
     assert sorted(c["type"] for c in h.clusters(3)) == ["cylinder", "plane", "plane"]
+
+
+def test_error_curve_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path):
+    run_cli(cli, "segment", fandisk, "--curve", tmp_path / "curve.csv", "--quiet")
+    expected = np.loadtxt(tmp_path / "curve.csv", delimiter=",", skiprows=1)
+    curve = fandisk_tree.error_curve()
+    assert curve.dtype == np.float64 and curve.shape == (12946, 2)
+    np.testing.assert_array_equal(curve, expected)  # %.17g round-trips
+    np.testing.assert_array_equal(curve[:, 0], np.arange(1, 12947))
+    assert curve[0, 1] > 0 and curve[-1, 1] == 0  # single faces fit their planes exactly

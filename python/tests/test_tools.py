@@ -292,3 +292,18 @@ def test_releases_the_gil(fandisk, name):
              "skeleton": lambda: primseg.skeleton(mesh, k=12, threads=1),
              "distance": lambda: primseg.distance(mesh, mesh, samples=200000, threads=1)}
     assert_releases_the_gil(calls[name])
+
+
+def test_write_mesh_gives_the_cli_outputs(cli, fandisk, noisy_fandisk, tmp_path):
+    # denoise -o: the positions denoise() returns, with the input's faces.
+    run_cli(cli, "denoise", noisy_fandisk, "--clusters", "30", "-o", tmp_path / "cli.ply", "--quiet")
+    noisy = primseg.read_mesh(noisy_fandisk)
+    primseg.write_mesh(tmp_path / "py.ply", noisy, positions=primseg.denoise(noisy, k=30))
+    assert (tmp_path / "py.ply").read_bytes() == (tmp_path / "cli.ply").read_bytes()
+    # segment --colored: the labels as face colours (PLY) and groups (OBJ).
+    for extension in (".ply", ".obj"):
+        run_cli(cli, "segment", fandisk, "--clusters", "12", "--colored",
+                tmp_path / f"cli{extension}", "--quiet")
+        mesh = primseg.read_mesh(fandisk)
+        primseg.write_mesh(tmp_path / f"py{extension}", mesh, labels=primseg.segment(mesh).cut(12))
+        assert (tmp_path / f"py{extension}").read_bytes() == (tmp_path / f"cli{extension}").read_bytes()
