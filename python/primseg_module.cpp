@@ -26,6 +26,7 @@
 #include "primseg/error.hpp"
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh_distance.hpp"
+#include "primseg/mesh_info.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
 #include "primseg/refine.hpp"
@@ -753,6 +754,47 @@ faces.)",
           "bounding_box_diagonal",
           [](const PyMesh& self) { return bounding_box_diagonal(*self.mesh); },
           doc::mesh__bounding_box_diagonal)
+      .def(
+          "info",
+          [](const PyMesh& self) {
+            MeshInfo i;
+            std::optional<std::string> out_of_range;
+            {
+              py::gil_scoped_release release;
+              i = describe_mesh(*self.mesh);
+              try {
+                check_geometric_range(*self.mesh);
+              } catch (const InvalidInputError& error) {
+                out_of_range = error.what();
+              }
+            }
+            py::dict d;
+            d["vertices"] = i.vertices;
+            d["isolated_vertices"] = i.isolated_vertices;
+            d["faces"] = i.faces;
+            d["polygons"] = i.polygons;
+            d["triangles"] = i.triangles;
+            d["components"] = i.components;
+            d["boundary_edges"] = i.boundary_edges;
+            d["non_manifold_edges"] = i.non_manifold_edges;
+            d["degenerate_triangles"] = i.degenerate_triangles;
+            d["duplicate_triangles"] = i.duplicate_triangles;
+            d["bbox_min"] = vector_list(i.bbox_min);
+            d["bbox_max"] = vector_list(i.bbox_max);
+            d["bbox_diagonal"] = i.bbox_diagonal;
+            d["out_of_range"] = out_of_range ? py::object(py::str(*out_of_range)) : py::none();
+            return d;
+          },
+          join_docs({R"(info() -> dict
+
+What `primseg info` prints, as a dict: vertices, isolated_vertices, faces, polygons (faces of
+more than 3 vertices), triangles, components, boundary_edges, non_manifold_edges,
+degenerate_triangles, duplicate_triangles, bbox_min, bbox_max, bbox_diagonal, and
+out_of_range: None, or the message the other functions would raise for coordinates too large
+or too spread out to fit reliably.)",
+                     cpp_doc("describe_mesh", doc::mesh_info__file),
+                     cpp_doc("check_geometric_range", doc::mesh__check_geometric_range)})
+              .c_str())
       .def("__repr__", [](const PyMesh& self) {
         return "<primseg.Mesh: " + std::to_string(self.mesh->vertex_count()) + " vertices, " +
                std::to_string(self.mesh->face_count()) + " faces, " +
@@ -912,6 +954,37 @@ as lists). json.dumps() takes it as it is.)",
                cpp_doc("ClusterReport::rms", doc::cut__ClusterReport__rms),
                cpp_doc("ClusterReport::max", doc::cut__ClusterReport__max),
                cpp_doc("named_parameters", doc::primitive__named_parameters)})
+              .c_str())
+      .def(
+          "auto_level",
+          [](const PyHierarchy& self) {
+            AutoLevel level;
+            {
+              py::gil_scoped_release release;
+              level = choose_level(*self.hierarchy);
+            }
+            py::list candidates;
+            for (const LevelCandidate& c : level.candidates) {
+              py::dict candidate;
+              candidate["clusters"] = c.clusters;
+              candidate["rms"] = c.rms;
+              candidate["score"] = c.score;
+              candidates.append(candidate);
+            }
+            py::dict d;
+            d["clusters"] = level.clusters;
+            d["rule"] = std::string(to_string(level.rule));
+            d["candidates"] = candidates;
+            return d;
+          },
+          join_docs({R"(auto_level() -> dict
+
+The level cut("auto") takes and why, as the CLI's --json "level" reports it: clusters (K), rule
+("jump", "knee" or "components") and candidates (best score first: dicts of clusters, rms in
+input units, and score).)",
+                     cpp_doc("choose_level", doc::auto_level__choose_level),
+                     cpp_doc("AutoLevel::clusters", doc::auto_level__AutoLevel__clusters),
+                     cpp_doc("LevelCandidate::score", doc::auto_level__LevelCandidate__score)})
               .c_str())
       .def(
           "error_curve",

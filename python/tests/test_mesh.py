@@ -151,3 +151,27 @@ def test_write_mesh_rejects_bad_arguments(fandisk, tmp_path):
     with pytest.raises(ValueError, match="F is missing"):
         primseg.write_mesh(out, mesh.V)
     assert not out.exists()
+
+
+def test_info_counts_what_the_cli_prints(cli, tmp_path):
+    from conftest import run_cli
+    # Two components, a quad, an isolated vertex, a duplicate and a degenerate triangle.
+    path = tmp_path / "defects.off"
+    path.write_text("OFF\n9 4 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n5 0 0\n6 0 0\n5 1 0\n7 7 7\n7 0 0\n"
+                    "4 0 1 2 3\n3 4 5 6\n3 6 5 4\n3 4 5 8\n")
+    info = primseg.read_mesh(path).info()
+    # Edge 4-5 has three triangles; the quad's four sides, 5-8 and 8-4 have one. The isolated
+    # vertex (7, 7, 7) is outside the bounding box of the faces.
+    assert info == {
+        "vertices": 9, "isolated_vertices": 1, "faces": 4, "polygons": 1, "triangles": 5,
+        "components": 2, "boundary_edges": 6, "non_manifold_edges": 1,
+        "degenerate_triangles": 1, "duplicate_triangles": 1, "bbox_min": [0.0, 0.0, 0.0],
+        "bbox_max": [7.0, 1.0, 0.0], "bbox_diagonal": 50 ** 0.5, "out_of_range": None}
+    printed = [line.split() for line in run_cli(cli, "info", path).splitlines()[1:]]
+    assert printed[:6] == [["vertices", "9", "(1", "isolated)"],
+                           ["faces", "4", "(1", "polygons),", "5", "triangles"],
+                           ["components", "2"], ["boundary", "edges", "6"],
+                           ["non-manifold", "edges", "1"],
+                           ["degenerate", "triangles", "1,", "duplicate", "triangles", "1"]]
+    far = primseg.Mesh(np.array([[0, 0, 0], [1e200, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    assert "vertex 1 has a coordinate of magnitude 1e+200" in far.info()["out_of_range"]

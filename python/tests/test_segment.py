@@ -198,3 +198,13 @@ def test_error_curve_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path):
     np.testing.assert_array_equal(curve, expected)  # %.17g round-trips
     np.testing.assert_array_equal(curve[:, 0], np.arange(1, 12947))
     assert curve[0, 1] > 0 and curve[-1, 1] == 0  # single faces fit their planes exactly
+
+
+def test_auto_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path):
+    run_cli(cli, "segment", fandisk, "--clusters", "auto", "--json", tmp_path / "c.json", "--quiet")
+    level = json.loads((tmp_path / "c.json").read_text())["level"]
+    auto = fandisk_tree.auto_level()
+    assert auto == {"clusters": level["clusters"], "rule": level["rule"],
+                    "candidates": level["candidates"]}
+    assert fandisk_tree.cut("auto").max() + 1 == auto["clusters"]
+    assert auto["rule"] == "knee"  # fandisk's curve has no jump (README, Measured quality)
