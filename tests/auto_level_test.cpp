@@ -123,6 +123,83 @@ TEST(AutoLevel, ANoisySingleSurfaceHasNoKnee) {
   }
 }
 
+// A hierarchy whose error curve is `rms` (rms[K − 1] for K clusters, input units, K < F): a strip
+// of F triangles merged one at a time in a chain, each merge given the error that makes its
+// level's RMS the one asked for (the curve only reads the merges' errors and the faces' weights).
+Hierarchy hierarchy_with_curve(const std::vector<double>& rms, std::uint32_t faces) {
+  std::vector<Vec3> positions;
+  for (std::uint32_t i = 0; i < faces / 2 + 1; ++i) {
+    positions.push_back({double(i), 0, 0});
+    positions.push_back({double(i), 1, 0});
+  }
+  std::vector<Triangle> triangles;
+  for (std::uint32_t t = 0; t < faces; ++t) {
+    const std::uint32_t i = t / 2;
+    triangles.push_back(t % 2 == 0 ? Triangle{2 * i, 2 * i + 2, 2 * i + 1}
+                                   : Triangle{2 * i + 1, 2 * i + 2, 2 * i + 3});
+  }
+  const auto mesh = std::make_shared<const Mesh>(
+      Mesh::from_triangles(std::move(positions), std::move(triangles)));
+  auto merges_for = [&](double total_weight, int exponent) {
+    std::vector<Merge> merges(faces - 1);
+    for (std::uint32_t m = 0; m + 1 < faces; ++m) {
+      // After m + 1 merges the level has K = F − m − 1 clusters: the chain and single faces.
+      const std::uint32_t k = faces - m - 1;
+      const double level_rms = k <= rms.size() ? rms[k - 1] : rms.back();
+      Merge& merge = merges[m];
+      merge.first = m + 1;
+      merge.second = m == 0 ? 0 : faces + m - 1;
+      if (merge.first > merge.second) std::swap(merge.first, merge.second);
+      merge.error = total_weight * std::pow(std::ldexp(level_rms, -exponent), 2);
+      merge.cost = merge.error;
+      merge.weight = total_weight * (m + 2) / faces;
+      merge.face_count = m + 2;
+    }
+    return merges;
+  };
+  const Hierarchy probe(mesh, {}, merges_for(1, 0));
+  double total_weight = 0;
+  for (std::uint32_t f = 0; f < faces; ++f) total_weight += probe.weight(f);
+  return Hierarchy(mesh, {}, merges_for(total_weight, probe.graph().frame().exponent));
+}
+
+// log rms falling by `coarse` per level down to K = bend, then by `fine`: ratios of e^0.05 at most,
+// far below a jump (2).
+std::vector<double> bent_curve(std::uint32_t bend, double coarse, double fine, std::uint32_t size) {
+  std::vector<double> rms(size);
+  for (std::uint32_t k = 1; k <= size; ++k)
+    rms[k - 1] =
+        1000 * std::exp(-coarse * (std::min(k, bend) - 1.0) - fine * (k - std::min(k, bend)));
+  return rms;
+}
+
+TEST(AutoLevel, ABendIsAKneeOnlyWhereTheCoarseLineIsMuchSteeper) {
+  constexpr std::uint32_t kFaces = 1000;
+  const Hierarchy sharp = hierarchy_with_curve(bent_curve(31, 0.05, 0.02, kFaces / 2), kFaces);
+  const std::vector<ErrorCurvePoint> curve = error_curve(sharp);
+  ASSERT_NEAR(curve[30].rms / curve[0].rms, std::exp(-1.5), 1e-12);  // the curve asked for
+  const AutoLevel knee = choose_level(sharp);
+  EXPECT_EQ(knee.rule, AutoLevelRule::Knee);
+  EXPECT_GE(knee.clusters, 30u);  // K = 31 is on both lines
+  EXPECT_LE(knee.clusters, 31u);
+  // Steeper by 0.05 / 0.035 = 1.43 only, below min_score (2): the curve falls nearly evenly.
+  const AutoLevel even =
+      choose_level(hierarchy_with_curve(bent_curve(31, 0.05, 0.035, kFaces / 2), kFaces));
+  EXPECT_EQ(even.rule, AutoLevelRule::Components);
+  EXPECT_EQ(even.clusters, 1u);
+}
+
+// The L-method tries every split that leaves two points to each line, the first included: a
+// curve whose only bend is after its first level (a fall of 1.9, short of a jump) bends there,
+// and is not read as a later knee.
+TEST(AutoLevel, TheBendAfterTheFirstLevelIsFoundAndTooSmall) {
+  constexpr std::uint32_t kFaces = 1000;
+  std::vector<double> rms = bent_curve(2, std::log(1.9), 0.06, kFaces / 2);
+  const AutoLevel level = choose_level(hierarchy_with_curve(rms, kFaces));
+  EXPECT_EQ(level.rule, AutoLevelRule::Components);
+  EXPECT_EQ(level.clusters, 1u);
+}
+
 TEST(AutoLevel, RulesHaveNames) {
   EXPECT_EQ(to_string(AutoLevelRule::Jump), "jump");
   EXPECT_EQ(to_string(AutoLevelRule::Knee), "knee");
