@@ -1,6 +1,10 @@
 #include <cstdio>
 #include <memory>
+#include <optional>
 
+#include <nlohmann/json.hpp>
+
+#include "../src/file_io.hpp"
 #include "command.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_info.hpp"
@@ -9,14 +13,50 @@
 namespace primseg::cli {
 
 Command add_info_command(CLI::App& app) {
-  auto path = std::make_shared<std::string>();
+  struct Options {
+    std::string path;
+    std::optional<std::string> json;
+  };
+  auto o = std::make_shared<Options>();
   auto* info = app.add_subcommand("info", "Print counts and defects of a mesh");
-  info->add_option("MESH", *path, "Input mesh")->required();
+  info->add_option("MESH", o->path, "Input mesh")->required();
+  info->add_option("--json", o->json,
+                   "Write the counts as JSON (- for standard output, instead of the text)");
 
-  return {info, [path] {
-            const Mesh mesh = read_mesh(*path);
+  return {info, [o] {
+            const Mesh mesh = read_mesh(o->path);
             const MeshInfo i = describe_mesh(mesh);
-            std::printf("%s\n", path->c_str());
+            // Reported, not refused: info is where a user finds out why the others refuse.
+            std::optional<std::string> out_of_range;
+            try {
+              check_geometric_range(mesh);
+            } catch (const InvalidInputError& error) {
+              out_of_range = error.what();
+            }
+            if (o->json) {
+              // The keys and values of the Python module's Mesh.info().
+              const nlohmann::json json = {
+                  {"vertices", i.vertices},
+                  {"isolated_vertices", i.isolated_vertices},
+                  {"faces", i.faces},
+                  {"polygons", i.polygons},
+                  {"triangles", i.triangles},
+                  {"components", i.components},
+                  {"boundary_edges", i.boundary_edges},
+                  {"non_manifold_edges", i.non_manifold_edges},
+                  {"degenerate_triangles", i.degenerate_triangles},
+                  {"duplicate_triangles", i.duplicate_triangles},
+                  {"bbox_min", i.bbox_min},
+                  {"bbox_max", i.bbox_max},
+                  {"bbox_diagonal", i.bbox_diagonal},
+                  {"out_of_range", out_of_range ? nlohmann::json(*out_of_range) : nullptr}};
+              if (*o->json == "-") {
+                std::printf("%s\n", json.dump(2).c_str());
+                return;
+              }
+              detail::write_file_atomically(*o->json, json.dump(2) + "\n");
+            }
+            std::printf("%s\n", o->path.c_str());
             std::printf("  vertices            %u (%u isolated)\n", i.vertices,
                         i.isolated_vertices);
             std::printf("  faces               %u (%u polygons), %u triangles\n", i.faces,
@@ -29,12 +69,7 @@ Command add_info_command(CLI::App& app) {
             std::printf("  bounding box        [%g %g %g] - [%g %g %g], diagonal %g\n",
                         i.bbox_min[0], i.bbox_min[1], i.bbox_min[2], i.bbox_max[0], i.bbox_max[1],
                         i.bbox_max[2], i.bbox_diagonal);
-            // Reported, not refused: info is where a user finds out why the others refuse.
-            try {
-              check_geometric_range(mesh);
-            } catch (const InvalidInputError& error) {
-              std::printf("  out of range        %s\n", error.what());
-            }
+            if (out_of_range) std::printf("  out of range        %s\n", out_of_range->c_str());
           }};
 }
 

@@ -1,6 +1,7 @@
 """read_mesh, Mesh(V, F) and the arrays they expose."""
 
 import gc
+import json
 
 import numpy as np
 import pytest
@@ -167,6 +168,7 @@ def test_info_counts_what_the_cli_prints(cli, tmp_path):
         "components": 2, "boundary_edges": 6, "non_manifold_edges": 1,
         "degenerate_triangles": 1, "duplicate_triangles": 1, "bbox_min": [0.0, 0.0, 0.0],
         "bbox_max": [7.0, 1.0, 0.0], "bbox_diagonal": 50 ** 0.5, "out_of_range": None}
+    assert json.loads(run_cli(cli, "info", path, "--json", "-")) == info  # the same keys and values
     printed = [line.split() for line in run_cli(cli, "info", path).splitlines()[1:]]
     assert printed[:6] == [["vertices", "9", "(1", "isolated)"],
                            ["faces", "4", "(1", "polygons),", "5", "triangles"],

@@ -669,6 +669,41 @@ TEST(Cli, InfoReportsCoordinatesTheOtherCommandsRefuse) {
       << info.output;
   const CliRun segment = run("segment " + dir.q("far.off") + " --quiet");
   EXPECT_EQ(segment.status, 1) << segment.output;
+  const CliRun as_json = run("info " + dir.q("far.off") + " --json -");
+  ASSERT_EXIT_OK(as_json);
+  EXPECT_EQ(json::parse(as_json.output)["out_of_range"],
+            "vertex 1 has a coordinate of magnitude 1e+40, above the 1e+32 that primseg computes "
+            "with")
+      << as_json.output;
+}
+
+TEST(Cli, InfoJsonHasEveryCount) {
+  TempDir dir("info-json");
+  // A quad and a second component: three triangles on edge 4-5 (one of them a duplicate), one
+  // degenerate, and an isolated vertex outside the faces' bounding box.
+  write_file(dir / "defects.off",
+             "OFF\n9 4 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n5 0 0\n6 0 0\n5 1 0\n7 7 7\n7 0 0\n"
+             "4 0 1 2 3\n3 4 5 6\n3 6 5 4\n3 4 5 8\n");
+  const CliRun r = run("info " + dir.q("defects.off") + " --json " + dir.q("info.json"));
+  ASSERT_EXIT_OK(r);
+  EXPECT_NE(r.output.find("vertices            9 (1 isolated)"), std::string::npos)
+      << "with a file, the text is printed too: " << r.output;
+  const json j = json::parse(testing::file_contents(dir / "info.json"));
+  const json expected = {{"vertices", 9},
+                         {"isolated_vertices", 1},
+                         {"faces", 4},
+                         {"polygons", 1},
+                         {"triangles", 5},
+                         {"components", 2},
+                         {"boundary_edges", 6},
+                         {"non_manifold_edges", 1},
+                         {"degenerate_triangles", 1},
+                         {"duplicate_triangles", 1},
+                         {"bbox_min", {0.0, 0.0, 0.0}},
+                         {"bbox_max", {7.0, 1.0, 0.0}},
+                         {"bbox_diagonal", std::sqrt(50.0)},
+                         {"out_of_range", nullptr}};
+  EXPECT_EQ(j, expected) << j.dump(1);
 }
 
 // ---------------------------------------------------------------------------------------------
