@@ -177,22 +177,32 @@ detail::SelectedModel select_leaf(const HierarchyOptions& options, const DualGra
 
 }  // namespace
 
+void Hierarchy::check_node(std::uint32_t node) const {
+  if (node >= node_count())
+    throw InvalidInputError(std::to_string(node) + " is not a node of the tree (" +
+                            std::to_string(node_count()) + " nodes: 2F − 1)");
+}
+
 Primitive Hierarchy::primitive(std::uint32_t node) const {
+  check_node(node);
   if (!is_leaf(node)) return merges_[node - face_count()].primitive;
   return graph_->frame().to_input(select_leaf(options_, *graph_, node).fit.primitive);
 }
 
 double Hierarchy::error(std::uint32_t node) const {
+  check_node(node);
   if (!is_leaf(node)) return merges_[node - face_count()].error;
   return select_leaf(options_, *graph_, node).fit.error;
 }
 
 double Hierarchy::weight(std::uint32_t node) const {
+  check_node(node);
   if (!is_leaf(node)) return merges_[node - face_count()].weight;
   return graph_->face_stats(node).moments.weight();
 }
 
 std::uint32_t Hierarchy::face_count(std::uint32_t node) const {
+  check_node(node);
   return is_leaf(node) ? 1 : merges_[node - face_count()].face_count;
 }
 

@@ -308,6 +308,23 @@ TEST(Hierarchy, SingleFaceMeshHasNoMerges) {
   EXPECT_EQ(h.primitive(0).type, PrimitiveType::Plane);
 }
 
+TEST(Hierarchy, NodeIdsBeyondTheTreeAreRefused) {
+  const Hierarchy h = build_hierarchy(make_shape("box", {}).mesh);
+  const std::uint32_t root = h.node_count() - 1;
+  EXPECT_EQ(h.face_count(root), h.face_count());
+  for (const std::uint32_t bad : {h.node_count(), h.node_count() + 7, UINT32_MAX}) {
+    EXPECT_THROW(h.primitive(bad), InvalidInputError) << bad;
+    EXPECT_THROW(h.error(bad), InvalidInputError) << bad;
+    EXPECT_THROW(h.weight(bad), InvalidInputError) << bad;
+    EXPECT_THROW(h.face_count(bad), InvalidInputError) << bad;
+    EXPECT_THROW(h.rms_estimate(bad), InvalidInputError) << bad;
+  }
+  // A hand-made segmentation naming such a node is refused too, before any fit.
+  Segmentation cut = cut_by_count(h, 6);
+  cut.nodes[2] = h.node_count();
+  EXPECT_THROW(describe_clusters(h, cut), InvalidInputError);
+}
+
 TEST(Hierarchy, InvalidOptionsAreRejected) {
   const Mesh mesh = make_shape("box", {}).mesh;
   HierarchyOptions none;

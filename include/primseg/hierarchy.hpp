@@ -109,7 +109,8 @@ class Hierarchy {
   /// Parent of each node (UINT32_MAX for the root), shape (2F − 1).
   const std::vector<std::uint32_t>& parents() const { return parents_; }
 
-  /// Fitted primitive of a node, input units (leaves are fitted on demand).
+  /// Fitted primitive of a node, input units (leaves are fitted on demand). This and the three
+  /// accessors below throw InvalidInputError for a node id not below node_count().
   Primitive primitive(std::uint32_t node) const;
   /// L2 error of a node's primitive (working frame, as Merge::error; 0 for planar leaves).
   double error(std::uint32_t node) const;
@@ -125,6 +126,7 @@ class Hierarchy {
   std::vector<std::array<double, 4>> linkage() const;
 
  private:
+  void check_node(std::uint32_t node) const;
   friend class HierarchyBuilder;
   // Adopts the dual graph the builder made (of this mesh, with these options' weights).
   Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options, std::vector<Merge> merges,
