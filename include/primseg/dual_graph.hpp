@@ -55,6 +55,9 @@ struct DualEdge {
 /// Non-manifold edges: the k >= 3 triangles on one mesh edge are sorted by index and joined in a
 /// chain (t1–t2, t2–t3, …): k − 1 dual links, never k², and every face on the edge stays
 /// connected to the others. Orientation propagates only across manifold edges.
+///
+/// The accessors that take a face, triangle or vertex index are the merge loop's: like a
+/// vector's operator[], they do not check it (it must be below the mesh's count).
 class DualGraph {
  public:
   /// Builds the graph of `mesh`, which must outlive it (the graph refers to it). Linear in T but

@@ -41,7 +41,7 @@ struct Mesh {
   }
   std::uint32_t vertex_count() const { return static_cast<std::uint32_t>(positions.size()); }
   std::uint32_t triangle_count() const { return static_cast<std::uint32_t>(triangles.size()); }
-  /// Vertex loop of input face f.
+  /// Vertex loop of input face f (f < face_count(), not checked).
   std::span<const std::uint32_t> polygon(std::uint32_t f) const {
     return {polygon_vertices.data() + polygon_offsets[f],
             polygon_vertices.data() + polygon_offsets[f + 1]};

@@ -41,6 +41,7 @@ struct SkinWeights {
   std::vector<double> weights;
 
   std::uint32_t vertex_count() const { return static_cast<std::uint32_t>(offsets.size() - 1); }
+  /// The bones and weights of one vertex's row (vertex < vertex_count(), not checked).
   std::span<const std::uint32_t> bones_of(std::uint32_t vertex) const {
     return {bones.data() + offsets[vertex], bones.data() + offsets[vertex + 1]};
   }
