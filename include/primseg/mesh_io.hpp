@@ -49,8 +49,9 @@ struct MeshWriteOptions {
   /// cluster_<id>` statement per group, faces grouped by id; OFF: per-face RGB colours; STL:
   /// ignored.
   std::span<const std::uint32_t> face_groups;
-  /// Colour of each group, shape (number of groups). Empty with groups: a built-in palette of
-  /// well-separated colours.
+  /// Colour of each group, shape (largest group id + 1). Empty with groups: a built-in palette
+  /// of well-separated colours, distinct_colors()[k] for group k while the ids are below the
+  /// face count; larger ids are numbered by rank first (the palette never outgrows the mesh).
   std::span<const std::array<std::uint8_t, 3>> group_colors;
   /// PLY and STL: binary little-endian (true) or ascii (false).
   bool binary = true;

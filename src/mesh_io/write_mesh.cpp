@@ -63,23 +63,51 @@ class OutputBuffer {
   std::string text_;
 };
 
-/// The groups' colours, after checking the options against the mesh.
-std::vector<Color> group_palette(const Mesh& mesh, const MeshWriteOptions& options) {
-  if (options.face_groups.empty()) return {};
+// The colour of each face's group: `palette[index()[f]]`.
+struct GroupColors {
+  std::span<const std::uint32_t> groups;  // MeshWriteOptions::face_groups
+  std::vector<std::uint32_t> ranks;       // the groups renumbered, when they are
+  std::vector<Color> palette;
+  std::span<const std::uint32_t> index() const {
+    return ranks.empty() ? groups : std::span<const std::uint32_t>(ranks);
+  }
+};
+
+/// The groups' colours, after checking the options against the mesh. The built-in palette gives
+/// group k colour k, the same in every file, while the ids are below the face count (as any
+/// segmentation's are); larger ids are numbered by rank first, so that a palette is never longer
+/// than the mesh.
+GroupColors group_colors(const Mesh& mesh, const MeshWriteOptions& options) {
+  GroupColors colors;
+  colors.groups = options.face_groups;
+  if (options.face_groups.empty()) return colors;
   if (options.face_groups.size() != mesh.face_count()) {
     throw InvalidInputError(
         "write_mesh: face_groups has " + std::to_string(options.face_groups.size()) +
         " entries but the mesh has " + std::to_string(mesh.face_count()) + " faces");
   }
-  const std::size_t group_count =
-      std::size_t{*std::max_element(options.face_groups.begin(), options.face_groups.end())} + 1;
-  if (options.group_colors.empty()) return distinct_colors(group_count);
-  if (options.group_colors.size() < group_count) {
-    throw InvalidInputError(
-        "write_mesh: group_colors has " + std::to_string(options.group_colors.size()) +
-        " colours but face_groups uses groups up to " + std::to_string(group_count - 1));
+  const std::uint32_t largest =
+      *std::max_element(options.face_groups.begin(), options.face_groups.end());
+  if (!options.group_colors.empty()) {
+    if (options.group_colors.size() <= largest) {
+      throw InvalidInputError(
+          "write_mesh: group_colors has " + std::to_string(options.group_colors.size()) +
+          " colours but face_groups uses groups up to " + std::to_string(largest));
+    }
+    colors.palette.assign(options.group_colors.begin(), options.group_colors.end());
+  } else if (largest < mesh.face_count()) {
+    colors.palette = distinct_colors(std::size_t{largest} + 1);
+  } else {
+    std::vector<std::uint32_t> ids(options.face_groups.begin(), options.face_groups.end());
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    colors.palette = distinct_colors(ids.size());
+    colors.ranks.resize(options.face_groups.size());
+    for (std::size_t f = 0; f < colors.ranks.size(); ++f)
+      colors.ranks[f] = static_cast<std::uint32_t>(
+          std::lower_bound(ids.begin(), ids.end(), options.face_groups[f]) - ids.begin());
   }
-  return {options.group_colors.begin(), options.group_colors.end()};
+  return colors;
 }
 
 void write_position(OutputBuffer& out, const Vec3& p) {
@@ -238,17 +266,17 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
                 const MeshWriteOptions& options) {
   const MeshFormat format = mesh_format_from_path(path);
   mesh.validate();
-  const std::vector<Color> palette = group_palette(mesh, options);
+  const GroupColors colors = group_colors(mesh, options);
   OutputBuffer out;
   switch (format) {
     case MeshFormat::Off:
-      write_off(out, mesh, options.face_groups, palette);
+      write_off(out, mesh, colors.index(), colors.palette);
       break;
     case MeshFormat::Obj:
       write_obj(out, mesh, options.face_groups);
       break;
     case MeshFormat::Ply:
-      write_ply(out, mesh, options.face_groups, palette, options.binary);
+      write_ply(out, mesh, colors.index(), colors.palette, options.binary);
       break;
     case MeshFormat::Stl:
       write_stl(out, mesh, options.binary);

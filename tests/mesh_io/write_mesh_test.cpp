@@ -203,6 +203,27 @@ TEST_F(WriteMeshTest, ObjGroupsAndOffColours) {
   expect_same_polygon_mesh(mesh, read_mesh(directory_ / "c.off"));
 }
 
+TEST_F(WriteMeshTest, GroupIdsBeyondTheFaceCountAreColouredByRank) {
+  const Mesh mesh = awkward_mesh();
+  // Ids below the face count keep their colour whatever else occurs; larger ones are ranked (a
+  // palette of four billion colours would not fit in memory).
+  const std::vector<std::uint32_t> sparse{4000000000u, 7, 4000000000u};
+  const std::vector<std::uint32_t> ranked{1, 0, 1};
+  for (const bool binary : {true, false}) {
+    write_mesh(directory_ / "sparse.ply", mesh, write_options(sparse, {}, binary));
+    write_mesh(directory_ / "ranked.ply", mesh, write_options(ranked, {}, binary));
+    EXPECT_EQ(testing::file_contents(directory_ / "sparse.ply"),
+              testing::file_contents(directory_ / "ranked.ply"));
+  }
+  write_mesh(directory_ / "sparse.off", mesh, write_options(sparse));
+  write_mesh(directory_ / "ranked.off", mesh, write_options(ranked));
+  EXPECT_EQ(testing::file_contents(directory_ / "sparse.off"),
+            testing::file_contents(directory_ / "ranked.off"));
+  write_mesh(directory_ / "sparse.obj", mesh, write_options(sparse));  // groups keep their ids
+  EXPECT_NE(testing::file_contents(directory_ / "sparse.obj").find("g cluster_4000000000\n"),
+            std::string::npos);
+}
+
 TEST_F(WriteMeshTest, RejectsBadOptionsAndPaths) {
   const Mesh mesh = awkward_mesh();
   const std::vector<std::uint32_t> too_few{0, 1};
