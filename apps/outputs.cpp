@@ -95,10 +95,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     detail::write_file_atomically(*files.curve, text);
   }
   if (files.png) {
-    const auto palette = distinct_colors(segmentation.cluster_count());
-    std::vector<std::array<std::uint8_t, 3>> colors(segmentation.labels.size());
-    for (std::size_t f = 0; f < colors.size(); ++f) colors[f] = palette[segmentation.labels[f]];
-    write_png(*files.png, hierarchy.mesh(), colors);
+    write_png(*files.png, hierarchy.mesh(), group_face_colors(segmentation.labels));
   }
 }
 

@@ -30,6 +30,7 @@
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
 #include "primseg/refine.hpp"
+#include "primseg/render.hpp"
 #include "primseg/skeleton.hpp"
 #include "primseg/skinning.hpp"
 #include "primseg/tree_io.hpp"
@@ -854,6 +855,52 @@ Raises InvalidInputError (a ValueError) for an unknown extension or bad arrays, 
 OSError) when the file cannot be written.)",
            cpp_doc("write_mesh", doc::mesh_io__write_mesh),
            cpp_doc("MeshWriteOptions::face_groups", doc::mesh_io__MeshWriteOptions__face_groups)})
+          .c_str());
+
+  m.def(
+      "render",
+      [](const py::object& first, const py::object& faces, const py::object& labels, int width,
+         int height, const std::array<double, 3>& view, const std::array<double, 3>& up, bool edges,
+         const std::optional<std::filesystem::path>& path) {
+        const std::shared_ptr<const Mesh> mesh =
+            py::isinstance<PyHierarchy>(first)
+                ? first.cast<const PyHierarchy&>().hierarchy->shared_mesh()
+                : mesh_argument("render", first, faces);
+        const std::vector<std::uint32_t> groups =
+            labels.is_none() ? std::vector<std::uint32_t>{} : face_labels(labels, *mesh);
+        RenderOptions options;
+        options.width = width;
+        options.height = height;
+        options.view_direction = view;
+        options.up = up;
+        options.edges = edges;
+        std::vector<std::uint8_t> rgb;
+        {
+          py::gil_scoped_release release;
+          rgb = render_mesh(*mesh, group_face_colors(groups), options);
+          if (path) write_png(*path, rgb, width, height);
+        }
+        return adopt<std::uint8_t>(std::move(rgb), {height, width, 3});
+      },
+      py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(),
+      py::arg("labels") = py::none(), py::arg("width") = 800, py::arg("height") = 600,
+      py::arg("view") = std::array<double, 3>{-1.0, -0.8, -1.3},
+      py::arg("up") = std::array<double, 3>{0.0, 1.0, 0.0}, py::arg("edges") = false,
+      py::arg("path") = py::none(),
+      join_docs(
+          {R"(render(mesh, *, labels=None, width=800, height=600, view=(-1, -0.8, -1.3), up=(0, 1, 0), edges=False, path=None) -> numpy.ndarray
+render(V, F, *, ...) -> numpy.ndarray
+
+A picture of a Mesh, a Hierarchy's mesh or arrays V, F: uint8 (height, width, 3), top row first
+(matplotlib: plt.imshow(picture)). labels: one integer per face (cut()'s), each cluster in the
+colour of the CLI's --png and --colored; None: light grey. view: direction from the eye to the
+model; up: direction that points up in the picture; edges: draw the triangle edges. path: also
+write the picture there as PNG (the CLI's --png, byte for byte, with cut()'s labels).
+Raises InvalidInputError (a ValueError) for sizes outside 1..16384 or bad arrays, IoError (an
+OSError) when the PNG cannot be written.)",
+           cpp_doc("render_mesh", doc::render__render_mesh),
+           cpp_doc("RenderOptions", doc::render__RenderOptions),
+           cpp_doc("group_face_colors", doc::mesh_io__group_face_colors)})
           .c_str());
 
   const char* segment_doc =

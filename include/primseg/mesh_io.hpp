@@ -49,9 +49,8 @@ struct MeshWriteOptions {
   /// cluster_<id>` statement per group, faces grouped by id; OFF: per-face RGB colours; STL:
   /// ignored.
   std::span<const std::uint32_t> face_groups;
-  /// Colour of each group, shape (largest group id + 1). Empty with groups: a built-in palette
-  /// of well-separated colours, distinct_colors()[k] for group k while the ids are below the
-  /// face count; larger ids are numbered by rank first (the palette never outgrows the mesh).
+  /// Colour of each group, shape (largest group id + 1). Empty with groups: the built-in colours
+  /// of group_face_colors().
   std::span<const std::array<std::uint8_t, 3>> group_colors;
   /// PLY and STL: binary little-endian (true) or ascii (false).
   bool binary = true;
@@ -63,7 +62,15 @@ struct MeshWriteOptions {
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
                 const MeshWriteOptions& options = {});
 
-/// A palette of `count` distinct, well-separated RGB colours (deterministic).
+/// A palette of `count` distinct, well-separated RGB colours (deterministic; each palette begins
+/// with the shorter ones).
 std::vector<std::array<std::uint8_t, 3>> distinct_colors(std::size_t count);
+
+/// The colour of each face of a labelling (one group id per face, shape (F)), as write_mesh, the
+/// CLI's --colored and --png and the Python module draw clusters: distinct_colors()[k] for group
+/// k, the same in every picture, while the ids are below F (as any segmentation's are); larger
+/// ids are numbered by rank first, so that the palette never outgrows the mesh. Shape (F).
+std::vector<std::array<std::uint8_t, 3>> group_face_colors(
+    std::span<const std::uint32_t> face_groups);
 
 }  // namespace primseg

@@ -208,3 +208,19 @@ def test_auto_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path):
                     "candidates": level["candidates"]}
     assert fandisk_tree.cut("auto").max() + 1 == auto["clusters"]
     assert auto["rule"] == "knee"  # fandisk's curve has no jump (README, Measured quality)
+
+
+def test_render_gives_the_cli_picture(cli, fandisk, fandisk_tree, tmp_path):
+    run_cli(cli, "segment", fandisk, "--clusters", "30", "--png", tmp_path / "cli.png", "--quiet")
+    picture = primseg.render(fandisk_tree, labels=fandisk_tree.cut(30), path=tmp_path / "py.png")
+    assert (tmp_path / "py.png").read_bytes() == (tmp_path / "cli.png").read_bytes()
+    assert picture.dtype == np.uint8 and picture.shape == (600, 800, 3)
+    assert len(np.unique(picture.reshape(-1, 3), axis=0)) > 30  # clusters, shading, background
+    assert np.array_equal(picture[0, 0], [255, 255, 255])  # the corner is background
+    grey = primseg.render(fandisk_tree.mesh, width=64, height=48, view=(0, 0, -1), edges=True)
+    assert grey.shape == (48, 64, 3)
+    channels = grey[grey.sum(axis=2) < 3 * 255].astype(int)  # the part's pixels are grey
+    assert len(channels) > 0 and np.all(channels[:, 0] == channels[:, 1])
+    for bad in ({"width": 0}, {"height": 20000}):
+        with pytest.raises(ValueError):
+            primseg.render(fandisk_tree, **bad)

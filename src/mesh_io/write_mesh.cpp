@@ -63,50 +63,25 @@ class OutputBuffer {
   std::string text_;
 };
 
-// The colour of each face's group: `palette[index()[f]]`.
-struct GroupColors {
-  std::span<const std::uint32_t> groups;  // MeshWriteOptions::face_groups
-  std::vector<std::uint32_t> ranks;       // the groups renumbered, when they are
-  std::vector<Color> palette;
-  std::span<const std::uint32_t> index() const {
-    return ranks.empty() ? groups : std::span<const std::uint32_t>(ranks);
-  }
-};
-
-/// The groups' colours, after checking the options against the mesh. The built-in palette gives
-/// group k colour k, the same in every file, while the ids are below the face count (as any
-/// segmentation's are); larger ids are numbered by rank first, so that a palette is never longer
-/// than the mesh.
-GroupColors group_colors(const Mesh& mesh, const MeshWriteOptions& options) {
-  GroupColors colors;
-  colors.groups = options.face_groups;
-  if (options.face_groups.empty()) return colors;
+/// The colour of each face, after checking the options against the mesh; empty without groups.
+std::vector<Color> face_colors(const Mesh& mesh, const MeshWriteOptions& options) {
+  if (options.face_groups.empty()) return {};
   if (options.face_groups.size() != mesh.face_count()) {
     throw InvalidInputError(
         "write_mesh: face_groups has " + std::to_string(options.face_groups.size()) +
         " entries but the mesh has " + std::to_string(mesh.face_count()) + " faces");
   }
+  if (options.group_colors.empty()) return group_face_colors(options.face_groups);
   const std::uint32_t largest =
       *std::max_element(options.face_groups.begin(), options.face_groups.end());
-  if (!options.group_colors.empty()) {
-    if (options.group_colors.size() <= largest) {
-      throw InvalidInputError(
-          "write_mesh: group_colors has " + std::to_string(options.group_colors.size()) +
-          " colours but face_groups uses groups up to " + std::to_string(largest));
-    }
-    colors.palette.assign(options.group_colors.begin(), options.group_colors.end());
-  } else if (largest < mesh.face_count()) {
-    colors.palette = distinct_colors(std::size_t{largest} + 1);
-  } else {
-    std::vector<std::uint32_t> ids(options.face_groups.begin(), options.face_groups.end());
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    colors.palette = distinct_colors(ids.size());
-    colors.ranks.resize(options.face_groups.size());
-    for (std::size_t f = 0; f < colors.ranks.size(); ++f)
-      colors.ranks[f] = static_cast<std::uint32_t>(
-          std::lower_bound(ids.begin(), ids.end(), options.face_groups[f]) - ids.begin());
+  if (options.group_colors.size() <= largest) {
+    throw InvalidInputError(
+        "write_mesh: group_colors has " + std::to_string(options.group_colors.size()) +
+        " colours but face_groups uses groups up to " + std::to_string(largest));
   }
+  std::vector<Color> colors(options.face_groups.size());
+  for (std::size_t f = 0; f < colors.size(); ++f)
+    colors[f] = options.group_colors[options.face_groups[f]];
   return colors;
 }
 
@@ -116,8 +91,7 @@ void write_position(OutputBuffer& out, const Vec3& p) {
 
 // One vertex per line, then one "n v0 .. v(n-1) [r g b]" line per polygon: the body shared by
 // OFF and ascii PLY.
-void write_ascii_body(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_t> groups,
-                      const std::vector<Color>& palette) {
+void write_ascii_body(OutputBuffer& out, const Mesh& mesh, std::span<const Color> colors) {
   for (const Vec3& p : mesh.positions) {
     write_position(out, p);
     out << '\n';
@@ -126,17 +100,16 @@ void write_ascii_body(OutputBuffer& out, const Mesh& mesh, std::span<const std::
     const auto loop = mesh.polygon(f);
     out << static_cast<std::uint32_t>(loop.size());
     for (const std::uint32_t v : loop) out << ' ' << v;
-    if (!groups.empty()) {
-      for (const std::uint8_t channel : palette[groups[f]]) out << ' ' << std::uint32_t{channel};
+    if (!colors.empty()) {
+      for (const std::uint8_t channel : colors[f]) out << ' ' << std::uint32_t{channel};
     }
     out << '\n';
   }
 }
 
-void write_off(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_t> groups,
-               const std::vector<Color>& palette) {
+void write_off(OutputBuffer& out, const Mesh& mesh, std::span<const Color> colors) {
   out << "OFF\n" << mesh.vertex_count() << ' ' << mesh.face_count() << " 0\n";
-  write_ascii_body(out, mesh, groups, palette);
+  write_ascii_body(out, mesh, colors);
 }
 
 void write_obj(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_t> groups) {
@@ -168,8 +141,7 @@ void write_obj(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_
   }
 }
 
-void write_ply(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_t> groups,
-               const std::vector<Color>& palette, bool binary) {
+void write_ply(OutputBuffer& out, const Mesh& mesh, std::span<const Color> colors, bool binary) {
   std::size_t largest_face = 0;
   for (std::uint32_t f = 0; f < mesh.face_count(); ++f) {
     largest_face = std::max(largest_face, mesh.polygon(f).size());
@@ -181,11 +153,11 @@ void write_ply(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_
       << "\nproperty double x\nproperty double y\nproperty double z\nelement face "
       << mesh.face_count() << "\nproperty list " << (short_lengths ? "uchar " : "uint ")
       << (signed_indices ? "int" : "uint") << " vertex_indices\n";
-  if (!groups.empty()) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (!colors.empty()) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   out << "end_header\n";
 
   if (!binary) {
-    write_ascii_body(out, mesh, groups, palette);
+    write_ascii_body(out, mesh, colors);
     return;
   }
   out.text().reserve(out.text().size() + 24 * mesh.positions.size() +
@@ -201,8 +173,8 @@ void write_ply(OutputBuffer& out, const Mesh& mesh, std::span<const std::uint32_
       out.put(static_cast<std::uint32_t>(loop.size()));
     }
     for (const std::uint32_t v : loop) out.put(v);  // int and uint share their bytes here.
-    if (!groups.empty()) {
-      for (const std::uint8_t channel : palette[groups[f]]) out.put(channel);
+    if (!colors.empty()) {
+      for (const std::uint8_t channel : colors[f]) out.put(channel);
     }
   }
 }
@@ -266,17 +238,17 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
                 const MeshWriteOptions& options) {
   const MeshFormat format = mesh_format_from_path(path);
   mesh.validate();
-  const GroupColors colors = group_colors(mesh, options);
+  const std::vector<Color> colors = face_colors(mesh, options);
   OutputBuffer out;
   switch (format) {
     case MeshFormat::Off:
-      write_off(out, mesh, colors.index(), colors.palette);
+      write_off(out, mesh, colors);
       break;
     case MeshFormat::Obj:
       write_obj(out, mesh, options.face_groups);
       break;
     case MeshFormat::Ply:
-      write_ply(out, mesh, colors.index(), colors.palette, options.binary);
+      write_ply(out, mesh, colors, options.binary);
       break;
     case MeshFormat::Stl:
       write_stl(out, mesh, options.binary);
@@ -331,6 +303,28 @@ std::vector<std::array<std::uint8_t, 3>> distinct_colors(std::size_t count) {
     hue += kGoldenRatioConjugate;
     hue -= std::floor(hue);
   }
+  return colors;
+}
+
+std::vector<std::array<std::uint8_t, 3>> group_face_colors(
+    std::span<const std::uint32_t> face_groups) {
+  if (face_groups.empty()) return {};
+  const std::size_t faces = face_groups.size();
+  const std::uint32_t largest = *std::max_element(face_groups.begin(), face_groups.end());
+  std::vector<Color> colors(faces);
+  if (largest < faces) {
+    const std::vector<Color> palette = distinct_colors(std::size_t{largest} + 1);
+    for (std::size_t f = 0; f < faces; ++f) colors[f] = palette[face_groups[f]];
+    return colors;
+  }
+  // Ids as large as the face count: numbered by rank, so that the palette stays that short.
+  std::vector<std::uint32_t> ids(face_groups.begin(), face_groups.end());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  const std::vector<Color> palette = distinct_colors(ids.size());
+  for (std::size_t f = 0; f < faces; ++f)
+    colors[f] = palette[static_cast<std::size_t>(
+        std::lower_bound(ids.begin(), ids.end(), face_groups[f]) - ids.begin())];
   return colors;
 }
 

@@ -287,6 +287,17 @@ TEST_F(WriteMeshTest, ReadErrorsOfPaths) {
   EXPECT_EQ(mesh_format_from_path("b.obj"), MeshFormat::Obj);
 }
 
+TEST(GroupFaceColors, GroupKGetsColourKAndLargeIdsTheirRank) {
+  const auto palette = distinct_colors(3);
+  const std::vector<std::uint32_t> dense{2, 0, 2};
+  EXPECT_EQ(group_face_colors(dense),
+            (std::vector<std::array<std::uint8_t, 3>>{palette[2], palette[0], palette[2]}));
+  const std::vector<std::uint32_t> sparse{4000000000u, 7, 4000000000u};  // 7 >= F = 3
+  EXPECT_EQ(group_face_colors(sparse),
+            (std::vector<std::array<std::uint8_t, 3>>{palette[1], palette[0], palette[1]}));
+  EXPECT_TRUE(group_face_colors({}).empty());
+}
+
 TEST(DistinctColors, DeterministicAndWellSeparated) {
   const auto colors = distinct_colors(64);
   ASSERT_EQ(colors.size(), 64u);
