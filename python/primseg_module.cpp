@@ -391,12 +391,22 @@ std::shared_ptr<const Mesh> mesh_argument(const std::string& function, const py:
                                           const py::object& faces) {
   if (py::isinstance<PyMesh>(first)) {
     if (!faces.is_none())
-      throw InvalidInputError(function + "(mesh) takes no F" +
-                              (function == "segment" ? "" : " (give the level as k=...)"));
+      throw InvalidInputError(
+          function + "(mesh) takes no F" +
+          (function == "denoise" || function == "skeleton" ? " (give the level as k=...)" : ""));
     return first.cast<const PyMesh&>().mesh;
   }
   if (faces.is_none()) throw InvalidInputError(function + "(V, F): F is missing");
   return mesh_from_python(first, faces);
+}
+
+// The first arguments of write_mesh and render: a Mesh, a Hierarchy (its mesh) or arrays V, F.
+std::shared_ptr<const Mesh> mesh_or_tree_argument(const std::string& function,
+                                                  const py::object& first,
+                                                  const py::object& faces) {
+  if (!py::isinstance<PyHierarchy>(first)) return mesh_argument(function, first, faces);
+  if (!faces.is_none()) throw InvalidInputError(function + "(hierarchy) takes no F");
+  return first.cast<const PyHierarchy&>().hierarchy->shared_mesh();
 }
 
 // One mesh of distance(a, b): a Mesh, a Hierarchy (its mesh) or a (V, F) pair.
@@ -821,10 +831,7 @@ faces.)",
       "write_mesh",
       [](const std::filesystem::path& path, const py::object& first, const py::object& faces,
          const py::object& positions, const py::object& labels, bool binary) {
-        std::shared_ptr<const Mesh> mesh =
-            py::isinstance<PyHierarchy>(first)
-                ? first.cast<const PyHierarchy&>().hierarchy->shared_mesh()
-                : mesh_argument("write_mesh", first, faces);
+        std::shared_ptr<const Mesh> mesh = mesh_or_tree_argument("write_mesh", first, faces);
         Mesh moved;
         if (!positions.is_none()) {
           moved = *mesh;
@@ -862,10 +869,7 @@ OSError) when the file cannot be written.)",
       [](const py::object& first, const py::object& faces, const py::object& labels, int width,
          int height, const std::array<double, 3>& view, const std::array<double, 3>& up, bool edges,
          const std::optional<std::filesystem::path>& path) {
-        const std::shared_ptr<const Mesh> mesh =
-            py::isinstance<PyHierarchy>(first)
-                ? first.cast<const PyHierarchy&>().hierarchy->shared_mesh()
-                : mesh_argument("render", first, faces);
+        const std::shared_ptr<const Mesh> mesh = mesh_or_tree_argument("render", first, faces);
         const std::vector<std::uint32_t> groups =
             labels.is_none() ? std::vector<std::uint32_t>{} : face_labels(labels, *mesh);
         RenderOptions options;

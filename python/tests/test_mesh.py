@@ -151,6 +151,10 @@ def test_write_mesh_rejects_bad_arguments(fandisk, tmp_path):
         primseg.write_mesh(tmp_path / "missing" / "out.ply", mesh)
     with pytest.raises(ValueError, match="F is missing"):
         primseg.write_mesh(out, mesh.V)
+    with pytest.raises(ValueError, match=r"write_mesh\(mesh\) takes no F$"):
+        primseg.write_mesh(out, mesh, mesh.F)
+    with pytest.raises(ValueError, match=r"write_mesh\(hierarchy\) takes no F"):
+        primseg.write_mesh(out, primseg.segment(mesh), mesh.F)
     assert not out.exists()
 
 
