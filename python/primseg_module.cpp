@@ -67,13 +67,17 @@ struct ArrayView {
   py::ssize_t itemsize = 0;
 };
 
-// A numpy view of `object` (any array-like; a non-array is converted by numpy.asarray), checked
-// to be (n, 3) of an accepted kind and size. `owner` keeps the array alive.
+// `object` as a numpy array: itself, or numpy.asarray of any other array-like.
+py::array as_numpy_array(const py::handle& object) {
+  if (py::isinstance<py::array>(object)) return py::reinterpret_borrow<py::array>(object);
+  return py::array(py::module_::import("numpy").attr("asarray")(object));
+}
+
+// A numpy view of `object` (any array-like, see as_numpy_array), checked to be (n, 3) of an
+// accepted kind and size. `owner` keeps the array alive.
 ArrayView view_n_by_3(const py::handle& object, const char* name, const char* accepted,
                       bool floating, py::object& owner) {
-  const py::module_ numpy = py::module_::import("numpy");
-  py::array array = py::isinstance<py::array>(object) ? py::reinterpret_borrow<py::array>(object)
-                                                      : py::array(numpy.attr("asarray")(object));
+  py::array array = as_numpy_array(object);
   const py::dtype dtype = array.dtype();
   const char kind = dtype.kind();
   const py::ssize_t itemsize = dtype.itemsize();
@@ -337,10 +341,7 @@ std::vector<Vec3> replacement_positions(const py::handle& object, const Mesh& me
 
 // write_mesh's `labels`: one non-negative integer per input face (polygon) of `mesh`.
 std::vector<std::uint32_t> face_labels(const py::handle& object, const Mesh& mesh) {
-  const py::module_ numpy = py::module_::import("numpy");
-  const py::array array = py::isinstance<py::array>(object)
-                              ? py::reinterpret_borrow<py::array>(object)
-                              : py::array(numpy.attr("asarray")(object));
+  const py::array array = as_numpy_array(object);
   const char kind = array.dtype().kind();
   if (kind != 'i' && kind != 'u')
     throw InvalidInputError("labels must be an array of integers, not " +
@@ -348,7 +349,7 @@ std::vector<std::uint32_t> face_labels(const py::handle& object, const Mesh& mes
   if (array.ndim() != 1 || static_cast<std::size_t>(array.shape(0)) != mesh.face_count())
     throw InvalidInputError("labels must have one entry per face: shape (" +
                             std::to_string(mesh.face_count()) + ",)");
-  const py::array_t<std::int64_t> values(numpy.attr("asarray")(array, "int64"));
+  const py::array_t<std::int64_t> values(array.attr("astype")("int64"));
   std::vector<std::uint32_t> labels(mesh.face_count());
   for (std::size_t f = 0; f < labels.size(); ++f) {
     const std::int64_t label = values.at(static_cast<py::ssize_t>(f));

@@ -207,7 +207,6 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
         ++leaving[labels[f]];
         moves.push_back(f);
       }
-    const std::vector<std::uint32_t> labels_before = labels;
     std::vector<std::uint32_t> origin(f_count);
     for (std::uint32_t f : moves) origin[f] = labels[f], labels[f] = target[f];
     undo_splitting_moves(adjacency, initial_components, moves, origin, labels);
@@ -223,7 +222,7 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
     // total error over the corners (what the tree and the reports measure) more than
     // kAllowedErrorRise above the cut's.
     if (total_squared_error(hierarchy, labels, refitted) > (1 + kAllowedErrorRise) * cut_error) {
-      labels = labels_before;
+      for (std::uint32_t f : moves) labels[f] = origin[f];  // the labels at the start of the pass
       break;
     }
     result.reports = std::move(refitted);

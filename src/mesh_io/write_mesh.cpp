@@ -63,15 +63,15 @@ class OutputBuffer {
   std::string text_;
 };
 
-/// The colour of each face, after checking the options against the mesh; empty without groups.
-std::vector<Color> face_colors(const Mesh& mesh, const MeshWriteOptions& options) {
-  if (options.face_groups.empty()) return {};
+/// Checks the groups and colours of the options against the mesh.
+void check_groups(const Mesh& mesh, const MeshWriteOptions& options) {
+  if (options.face_groups.empty()) return;
   if (options.face_groups.size() != mesh.face_count()) {
     throw InvalidInputError(
         "write_mesh: face_groups has " + std::to_string(options.face_groups.size()) +
         " entries but the mesh has " + std::to_string(mesh.face_count()) + " faces");
   }
-  if (options.group_colors.empty()) return group_face_colors(options.face_groups);
+  if (options.group_colors.empty()) return;
   const std::uint32_t largest =
       *std::max_element(options.face_groups.begin(), options.face_groups.end());
   if (options.group_colors.size() <= largest) {
@@ -79,6 +79,12 @@ std::vector<Color> face_colors(const Mesh& mesh, const MeshWriteOptions& options
         "write_mesh: group_colors has " + std::to_string(options.group_colors.size()) +
         " colours but face_groups uses groups up to " + std::to_string(largest));
   }
+}
+
+/// The colour of each face of checked options (OFF and PLY); empty without groups.
+std::vector<Color> face_colors(const MeshWriteOptions& options) {
+  if (options.face_groups.empty()) return {};
+  if (options.group_colors.empty()) return group_face_colors(options.face_groups);
   std::vector<Color> colors(options.face_groups.size());
   for (std::size_t f = 0; f < colors.size(); ++f)
     colors[f] = options.group_colors[options.face_groups[f]];
@@ -238,17 +244,17 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
                 const MeshWriteOptions& options) {
   const MeshFormat format = mesh_format_from_path(path);
   mesh.validate();
-  const std::vector<Color> colors = face_colors(mesh, options);
+  check_groups(mesh, options);
   OutputBuffer out;
   switch (format) {
     case MeshFormat::Off:
-      write_off(out, mesh, colors);
+      write_off(out, mesh, face_colors(options));
       break;
     case MeshFormat::Obj:
       write_obj(out, mesh, options.face_groups);
       break;
     case MeshFormat::Ply:
-      write_ply(out, mesh, colors, options.binary);
+      write_ply(out, mesh, face_colors(options), options.binary);
       break;
     case MeshFormat::Stl:
       write_stl(out, mesh, options.binary);
