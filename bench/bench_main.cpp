@@ -22,6 +22,7 @@
 #include "primseg/dual_graph.hpp"
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/refine.hpp"
 #include "primseg/shape_generator.hpp"
 
 namespace primseg::bench {
@@ -98,18 +99,38 @@ void read(benchmark::State& state, const std::string& name) {
   });
 }
 
+/// The hierarchy of an input, built once per process (the benchmarks of a level time the level).
+const Hierarchy& prebuilt_hierarchy(const std::string& input) {
+  static std::map<std::string, std::unique_ptr<const Hierarchy>> trees;
+  auto& tree = trees[input];
+  if (!tree) tree = std::make_unique<const Hierarchy>(build_hierarchy(load_input(input)));
+  return *tree;
+}
+
 /// One level of a prebuilt hierarchy: cut_by_count at K clusters, then describe_clusters.
 void cut_and_describe(benchmark::State& state, const std::string& input, std::uint32_t clusters) {
   guarded(state, [&] {
-    static std::map<std::string, std::unique_ptr<const Hierarchy>> trees;
-    auto& tree = trees[input];
-    if (!tree) tree = std::make_unique<const Hierarchy>(build_hierarchy(load_input(input)));
+    const Hierarchy& tree = prebuilt_hierarchy(input);
     for (auto _ : state) {
-      const Segmentation level = cut_by_count(*tree, clusters);
-      const auto reports = describe_clusters(*tree, level);
+      const Segmentation level = cut_by_count(tree, clusters);
+      const auto reports = describe_clusters(tree, level);
       benchmark::DoNotOptimize(reports.data());
     }
-    set_face_counters(state, tree->face_count());
+    set_face_counters(state, tree.face_count());
+  });
+}
+
+/// Boundary refinement of one level of a prebuilt hierarchy (refine_boundaries with its default
+/// 5 passes, each refitting the clusters geometrically), the level cut and described beforehand.
+void refine_level(benchmark::State& state, const std::string& input, std::uint32_t clusters) {
+  guarded(state, [&] {
+    const Hierarchy& tree = prebuilt_hierarchy(input);
+    const Segmentation level = cut_by_count(tree, clusters);
+    for (auto _ : state) {
+      const RefinedLevel refined = refine_boundaries(tree, level);
+      benchmark::DoNotOptimize(refined.reports.data());
+    }
+    set_face_counters(state, tree.face_count());
   });
 }
 
@@ -207,6 +228,8 @@ void register_benchmarks() {
   configure(benchmark::RegisterBenchmark("read_mesh/bunny00", read, "bunny00.off"));
   configure(benchmark::RegisterBenchmark("cut_describe_k30/fandisk", cut_and_describe,
                                          "fandisk.off", std::uint32_t{30}));
+  configure(benchmark::RegisterBenchmark("refine_k40/bunny00", refine_level, "bunny00.off",
+                                         std::uint32_t{40}));
   for (std::uint32_t faces : {10u, 1000u, 100000u})
     configure(
         benchmark::RegisterBenchmark(("candidate_evaluation/" + std::to_string(faces)).c_str(),

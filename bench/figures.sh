@@ -127,6 +127,10 @@ print()
 if cut is not None:
     print(f"`cut_by_count` + `describe_clusters` at K = 30 on fandisk.off: "
           f"{ms(cut):.2f} ms (median of 5).")
+refined = aggregate("refine_k40/bunny00/", "median")
+if refined is not None:
+    print(f"`refine_boundaries` (5 passes) at K = 40 on bunny00.off: "
+          f"{ms(refined):.0f} ms (median of 5).")
 print()
 ctx = report["context"]
 print(f"Commit {commit}, Release, {ctx['num_cpus']} × {ctx['mhz_per_cpu']} MHz, "

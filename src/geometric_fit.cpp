@@ -3,7 +3,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "geometric_models.hpp"
 #include "primseg/error.hpp"
@@ -279,11 +281,19 @@ Normalised normalise(std::span<const Vec3> points, std::span<const double> weigh
   for (const Vec3& p : points)
     for (int k = 0; k < 3; ++k) extent = std::max(extent, std::abs(p[k] - n.centre[k]));
   if (extent > 0) std::frexp(extent, &n.exponent);
+  // Multiplying by a power of two rounds as ldexp does (both round the exact product once), at a
+  // fraction of its cost; ldexp only where 2^−exponent itself overflows (subnormal extents).
+  const double scale = std::ldexp(1.0, -n.exponent);
   n.points.reserve(points.size());
-  for (const Vec3& p : points)
-    n.points.emplace_back(std::ldexp(p[0] - n.centre.x(), -n.exponent),
-                          std::ldexp(p[1] - n.centre.y(), -n.exponent),
-                          std::ldexp(p[2] - n.centre.z(), -n.exponent));
+  for (const Vec3& p : points) {
+    const Eigen::Vector3d offset(p[0] - n.centre.x(), p[1] - n.centre.y(), p[2] - n.centre.z());
+    if (std::isfinite(scale))
+      n.points.emplace_back(offset * scale);
+    else
+      n.points.emplace_back(std::ldexp(offset.x(), -n.exponent),
+                            std::ldexp(offset.y(), -n.exponent),
+                            std::ldexp(offset.z(), -n.exponent));
+  }
   return n;
 }
 
@@ -301,15 +311,59 @@ Primitive from_normalised(Primitive p, const Normalised& n) {
   return p;
 }
 
-double cost(const GeometricModel& model, const Normalised& n, std::span<const double> weights) {
-  double gradient[detail::kMaxParameters];
-  double sum = 0;
-  for (std::size_t i = 0; i < n.points.size(); ++i) {
-    const double d = model.residual(n.points[i], gradient);
-    sum += weights[i] * d * d;
+// At most kMaxParameters: fixed-capacity matrices, no heap and no blocked products (the torus fit
+// runs Levenberg–Marquardt on its 32-point sample for every candidate merge).
+using NormalMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
+                                   detail::kMaxParameters, detail::kMaxParameters>;
+using ParameterVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, detail::kMaxParameters, 1>;
+
+// Σ w d² of a model, and the Gauss–Newton normal equations at it (N = Σ w g gᵀ, rhs = −Σ w d g,
+// g = ∂d/∂parameters) from the same pass over the points: a step the fit accepts has its next
+// system ready.
+struct LinearisedCost {
+  double cost = 0;
+  NormalMatrix normal;
+  ParameterVector rhs;
+
+  LinearisedCost(const GeometricModel& model, const Normalised& n,
+                 std::span<const double> weights) {
+    const int count = model.parameter_count();
+    if (count < 1 || count > detail::kMaxParameters)
+      throw std::logic_error("a geometric model has 1 to kMaxParameters parameters");
+    // accumulate<count>: one instance per possible count.
+    [&]<int... K>(std::integer_sequence<int, K...>) {
+      ((count == K + 1 ? accumulate<K + 1>(model, n, weights) : void()), ...);
+    }
+    (std::make_integer_sequence<int, detail::kMaxParameters>());
   }
-  return sum;
-}
+
+ private:
+  // The parameter count as a constant: the per-point update of the upper triangle unrolls (a
+  // dynamic-size outer product cost most of a fit).
+  template <int K>
+  void accumulate(const GeometricModel& model, const Normalised& n,
+                  std::span<const double> weights) {
+    static_assert(K <= detail::kMaxParameters);
+    double upper[K][K] = {}, minus_rhs[K] = {};
+    double gradient[detail::kMaxParameters];
+    for (std::size_t i = 0; i < n.points.size(); ++i) {
+      const double d = model.residual(n.points[i], gradient);
+      const double w = weights[i], wd = w * d;
+      cost += wd * d;
+      for (int a = 0; a < K; ++a) {
+        const double wg = w * gradient[a];
+        for (int b = a; b < K; ++b) upper[a][b] += wg * gradient[b];
+        minus_rhs[a] += wd * gradient[a];
+      }
+    }
+    normal.resize(K, K);
+    rhs.resize(K);
+    for (int a = 0; a < K; ++a) {
+      for (int b = a; b < K; ++b) normal(a, b) = normal(b, a) = upper[a][b];
+      rhs(a) = -minus_rhs[a];
+    }
+  }
+};
 
 // The canonical form of primitive.hpp, in the normalised frame (weighted centroid at 0).
 Primitive canonical(Primitive p, const Primitive& initial_normalised) {
@@ -364,38 +418,31 @@ GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> point
   result.primitive = initial;
   if (model) {
     const int k = model->parameter_count();
-    double current = cost(*model, n, weights);
+    LinearisedCost current(*model, n, weights);
     double lambda = 1e-3;
-    double gradient[detail::kMaxParameters];
-    // At most kMaxParameters: fixed-capacity matrices, no heap and no blocked products (the torus
-    // fit runs this on its 32-point sample for every candidate merge).
-    using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, detail::kMaxParameters,
-                                 detail::kMaxParameters>;
-    using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, detail::kMaxParameters, 1>;
-    while (result.iterations < options.max_iterations && current > 0) {
-      Matrix normal = Matrix::Zero(k, k);
-      Vector rhs = Vector::Zero(k);
-      for (std::size_t i = 0; i < n.points.size(); ++i) {
-        const double d = model->residual(n.points[i], gradient);
-        const Eigen::Map<const Vector> g(gradient, k);
-        normal.noalias() += weights[i] * g * g.transpose();
-        rhs.noalias() -= weights[i] * d * g;
-      }
+    while (result.iterations < options.max_iterations && current.cost > 0) {
       bool accepted = false;
       while (lambda < 1e16) {
-        Matrix damped = normal;
-        for (int j = 0; j < k; ++j) damped(j, j) += lambda * normal(j, j) + 1e-300;
-        const Vector step = damped.ldlt().solve(rhs);
+        NormalMatrix damped = current.normal;
+        for (int j = 0; j < k; ++j) damped(j, j) += lambda * current.normal(j, j) + 1e-300;
+        const ParameterVector step = damped.ldlt().solve(current.rhs);
         if (!step.allFinite()) {
           lambda *= 10;
           continue;
         }
+        // The linearised residuals' Σ w d² falls by 2 sᵀ rhs − sᵀ N s along the step s, and more
+        // damping only shortens the step: once that is within the tolerance the fit has
+        // converged, and trying ever more damped steps (a full pass over the points each) would
+        // at best find a decrease of round-off size.
+        const double predicted = 2 * step.dot(current.rhs) - step.dot(current.normal * step);
+        if (!(predicted > options.relative_tolerance * current.cost)) break;
         std::unique_ptr<GeometricModel> candidate = model->stepped(step.data());
-        const double trial = cost(*candidate, n, weights);
-        if (trial < current) {
-          const bool converged = current - trial <= options.relative_tolerance * current;
+        LinearisedCost trial(*candidate, n, weights);
+        if (trial.cost < current.cost) {
+          const bool converged =
+              current.cost - trial.cost <= options.relative_tolerance * current.cost;
           model = std::move(candidate);
-          current = trial;
+          current = std::move(trial);
           lambda = std::max(lambda / 10, 1e-12);
           accepted = !converged;
           ++result.iterations;

@@ -172,6 +172,101 @@ TEST(GeometricFit, RecoversConesAndToriFromPerturbedStarts) {
     EXPECT_TRUE(has_geometric_model(static_cast<PrimitiveType>(t)));
 }
 
+// Noisy points have no exact fit: the refinement must still reach the least-squares minimum,
+// where Σ w d² is stationary in every parameter, not merely stop lowering it. For a sphere
+// (centre c, radius r, unit directions n = (x − c)/|x − c|): Σ w d = 0 and Σ w d n = 0. For a
+// cylinder (axis a through q, n the unit radial direction, t = a·(x − q) the axial coordinate):
+// Σ w d = 0, Σ w d n = 0 and Σ w d t n = 0 (tilting the axis). Each sum is compared with the
+// same sum of |d|. The fit stops once a step would lower Σ w d² by at most 1e-15 of it, which
+// leaves these ratios near 1e-8 (the square root); a fit stopped at 1e-10 leaves them near 1e-5.
+// A second fit from the result makes at most one more step.
+TEST(GeometricFit, NoisyFitsReachTheLeastSquaresMinimum) {
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> noise(0, 0.01);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int trial = 0; trial < 6; ++trial) {
+    const auto rotation = testing::random_rotation(rng);
+    const Eigen::Matrix3d r =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&rotation[0][0]);
+    const Eigen::Vector3d origin(10 * unit(rng) - 5, 10 * unit(rng) - 5, 10 * unit(rng) - 5);
+    const double radius = 0.5 + unit(rng);
+    std::vector<Vec3> sphere_points, cylinder_points;
+    std::vector<double> weights;
+    for (int i = 0; i < 400; ++i) {
+      // A cap and a partial cylinder: an unevenly constrained fit.
+      const double phi = 2.5 * unit(rng), z = 0.2 + 0.8 * unit(rng);
+      const Eigen::Vector3d cap(std::sqrt(1 - z * z) * std::cos(phi),
+                                std::sqrt(1 - z * z) * std::sin(phi), z);
+      const Eigen::Vector3d s = origin + (radius + noise(rng)) * (r * cap);
+      const Eigen::Vector3d c =
+          origin + r * Eigen::Vector3d((radius + noise(rng)) * std::cos(phi),
+                                       (radius + noise(rng)) * std::sin(phi), 3 * z);
+      sphere_points.push_back({s.x(), s.y(), s.z()});
+      cylinder_points.push_back({c.x(), c.y(), c.z()});
+      weights.push_back(0.5 + unit(rng));
+    }
+    const Eigen::Vector3d axis = r.col(2);
+    const Eigen::Vector3d moved = origin + Eigen::Vector3d(0.03, -0.02, 0.02);
+    const Eigen::Vector3d tilted = (axis + Eigen::Vector3d(0.02, 0.03, -0.01)).normalized();
+
+    Primitive sphere;
+    sphere.type = PrimitiveType::Sphere;
+    sphere.point = {moved.x(), moved.y(), moved.z()};
+    sphere.radius = radius * 1.05;
+    const GeometricFit sphere_fit = fit_geometric(sphere, sphere_points, weights);
+    {
+      const Eigen::Vector3d centre = eigen(sphere_fit.primitive.point);
+      double sum_d = 0, sum_abs = 0;
+      Eigen::Vector3d sum_dn = Eigen::Vector3d::Zero();
+      for (std::size_t i = 0; i < sphere_points.size(); ++i) {
+        const Eigen::Vector3d offset = eigen(sphere_points[i]) - centre;
+        const double d = offset.norm() - sphere_fit.primitive.radius;
+        sum_d += weights[i] * d;
+        sum_dn += weights[i] * d * offset.normalized();
+        sum_abs += weights[i] * std::abs(d);
+      }
+      EXPECT_GT(sphere_fit.rms, 0.005) << "the points are noisy";
+      EXPECT_LE(std::abs(sum_d), 1e-7 * sum_abs) << trial;
+      EXPECT_LE(sum_dn.norm(), 1e-7 * sum_abs) << trial;
+      const GeometricFit again = fit_geometric(sphere_fit.primitive, sphere_points, weights);
+      EXPECT_LE(again.iterations, 1) << trial;
+      EXPECT_NEAR(again.rms, sphere_fit.rms, 1e-12 * sphere_fit.rms) << trial;
+    }
+
+    Primitive cylinder;
+    cylinder.type = PrimitiveType::Cylinder;
+    cylinder.point = {moved.x(), moved.y(), moved.z()};
+    cylinder.axis = {tilted.x(), tilted.y(), tilted.z()};
+    cylinder.radius = radius * 0.95;
+    const GeometricFit cylinder_fit = fit_geometric(cylinder, cylinder_points, weights);
+    {
+      const Eigen::Vector3d a = eigen(cylinder_fit.primitive.axis).normalized();
+      const Eigen::Vector3d q = eigen(cylinder_fit.primitive.point);
+      double sum_d = 0, sum_abs = 0, sum_abs_t = 0;
+      Eigen::Vector3d sum_dn = Eigen::Vector3d::Zero(), sum_dtn = Eigen::Vector3d::Zero();
+      for (std::size_t i = 0; i < cylinder_points.size(); ++i) {
+        const Eigen::Vector3d offset = eigen(cylinder_points[i]) - q;
+        const double t = a.dot(offset);
+        const Eigen::Vector3d radial = offset - t * a;
+        const double d = radial.norm() - cylinder_fit.primitive.radius;
+        sum_d += weights[i] * d;
+        sum_dn += weights[i] * d * radial.normalized();
+        sum_dtn += weights[i] * d * t * radial.normalized();
+        sum_abs += weights[i] * std::abs(d);
+        sum_abs_t += weights[i] * std::abs(d * t);
+      }
+      EXPECT_GT(cylinder_fit.rms, 0.005) << "the points are noisy";
+      EXPECT_GT(std::abs(a.dot(axis)), 0.999) << trial;
+      EXPECT_LE(std::abs(sum_d), 1e-7 * sum_abs) << trial;
+      EXPECT_LE(sum_dn.norm(), 1e-7 * sum_abs) << trial;
+      EXPECT_LE(sum_dtn.norm(), 1e-7 * sum_abs_t) << trial;
+      const GeometricFit again = fit_geometric(cylinder_fit.primitive, cylinder_points, weights);
+      EXPECT_LE(again.iterations, 1) << trial;
+      EXPECT_NEAR(again.rms, cylinder_fit.rms, 1e-12 * cylinder_fit.rms) << trial;
+    }
+  }
+}
+
 TEST(GeometricFit, RejectsBadInput) {
   Primitive plane;
   plane.axis = {0, 0, 1};
