@@ -2,15 +2,17 @@
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <string>
 
+#include "parallel.hpp"
 #include "primseg/error.hpp"
+#include "primseg/geometric_fit.hpp"
 #include "vertex_triangles.hpp"
 
 namespace primseg {
@@ -103,20 +105,19 @@ Eigen::Vector3d least_squares_point(const Eigen::Vector3d& x,
 
 // Weighted least-squares plane through points (PCA), its normal on the side of `reference`;
 // nullopt when the points do not span a plane.
-std::optional<Primitive> fit_plane(const std::vector<Eigen::Vector3d>& points,
-                                   const std::vector<double>& weights,
+std::optional<Primitive> fit_plane(std::span<const Vec3> points, std::span<const double> weights,
                                    const Eigen::Vector3d& reference) {
   double total = 0;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
     total += weights[i];
-    centroid += weights[i] * points[i];
+    centroid += weights[i] * to_eigen(points[i]);
   }
   if (points.size() < 3 || !(total > 0)) return std::nullopt;
   centroid /= total;
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3d d = points[i] - centroid;
+    const Eigen::Vector3d d = to_eigen(points[i]) - centroid;
     scatter += weights[i] * d * d.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
@@ -131,89 +132,17 @@ std::optional<Primitive> fit_plane(const std::vector<Eigen::Vector3d>& points,
   return plane;
 }
 
-// Signed distance of x to a sphere or cylinder given by a parameter vector: sphere (centre,
-// radius), cylinder (point, axis of any length, radius).
-double signed_distance(PrimitiveType type, const Eigen::VectorXd& q, const Eigen::Vector3d& x) {
-  const Eigen::Vector3d d = x - q.head<3>();
-  if (type == PrimitiveType::Sphere) return d.norm() - q(3);
-  const Eigen::Vector3d axis = q.segment<3>(3).normalized();
-  return (d - axis * axis.dot(d)).norm() - q(6);
-}
-
-// Gauss-Newton refinement of a sphere or cylinder on weighted points (geometric distances), each
-// step the minimum-norm least-squares solution (the parametrisation has free directions: a
-// cylinder's point along its axis, its axis length). nullopt when it does not lower the error.
-// It runs without units (lengths over the start's radius, weights over their sum), so that the
-// result does not depend on the input's units: the axis is a direction, its derivatives are taken
-// with the same step as the lengths', and the singular value threshold compares them.
-std::optional<Primitive> refine_curved(const Primitive& start,
-                                       const std::vector<Eigen::Vector3d>& points,
-                                       const std::vector<double>& weights) {
-  const bool sphere = start.type == PrimitiveType::Sphere;
-  const Eigen::Index k = sphere ? 4 : 7;
-  const auto m = static_cast<Eigen::Index>(points.size());
-  if (m < 2 * k || !(start.radius > 0)) return std::nullopt;
-  const Eigen::Vector3d origin = to_eigen(start.point);
-  const double length = start.radius;
-  double total_weight = 0;
-  for (const double w : weights) total_weight += w;
-  if (!(total_weight > 0) || !std::isfinite(total_weight)) return std::nullopt;
-  std::vector<Eigen::Vector3d> scaled(points.size());
-  std::vector<double> root_weights(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    scaled[i] = (points[i] - origin) / length;
-    root_weights[i] = std::sqrt(weights[i] / total_weight);
-  }
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(k);  // point (0: the start's), axis, radius (1)
-  if (!sphere) q.segment<3>(3) = to_eigen(start.axis);
-  q(k - 1) = 1;
-  auto residuals = [&](const Eigen::VectorXd& params) {
-    Eigen::VectorXd r(m);
-    for (Eigen::Index i = 0; i < m; ++i)
-      r(i) = root_weights[i] * signed_distance(start.type, params, scaled[i]);
-    return r;
-  };
-  Eigen::VectorXd r = residuals(q);
-  const double initial = r.squaredNorm();
-  if (!std::isfinite(initial)) return std::nullopt;
-  double error = initial;
-  constexpr double step = 1e-7;
-  for (int iteration = 0; iteration < 15; ++iteration) {
-    Eigen::MatrixXd jacobian(m, k);
-    for (Eigen::Index j = 0; j < k; ++j) {
-      Eigen::VectorXd plus = q, minus = q;
-      plus(j) += step;
-      minus(j) -= step;
-      jacobian.col(j) = (residuals(plus) - residuals(minus)) / (2 * step);
-    }
-    if (!jacobian.allFinite()) break;  // Eigen's SVD reads out of its arrays on a NaN
-    // Singular values below 1e-9 of the largest are the free directions: no step along them.
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinU | Eigen::ComputeThinV);
-    svd.setThreshold(1e-9);
-    Eigen::VectorXd delta = svd.solve(-r);
-    bool improved = false;
-    for (int halving = 0; halving < 8 && !improved; ++halving, delta /= 2) {
-      const Eigen::VectorXd candidate = q + delta;
-      const Eigen::VectorXd candidate_r = residuals(candidate);
-      if (candidate_r.allFinite() && candidate_r.squaredNorm() < error) {
-        q = candidate;
-        r = candidate_r;
-        error = r.squaredNorm();
-        improved = true;
-      }
-    }
-    if (!improved) break;
-  }
-  if (!(error < initial)) return std::nullopt;
-  Primitive refined = start;
-  refined.point = to_vec3(origin + length * q.head<3>());
-  refined.radius = length * q(k - 1);
-  if (!sphere) {
-    const Eigen::Vector3d axis = q.segment<3>(3).normalized();
-    refined.axis = to_vec3(axis.dot(to_eigen(start.axis)) < 0 ? Eigen::Vector3d(-axis) : axis);
-  }
-  if (!(refined.radius > 0) || !std::isfinite(refined.radius)) return std::nullopt;
-  return refined;
+// Geometric least-squares refinement of a sphere or cylinder (fit_geometric); nullopt when it
+// does not lower the error, or for fewer than two points per parameter of the old
+// parametrisation (sphere 4, cylinder 7), where a curved fit follows the noise.
+std::optional<Primitive> fit_curved(const Primitive& start, std::span<const Vec3> points,
+                                    std::span<const double> weights) {
+  const std::size_t parameters = start.type == PrimitiveType::Sphere ? 4 : 7;
+  if (points.size() < 2 * parameters || !(start.radius > 0)) return std::nullopt;
+  const GeometricFit fit = fit_geometric(start, points, weights);
+  if (fit.iterations == 0 || !(fit.primitive.radius > 0) || !std::isfinite(fit.primitive.radius))
+    return std::nullopt;
+  return fit.primitive;
 }
 
 }  // namespace
@@ -356,7 +285,7 @@ SnapReport Denoiser::iterate(const LevelSelector& level) {
 
 void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const {
   // Every vertex of a cluster's faces, weighted by the area of its triangles in the cluster.
-  std::vector<std::vector<Eigen::Vector3d>> points(primitives.size());
+  std::vector<std::vector<Vec3>> points(primitives.size());
   std::vector<std::vector<double>> weights(primitives.size());
   std::vector<std::pair<std::uint32_t, double>> area_by_cluster;
   for (std::uint32_t v = 0; v < mesh_.vertex_count(); ++v) {
@@ -377,27 +306,29 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
         found->second += area;
     }
     for (const auto& [c, area] : area_by_cluster) {
-      points[c].push_back(to_eigen(mesh_.positions[v]));
+      points[c].push_back(mesh_.positions[v]);
       weights[c].push_back(area);
     }
   }
   const double floor = 1e-12 * bounding_box_diagonal(mesh_);
-  std::vector<double> residuals;
-  for (std::size_t c = 0; c < primitives.size(); ++c) {
+  // Each cluster on its own: the same result for any thread count.
+  const unsigned threads = detail::thread_count(options_.hierarchy.threads);
+  detail::parallel_for_threads(primitives.size(), threads, [&](std::size_t c, unsigned) {
     const PrimitiveType type = primitives[c].type;
-    if (points[c].empty()) continue;  // a cluster that relabelling emptied
+    if (points[c].empty()) return;  // a cluster that relabelling emptied
     if (type != PrimitiveType::Plane && type != PrimitiveType::Sphere &&
         type != PrimitiveType::Cylinder)
-      continue;
+      return;
     Primitive current = primitives[c];
-    std::vector<Eigen::Vector3d> kept_points = points[c];
-    std::vector<double> kept_weights = weights[c];
+    std::vector<double> residuals;
+    std::vector<Vec3> kept_points;
+    std::vector<double> kept_weights;
     constexpr int kRounds = 3;
     for (int round = 0; round < kRounds; ++round) {
       // Inliers: residual within the threshold times the robust deviation (1.4826 MAD) of all
       // the cluster's vertices from the current fit.
       residuals.clear();
-      for (const Eigen::Vector3d& p : points[c]) residuals.push_back(current.distance(to_vec3(p)));
+      for (const Vec3& p : points[c]) residuals.push_back(current.distance(p));
       std::vector<double> sorted = residuals;
       std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
       const double limit =
@@ -412,12 +343,12 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
       const std::optional<Primitive> refit =
           type == PrimitiveType::Plane
               ? fit_plane(kept_points, kept_weights, to_eigen(current.axis))
-              : refine_curved(current, kept_points, kept_weights);
+              : fit_curved(current, kept_points, kept_weights);
       if (!refit) break;
       current = *refit;
     }
     primitives[c] = current;
-  }
+  });
 }
 
 void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,

@@ -286,6 +286,19 @@ TEST(Denoise, IsDeterministic) {
   const Mesh first = denoise(box.noisy.mesh, level_by_count(6), {}, 2);
   const Mesh second = denoise(box.noisy.mesh, level_by_count(6), {}, 2);
   EXPECT_EQ(first.positions, second.positions);
+  // The hierarchy, the clusters' robust refits and the snapping run on several threads: the
+  // result does not depend on how many (a curved shape, so that sphere and cylinder refits run).
+  const NoisyShape cylinder = noisy_shape("capped_cylinder", 0.004, 0.04);
+  Mesh reference;
+  for (const unsigned threads : {1u, 2u, 3u}) {
+    DenoiseOptions options;
+    options.hierarchy.threads = threads;
+    const Mesh denoised = denoise(cylinder.noisy.mesh, level_by_count(12), options, 2);
+    if (threads == 1)
+      reference = denoised;
+    else
+      EXPECT_EQ(denoised.positions, reference.positions) << threads << " threads";
+  }
 }
 
 TEST(Denoise, TaubinStepsOnTheSegmentedCopyDoNotShrinkTheShape) {
