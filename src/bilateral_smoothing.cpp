@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "vertex_triangles.hpp"
 
@@ -84,12 +85,14 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
   const double spatial_factor = spatial > 0 ? 1 / (2 * spatial * spatial) : 0;
   const double normal_factor = 1 / (2 * options.normal_sigma * options.normal_sigma);
 
+  // Each face and each vertex of a pass reads only the previous pass: any number of threads.
+  const unsigned threads = detail::thread_count(options.threads);
   std::vector<Eigen::Vector3d> filtered(face_count);
   for (int pass = 0; pass < options.normal_iterations; ++pass) {
-    for (std::uint32_t t = 0; t < face_count; ++t) {
+    detail::parallel_for(face_count, threads, [&](std::size_t t) {
       if (areas[t] == 0) {
         filtered[t] = normals[t];
-        continue;
+        return;
       }
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       for (const std::uint32_t u : rings[t]) {
@@ -99,7 +102,7 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
       }
       const double length = sum.norm();
       filtered[t] = length > 0 ? Eigen::Vector3d(sum / length) : normals[t];
-    }
+    });
     normals.swap(filtered);
   }
 
@@ -113,7 +116,7 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
                       to_eigen(smoothed.positions[c[2]])) /
                      3;
     }
-    for (std::uint32_t v = 0; v < smoothed.vertex_count(); ++v) {
+    detail::parallel_for(smoothed.vertex_count(), threads, [&](std::size_t v) {
       const Eigen::Vector3d x = to_eigen(smoothed.positions[v]);
       Eigen::Vector3d move = Eigen::Vector3d::Zero();
       const std::uint32_t begin = around.offsets[v], end = around.offsets[v + 1];
@@ -123,7 +126,7 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
       }
       const Eigen::Vector3d moved = end > begin ? Eigen::Vector3d(x + move / (end - begin)) : x;
       next[v] = {moved.x(), moved.y(), moved.z()};
-    }
+    });
     smoothed.positions.swap(next);
   }
   return smoothed;

@@ -62,6 +62,13 @@ TEST(BilateralSmoothing, IsDeterministicAndKeepsConnectivity) {
   const Mesh a = bilateral_smooth(noisy), b = bilateral_smooth(noisy);
   EXPECT_EQ(a.positions, b.positions);
   EXPECT_EQ(a.face_of_triangle, noisy.face_of_triangle);
+  // The same, bit for bit, on any number of threads (the box has enough faces for three).
+  ASSERT_GE(noisy.triangle_count(), 2 * 1024u);
+  for (const unsigned threads : {1u, 2u, 3u}) {
+    BilateralSmoothingOptions options;
+    options.threads = threads;
+    EXPECT_EQ(bilateral_smooth(noisy, options).positions, a.positions) << threads << " threads";
+  }
 }
 
 TEST(BilateralSmoothing, ZeroIterationsChangeNothing) {

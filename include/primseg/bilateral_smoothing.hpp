@@ -30,6 +30,9 @@ struct BilateralSmoothingOptions {
   /// Passes of the vertex update (each moves every vertex towards the planes of its faces, with
   /// the filtered normals). >= 0.
   int vertex_iterations = 10;
+  /// Threads over the faces and vertices of each pass (0: all hardware threads); the result is
+  /// the same, bit for bit, for any number.
+  unsigned threads = 0;
 };
 
 /// Throws InvalidInputError for options out of range.
