@@ -87,6 +87,26 @@ TEST(MeshFromPolygons, FlatVerticesNeverMakeDegenerateTriangles) {
       {{0.5, 0, 0}, {1, 0, 0}, {1.5, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {0, 0, 0}}, 4.0);
 }
 
+TEST(MeshFromPolygons, SquareWithASquareHoleThroughABridgeIsTiled) {
+  // One loop: the outer square counter-clockwise, a bridge from the middle of its left side to
+  // a corner of the hole, the hole clockwise, and back along the bridge, so each end of the
+  // bridge appears twice. At the hole's corner the bridge leaves 45 and 225 degrees: one copy is
+  // reflex and lies on a corner of the ears next to the other, which it must not block. The hole
+  // stays empty.
+  expect_tiles_polygon({{0, 0, 0},
+                        {4, 0, 0},
+                        {4, 4, 0},
+                        {0, 4, 0},
+                        {0, 2, 0},
+                        {1, 1, 0},
+                        {1, 3, 0},
+                        {3, 3, 0},
+                        {3, 1, 0},
+                        {1, 1, 0},
+                        {0, 2, 0}},
+                       16.0 - 4.0);
+}
+
 TEST(MeshFromPolygons, CombWithManyReflexVerticesIsTiled) {
   // A comb: a base strip 0 <= y <= 1 with n teeth up to y = 3 between notches.
   const int teeth = 25;
