@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
@@ -25,6 +26,16 @@ double distance_to_line(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
                         const Eigen::Vector3d& a) {
   const Eigen::Vector3d d = p - q;
   return (d - a * a.dot(d)).norm();
+}
+
+// A random rotation and an origin in [-5, 5]^3.
+std::pair<Eigen::Matrix3d, Eigen::Vector3d> random_pose(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  const auto rotation = testing::random_rotation(rng);
+  const Eigen::Matrix3d r =
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&rotation[0][0]);
+  const Eigen::Vector3d origin(10 * unit(rng) - 5, 10 * unit(rng) - 5, 10 * unit(rng) - 5);
+  return {r, origin};
 }
 
 // Cylinders sampled on a grid whose vertices are jittered along the surface (so they lie on it
@@ -123,10 +134,7 @@ TEST(GeometricFit, RecoversConesAndToriFromPerturbedStarts) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(0, 1);
   for (int trial = 0; trial < 10; ++trial) {
-    const auto rotation = testing::random_rotation(rng);
-    const Eigen::Matrix3d r =
-        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&rotation[0][0]);
-    const Eigen::Vector3d origin(10 * unit(rng) - 5, 10 * unit(rng) - 5, 10 * unit(rng) - 5);
+    const auto [r, origin] = random_pose(rng);
     const Eigen::Vector3d axis = r.col(2);
     const double half_angle = 0.2 + unit(rng), major = 1 + unit(rng), minor = 0.2 + 0.5 * unit(rng);
     std::vector<Vec3> cone_points, torus_points;
@@ -185,10 +193,7 @@ TEST(GeometricFit, NoisyFitsReachTheLeastSquaresMinimum) {
   std::normal_distribution<double> noise(0, 0.01);
   std::uniform_real_distribution<double> unit(0, 1);
   for (int trial = 0; trial < 6; ++trial) {
-    const auto rotation = testing::random_rotation(rng);
-    const Eigen::Matrix3d r =
-        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&rotation[0][0]);
-    const Eigen::Vector3d origin(10 * unit(rng) - 5, 10 * unit(rng) - 5, 10 * unit(rng) - 5);
+    const auto [r, origin] = random_pose(rng);
     const double radius = 0.5 + unit(rng);
     std::vector<Vec3> sphere_points, cylinder_points;
     std::vector<double> weights;
