@@ -66,9 +66,9 @@ Command add_denoise_command(CLI::App& app) {
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
   denoise->add_option("--noise-factor", o->noise_factor,
-                      "With --clusters auto and no jump in the error curve: clusters within this "
-                      "multiple of the estimated noise (default: 1.2, 0.8 with --smooth, 0.4 with "
-                      "--bilateral)");
+                      "With --clusters auto and no jump in the error curve (or one whose clusters "
+                      "fit more than 4.5 times worse): clusters within this multiple of the "
+                      "estimated noise (default: 1.2, 0.8 with --smooth, 0.4 with --bilateral)");
   denoise->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
       ->capture_default_str();
   denoise->add_option("--threads", o->threads, "Threads for the hierarchy (0: all cores)")

@@ -1134,8 +1134,9 @@ then snaps onto that tree's level without building it again (smoothing_steps mus
 later rounds use its primitives and weights).
 Level: k (count or "auto"), tolerance or relative_tolerance as in Hierarchy.cut, the CLI's
 --clusters and --tolerance; none: 0.1% of the diagonal. k="auto" is denoising's automatic level
-(Denoiser::automatic_level): a jump of the error curve, else the clusters within a multiple of
-the estimated noise (noise_tolerance_factor: None for the default of the segmented copy).
+(Denoiser::automatic_level): a jump of the error curve whose clusters each fit within 4.5
+times that tolerance, else the clusters within a multiple of the estimated noise
+(noise_tolerance_factor: None for the default of the segmented copy).
 stylize: --stylize (each vertex onto its own cluster's primitive); max_move: --max-move (in mean
 incident edge lengths); min_crease_angle: --min-crease-angle (degrees); relabel_passes:
 --relabel-passes (faces moved to the nearest refitted neighbouring primitive); smoothing_steps:

@@ -54,9 +54,9 @@ struct DenoiseOptions {
   /// vertices farther from the current fit than this many robust standard deviations (1.4826 ×
   /// the median distance) are left out and the rest refitted, three times. The vertices left out
   /// are those of chamfers and of misassigned faces along the borders, which tilt and offset the
-  /// hierarchy's fit. Planes by weighted PCA; spheres and cylinders by Gauss-Newton on the
-  /// geometric distance from the hierarchy's fit, kept only when it lowers the error; other types
-  /// keep the hierarchy's fit. 0 disables the refit.
+  /// hierarchy's fit. Planes by weighted PCA; spheres, cylinders, cones and tori by
+  /// Levenberg–Marquardt on the geometric distance (fit_geometric) from the hierarchy's fit,
+  /// kept only when it lowers the error. 0 disables the refit.
   double refit_outlier_threshold = 2.5;
   /// The segmentation of each iteration is computed on a copy of the mesh smoothed by this many
   /// Taubin λ|μ steps (λ = 0.5, μ = −0.53, uniform weights), so that noise does not fragment it
@@ -109,12 +109,14 @@ double estimate_noise(const Mesh& mesh, const BilateralSmoothingOptions& options
 /// The automatic level of a denoising round (Denoiser::automatic_level), and how it was chosen.
 struct DenoiseLevel {
   Segmentation segmentation;
-  /// choose_level() on the hierarchy: its Jump level is kept when it has one.
+  /// choose_level() on the hierarchy: its Jump level is kept when its clusters fit the noise.
   AutoLevel automatic;
-  /// True when the noise rule chose (no significant jump): the tolerance cut below.
+  /// True when the noise rule chose (no significant jump, or one whose clusters do not fit
+  /// within 4.5 tolerances): the tolerance cut below.
   bool by_noise = false;
-  double noise = 0;  ///< estimate_noise() of the mesh being denoised, input units (by_noise only)
-  double tolerance = 0;  ///< noise × the tolerance factor, input units (by_noise only)
+  /// estimate_noise() of the mesh being denoised, input units (0 in NearestIncident mode).
+  double noise = 0;
+  double tolerance = 0;  ///< noise × the tolerance factor, input units (0 in NearestIncident mode)
 };
 
 /// What one snapping pass did.
@@ -152,14 +154,17 @@ class Denoiser {
   std::shared_ptr<const Mesh> segmented_mesh() const;
 
   /// `--clusters auto` for denoising. When the hierarchy's error curve has a significant jump
-  /// (choose_level's Jump rule: regular parts, chamfers) that level. Otherwise, as under noise,
-  /// the tolerance cut (cut_by_tolerance) at noise_tolerance_factor × estimate_noise(mesh()):
-  /// clusters that fit their primitive as well as the noise allows. The knee of the curve, the
-  /// segmentation's fallback, is too coarse to denoise with: on fandisk with 0.3% noise and
-  /// bilateral filtering, RMS 3.8x lower against 2.3x at the knee; on mech-holes-shark 2.1x
-  /// against 0.4x. `hierarchy` is one built on segmented_mesh() (or on a mesh with its
-  /// connectivity). In NearestIncident mode (stylization, which wants few clusters) the level is
-  /// always choose_level()'s.
+  /// (choose_level's Jump rule: regular parts, chamfers) and every cluster of that level fits its
+  /// primitive within 4.5 times the tolerance below (RMS), that level. Otherwise, as under
+  /// noise, the tolerance cut (cut_by_tolerance) at noise_tolerance_factor ×
+  /// estimate_noise(mesh()): clusters that fit their primitive as well as the noise allows. A
+  /// jump with a cluster beyond 4.5 tolerances has merged two surfaces (on the generated noisy
+  /// shapes such jumps made the mesh 2 to 7 times farther from the clean shape than its input). The
+  /// knee of the curve, the segmentation's fallback, is too coarse to denoise with: on fandisk with
+  /// 0.3% noise and bilateral filtering, RMS 3.8x lower against 2.3x at the knee; on
+  /// mech-holes-shark 2.1x against 0.4x. `hierarchy` is one built on segmented_mesh() (or on a mesh
+  /// with its connectivity). In NearestIncident mode (stylization, which wants few clusters) the
+  /// level is always choose_level()'s.
   DenoiseLevel automatic_level(const Hierarchy& hierarchy) const;
 
   /// The factor automatic_level() uses: DenoiseOptions::noise_tolerance_factor, or its default
