@@ -319,12 +319,10 @@ DenoiseLevel Denoiser::automatic_level(const Hierarchy& hierarchy) const {
   DenoiseLevel level;
   level.automatic = choose_level(hierarchy);
   const bool jump = level.automatic.rule == AutoLevelRule::Jump;
-  if (jump) level.segmentation = cut_by_count(hierarchy, level.automatic.clusters);
   // Stylization wants few clusters: the segmentation's own level.
-  if (options_.mode == SnapMode::NearestIncident) {
-    if (!jump) level.segmentation = cut_by_count(hierarchy, level.automatic.clusters);
-    return level;
-  }
+  const bool stylize = options_.mode == SnapMode::NearestIncident;
+  if (jump || stylize) level.segmentation = cut_by_count(hierarchy, level.automatic.clusters);
+  if (stylize) return level;
   // Only here: the estimate smooths the whole mesh once more.
   level.noise = estimate_noise(mesh_);
   level.tolerance = noise_tolerance_factor() * level.noise;
