@@ -88,7 +88,7 @@ Eigen::Vector3d least_squares_point(const Eigen::Vector3d& x,
       right_side -= n * n.dot(y - closest);
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal_matrix);
-    const Eigen::Vector3d values = eigen.eigenvalues();  // increasing
+    const Eigen::Vector3d& values = eigen.eigenvalues();  // increasing
     const double largest = values(2);
     if (!(largest > 0)) break;
     Eigen::Vector3d delta = Eigen::Vector3d::Zero();
@@ -485,6 +485,7 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
     std::sort(clusters.begin(), clusters.end());
     clusters.erase(std::unique(clusters.begin(), clusters.end()), clusters.end());
     std::vector<std::pair<double, std::uint32_t>> by_distance;
+    by_distance.reserve(clusters.size());
     for (const std::uint32_t c : clusters)
       by_distance.emplace_back(primitives[c].distance(start[v]), c);
     std::sort(by_distance.begin(), by_distance.end());

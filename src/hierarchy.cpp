@@ -756,7 +756,7 @@ class HierarchyBuilder::Impl {
       if (bound > 0)
         requeue({bound, false, PrimitiveType::Plane, id});
       else
-        batch_.push_back({0, false, PrimitiveType::Plane, id});
+        batch_.emplace_back(0.0, false, PrimitiveType::Plane, id);
     }
     // The faces' corners, now that their triangles have arrived.
     for (const QueuedCandidate& queued : batch_) {
@@ -836,7 +836,7 @@ class HierarchyBuilder::Impl {
   void add_trailing_merges() {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> roots;  // (lowest face, slot)
     for (std::uint32_t slot = 0; slot < slots_.size(); ++slot)
-      if (slots_[slot].node != kNone) roots.push_back({slots_[slot].min_face, slot});
+      if (slots_[slot].node != kNone) roots.emplace_back(slots_[slot].min_face, slot);
     std::sort(roots.begin(), roots.end());
     const double cost = max_cost_ > 0 ? 2 * max_cost_ : 1.0;
     std::uint32_t joined = slots_[roots.front().second].node;

@@ -31,6 +31,7 @@ std::vector<ClusterPairBoundary> cluster_pair_boundaries(
   // consecutive.
   struct EdgeEntry {
     std::uint32_t low, high, label;
+    // NOLINTNEXTLINE(modernize-use-nullptr): clang-tidy 14 misreads the defaulted <=>.
     auto operator<=>(const EdgeEntry&) const = default;
   };
   std::vector<EdgeEntry> entries;

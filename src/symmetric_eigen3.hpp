@@ -131,7 +131,7 @@ inline IsolatedRoot isolated_root(const Eigen::Matrix3d& a) {
 inline Eigen::Vector3d smaller_orthogonal_eigenvector(const Eigen::Matrix3d& b,
                                                       const Eigen::Vector3d& first) {
   // Basis (u, v) of the plane, matrix [[buu, buv], [buv, bvv]].
-  const Eigen::Vector3d u = eigen3_detail::any_orthogonal(first);
+  Eigen::Vector3d u = eigen3_detail::any_orthogonal(first);  // (not const: returned)
   const Eigen::Vector3d v = first.cross(u);
   const Eigen::Vector3d bu = b * u, bv = b * v;
   const double buu = u.dot(bu), bvv = v.dot(bv), buv = u.dot(bv);

@@ -156,9 +156,9 @@ struct FaceCorners {
   /// The weighted centroid of the corners (the first triangle's centroid if they weigh nothing).
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   /// Corner positions − centroid, three per triangle; the first 3 triangle_count are set.
-  std::array<Eigen::Vector3d, 3 * kMaxTriangles> offsets;
+  std::array<Eigen::Vector3d, std::size_t{3} * kMaxTriangles> offsets;
   /// Their weights w.
-  std::array<double, 3 * kMaxTriangles> weights{};
+  std::array<double, std::size_t{3} * kMaxTriangles> weights{};
   /// Per triangle: area × unit normal (consistently oriented), area, and centroid − centroid.
   std::array<Eigen::Vector3d, kMaxTriangles> area_normals;
   std::array<double, kMaxTriangles> areas{};

@@ -116,7 +116,7 @@ ConeAtApex cone_at_apex(const Moments& moments, const Eigen::Vector3d& apex, dou
   if (quadric.info() != Eigen::Success) return cone;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(
       matrix_of(quadric.eigenvectors().col(0)));
-  const Eigen::Vector3d mu = shape.eigenvalues();  // ascending
+  const Eigen::Vector3d& mu = shape.eigenvalues();  // ascending
   // The eigenvalue of distinct sign is the one farther from the middle one.
   const int distinct = mu(1) - mu(0) > mu(2) - mu(1) ? 0 : 2;
   cone.axis = shape.eigenvectors().col(distinct).normalized();

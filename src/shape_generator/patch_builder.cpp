@@ -300,7 +300,7 @@ void PatchBuilder::icosphere(std::uint32_t region, const Vec3& centre, double ra
     std::sort(weights.begin(), weights.end());
     std::array<int, 6> key{-1, 0, -1, 0, -1, 0};
     Vec3 direction{0, 0, 0};
-    int slot = 0;
+    std::size_t slot = 0;
     for (const auto& [corner, weight] : weights) {
       if (weight == 0) continue;
       key[2 * slot] = corner, key[2 * slot + 1] = weight, ++slot;

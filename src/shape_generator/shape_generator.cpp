@@ -17,9 +17,11 @@ using shape_detail::dot;
 using shape_detail::normalized;
 using shape_detail::PatchBuilder;
 using shape_detail::SplitMix64;
-using shape_detail::operator+;
-using shape_detail::operator-;
-using shape_detail::operator*;
+// Vec3 is a std::array, so argument-dependent lookup cannot find these (clang-tidy 14 reports
+// them unused all the same).
+using shape_detail::operator+;  // NOLINT(misc-unused-using-decls)
+using shape_detail::operator-;  // NOLINT(misc-unused-using-decls)
+using shape_detail::operator*;  // NOLINT(misc-unused-using-decls)
 
 // Independent streams for motion and noise, so that adding noise does not change the motion.
 constexpr std::uint64_t kMotionStream = 0x6D6F74696F6E0001ull;
