@@ -8,7 +8,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
-files=('src/mesh_io/.*\.cpp$' 'src/file_io\.cpp$' 'apps/.*\.cpp$')
-[[ ${2:-} == --all ]] && files=('src/.*\.cpp$' 'apps/.*\.cpp$')
+case ${2:-} in
+  "") files=('src/mesh_io/.*\.cpp$' 'src/file_io\.cpp$' 'apps/.*\.cpp$') ;;
+  --all) files=('src/.*\.cpp$' 'apps/.*\.cpp$') ;;
+  *) echo "usage: scripts/tidy.sh [BUILD_DIR] [--all]" >&2; exit 2 ;;
+esac
 cmake -S . -B "$build" -DCMAKE_EXPORT_COMPILE_COMMANDS=ON >/dev/null
 run-clang-tidy -quiet -j "$(nproc)" -p "$build" "${files[@]}"
