@@ -11,13 +11,9 @@
 #include "primseg/render.hpp"
 
 namespace primseg::cli {
-namespace {
-
-nlohmann::json vec(const Vec3& v) {
+nlohmann::json vec3_json(const Vec3& v) {
   return nlohmann::json::array({v[0], v[1], v[2]});
 }
-
-}  // namespace
 
 void validate_output_files(const OutputFiles& files) {
   if (files.colored) {
@@ -36,7 +32,7 @@ void validate_output_files(const OutputFiles& files) {
 nlohmann::json primitive_params(const Primitive& primitive) {
   nlohmann::json params = nlohmann::json::object();
   for (const NamedParameter& p : named_parameters(primitive))
-    params[std::string(p.name)] = p.is_vector ? vec(p.value) : nlohmann::json(p.value[0]);
+    params[std::string(p.name)] = p.is_vector ? vec3_json(p.value) : nlohmann::json(p.value[0]);
   return params;
 }
 

@@ -22,6 +22,9 @@ struct OutputFiles {
 /// Throws InvalidInputError for output names that cannot be written (checked before any work).
 void validate_output_files(const OutputFiles& files);
 
+/// A point or direction as the JSON array [x, y, z].
+nlohmann::json vec3_json(const Vec3& v);
+
 /// JSON parameters of a primitive, input units.
 nlohmann::json primitive_params(const Primitive& primitive);
 

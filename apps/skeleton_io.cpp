@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "../src/file_io.hpp"
+#include "outputs.hpp"
 #include "primseg/error.hpp"
 #include "primseg/skeleton_render.hpp"
 
@@ -14,10 +15,6 @@ namespace primseg::cli {
 namespace {
 
 using nlohmann::json;
-
-json vec(const Vec3& v) {
-  return json::array({v[0], v[1], v[2]});
-}
 
 // Parses a whole JSON file; ParseError with the file name on malformed text.
 json parse_file(const std::string& path) {
@@ -60,7 +57,7 @@ json skeleton_to_json(const Skeleton& skeleton) {
   json joints = json::array();
   for (const Joint& j : skeleton.joints)
     joints.push_back({{"id", j.id},
-                      {"position", vec(j.position)},
+                      {"position", vec3_json(j.position)},
                       {"kind", std::string(to_string(j.kind))},
                       {"visible", j.visible},
                       {"bones", j.bones}});
@@ -70,8 +67,8 @@ json skeleton_to_json(const Skeleton& skeleton) {
                      {"cluster", b.cluster},
                      {"joints", b.joints},
                      {"visible", b.visible},
-                     {"axis", vec(b.axis)},
-                     {"point", vec(b.point)},
+                     {"axis", vec3_json(b.axis)},
+                     {"point", vec3_json(b.point)},
                      {"radius", b.radius},
                      {"area", b.area}});
   return {{"cluster_count", skeleton.cluster_count()},

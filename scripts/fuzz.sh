@@ -12,7 +12,7 @@ build=${PRIMSEG_FUZZ_BUILD_DIR:-build-fuzz}
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
   -DPRIMSEG_FUZZ=ON -DPRIMSEG_WERROR=ON -DPRIMSEG_BUILD_TESTS=OFF -DPRIMSEG_BUILD_CLI=OFF \
-  -DPRIMSEG_BUILD_BENCH=OFF >/dev/null
+  -DPRIMSEG_BUILD_BENCH=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build "$build" --target fuzz_read_off fuzz_read_obj fuzz_read_ply fuzz_read_stl \
   fuzz_read_detect fuzz_segment
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "eigen_conversions.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "vertex_triangles.hpp"
@@ -14,9 +15,7 @@
 namespace primseg {
 namespace {
 
-Eigen::Vector3d to_eigen(const Vec3& v) {
-  return {v[0], v[1], v[2]};
-}
+using detail::to_eigen;
 
 // The faces sharing a vertex with each face (itself included), as compressed rows, sorted.
 std::vector<std::vector<std::uint32_t>> face_neighbourhoods(const Mesh& mesh,

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <string>
 
+#include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "working_primitive.hpp"
@@ -14,7 +15,7 @@
 namespace primseg {
 namespace {
 
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+using detail::kNone;
 
 // Numbers the clusters given by `cluster_of_face` (arbitrary ids < nodes.size()) by decreasing
 // area, ties by lowest face.

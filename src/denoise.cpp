@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 
+#include "eigen_conversions.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "primseg/geometric_fit.hpp"
@@ -18,12 +19,8 @@
 namespace primseg {
 namespace {
 
-Eigen::Vector3d to_eigen(const Vec3& v) {
-  return {v[0], v[1], v[2]};
-}
-Vec3 to_vec3(const Eigen::Vector3d& v) {
-  return {v.x(), v.y(), v.z()};
-}
+using detail::to_eigen;
+using detail::to_vec3;
 
 Eigen::Vector3d triangle_normal(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                 const Eigen::Vector3d& c) {

@@ -9,12 +9,13 @@
 #include <tuple>
 #include <utility>
 
+#include "no_index.hpp"
 #include "parallel.hpp"
 
 namespace primseg {
 namespace {
 
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+using detail::kNone;
 
 // Side c of a triangle runs from its corner c to corner c + 1 (mod 3).
 std::uint32_t side_end(const Triangle& tri, unsigned c) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "eigen_conversions.hpp"
 #include "geometric_models.hpp"
 #include "primseg/error.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
@@ -14,13 +15,6 @@
 namespace primseg {
 namespace detail {
 namespace {
-
-Eigen::Vector3d to_eigen(const Vec3& v) {
-  return {v[0], v[1], v[2]};
-}
-Vec3 to_vec3(const Eigen::Vector3d& v) {
-  return {v.x(), v.y(), v.z()};
-}
 
 // A unit vector orthogonal to the unit vector a, and a third completing a right-handed frame.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> orthonormal_pair(const Eigen::Vector3d& a) {

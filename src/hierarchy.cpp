@@ -11,13 +11,14 @@
 #include "batch_pool.hpp"
 #include "indexed_heap.hpp"
 #include "model_selection.hpp"
+#include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg {
 namespace {
 
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+using detail::kNone;
 constexpr std::uint32_t kPairTag = 1u << 31;
 
 // A candidate merge in the queue: the dual edge's id and its key. Candidates are ordered by

@@ -4,18 +4,16 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "eigen_conversions.hpp"
+
 namespace primseg {
 namespace {
 
 constexpr std::string_view kNames[kPrimitiveTypeCount] = {"plane", "cylinder", "sphere", "cone",
                                                           "torus"};
 
-Eigen::Vector3d to_eigen(const Vec3& v) {
-  return {v[0], v[1], v[2]};
-}
-Vec3 to_vec3(const Eigen::Vector3d& v) {
-  return {v.x(), v.y(), v.z()};
-}
+using detail::to_eigen;
+using detail::to_vec3;
 
 // Any unit vector orthogonal to the unit vector a.
 Eigen::Vector3d orthogonal_to(const Eigen::Vector3d& a) {

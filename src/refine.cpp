@@ -7,13 +7,14 @@
 #include <numeric>
 #include <string>
 
+#include "no_index.hpp"
 #include "primseg/error.hpp"
 #include "working_primitive.hpp"
 
 namespace primseg {
 namespace {
 
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+using detail::kNone;
 // How far above the cut's total error (over the corners) refinement may take it: passes trade a
 // little of it for borders the corners cannot see (measured on the generated CAD-tessellated
 // shapes: a chamfered cylinder's borders move right while its corner error rises by 0.1%).

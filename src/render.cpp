@@ -532,10 +532,10 @@ std::string deflate_fixed(std::span<const std::uint8_t> data) {
   constexpr std::size_t kMaxMatch = 258;
   constexpr int kHashBits = 15;
   constexpr int kMaxChain = 32;
-  constexpr std::int64_t kNone = -1;
+  constexpr std::int64_t kNoPosition = -1;
 
-  std::vector<std::int64_t> head(std::size_t{1} << kHashBits, kNone);
-  std::vector<std::int64_t> previous(kWindow, kNone);
+  std::vector<std::int64_t> head(std::size_t{1} << kHashBits, kNoPosition);
+  std::vector<std::int64_t> previous(kWindow, kNoPosition);
   auto hash_at = [&](std::size_t i) {
     const std::uint32_t key = (std::uint32_t{data[i]} << 16) | (std::uint32_t{data[i + 1]} << 8) |
                               std::uint32_t{data[i + 2]};
@@ -560,7 +560,7 @@ std::string deflate_fixed(std::span<const std::uint8_t> data) {
     if (i + kMinMatch <= data.size()) {
       const std::size_t longest = std::min(kMaxMatch, data.size() - i);
       std::int64_t candidate = head[hash_at(i)];
-      for (int chain = 0; chain < kMaxChain && candidate != kNone; ++chain) {
+      for (int chain = 0; chain < kMaxChain && candidate != kNoPosition; ++chain) {
         const auto start = static_cast<std::size_t>(candidate);
         if (i - start > kWindow) break;
         std::size_t match = 0;

@@ -10,6 +10,7 @@
 #include <string>
 #include <utility>
 
+#include "no_index.hpp"
 #include "primseg/error.hpp"
 #include "skeleton_geometry.hpp"
 
@@ -37,7 +38,7 @@ namespace {
 
 using namespace skeleton_detail;
 
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+using detail::kNone;
 
 std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
   while (parent[x] != x) {

@@ -11,7 +11,7 @@
 namespace primseg {
 namespace {
 
-using Point2 = std::array<double, 2>;
+using PixelPoint = std::array<double, 2>;
 using Rgb = std::array<std::uint8_t, 3>;
 
 constexpr Rgb kBoneColor{25, 25, 25};
@@ -27,7 +27,7 @@ class Canvas {
       : rgb_(rgb), width_(width), height_(height) {}
 
   // Pixels whose centre is within half_width of the segment.
-  void segment(Point2 a, Point2 b, double half_width, const Rgb& color) {
+  void segment(PixelPoint a, PixelPoint b, double half_width, const Rgb& color) {
     const double dx = b[0] - a[0], dy = b[1] - a[1];
     const double length2 = dx * dx + dy * dy;
     fill_box(std::min(a[0], b[0]) - half_width, std::max(a[0], b[0]) + half_width,
@@ -40,14 +40,14 @@ class Canvas {
              });
   }
 
-  void disc(Point2 c, double radius, const Rgb& color) {
+  void disc(PixelPoint c, double radius, const Rgb& color) {
     fill_box(c[0] - radius, c[0] + radius, c[1] - radius, c[1] + radius, color,
              [&](double x, double y) {
                return (x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) <= radius * radius;
              });
   }
 
-  void square(Point2 c, double half_side, const Rgb& color) {
+  void square(PixelPoint c, double half_side, const Rgb& color) {
     fill_box(c[0] - half_side, c[0] + half_side, c[1] - half_side, c[1] + half_side, color,
              [](double, double) { return true; });
   }
@@ -97,7 +97,7 @@ std::vector<std::uint8_t> render_skeleton(const Mesh& mesh, const Skeleton& skel
 
   std::vector<Vec3> joint_positions;
   for (const Joint& joint : skeleton.joints) joint_positions.push_back(joint.position);
-  const std::vector<Point2> joints = project_to_picture(mesh, joint_positions, options);
+  const std::vector<PixelPoint> joints = project_to_picture(mesh, joint_positions, options);
   Canvas canvas(rgb, options.width, options.height);
   const double scale = std::max(1.0, std::min(options.width, options.height) / 600.0);
   for (const bool visible_pass : {false, true})  // visible bones over hidden ones
@@ -109,7 +109,7 @@ std::vector<std::uint8_t> render_skeleton(const Mesh& mesh, const Skeleton& skel
         canvas.segment(joints[bone.joints[0]], joints[bone.joints[1]], half_width, color);
         continue;
       }
-      Point2 hub{0, 0};
+      PixelPoint hub{0, 0};
       for (const std::uint32_t j : bone.joints) {
         hub[0] += joints[j][0] / static_cast<double>(bone.joints.size());
         hub[1] += joints[j][1] / static_cast<double>(bone.joints.size());
@@ -118,7 +118,7 @@ std::vector<std::uint8_t> render_skeleton(const Mesh& mesh, const Skeleton& skel
     }
   for (const Joint& joint : skeleton.joints) {
     if (!joint.visible) continue;
-    const Point2& p = joints[joint.id];
+    const PixelPoint& p = joints[joint.id];
     switch (joint.kind) {
       case JointKind::Sensitive:
         canvas.disc(p, 4.5 * scale, kSensitiveColor);

@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "no_index.hpp"
 #include "primseg/error.hpp"
 #include "skeleton_geometry.hpp"
 
@@ -17,7 +18,7 @@ using namespace skeleton_detail;
 
 namespace {
 
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+using detail::kNone;
 
 double smoothstep(double t) {
   t = std::clamp(t, 0.0, 1.0);
