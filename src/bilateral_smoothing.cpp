@@ -16,6 +16,7 @@ namespace primseg {
 namespace {
 
 using detail::to_eigen;
+using detail::to_vec3;
 
 // The faces sharing a vertex with each face (itself included), as compressed rows, sorted.
 std::vector<std::vector<std::uint32_t>> face_neighbourhoods(const Mesh& mesh,
@@ -124,7 +125,7 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
         move += normals[t] * normals[t].dot(centroids[t] - x);
       }
       const Eigen::Vector3d moved = end > begin ? Eigen::Vector3d(x + move / (end - begin)) : x;
-      next[v] = {moved.x(), moved.y(), moved.z()};
+      next[v] = to_vec3(moved);
     });
     smoothed.positions.swap(next);
   }

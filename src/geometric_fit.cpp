@@ -253,6 +253,8 @@ std::unique_ptr<GeometricModel> geometric_model_for(const Primitive& p) {
 namespace {
 
 using detail::GeometricModel;
+using detail::to_eigen;
+using detail::to_vec3;
 
 struct Normalised {
   std::vector<Eigen::Vector3d> points;
@@ -362,28 +364,26 @@ struct LinearisedCost {
 // The canonical form of primitive.hpp, in the normalised frame (weighted centroid at 0).
 Primitive canonical(Primitive p, const Primitive& initial_normalised) {
   const Eigen::Vector3d axis(p.axis[0], p.axis[1], p.axis[2]);
-  const Eigen::Vector3d point(p.point[0], p.point[1], p.point[2]);
+  const Eigen::Vector3d point = to_eigen(p.point);
   if (p.type == PrimitiveType::Plane) {
-    const Eigen::Vector3d initial(initial_normalised.axis[0], initial_normalised.axis[1],
-                                  initial_normalised.axis[2]);
+    const Eigen::Vector3d initial = to_eigen(initial_normalised.axis);
     const Eigen::Vector3d normal = axis.dot(initial) < 0 ? Eigen::Vector3d(-axis) : axis;
     // The centroid (the origin here) projected on the plane.
     const Eigen::Vector3d foot = normal * normal.dot(point);
-    p.axis = {normal.x(), normal.y(), normal.z()};
-    p.point = {foot.x(), foot.y(), foot.z()};
+    p.axis = to_vec3(normal);
+    p.point = to_vec3(foot);
   } else if (p.type == PrimitiveType::Cylinder) {
     const Eigen::Vector3d a = canonical_axis(axis);
     const Eigen::Vector3d foot = point - a * a.dot(point);
-    p.axis = {a.x(), a.y(), a.z()};
-    p.point = {foot.x(), foot.y(), foot.z()};
+    p.axis = to_vec3(a);
+    p.point = to_vec3(foot);
     p.radius = std::abs(p.radius);
   } else if (p.type == PrimitiveType::Sphere) {
     p.radius = std::abs(p.radius);
   } else if (p.type == PrimitiveType::Cone) {
-    p.axis = {axis.x(), axis.y(), axis.z()};  // from the apex into the cone: keep its side
+    p.axis = to_vec3(axis);  // from the apex into the cone: keep its side
   } else if (p.type == PrimitiveType::Torus) {
-    const Eigen::Vector3d a = canonical_axis(axis);
-    p.axis = {a.x(), a.y(), a.z()};
+    p.axis = to_vec3(canonical_axis(axis));
   }
   return p;
 }
@@ -454,7 +454,7 @@ GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> point
   double sum = 0, total = 0, largest = 0;
   for (std::size_t i = 0; i < n.points.size(); ++i) {
     const Eigen::Vector3d& x = n.points[i];
-    const double d = final_normalised.distance({x.x(), x.y(), x.z()});
+    const double d = final_normalised.distance(to_vec3(x));
     sum += weights[i] * d * d;
     total += weights[i];
     if (weights[i] > 0) largest = std::max(largest, d);

@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <map>
 
+#include "eigen_conversions.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
 
 namespace primseg::skeleton_detail {
 
 Vec3 canonical_direction(const Vec3& unit) {
-  const Eigen::Vector3d flipped = canonical_axis(Eigen::Vector3d(unit[0], unit[1], unit[2]));
-  return {flipped[0], flipped[1], flipped[2]};
+  return detail::to_vec3(canonical_axis(detail::to_eigen(unit)));
 }
 
 double distance_to_line(const Vec3& x, const Vec3& point, const Vec3& axis) {

@@ -23,6 +23,7 @@
 #include <cmath>
 #include <vector>
 
+#include "eigen_conversions.hpp"
 #include "primitives/pratt_fit.hpp"
 #include "primseg/geometric_fit.hpp"
 
@@ -152,10 +153,9 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
     const Eigen::Vector3d y = x - torus_centre;
     const Eigen::Vector3d radial = y - torus_axis * torus_axis.dot(y);
     if (!(radial.squaredNorm() > 0)) return 0.0;
-    const Vec3 nearest = torus.closest_point({x.x(), x.y(), x.z()});
+    const Eigen::Vector3d nearest = detail::to_eigen(torus.closest_point(detail::to_vec3(x)));
     const Eigen::Vector3d ring = torus_centre + radial.normalized() * torus.radius;
-    const Eigen::Vector3d normal =
-        (Eigen::Vector3d(nearest[0], nearest[1], nearest[2]) - ring).normalized();
+    const Eigen::Vector3d normal = (nearest - ring).normalized();
     return std::abs(normal.dot(face_normal));
   };
   double at_corners = 0, at_centroids = 0;
