@@ -69,11 +69,9 @@ void set_face_counters(benchmark::State& state, std::uint32_t faces) {
 
 /// The full hierarchy (build_hierarchy on a shared mesh: no copy). The Hierarchy's destruction
 /// is part of the timed iteration.
-void hierarchy(benchmark::State& state, const std::string& input, bool exact_costs) {
+void hierarchy(benchmark::State& state, const std::string& input, const HierarchyOptions& options) {
   guarded(state, [&] {
     const auto mesh = load_input(input);
-    HierarchyOptions options;
-    options.exact_costs = exact_costs;
     for (auto _ : state) {
       Hierarchy tree = build_hierarchy(mesh, options);
       benchmark::DoNotOptimize(tree.merges().data());
@@ -214,15 +212,25 @@ void register_benchmarks() {
   const std::string shape = std::string("shape:") + kShapeName;
   // A hierarchy build takes long enough that one iteration per repetition is a stable figure:
   // the 5 repetitions are then 5 independent builds and the median is their median.
-  configure(benchmark::RegisterBenchmark("hierarchy/fandisk", hierarchy, "fandisk.off", false))
+  HierarchyOptions exact_costs;
+  exact_costs.exact_costs = true;
+  HierarchyOptions all_types;
+  all_types.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
+                          PrimitiveType::Cone, PrimitiveType::Torus};
+  configure(benchmark::RegisterBenchmark("hierarchy/fandisk", hierarchy, "fandisk.off",
+                                         HierarchyOptions{}))
       ->Iterations(1);
-  configure(benchmark::RegisterBenchmark("hierarchy/bunny00", hierarchy, "bunny00.off", false))
+  configure(benchmark::RegisterBenchmark("hierarchy/bunny00", hierarchy, "bunny00.off",
+                                         HierarchyOptions{}))
       ->Iterations(1);
-  configure(
-      benchmark::RegisterBenchmark("hierarchy/box_with_hole_uniform_0.01", hierarchy, shape, false))
+  configure(benchmark::RegisterBenchmark("hierarchy/box_with_hole_uniform_0.01", hierarchy, shape,
+                                         HierarchyOptions{}))
       ->Iterations(1);
-  configure(
-      benchmark::RegisterBenchmark("hierarchy_exact_costs/fandisk", hierarchy, "fandisk.off", true))
+  configure(benchmark::RegisterBenchmark("hierarchy_exact_costs/fandisk", hierarchy, "fandisk.off",
+                                         exact_costs))
+      ->Iterations(1);
+  configure(benchmark::RegisterBenchmark("hierarchy_all_types/fandisk", hierarchy, "fandisk.off",
+                                         all_types))
       ->Iterations(1);
   configure(benchmark::RegisterBenchmark("read_mesh/fandisk", read, "fandisk.off"));
   configure(benchmark::RegisterBenchmark("read_mesh/bunny00", read, "bunny00.off"));

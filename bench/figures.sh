@@ -98,6 +98,8 @@ rows = [
      "--shape box_with_hole 0.01"),
     ("fandisk.off, `exact_costs` (reference mode)", "hierarchy_exact_costs/fandisk/", None,
      "--cgal fandisk.off --exact-costs"),
+    ("fandisk.off, all five types (plane, cylinder, sphere, cone, torus)",
+     "hierarchy_all_types/fandisk/", None, None),
 ]
 
 print("| input | faces | full hierarchy, median of 5 (ms) | faces/s | peak RSS (MB) "
@@ -109,17 +111,18 @@ for label, hierarchy, read, mem in rows:
     if median is None:
         continue
     faces = int(median["faces"])
-    m = memory.get(mem, {})
-    peak = int(m.get("peak_rss", 0))
+    peak = int(memory.get(mem, {}).get("peak_rss", 0)) if mem else 0
     read_cell = "–"
     if read:
         r = aggregate(read, "median")
         if r is not None:
             read_cell = f"{r['bytes_per_second'] / 1e6:.0f} ({ms(r):.2f} ms)"
     print(f"| {label} | {faces:,} | {ms(median):,.0f} | {faces / (ms(median) / 1e3):,.0f} "
-          f"| {peak / 1e6:.1f} | {peak / faces:,.0f} | {read_cell} |")
+          f"| {f'{peak / 1e6:.1f}' if peak else '–'} | {f'{peak / faces:,.0f}' if peak else '–'} "
+          f"| {read_cell} |")
     notes.append(f"{label.split(',')[0].split(' (')[0]}"
-                 f"{' exact' if 'exact' in hierarchy else ''}: CPU {ms(median, 'cpu_time'):,.0f} ms,"
+                 f"{' exact' if 'exact' in hierarchy else ''}"
+                 f"{' all types' if 'all_types' in hierarchy else ''}: CPU {ms(median, 'cpu_time'):,.0f} ms,"
                  f" CV {100 * cv['real_time']:.0f}%")
 
 cut = aggregate("cut_describe_k30/fandisk/", "median")

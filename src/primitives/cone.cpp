@@ -24,6 +24,9 @@
 #include <Eigen/Eigenvalues>
 #include <array>
 #include <cmath>
+#include <cstdint>
+
+#include "small_cholesky.hpp"
 
 namespace primseg {
 namespace {
@@ -53,9 +56,10 @@ constexpr std::array<std::array<int, 2>, 6> kEntries = {
 
 // The eigenpairs of A x = λ B x, A symmetric and B symmetric positive definite: eigenvalues
 // ascending, eigenvectors with xᵀBx = 1. The steps of Eigen's GeneralizedSelfAdjointEigenSolver
-// (B = L Lᵀ, the ordinary problem of C = L⁻¹ A L⁻ᵀ, x = L⁻ᵀ y), written out for a small fixed
-// size: Eigen's solver also compiles its two other problem types and its blocked matrix kernels,
-// the slowest part of the slowest file to compile (g++ -O3: 65 s with it, 49 s without).
+// (B = L Lᵀ, the ordinary problem of C = L⁻¹ A L⁻ᵀ, x = L⁻ᵀ y), with the written-out factor
+// and substitutions of small_cholesky.hpp: Eigen's solver also compiles its two other problem types
+// and its blocked matrix kernels, the slowest part of the slowest file to compile (g++ -O3: 65 s
+// with it, 49 s without).
 template <int N>
 struct GeneralizedEigen {
   bool valid = false;
@@ -68,39 +72,18 @@ GeneralizedEigen<N> generalized_eigen(const Eigen::Matrix<double, N, N>& a,
                                       const Eigen::Matrix<double, N, N>& b) {
   using Matrix = Eigen::Matrix<double, N, N>;
   GeneralizedEigen<N> result;
-  Matrix l = Matrix::Zero();  // Cholesky factor of B
-  for (int j = 0; j < N; ++j) {
-    double pivot = b(j, j);
-    for (int k = 0; k < j; ++k) pivot -= l(j, k) * l(j, k);
-    if (!(pivot > 0)) return result;  // B not positive definite, or not finite
-    l(j, j) = std::sqrt(pivot);
-    for (int i = j + 1; i < N; ++i) {
-      double sum = b(i, j);
-      for (int k = 0; k < j; ++k) sum -= l(i, k) * l(j, k);
-      l(i, j) = sum / l(j, j);
-    }
-  }
-  const auto solve_lower = [&l](Matrix m) {  // L⁻¹ m, forward substitution
-    for (int column = 0; column < N; ++column)
-      for (int i = 0; i < N; ++i) {
-        double sum = m(i, column);
-        for (int k = 0; k < i; ++k) sum -= l(i, k) * m(k, column);
-        m(i, column) = sum / l(i, i);
-      }
-    return m;
-  };
+  Matrix l;
+  if (!detail::cholesky_factor(b, l)) return result;
   // C = L⁻¹ (L⁻¹ A)ᵀ, A being symmetric.
-  const Matrix c = solve_lower(solve_lower(a).transpose());
+  Matrix c = a;
+  detail::solve_lower_in_place(l, c);
+  c.transposeInPlace();
+  detail::solve_lower_in_place(l, c);
   const Eigen::SelfAdjointEigenSolver<Matrix> ordinary(c);
   if (ordinary.info() != Eigen::Success) return result;
   result.values = ordinary.eigenvalues();
   result.vectors = ordinary.eigenvectors();
-  for (int column = 0; column < N; ++column)  // L⁻ᵀ y, back substitution
-    for (int i = N - 1; i >= 0; --i) {
-      double sum = result.vectors(i, column);
-      for (int k = i + 1; k < N; ++k) sum -= l(k, i) * result.vectors(k, column);
-      result.vectors(i, column) = sum / l(i, i);
-    }
+  detail::solve_lower_transposed_in_place(l, result.vectors);  // x = L⁻ᵀ y
   result.valid = true;
   return result;
 }
@@ -188,19 +171,38 @@ ConeAtApex cone_at_apex(const Moments& moments, const Eigen::Vector3d& apex, dou
 }
 
 // Polynomials of degree at most 2 in y, as coefficients of (1, x, y, z, x², y², z², xy, xz, yz):
-// Σ w p q = pᵀ G q with G the 10×10 Gram matrix of moments up to degree 4.
-using Poly = Eigen::Matrix<double, 10, 1>;
+// Σ w p q = pᵀ G q with G the 10×10 Gram matrix of moments up to degree 4. Every polynomial
+// below is homogeneous (a constant, a linear form or a quadratic form), so only G's blocks
+// between two degrees are multiplied: G₀₀ (1×1), G₀₁ (1×3), G₁₁ (3×3), G₁₂ (3×6), G₂₂ (6×6).
 using Gram = Eigen::Matrix<double, 10, 10>;
-constexpr std::array<std::array<int, 3>, 10> kLowMonomials = {{{0, 0, 0},
-                                                               {1, 0, 0},
-                                                               {0, 1, 0},
-                                                               {0, 0, 1},
-                                                               {2, 0, 0},
-                                                               {0, 2, 0},
-                                                               {0, 0, 2},
-                                                               {1, 1, 0},
-                                                               {1, 0, 1},
-                                                               {0, 1, 1}}};
+using Quadratic = Eigen::Matrix<double, 6, 1>;  // coefficients of x², y², z², xy, xz, yz
+// Where each entry of G comes from: the moment of the product of its two monomials, and that
+// product's degree (the power of the length scale).
+struct GramEntry {
+  std::uint8_t moment;
+  std::uint8_t degree;
+};
+constexpr std::array<std::array<GramEntry, 10>, 10> kGramEntries = [] {
+  constexpr std::array<std::array<int, 3>, 10> monomials = {{{0, 0, 0},
+                                                             {1, 0, 0},
+                                                             {0, 1, 0},
+                                                             {0, 0, 1},
+                                                             {2, 0, 0},
+                                                             {0, 2, 0},
+                                                             {0, 0, 2},
+                                                             {1, 1, 0},
+                                                             {1, 0, 1},
+                                                             {0, 1, 1}}};
+  std::array<std::array<GramEntry, 10>, 10> entries{};
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j) {
+      const auto &a = monomials[i], &b = monomials[j];
+      entries[i][j] = {
+          static_cast<std::uint8_t>(Moments::index(a[0] + b[0], a[1] + b[1], a[2] + b[2])),
+          static_cast<std::uint8_t>(a[0] + a[1] + a[2] + b[0] + b[1] + b[2])};
+    }
+  return entries;
+}();
 
 Gram gram_of(const Moments& moments, double scale) {
   double power[5] = {1, scale, scale * scale, 0, 0};
@@ -209,32 +211,25 @@ Gram gram_of(const Moments& moments, double scale) {
   Gram g;
   for (int i = 0; i < 10; ++i)
     for (int j = i; j < 10; ++j) {
-      const auto& a = kLowMonomials[i];
-      const auto& b = kLowMonomials[j];
-      const int degree = a[0] + a[1] + a[2] + b[0] + b[1] + b[2];
-      g(i, j) = g(j, i) = moments.at(a[0] + b[0], a[1] + b[1], a[2] + b[2]) * power[degree];
+      const GramEntry entry = kGramEntries[i][j];
+      g(i, j) = g(j, i) = moments.values()[entry.moment] * power[entry.degree];
     }
   return g;
 }
 
-Poly constant_poly(double c) {
-  Poly p = Poly::Zero();
-  p(0) = c;
-  return p;
+auto linear_block(const Gram& g) {  // G₁₁
+  return g.block<3, 3>(1, 1);
 }
-Poly linear_poly(const Eigen::Vector3d& v) {
-  Poly p = Poly::Zero();
-  p.segment<3>(1) = v;
-  return p;
+auto linear_quadratic_block(const Gram& g) {  // G₁₂
+  return g.block<3, 6>(1, 4);
 }
-Poly quadratic_poly(const Eigen::Matrix3d& q) {  // yᵀ q y
-  Poly p = Poly::Zero();
-  p(4) = q(0, 0);
-  p(5) = q(1, 1);
-  p(6) = q(2, 2);
-  p(7) = q(0, 1) + q(1, 0);
-  p(8) = q(0, 2) + q(2, 0);
-  p(9) = q(1, 2) + q(2, 1);
+auto quadratic_block(const Gram& g) {  // G₂₂
+  return g.block<6, 6>(4, 4);
+}
+
+Quadratic quadratic_form(const Eigen::Matrix3d& q) {  // yᵀ q y
+  Quadratic p;
+  p << q(0, 0), q(1, 1), q(2, 2), q(0, 1) + q(1, 0), q(0, 2) + q(2, 0), q(1, 2) + q(2, 1);
   return p;
 }
 
@@ -247,13 +242,13 @@ struct ConeParameters {
 std::pair<double, double> taubin_terms(const Gram& g, const ConeParameters& cone) {
   const Eigen::Matrix3d m =
       cone.axis * cone.axis.transpose() - cone.cos2 * Eigen::Matrix3d::Identity();
-  const Poly f = quadratic_poly(m);
+  const Quadratic f = quadratic_form(m);
   double d = 0;
   for (int i = 0; i < 3; ++i) {
-    const Poly gradient = linear_poly(2 * m.row(i).transpose());
-    d += gradient.dot(g.lazyProduct(gradient));
+    const Eigen::Vector3d gradient = 2 * m.row(i).transpose();  // (∇f)_i = 2 (My)_i, linear
+    d += gradient.dot(linear_block(g).lazyProduct(gradient));
   }
-  return {f.dot(g.lazyProduct(f)), d};
+  return {f.dot(quadratic_block(g).lazyProduct(f)), d};
 }
 
 // Levenberg–Marquardt on Taubin's ratio R = N / D over all six parameters at once (apex, axis
@@ -264,6 +259,8 @@ std::pair<double, double> taubin_terms(const Gram& g, const ConeParameters& cone
 // angle; the joint step does not.
 void refine_cone(const Moments& moments, double scale, ConeParameters& cone, double& ratio,
                  Moments& about_apex) {
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
+  using Matrix6 = Eigen::Matrix<double, 6, 6>;
   Gram g = gram_of(about_apex, scale);
   double lambda = 1e-3;
   for (int iteration = 0; iteration < kRefinementSteps; ++iteration) {
@@ -273,41 +270,66 @@ void refine_cone(const Moments& moments, double scale, ConeParameters& cone, dou
     const Eigen::Vector3d e1 = u.cross(Eigen::Vector3d::Unit(least)).normalized();
     const Eigen::Vector3d e2 = u.cross(e1);
     const Eigen::Matrix3d m = u * u.transpose() - cone.cos2 * Eigen::Matrix3d::Identity();
-    const Poly f = quadratic_poly(m);
-    Eigen::Matrix<double, 10, 6> jacobian;  // ∂f / ∂(apex, tilt e1, tilt e2, cos²θ)
-    for (int k = 0; k < 3; ++k) jacobian.col(k) = linear_poly(-2 * m.row(k).transpose());
-    jacobian.col(3) = quadratic_poly(u * e1.transpose() + e1 * u.transpose());
-    jacobian.col(4) = quadratic_poly(u * e2.transpose() + e2 * u.transpose());
-    jacobian.col(5) = quadratic_poly(-Eigen::Matrix3d::Identity());
+    const Quadratic f = quadratic_form(m);
+    // ∂f / ∂(apex, tilt e1, tilt e2, cos²θ): linear in y for the apex, quadratic for the rest.
+    Eigen::Matrix3d by_apex;
+    for (int k = 0; k < 3; ++k) by_apex.col(k) = -2 * m.row(k).transpose();
+    Eigen::Matrix<double, 6, 3> by_shape;
+    by_shape.col(0) = quadratic_form(u * e1.transpose() + e1 * u.transpose());
+    by_shape.col(1) = quadratic_form(u * e2.transpose() + e2 * u.transpose());
+    by_shape.col(2) = quadratic_form(-Eigen::Matrix3d::Identity());
     // Small fixed sizes: coefficient-wise products (lazyProduct) beat Eigen's blocked kernels.
-    const Poly gf = g.lazyProduct(f);
-    const Eigen::Matrix<double, 10, 6> gj = g.lazyProduct(jacobian);
-    const Eigen::Matrix<double, 6, 1> grad_n = 2 * jacobian.transpose().lazyProduct(gf);
-    const Eigen::Matrix<double, 6, 6> hess_n = 2 * jacobian.transpose().lazyProduct(gj);
-    Eigen::Matrix<double, 6, 1> grad_d = Eigen::Matrix<double, 6, 1>::Zero();
-    Eigen::Matrix<double, 6, 6> hess_d = Eigen::Matrix<double, 6, 6>::Zero();
+    const auto g11 = linear_block(g);
+    const auto g12 = linear_quadratic_block(g);
+    const auto g22 = quadratic_block(g);
+    const Quadratic g22f = g22.lazyProduct(f);
+    Vector6 grad_n;
+    grad_n.head<3>() = 2 * by_apex.transpose().lazyProduct(g12.lazyProduct(f));
+    grad_n.tail<3>() = 2 * by_shape.transpose().lazyProduct(g22f);
+    Matrix6 hess_n;
+    hess_n.topLeftCorner<3, 3>() = 2 * by_apex.transpose().lazyProduct(g11.lazyProduct(by_apex));
+    hess_n.topRightCorner<3, 3>() = 2 * by_apex.transpose().lazyProduct(g12.lazyProduct(by_shape));
+    hess_n.bottomLeftCorner<3, 3>() = hess_n.topRightCorner<3, 3>().transpose();
+    hess_n.bottomRightCorner<3, 3>() =
+        2 * by_shape.transpose().lazyProduct(g22.lazyProduct(by_shape));
+    // (∇f)_i = 2 (My)_i is linear in y; its derivatives are constant for the apex and linear for
+    // the rest.
+    Vector6 grad_d = Vector6::Zero();
+    Matrix6 hess_d = Matrix6::Zero();
     double d = 0;
     for (int i = 0; i < 3; ++i) {
-      const Poly gradient = linear_poly(2 * m.row(i).transpose());  // (∇f)_i = 2 (My)_i
-      Eigen::Matrix<double, 10, 6> dgradient;
-      for (int k = 0; k < 3; ++k) dgradient.col(k) = constant_poly(-2 * m(i, k));
-      dgradient.col(3) = linear_poly(2 * (u(i) * e1 + e1(i) * u));
-      dgradient.col(4) = linear_poly(2 * (u(i) * e2 + e2(i) * u));
-      dgradient.col(5) = linear_poly(-2 * Eigen::Vector3d::Unit(i));
-      const Poly g_gradient = g.lazyProduct(gradient);
-      grad_d += 2 * dgradient.transpose().lazyProduct(g_gradient);
-      hess_d += 2 * dgradient.transpose().lazyProduct(g.lazyProduct(dgradient));
+      const Eigen::Vector3d gradient = 2 * m.row(i).transpose();
+      const Eigen::RowVector3d constant = -2 * m.row(i);
+      Eigen::Matrix3d linear;
+      linear.col(0) = 2 * (u(i) * e1 + e1(i) * u);
+      linear.col(1) = 2 * (u(i) * e2 + e2(i) * u);
+      linear.col(2) = -2 * Eigen::Vector3d::Unit(i);
+      const Eigen::Vector3d g_gradient = g11.lazyProduct(gradient);
+      const double g01_gradient = g.block<1, 3>(0, 1).dot(gradient);
+      grad_d.head<3>() += 2 * g01_gradient * constant.transpose();
+      grad_d.tail<3>() += 2 * linear.transpose().lazyProduct(g_gradient);
+      hess_d.topLeftCorner<3, 3>() += 2 * g(0, 0) * constant.transpose() * constant;
+      const Eigen::Matrix3d mixed =
+          2 * constant.transpose() * (g.block<1, 3>(0, 1).lazyProduct(linear));
+      hess_d.topRightCorner<3, 3>() += mixed;
+      hess_d.bottomLeftCorner<3, 3>() += mixed.transpose();
+      hess_d.bottomRightCorner<3, 3>() +=
+          2 * linear.transpose().lazyProduct(g11.lazyProduct(linear));
       d += gradient.dot(g_gradient);
     }
     if (!(d > 0)) return;
-    const double r = f.dot(gf) / d;
-    const Eigen::Matrix<double, 6, 1> gradient = grad_n - r * grad_d;
-    const Eigen::Matrix<double, 6, 6> hessian = hess_n - r * hess_d;
+    const double r = f.dot(g22f) / d;
+    const Vector6 gradient = grad_n - r * grad_d;
+    const Matrix6 hessian = hess_n - r * hess_d;
     bool accepted = false;
     while (lambda < 1e8) {
-      Eigen::Matrix<double, 6, 6> damped = hessian;
+      Matrix6 damped = hessian;
       for (int k = 0; k < 6; ++k) damped(k, k) += lambda * std::abs(hessian(k, k)) + 1e-300;
-      const Eigen::Matrix<double, 6, 1> step = damped.ldlt().solve(-gradient);
+      // Near a minimum the damped Hessian is positive definite; elsewhere LDLᵀ gives a step
+      // whose ratio is then checked like any other.
+      Vector6 step;
+      if (!detail::cholesky_solve(damped, Vector6(-gradient), step))
+        step = damped.ldlt().solve(-gradient);
       if (!step.allFinite()) {
         lambda *= 10;
         continue;

@@ -20,8 +20,9 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <vector>
+#include <span>
 
 #include "eigen_conversions.hpp"
 #include "primitives/pratt_fit.hpp"
@@ -63,10 +64,12 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   if (!(spread2 > 0) || !std::isfinite(spread2)) return result;
   const double scale = 1 / std::sqrt(spread2);
 
-  // Samples about the centroid, in units of the RMS spread.
-  std::vector<Vec3> points(n);
-  std::vector<double> weights(n);
-  std::vector<Eigen::Vector3d> positions(n), normals(n);
+  // Samples about the centroid, in units of the RMS spread (fixed capacity: this runs for every
+  // candidate merge).
+  constexpr std::size_t kCapacity = SampleReservoir::kCapacity;
+  std::array<Vec3, kCapacity> points;
+  std::array<double, kCapacity> weights;
+  std::array<Eigen::Vector3d, kCapacity> positions, normals;
   double sample_weight = 0;
   for (std::size_t i = 0; i < n; ++i) {
     positions[i] = (reservoir.samples[i].position - m.origin()) * scale;
@@ -101,7 +104,7 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
 
   // 2. The tube's circle in the (ρ, h) half-plane.
   detail::CentredMomentsND<2> profile;
-  std::vector<Eigen::Vector2d> rho_h(n);
+  std::array<Eigen::Vector2d, kCapacity> rho_h;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d y = positions[i] - on_axis;
@@ -134,7 +137,8 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   start.minor_radius = circle.radius;
   GeometricFitOptions options;
   options.max_iterations = kRefinementSteps;
-  const GeometricFit refined = fit_geometric(start, points, weights, options);
+  const GeometricFit refined = fit_geometric(start, std::span<const Vec3>(points.data(), n),
+                                             std::span<const double>(weights.data(), n), options);
   const Primitive& torus = refined.primitive;
   if (!(torus.minor_radius > 0 && torus.radius >= kMinRelativeMajorRadius * torus.minor_radius) ||
       !(torus.radius <= detail::kMaxRelativeRadius &&
