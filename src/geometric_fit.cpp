@@ -1,6 +1,5 @@
 #include "primseg/geometric_fit.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <stdexcept>
@@ -198,9 +197,10 @@ class TorusModel final : public GeometricModel {
     const Eigen::Vector3d direction = rho > 0 ? Eigen::Vector3d(radial / rho) : u_;
     // Not std::hypot (a tenth of a torus-enabled hierarchy's time): the points are normalised to
     // the unit ball, so the squares cannot overflow for any torus whose fit is finite.
-    const double tube = std::sqrt((rho - major_radius_) * (rho - major_radius_) + h * h);
+    const double across = rho - major_radius_;
+    const double tube = std::sqrt(across * across + h * h);
     // Unit direction from the tube's centre to x, in the (ρ, h) half-plane.
-    const double q_rho = tube > 0 ? (rho - major_radius_) / tube : 1;
+    const double q_rho = tube > 0 ? across / tube : 1;
     const double q_h = tube > 0 ? h / tube : 0;
     const Eigen::Vector3d normal = q_rho * direction + q_h * axis_;
     for (int i = 0; i < 3; ++i) gradient[i] = -normal[i];
@@ -366,7 +366,7 @@ struct LinearisedCost {
 
 // The canonical form of primitive.hpp, in the normalised frame (weighted centroid at 0).
 Primitive canonical(Primitive p, const Primitive& initial_normalised) {
-  const Eigen::Vector3d axis(p.axis[0], p.axis[1], p.axis[2]);
+  const Eigen::Vector3d axis = to_eigen(p.axis);
   const Eigen::Vector3d point = to_eigen(p.point);
   if (p.type == PrimitiveType::Plane) {
     const Eigen::Vector3d initial = to_eigen(initial_normalised.axis);
@@ -422,11 +422,9 @@ GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> point
       while (lambda < 1e16) {
         NormalMatrix damped = current.normal;
         for (int j = 0; j < k; ++j) damped(j, j) += lambda * current.normal(j, j) + 1e-300;
-        // N is positive semi-definite and the damping makes it definite unless a parameter
-        // has no effect at all (LDLᵀ then gives a least-norm-like step, or none).
-        ParameterVector step;
-        if (!detail::cholesky_solve(damped, current.rhs, step))
-          step = damped.ldlt().solve(current.rhs);
+        // N is positive semi-definite; the damping makes it definite unless a parameter has no
+        // effect at all.
+        const ParameterVector step = detail::solve_symmetric(damped, current.rhs);
         if (!step.allFinite()) {
           lambda *= 10;
           continue;

@@ -2,8 +2,10 @@
 // Cholesky factorisation and solves for the small symmetric systems of the fits (at most 8×8,
 // fixed or bounded size), written out: Eigen's LLT and LDLT run their blocked kernels through
 // dynamic-size blocks even for a 6×6 matrix, which made the damped solves of the cone's and the
-// geometric fits' Levenberg–Marquardt steps a seventh of a cone-enabled hierarchy's time.
+// geometric fits' Levenberg–Marquardt steps a seventh of a cone-enabled hierarchy's time. Eigen's
+// LDLᵀ remains the fallback for matrices that are not positive definite (solve_symmetric).
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <cmath>
 
@@ -61,6 +63,16 @@ bool cholesky_solve(const Matrix& a, const Vector& b, Vector& x) {
   solve_lower_in_place(l, x);
   solve_lower_transposed_in_place(l, x);
   return true;
+}
+
+/// A⁻¹ b for a symmetric A (lower triangle read): by Cholesky when A is positive definite (the
+/// damped normal equations of a Levenberg–Marquardt step, nearly always), else by Eigen's LDLᵀ,
+/// whose step may be non-finite: the callers then damp more.
+template <typename Matrix, typename Vector>
+Vector solve_symmetric(const Matrix& a, const Vector& b) {
+  Vector x;
+  if (cholesky_solve(a, b, x)) return x;
+  return a.ldlt().solve(b);
 }
 
 }  // namespace primseg::detail

@@ -97,5 +97,16 @@ TEST(SmallCholesky, RefusesMatricesThatAreNotPositiveDefinite) {
   EXPECT_FALSE(cholesky_solve(with_infinity, b, x));
 }
 
+TEST(SmallCholesky, SolveSymmetricFallsBackToLdltWhenIndefinite) {
+  Eigen::Matrix3d indefinite = Eigen::Matrix3d::Identity();
+  indefinite(2, 2) = -2;
+  indefinite(0, 1) = indefinite(1, 0) = 0.5;
+  const Eigen::Vector3d b(1, 2, 3);
+  const Eigen::Vector3d x = solve_symmetric(indefinite, b);
+  EXPECT_LE((indefinite * x - b).norm(), 1e-14 * b.norm());
+  const Eigen::Matrix3d definite = random_positive_definite<Eigen::Matrix3d>(3, 1e2, 5);
+  EXPECT_LE((definite * solve_symmetric(definite, b) - b).norm(), 1e-13 * b.norm());
+}
+
 }  // namespace
 }  // namespace primseg::detail

@@ -20,7 +20,6 @@
 // weighted mean square is unbiased when the deviations do not depend on that distance.
 #include "primseg/primitives/cone.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <array>
 #include <cmath>
@@ -279,6 +278,7 @@ void refine_cone(const Moments& moments, double scale, ConeParameters& cone, dou
     by_shape.col(1) = quadratic_form(u * e2.transpose() + e2 * u.transpose());
     by_shape.col(2) = quadratic_form(-Eigen::Matrix3d::Identity());
     // Small fixed sizes: coefficient-wise products (lazyProduct) beat Eigen's blocked kernels.
+    const auto g01 = g.block<1, 3>(0, 1);
     const auto g11 = linear_block(g);
     const auto g12 = linear_quadratic_block(g);
     const auto g22 = quadratic_block(g);
@@ -305,12 +305,11 @@ void refine_cone(const Moments& moments, double scale, ConeParameters& cone, dou
       linear.col(1) = 2 * (u(i) * e2 + e2(i) * u);
       linear.col(2) = -2 * Eigen::Vector3d::Unit(i);
       const Eigen::Vector3d g_gradient = g11.lazyProduct(gradient);
-      const double g01_gradient = g.block<1, 3>(0, 1).dot(gradient);
+      const double g01_gradient = g01.dot(gradient);
       grad_d.head<3>() += 2 * g01_gradient * constant.transpose();
       grad_d.tail<3>() += 2 * linear.transpose().lazyProduct(g_gradient);
       hess_d.topLeftCorner<3, 3>() += 2 * g(0, 0) * constant.transpose() * constant;
-      const Eigen::Matrix3d mixed =
-          2 * constant.transpose() * (g.block<1, 3>(0, 1).lazyProduct(linear));
+      const Eigen::Matrix3d mixed = 2 * constant.transpose() * (g01.lazyProduct(linear));
       hess_d.topRightCorner<3, 3>() += mixed;
       hess_d.bottomLeftCorner<3, 3>() += mixed.transpose();
       hess_d.bottomRightCorner<3, 3>() +=
@@ -325,11 +324,8 @@ void refine_cone(const Moments& moments, double scale, ConeParameters& cone, dou
     while (lambda < 1e8) {
       Matrix6 damped = hessian;
       for (int k = 0; k < 6; ++k) damped(k, k) += lambda * std::abs(hessian(k, k)) + 1e-300;
-      // Near a minimum the damped Hessian is positive definite; elsewhere LDLᵀ gives a step
-      // whose ratio is then checked like any other.
-      Vector6 step;
-      if (!detail::cholesky_solve(damped, Vector6(-gradient), step))
-        step = damped.ldlt().solve(-gradient);
+      // Not positive definite away from a minimum: the step is then checked like any other.
+      const Vector6 step = detail::solve_symmetric(damped, Vector6(-gradient));
       if (!step.allFinite()) {
         lambda *= 10;
         continue;
