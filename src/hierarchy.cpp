@@ -14,6 +14,7 @@
 #include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
+#include "tree_check.hpp"
 
 namespace primseg {
 namespace {
@@ -140,7 +141,9 @@ struct Scratch {
 
 Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
                      std::vector<Merge> merges)
-    : Hierarchy(std::move(mesh), std::move(options), std::move(merges), nullptr) {}
+    : Hierarchy(std::move(mesh), std::move(options), std::move(merges), nullptr) {
+  detail::check_tree_parts(*graph_, options_, merges_);
+}
 
 Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
                      std::vector<Merge> merges, std::unique_ptr<DualGraph> graph)

@@ -150,7 +150,9 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
   const auto weights = r.get<std::uint8_t>("the options");
   if (weights > 1) r.fail("unknown vertex weighting " + std::to_string(weights));
   options.weights = static_cast<VertexWeights>(weights);
-  options.exact_costs = r.get<std::uint8_t>("the options") != 0;
+  const auto exact_costs = r.get<std::uint8_t>("the options");
+  if (exact_costs > 1) r.fail("exact_costs must be 0 or 1, not " + std::to_string(exact_costs));
+  options.exact_costs = exact_costs == 1;
   const auto type_count = r.get<std::uint8_t>("the options");
   options.primitives.clear();
   for (int i = 0; i < type_count; ++i) {
@@ -190,7 +192,10 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
     m.error = r.get<double>("the merges");
     m.weight = r.get<double>("the merges");
     m.face_count = r.get<std::uint32_t>("the merges");
-    m.trailing = r.get<std::uint8_t>("the merges") != 0;
+    const auto trailing = r.get<std::uint8_t>("the merges");
+    if (trailing > 1)
+      r.fail("a merge's trailing flag must be 0 or 1, not " + std::to_string(trailing));
+    m.trailing = trailing == 1;
     const auto type = r.get<std::uint8_t>("the merges");
     if (type >= kPrimitiveTypeCount) r.fail("unknown primitive type " + std::to_string(type));
     m.primitive.type = static_cast<PrimitiveType>(type);

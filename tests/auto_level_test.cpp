@@ -154,6 +154,7 @@ Hierarchy hierarchy_with_curve(const std::vector<double>& rms, std::uint32_t fac
       merge.cost = merge.error;
       merge.weight = total_weight * (m + 2) / faces;
       merge.face_count = m + 2;
+      merge.primitive.axis = {0, 0, 1};  // the strip's plane
     }
     return merges;
   };

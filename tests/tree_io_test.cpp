@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "primseg/cut.hpp"
@@ -102,6 +105,21 @@ TEST(TreeIo, BadContentIsRejectedBehindAValidChecksum) {
   type[kFirstType] = 9;
   expect_parse_error(with_checksum(type), "unknown primitive type 9");
 
+  constexpr std::size_t kExactCosts = 13;
+  std::string exact_costs = body;
+  exact_costs[kExactCosts] = 2;
+  expect_parse_error(with_checksum(exact_costs), "exact_costs must be 0 or 1, not 2");
+
+  // A merge: first, second (u32), cost, error, weight (f64), face_count (u32), then trailing.
+  std::string trailing = body;
+  trailing[body.size() - 110 + 4 + 4 + 3 * 8 + 4] = 7;
+  expect_parse_error(with_checksum(trailing), "trailing flag must be 0 or 1, not 7");
+
+  // Content the reader parses but the tree cannot hold: a negative cost.
+  std::string negative_cost = body;
+  negative_cost[body.size() - 110 + 8 + 7] = static_cast<char>(0xbf);  // sign and exponent of -x
+  expect_parse_error(with_checksum(negative_cost), "invalid tree: merge");
+
   expect_parse_error(with_checksum(body + "extra"), "unexpected data after the merges");
   expect_parse_error(with_checksum(body.substr(0, body.size() - 1)), "exceeds the file size");
 
@@ -111,6 +129,22 @@ TEST(TreeIo, BadContentIsRejectedBehindAValidChecksum) {
   std::copy_n(body.begin() + static_cast<std::ptrdiff_t>(last), 4,
               self_merge.begin() + static_cast<std::ptrdiff_t>(last + 4));
   expect_parse_error(with_checksum(self_merge), "invalid tree");
+}
+
+// fuzz/corpus/tree/ holds tree files without their checksum (the fuzzer appends it): each must
+// then be a valid tree, or the fuzzer would start from rejected inputs only.
+TEST(TreeIo, TheFuzzersSeedsAreValidTrees) {
+  int seeds = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(
+           std::filesystem::path(PRIMSEG_FUZZ_DIR) / "corpus" / "tree")) {
+    SCOPED_TRACE(entry.path().string());
+    std::ifstream in(entry.path(), std::ios::binary);
+    const std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const Hierarchy h = deserialize_tree(with_checksum(body));
+    EXPECT_GT(h.face_count(), 1u);
+    ++seeds;
+  }
+  EXPECT_GE(seeds, 5);
 }
 
 }  // namespace

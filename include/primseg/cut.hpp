@@ -45,7 +45,9 @@ struct ClusterReport {
   /// Exact weighted RMS Euclidean distance of the cluster's vertices to `primitive` (each
   /// triangle corner weighted as in the hierarchy), input units.
   double rms = 0;
-  /// Largest Euclidean distance of a cluster vertex to `primitive`, input units.
+  /// Largest Euclidean distance to `primitive` of a cluster vertex of positive weight, input
+  /// units. Under area weights the corners of zero-area triangles weigh nothing and are left out
+  /// (0 for a cluster of zero-area triangles only), as they are from the fit and from `rms`.
   double max = 0;
 };
 

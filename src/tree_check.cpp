@@ -1,0 +1,104 @@
+#include "tree_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "no_index.hpp"
+#include "primseg/error.hpp"
+
+namespace primseg::detail {
+namespace {
+
+bool finite_non_negative(double x) {
+  return std::isfinite(x) && x >= 0;
+}
+
+// Lengths beyond this many working units (the mesh spans about 2) are no fit of it: their squares
+// would overflow the reports' distances.
+constexpr double kMaxWorkingLength = 1e30;
+
+bool valid_primitive(const Primitive& p, const WorkingFrame& frame) {
+  const Eigen::Vector3d point = frame.to_working(p.point);
+  const double scale = frame.scale();
+  if (!point.allFinite() || point.lpNorm<Eigen::Infinity>() > kMaxWorkingLength) return false;
+  for (const double radius : {p.radius, p.minor_radius})
+    if (!finite_non_negative(radius) || radius / scale > kMaxWorkingLength) return false;
+  if (!std::isfinite(p.half_angle)) return false;
+  if (p.type == PrimitiveType::Sphere) return true;  // the only type without an axis
+  const double length = std::hypot(p.axis[0], p.axis[1], p.axis[2]);
+  return std::abs(length - 1) <= 1e-9;
+}
+
+[[noreturn]] void reject(std::size_t merge, const std::string& why) {
+  throw InvalidInputError("merge " + std::to_string(merge) + " " + why);
+}
+
+}  // namespace
+
+void check_tree_parts(const DualGraph& graph, const HierarchyOptions& options,
+                      std::span<const Merge> merges) {
+  const std::uint32_t f = graph.face_count();
+  // Each face's dual neighbours (compressed rows).
+  std::vector<std::uint32_t> offsets(std::size_t{f} + 1, 0);
+  for (const DualEdge& e : graph.edges()) ++offsets[e.first + 1], ++offsets[e.second + 1];
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  std::vector<std::uint32_t> neighbours(offsets.back());
+  {
+    std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
+    for (const DualEdge& e : graph.edges())
+      neighbours[next[e.first]++] = e.second, neighbours[next[e.second]++] = e.first;
+  }
+  // Live clusters as linked lists of faces; a face's label is its cluster's list. Merging
+  // relabels the smaller list, so each face is relabelled (and its neighbours read) O(log F)
+  // times.
+  std::vector<std::uint32_t> label(f), next_face(f, kNone), head(f), tail(f), size(f, 1);
+  std::vector<std::uint32_t> list_of_node(2 * std::size_t{f} - 1, kNone);
+  std::vector<std::uint32_t> faces_of_node(2 * std::size_t{f} - 1, 1);
+  std::iota(label.begin(), label.end(), 0u);
+  std::iota(head.begin(), head.end(), 0u);
+  std::iota(tail.begin(), tail.end(), 0u);
+  std::iota(list_of_node.begin(), list_of_node.begin() + f, 0u);
+
+  const std::uint32_t real_count = f - graph.component_count();
+  for (std::size_t i = 0; i < merges.size(); ++i) {
+    const Merge& m = merges[i];
+    if (m.first >= m.second) reject(i, "must give its children as first < second");
+    if (m.face_count != faces_of_node[m.first] + faces_of_node[m.second])
+      reject(i, "has " + std::to_string(m.face_count) + " faces, its children " +
+                    std::to_string(faces_of_node[m.first] + faces_of_node[m.second]));
+    faces_of_node[f + i] = m.face_count;
+    if (!finite_non_negative(m.cost) || !finite_non_negative(m.error) ||
+        !finite_non_negative(m.weight))
+      reject(i, "has a negative or non-finite cost, error or weight");
+    if (m.trailing != (i >= real_count))
+      reject(i, std::string(m.trailing ? "is trailing" : "is not trailing") + ": the mesh's " +
+                    std::to_string(graph.component_count()) + " components need " +
+                    std::to_string(real_count) + " real merges, then trailing ones");
+    std::uint32_t a = list_of_node[m.first], b = list_of_node[m.second];
+    if (size[a] < size[b]) std::swap(a, b);  // b is the smaller list
+    if (!m.trailing) {
+      if (std::find(options.primitives.begin(), options.primitives.end(), m.primitive.type) ==
+          options.primitives.end())
+        reject(i, "has a primitive of a type the tree's options do not enable");
+      if (!valid_primitive(m.primitive, graph.frame()))
+        reject(i,
+               "has an invalid primitive: non-finite or huge parameters, a negative radius or a "
+               "non-unit axis");
+      bool adjacent = false;
+      for (std::uint32_t x = head[b]; x != kNone && !adjacent; x = next_face[x])
+        for (std::uint32_t k = offsets[x]; k < offsets[x + 1] && !adjacent; ++k)
+          adjacent = label[neighbours[k]] == a;
+      if (!adjacent) reject(i, "joins two clusters that share no mesh edge");
+    }
+    for (std::uint32_t x = head[b]; x != kNone; x = next_face[x]) label[x] = a;
+    next_face[tail[a]] = head[b];
+    tail[a] = tail[b];
+    size[a] += size[b];
+    list_of_node[f + i] = a;
+  }
+}
+
+}  // namespace primseg::detail
