@@ -3,7 +3,7 @@
 # its committed seed corpus and dictionary. Fails on the first finding, leaving the reproducer in
 # $build/artifacts/ (make it a regression test: fuzz/regressions/ and tests/mesh_io/).
 #
-#   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 45: 6 targets, about 5 minutes)
+#   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 45: 8 targets, about 6 minutes)
 #   PRIMSEG_FUZZ_BUILD_DIR=build-fuzz        build directory
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,18 +14,18 @@ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_CO
   -DPRIMSEG_FUZZ=ON -DPRIMSEG_WERROR=ON -DPRIMSEG_BUILD_TESTS=OFF -DPRIMSEG_BUILD_CLI=OFF \
   -DPRIMSEG_BUILD_BENCH=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build "$build" --target fuzz_read_off fuzz_read_obj fuzz_read_ply fuzz_read_stl \
-  fuzz_read_detect fuzz_segment
+  fuzz_read_detect fuzz_read_tree fuzz_segment fuzz_tools
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 mkdir -p "$build/artifacts"
-for target in off obj ply stl detect segment; do
+for target in off obj ply stl detect tree segment tools; do
   dict=fuzz/dict/$target.dict
   case $target in
     detect) cat fuzz/dict/{off,obj,ply,stl}.dict >"$build/detect.dict"; dict=$build/detect.dict ;;
-    segment) dict= ;;
+    tree | segment | tools) dict= ;;
   esac
   binary=$build/fuzz/fuzz_read_$target
-  [[ $target == segment ]] && binary=$build/fuzz/fuzz_segment
+  [[ $target == segment || $target == tools ]] && binary=$build/fuzz/fuzz_$target
   # New inputs go to a scratch corpus in the build directory, never into the committed seeds.
   work=$build/corpus/$target
   mkdir -p "$work"

@@ -1,0 +1,360 @@
+// libFuzzer target for what users do with a tree: cluster reports with geometric fits, boundary
+// refinement, skeletons and skinning weights, denoising, the mesh distance and pictures, on the
+// small grid meshes of grid_mesh.hpp (degenerate, duplicate and non-manifold faces, several
+// components).
+//
+// Each input runs twice: on the decoded mesh and on the same mesh scaled by a power of two.
+// Checked:
+// - every result is finite, and holds what its header promises: a report's `max` is the largest
+//   distance of its cluster's vertices of positive weight and bounds its `rms`; refinement keeps
+//   the number of clusters and each one connected; a skeleton has a bone per cluster and valid
+//   joint ids; every skinning row sums to 1; denoising keeps the connectivity and inverts no
+//   triangle; a distance's mean <= RMS <= Hausdorff;
+// - units do not matter (mesh.hpp, kMaxCoordinateMagnitude): the scaled run gives the same tree,
+//   costs, labels, weights and picture, and every length scaled by exactly the same power of two;
+// - nothing throws but primseg::InvalidInputError where a function documents it.
+//
+// Input layout: byte 0 = options (bit 0: all five primitive types, bit 1: uniform weights,
+// bit 2: denoise on a bilateral copy, bit 3: stylize, bit 4: denoise at the automatic level,
+// bits 5-7: the scale's exponent), byte 1 = K (mod F), then grid_mesh.hpp's layout.
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "grid_mesh.hpp"
+#include "primseg/cut.hpp"
+#include "primseg/denoise.hpp"
+#include "primseg/error.hpp"
+#include "primseg/hierarchy.hpp"
+#include "primseg/mesh_distance.hpp"
+#include "primseg/refine.hpp"
+#include "primseg/render.hpp"
+#include "primseg/skeleton.hpp"
+#include "primseg/skinning.hpp"
+#include "tree_invariants.hpp"
+
+namespace {
+
+using namespace primseg;
+
+using fuzz::fail;
+
+void check_finite(const Vec3& v, const char* what) {
+  for (const double c : v)
+    if (!std::isfinite(c)) fail(what, c);
+}
+
+void check_length(double x, const char* what) {
+  if (!std::isfinite(x) || x < 0) fail(what, x);
+}
+
+void check_primitive(const Primitive& p) {
+  check_finite(p.point, "primitive point");
+  check_finite(p.axis, "primitive axis");
+  check_length(p.radius, "primitive radius");
+  check_length(p.minor_radius, "primitive minor radius");
+  if (!std::isfinite(p.half_angle)) fail("primitive half angle", p.half_angle);
+}
+
+struct Settings {
+  HierarchyOptions hierarchy;
+  DenoiseOptions denoise;
+  bool automatic_level = false;
+  int exponent = 0;
+  std::uint8_t level = 0;
+};
+
+Settings decode_settings(std::uint8_t flags, std::uint8_t level) {
+  constexpr int kExponents[8] = {1, -1, 3, -5, 20, -20, 100, -100};
+  Settings settings;
+  settings.hierarchy.threads = 1;
+  if (flags & 1)
+    settings.hierarchy.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder,
+                                     PrimitiveType::Sphere, PrimitiveType::Cone,
+                                     PrimitiveType::Torus};
+  if (flags & 2) settings.hierarchy.weights = VertexWeights::Uniform;
+  settings.denoise.hierarchy = settings.hierarchy;
+  if (flags & 4) {
+    BilateralSmoothingOptions bilateral;
+    bilateral.threads = 1;
+    settings.denoise.bilateral_smoothing = bilateral;
+  }
+  if (flags & 8) settings.denoise.mode = SnapMode::NearestIncident;
+  settings.automatic_level = (flags & 16) != 0;
+  settings.exponent = kExponents[flags >> 5];
+  settings.level = level;
+  return settings;
+}
+
+// Everything one run computes.
+struct Results {
+  std::optional<Hierarchy> hierarchy;
+  Segmentation level;
+  std::vector<ClusterReport> reports;
+  RefinedLevel refined;
+  Skeleton skeleton;
+  SkinWeights skin;
+  Mesh denoised;
+  std::optional<MeshDistance> distance;
+  std::vector<std::uint8_t> picture;
+};
+
+Vec3 triangle_normal(const Mesh& mesh, const Triangle& t) {
+  const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
+  const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+}
+
+double norm(const Vec3& v) {
+  return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+void check_reports(const Hierarchy& hierarchy, const Segmentation& level,
+                   const std::vector<ClusterReport>& reports) {
+  const Mesh& mesh = hierarchy.mesh();
+  const DualGraph& graph = hierarchy.graph();
+  if (reports.size() != level.cluster_count()) fail("report count", double(reports.size()));
+  std::vector<double> largest(reports.size(), 0);
+  std::vector<std::uint32_t> faces(reports.size(), 0);
+  const double diagonal = bounding_box_diagonal(mesh);
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const std::uint32_t label = level.labels[mesh.face_of_triangle[t]];
+    const std::array<double, 3> weights = graph.corner_weights(t);
+    for (int k = 0; k < 3; ++k)
+      if (weights[k] > 0)
+        largest[label] =
+            std::max(largest[label],
+                     reports[label].primitive.distance(mesh.positions[mesh.triangles[t][k]]));
+  }
+  for (const std::uint32_t label : level.labels) ++faces[label];
+  for (std::size_t c = 0; c < reports.size(); ++c) {
+    const ClusterReport& report = reports[c];
+    check_primitive(report.primitive);
+    check_primitive(report.algebraic);
+    check_length(report.area, "report area");
+    check_length(report.rms, "report rms");
+    check_length(report.max, "report max");
+    if (report.face_count != faces[c]) fail("report face count", report.face_count, faces[c]);
+    // Reports measure in the working frame: equal up to round-off of the mesh's size.
+    if (std::abs(report.max - largest[c]) > 1e-9 * largest[c] + 1e-12 * diagonal)
+      fail("report max is not the largest distance", report.max, largest[c]);
+    if (report.rms > report.max * (1 + 1e-12)) fail("report rms above max", report.rms, report.max);
+  }
+}
+
+void check_skeleton(const Mesh& mesh, const Segmentation& level, const Skeleton& skeleton,
+                    const SkinWeights& skin) {
+  if (skeleton.bones.size() != level.cluster_count()) fail("bone count");
+  if (skeleton.face_labels != level.labels) fail("skeleton labels");
+  for (const Joint& joint : skeleton.joints) {
+    check_finite(joint.position, "joint position");
+    for (const std::uint32_t bone : joint.bones)
+      if (bone >= skeleton.bones.size()) fail("joint's bone id", bone);
+  }
+  for (const Bone& bone : skeleton.bones) {
+    check_finite(bone.axis, "bone axis");
+    check_finite(bone.point, "bone point");
+    check_length(bone.radius, "bone radius");
+    check_length(bone.area, "bone area");
+    for (const std::uint32_t joint : bone.joints)
+      if (joint >= skeleton.joints.size()) fail("bone's joint id", joint);
+  }
+  if (skin.vertex_count() != mesh.vertex_count()) fail("skin rows");
+  std::vector<char> used(mesh.vertex_count(), 0);
+  for (const Triangle& t : mesh.triangles)
+    for (const std::uint32_t v : t) used[v] = 1;
+  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    double sum = 0;
+    for (const double w : skin.weights_of(v)) {
+      if (!(w > 0 && w <= 1)) fail("skin weight", v, w);
+      sum += w;
+    }
+    for (const std::uint32_t bone : skin.bones_of(v))
+      if (bone >= skeleton.bones.size()) fail("skin bone id", v, bone);
+    if (used[v] ? std::abs(sum - 1) > 1e-12 : !skin.bones_of(v).empty())
+      fail("skin row sum", v, sum);
+  }
+}
+
+void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& report,
+                    bool stylize) {
+  if (denoised.vertex_count() != input.vertex_count() || denoised.triangles != input.triangles ||
+      denoised.face_of_triangle != input.face_of_triangle)
+    fail("denoising changed the connectivity");
+  for (const Vec3& p : denoised.positions) check_finite(p, "denoised position");
+  // The snap allows a triangle flattened to zero area; this cross product may differ from the
+  // library's by round-off, hence the relative margin.
+  for (const Triangle& t : input.triangles) {
+    const Vec3 before = triangle_normal(input, t), after = triangle_normal(denoised, t);
+    const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
+    if (dot < -1e-9 * norm(before) * norm(after)) fail("denoising inverted a triangle", dot);
+  }
+  std::uint32_t isolated = input.vertex_count();
+  std::vector<char> used(input.vertex_count(), 0);
+  for (const Triangle& t : input.triangles)
+    for (const std::uint32_t v : t)
+      if (!used[v]) used[v] = 1, --isolated;
+  if (report.moved + report.blocked + isolated != input.vertex_count())
+    fail("snap report: moved + blocked", report.moved, report.blocked);
+  if (report.interior_vertices + report.boundary_vertices + isolated != input.vertex_count())
+    fail("snap report: interior + boundary", report.interior_vertices, report.boundary_vertices);
+  if (!stylize && report.fallbacks > report.moved) fail("snap report: fallbacks", report.fallbacks);
+}
+
+Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
+  Results results;
+  results.hierarchy.emplace(build_hierarchy(mesh, settings.hierarchy));
+  const Hierarchy& hierarchy = *results.hierarchy;
+  fuzz::check_tree(hierarchy);
+  const std::uint32_t clusters = 1 + settings.level % hierarchy.face_count();
+  results.level = cut_by_count(hierarchy, clusters);
+
+  DescribeOptions describe;
+  describe.threads = 1;
+  results.reports = describe_clusters(hierarchy, results.level, describe);
+  check_reports(hierarchy, results.level, results.reports);
+
+  BoundaryRefinementOptions refinement;
+  refinement.describe = describe;
+  results.refined = refine_boundaries(hierarchy, results.level, refinement);
+  if (results.refined.segmentation.cluster_count() != results.level.cluster_count())
+    fail("refinement changed the cluster count");
+  fuzz::check_cut(hierarchy, results.refined.segmentation);
+  check_reports(hierarchy, results.refined.segmentation, results.refined.reports);
+
+  results.skeleton = extract_skeleton(hierarchy, results.level);
+  results.skin = compute_skin_weights(*mesh, results.skeleton);
+  check_skeleton(*mesh, results.level, results.skeleton, results.skin);
+
+  Denoiser denoiser(*mesh, settings.denoise);
+  const SnapReport report = settings.automatic_level ? denoiser.iterate([&](const Hierarchy& h) {
+    return denoiser.automatic_level(h).segmentation;
+  })
+                                                     : denoiser.iterate(level_by_count(clusters));
+  results.denoised = denoiser.mesh();
+  check_denoised(*mesh, results.denoised, report,
+                 settings.denoise.mode == SnapMode::NearestIncident);
+
+  DistanceOptions distance;
+  distance.samples = 200;
+  distance.threads = 1;
+  try {
+    results.distance = mesh_distance(results.denoised, *mesh, distance);
+  } catch (const InvalidInputError&) {
+    // Documented: either mesh may have no triangle of positive area.
+  }
+  if (results.distance) {
+    const MeshDistance& d = *results.distance;
+    check_length(d.mean, "distance mean");
+    if (!(d.mean <= d.rms * (1 + 1e-12) && d.rms <= d.hausdorff * (1 + 1e-12)))
+      fail("distance: mean <= rms <= hausdorff", d.rms, d.hausdorff);
+  }
+  // A small picture of the level, edges drawn: every triangle rasterised, whatever its shape.
+  std::vector<std::array<std::uint8_t, 3>> colors(mesh->face_count());
+  for (std::uint32_t f = 0; f < colors.size(); ++f) {
+    const std::uint32_t label = results.level.labels[f];
+    colors[f] = {static_cast<std::uint8_t>(40 * label), static_cast<std::uint8_t>(90 + label), 200};
+  }
+  RenderOptions render;
+  render.width = 40;
+  render.height = 30;
+  render.edges = true;
+  results.picture = render_mesh(*mesh, colors, render);
+  if (results.picture.size() != std::size_t{3} * render.width * render.height)
+    fail("picture size", double(results.picture.size()));
+  return results;
+}
+
+// Scaling by 2^exponent: lengths exactly so, everything else identical.
+struct ScaleCheck {
+  int exponent;
+  void length(double a, double b, const char* what) const {
+    if (std::ldexp(a, exponent) != b) fail(what, a, b);
+  }
+  void area(double a, double b, const char* what) const {
+    if (std::ldexp(a, 2 * exponent) != b) fail(what, a, b);
+  }
+  void point(const Vec3& a, const Vec3& b, const char* what) const {
+    for (int i = 0; i < 3; ++i) length(a[i], b[i], what);
+  }
+  static void same(double a, double b, const char* what) {
+    if (a != b && !(std::isnan(a) && std::isnan(b))) fail(what, a, b);
+  }
+  void primitive(const Primitive& a, const Primitive& b) const {
+    if (a.type != b.type) fail("scaled primitive type");
+    point(a.point, b.point, "scaled primitive point");
+    for (int i = 0; i < 3; ++i) same(a.axis[i], b.axis[i], "scaled primitive axis");
+    length(a.radius, b.radius, "scaled primitive radius");
+    length(a.minor_radius, b.minor_radius, "scaled primitive minor radius");
+    same(a.half_angle, b.half_angle, "scaled primitive half angle");
+  }
+  void reports(const std::vector<ClusterReport>& a, const std::vector<ClusterReport>& b) const {
+    for (std::size_t c = 0; c < a.size(); ++c) {
+      primitive(a[c].primitive, b[c].primitive);
+      primitive(a[c].algebraic, b[c].algebraic);
+      area(a[c].area, b[c].area, "scaled report area");
+      length(a[c].rms, b[c].rms, "scaled report rms");
+      length(a[c].max, b[c].max, "scaled report max");
+    }
+  }
+};
+
+void check_scaled(const Results& a, const Results& b, int exponent) {
+  const ScaleCheck scaled{exponent};
+  const std::span<const Merge> merges = a.hierarchy->merges();
+  const std::span<const Merge> scaled_merges = b.hierarchy->merges();
+  for (std::size_t i = 0; i < merges.size(); ++i) {
+    const Merge &m = merges[i], &s = scaled_merges[i];
+    if (m.first != s.first || m.second != s.second || m.trailing != s.trailing)
+      fail("scaled tree differs at merge", double(i));
+    ScaleCheck::same(m.cost, s.cost, "scaled merge cost (working frame)");
+    ScaleCheck::same(m.error, s.error, "scaled merge error (working frame)");
+    ScaleCheck::same(m.weight, s.weight, "scaled merge weight (working frame)");
+    scaled.primitive(m.primitive, s.primitive);
+  }
+  if (a.level.labels != b.level.labels) fail("scaled level labels");
+  scaled.reports(a.reports, b.reports);
+  if (a.refined.segmentation.labels != b.refined.segmentation.labels) fail("scaled refined labels");
+  scaled.reports(a.refined.reports, b.refined.reports);
+  if (a.skeleton.joints.size() != b.skeleton.joints.size()) fail("scaled joint count");
+  for (std::size_t j = 0; j < a.skeleton.joints.size(); ++j)
+    scaled.point(a.skeleton.joints[j].position, b.skeleton.joints[j].position,
+                 "scaled joint position");
+  for (std::size_t i = 0; i < a.skeleton.bones.size(); ++i) {
+    const Bone &x = a.skeleton.bones[i], &y = b.skeleton.bones[i];
+    scaled.point(x.point, y.point, "scaled bone point");
+    for (int k = 0; k < 3; ++k) ScaleCheck::same(x.axis[k], y.axis[k], "scaled bone axis");
+    scaled.length(x.radius, y.radius, "scaled bone radius");
+    scaled.area(x.area, y.area, "scaled bone area");
+  }
+  if (a.skin.bones != b.skin.bones || a.skin.weights != b.skin.weights) fail("scaled skin weights");
+  for (std::size_t v = 0; v < a.denoised.positions.size(); ++v)
+    scaled.point(a.denoised.positions[v], b.denoised.positions[v], "scaled denoised position");
+  if (a.picture != b.picture) fail("scaled picture differs");
+  if (a.distance.has_value() != b.distance.has_value()) fail("scaled distance refused");
+  if (a.distance) {
+    scaled.length(a.distance->rms, b.distance->rms, "scaled distance rms");
+    scaled.length(a.distance->hausdorff, b.distance->hausdorff, "scaled distance hausdorff");
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 3) return 0;
+  const Settings settings = decode_settings(data[0], data[1]);
+  std::optional<Mesh> decoded = fuzz::decode_grid_mesh(data + 2, size - 2);
+  if (!decoded) return 0;
+  std::optional<Mesh> scaled =
+      fuzz::decode_grid_mesh(data + 2, size - 2, std::ldexp(1.0, settings.exponent));
+  const Results results = run(std::make_shared<const Mesh>(std::move(*decoded)), settings);
+  const Results scaled_results = run(std::make_shared<const Mesh>(std::move(*scaled)), settings);
+  check_scaled(results, scaled_results, settings.exponent);
+  return 0;
+}
