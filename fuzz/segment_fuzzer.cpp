@@ -2,7 +2,8 @@
 // integer grid, so that coplanar, cocircular, degenerate and duplicate configurations are
 // common), builds its hierarchy and checks the invariants a user relies on:
 // - the tree is a full binary tree over the F faces (F − 1 merges, children created before their
-//   parent, every node but the root has exactly one parent);
+//   parent, every node but the root has exactly one parent), and Hierarchy's constructor from
+//   parts, which checks tree files, accepts it (tree_invariants.hpp);
 // - every cut, by count for every K in 1..F and by tolerance at a few levels, labels each face
 //   with a cluster in 0..K'-1, every cluster is non-empty and edge-connected in the dual graph.
 //
@@ -16,7 +17,6 @@
 
 #include "grid_mesh.hpp"
 #include "primseg/cut.hpp"
-#include "primseg/error.hpp"
 #include "primseg/hierarchy.hpp"
 #include "tree_invariants.hpp"
 
