@@ -17,8 +17,13 @@ bool finite_non_negative(double x) {
 }
 
 // Lengths beyond this many working units (the mesh spans about 2) are no fit of it: their squares
-// would overflow the reports' distances.
+// would overflow the reports' distances. The same bounds a node's RMS error.
 constexpr double kMaxWorkingLength = 1e30;
+// Costs only order merges; this leaves room above the largest for SciPy's strictly increasing
+// heights (cut.hpp, scipy_linkage).
+constexpr double kMaxCost = 1e300;
+// A node's weight is the sum of its faces' corner weights, summed in another order by the builder.
+constexpr double kWeightTolerance = 1e-9;
 
 bool valid_primitive(const Primitive& p, const WorkingFrame& frame) {
   const Eigen::Vector3d point = frame.to_working(p.point);
@@ -57,6 +62,10 @@ void check_tree_parts(const DualGraph& graph, const HierarchyOptions& options,
   std::vector<std::uint32_t> label(f), next_face(f, kNone), head(f), tail(f), size(f, 1);
   std::vector<std::uint32_t> list_of_node(2 * std::size_t{f} - 1, kNone);
   std::vector<std::uint32_t> faces_of_node(2 * std::size_t{f} - 1, 1);
+  std::vector<double> weight_of_node(2 * std::size_t{f} - 1, 0);
+  for (std::uint32_t face = 0; face < f; ++face)
+    for (std::uint32_t t = graph.first_triangle(face); t < graph.first_triangle(face + 1); ++t)
+      for (const double w : graph.corner_weights(t)) weight_of_node[face] += w;
   std::iota(label.begin(), label.end(), 0u);
   std::iota(head.begin(), head.end(), 0u);
   std::iota(tail.begin(), tail.end(), 0u);
@@ -73,6 +82,12 @@ void check_tree_parts(const DualGraph& graph, const HierarchyOptions& options,
     if (!finite_non_negative(m.cost) || !finite_non_negative(m.error) ||
         !finite_non_negative(m.weight))
       reject(i, "has a negative or non-finite cost, error or weight");
+    const double weight = weight_of_node[m.first] + weight_of_node[m.second];
+    if (std::abs(m.weight - weight) > kWeightTolerance * weight)
+      reject(i, "has a weight that is not the sum of its faces' weights");
+    weight_of_node[f + i] = weight;
+    if (m.cost > kMaxCost || m.error > m.weight * (kMaxWorkingLength * kMaxWorkingLength))
+      reject(i, "has a cost above 1e300 or an RMS error above 1e30 working units");
     if (m.trailing != (i >= real_count))
       reject(i, std::string(m.trailing ? "is trailing" : "is not trailing") + ": the mesh's " +
                     std::to_string(graph.component_count()) + " components need " +

@@ -11,8 +11,10 @@
 namespace primseg::detail {
 
 /// Throws InvalidInputError naming the first merge that breaks a rule: children given as
-/// first < second; each merge's face count the sum of its children's; cost, error and weight
-/// finite and non-negative; a real merge's primitive of an enabled type with finite parameters
+/// first < second; each merge's face count the sum of its children's, and its weight the sum of
+/// its faces' corner weights (within 1e-9 relative); cost, error and weight finite and
+/// non-negative, the cost at most 1e300 and the RMS error sqrt(error / weight) at most 1e30
+/// working units; a real merge's primitive of an enabled type with finite parameters
 /// within 1e30 working units of the mesh, non-negative radii and a unit axis (within 1e-9; every
 /// type but the sphere has one), and its children sharing a mesh edge (dual-graph neighbours); the
 /// F − C real merges first, then C − 1 trailing ones. `merges` must already form a binary tree

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "primseg/cut.hpp"
+#include "primseg/dual_graph.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/shape_generator.hpp"
@@ -140,28 +141,31 @@ Hierarchy hierarchy_with_curve(const std::vector<double>& rms, std::uint32_t fac
   }
   const auto mesh = std::make_shared<const Mesh>(
       Mesh::from_triangles(std::move(positions), std::move(triangles)));
-  auto merges_for = [&](double total_weight, int exponent) {
-    std::vector<Merge> merges(faces - 1);
-    for (std::uint32_t m = 0; m + 1 < faces; ++m) {
-      // After m + 1 merges the level has K = F − m − 1 clusters: the chain and single faces.
-      const std::uint32_t k = faces - m - 1;
-      const double level_rms = k <= rms.size() ? rms[k - 1] : rms.back();
-      Merge& merge = merges[m];
-      merge.first = m + 1;
-      merge.second = m == 0 ? 0 : faces + m - 1;
-      if (merge.first > merge.second) std::swap(merge.first, merge.second);
-      merge.error = total_weight * std::pow(std::ldexp(level_rms, -exponent), 2);
-      merge.cost = merge.error;
-      merge.weight = total_weight * (m + 2) / faces;
-      merge.face_count = m + 2;
-      merge.primitive.axis = {0, 0, 1};  // the strip's plane
-    }
-    return merges;
-  };
-  const Hierarchy probe(mesh, {}, merges_for(1, 0));
+  // Each face's weight (working frame), as the tree's parts must add them up.
+  const DualGraph graph(*mesh, VertexWeights::Area);
+  std::vector<double> face_weight(faces, 0);
+  for (std::uint32_t f = 0; f < faces; ++f)
+    for (const double w : graph.corner_weights(graph.first_triangle(f))) face_weight[f] += w;
   double total_weight = 0;
-  for (std::uint32_t f = 0; f < faces; ++f) total_weight += probe.weight(f);
-  return Hierarchy(mesh, {}, merges_for(total_weight, probe.graph().frame().exponent));
+  for (const double w : face_weight) total_weight += w;
+  const int exponent = graph.frame().exponent;
+  std::vector<Merge> merges(faces - 1);
+  double chain_weight = face_weight[0];
+  for (std::uint32_t m = 0; m + 1 < faces; ++m) {
+    // After m + 1 merges the level has K = F − m − 1 clusters: the chain and single faces.
+    const std::uint32_t k = faces - m - 1;
+    const double level_rms = k <= rms.size() ? rms[k - 1] : rms.back();
+    Merge& merge = merges[m];
+    merge.first = m + 1;
+    merge.second = m == 0 ? 0 : faces + m - 1;
+    if (merge.first > merge.second) std::swap(merge.first, merge.second);
+    merge.error = total_weight * std::pow(std::ldexp(level_rms, -exponent), 2);
+    merge.cost = merge.error;
+    merge.weight = chain_weight += face_weight[m + 1];
+    merge.face_count = m + 2;
+    merge.primitive.axis = {0, 0, 1};  // the strip's plane
+  }
+  return Hierarchy(mesh, {}, std::move(merges));
 }
 
 // log rms falling by `coarse` per level down to K = bend, then by `fine`: ratios of e^0.05 at most,

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "primseg/cut.hpp"
+#include "primseg/dual_graph.hpp"
 #include "primseg/error.hpp"
 #include "primseg/hierarchy.hpp"
 #include "support/test_support.hpp"
@@ -73,6 +74,21 @@ TEST(TreeCheck, MergesWithInconsistentRecordsAreRejected) {
     }
   {
     Parts p = valid;
+    p.merges[i].weight *= 1 + 1e-6;
+    expect_rejected(p, "merge " + std::to_string(i) + " has a weight that is not the sum");
+  }
+  {
+    Parts p = valid;
+    p.merges[i].error = 1e300;
+    expect_rejected(p, "an RMS error above 1e30 working units");
+  }
+  {
+    Parts p = valid;
+    p.merges[i].cost = 1e305;
+    expect_rejected(p, "a cost above 1e300");
+  }
+  {
+    Parts p = valid;
     p.merges[i].primitive.type = PrimitiveType::Torus;
     expect_rejected(p, "a type the tree's options do not enable");
   }
@@ -107,19 +123,27 @@ std::shared_ptr<const Mesh> strip() {
       {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}}, {{0, 1, 2}, {1, 3, 2}, {1, 4, 3}}));
 }
 
-Merge plane_merge(std::uint32_t first, std::uint32_t second, std::uint32_t faces) {
+// A merge of the strip with a plane and zero error; its weight adds up the faces' weights.
+Merge plane_merge(const DualGraph& graph, std::uint32_t first, std::uint32_t second,
+                  std::vector<std::uint32_t> faces) {
   Merge m;
   m.first = first;
   m.second = second;
-  m.face_count = faces;
+  m.face_count = static_cast<std::uint32_t>(faces.size());
+  for (const std::uint32_t f : faces)
+    for (const double w : graph.corner_weights(graph.first_triangle(f))) m.weight += w;
   m.primitive.axis = {0, 0, 1};
   return m;
 }
 
 TEST(TreeCheck, AMergeOfClustersThatShareNoEdgeIsRejected) {
-  const Parts adjacent{strip(), {}, {plane_merge(0, 1, 2), plane_merge(2, 3, 3)}};
+  const auto mesh = strip();
+  const DualGraph graph(*mesh, VertexWeights::Area);
+  const Parts adjacent{
+      mesh, {}, {plane_merge(graph, 0, 1, {0, 1}), plane_merge(graph, 2, 3, {0, 1, 2})}};
   EXPECT_NO_THROW(Hierarchy(adjacent.mesh, adjacent.options, adjacent.merges));
-  const Parts apart{strip(), {}, {plane_merge(0, 2, 2), plane_merge(1, 3, 3)}};
+  const Parts apart{
+      mesh, {}, {plane_merge(graph, 0, 2, {0, 2}), plane_merge(graph, 1, 3, {0, 1, 2})}};
   expect_rejected(apart, "merge 0 joins two clusters that share no mesh edge");
 }
 

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
@@ -131,20 +133,38 @@ TEST(TreeIo, BadContentIsRejectedBehindAValidChecksum) {
   expect_parse_error(with_checksum(self_merge), "invalid tree");
 }
 
-// fuzz/corpus/tree/ holds tree files without their checksum (the fuzzer appends it): each must
-// then be a valid tree, or the fuzzer would start from rejected inputs only.
-TEST(TreeIo, TheFuzzersSeedsAreValidTrees) {
-  int seeds = 0;
+// The tree fuzzer's inputs in fuzz/<folder>/tree/, by file name: tree files without their
+// checksum (the fuzzer appends it), returned with it.
+std::vector<std::pair<std::string, std::string>> fuzz_tree_inputs(const char* folder) {
+  std::vector<std::pair<std::string, std::string>> inputs;
   for (const auto& entry : std::filesystem::directory_iterator(
-           std::filesystem::path(PRIMSEG_FUZZ_DIR) / "corpus" / "tree")) {
-    SCOPED_TRACE(entry.path().string());
+           std::filesystem::path(PRIMSEG_FUZZ_DIR) / folder / "tree")) {
     std::ifstream in(entry.path(), std::ios::binary);
-    const std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const Hierarchy h = deserialize_tree(with_checksum(body));
-    EXPECT_GT(h.face_count(), 1u);
-    ++seeds;
+    std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    inputs.emplace_back(entry.path().filename().string(), with_checksum(std::move(body)));
   }
-  EXPECT_GE(seeds, 5);
+  return inputs;
+}
+
+// Every seed is a valid tree, or the fuzzer would start from rejected inputs only.
+TEST(TreeIo, TheFuzzersSeedsAreValidTrees) {
+  const auto seeds = fuzz_tree_inputs("corpus");
+  EXPECT_GE(seeds.size(), 5u);
+  for (const auto& [name, image] : seeds) {
+    SCOPED_TRACE(name);
+    EXPECT_GT(deserialize_tree(image).face_count(), 1u);
+  }
+}
+
+// Tree files the fuzzer once found accepted with content that broke cuts or reports (an infinite
+// error curve, infinite report distances) are refused, naming the file and the merge.
+TEST(TreeIo, TheFuzzersFindingsAreRefused) {
+  const auto findings = fuzz_tree_inputs("regressions");
+  EXPECT_GE(findings.size(), 2u);
+  for (const auto& [name, image] : findings) {
+    SCOPED_TRACE(name);
+    expect_parse_error(image, "x.tree: invalid tree: merge");
+  }
 }
 
 }  // namespace

@@ -93,12 +93,12 @@ struct Merge {
 class Hierarchy {
  public:
   /// A tree from its parts (as read from a tree file). Throws InvalidInputError unless `merges`
-  /// form a binary tree over the mesh's F faces (F − 1 merges, children before parents) with
-  /// what build_hierarchy guarantees: children as first < second, face counts that add up,
-  /// finite non-negative costs, errors and weights; each real merge joins two clusters that share
-  /// a mesh edge and carries a primitive of an enabled type with finite parameters and a unit
-  /// axis; the F − C real merges come before the C − 1 trailing ones. O(E log F) for E pairs of
-  /// adjacent faces.
+  /// form a binary tree over the mesh's F faces (F − 1 merges, children before parents) with what
+  /// build_hierarchy guarantees: children as first < second, face counts and weights that add up,
+  /// finite non-negative costs, errors and weights (costs at most 1e300, RMS errors at most 1e30
+  /// working units); each real merge joins two clusters that share a mesh edge and carries a
+  /// primitive of an enabled type with finite parameters and a unit axis; the F − C real merges
+  /// come before the C − 1 trailing ones. O(E log F) for E pairs of adjacent faces.
   Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options, std::vector<Merge> merges);
 
   const Mesh& mesh() const { return *mesh_; }
