@@ -7,6 +7,7 @@
 #include <numeric>
 #include <string>
 
+#include "face_adjacency.hpp"
 #include "no_index.hpp"
 #include "primseg/error.hpp"
 #include "working_primitive.hpp"
@@ -15,26 +16,11 @@ namespace primseg {
 namespace {
 
 using detail::kNone;
+using Adjacency = detail::FaceAdjacency;
 // How far above the cut's total error (over the corners) refinement may take it: passes trade a
 // little of it for borders the corners cannot see (measured on the generated CAD-tessellated
 // shapes: a chamfered cylinder's borders move right while its corner error rises by 0.1%).
 constexpr double kAllowedErrorRise = 0.05;
-
-// Dual-graph neighbours of every face, as offsets into one array.
-struct Adjacency {
-  std::vector<std::uint32_t> offset, neighbour;
-
-  explicit Adjacency(const DualGraph& graph) : offset(graph.face_count() + 1, 0) {
-    for (const DualEdge& e : graph.edges()) ++offset[e.first + 1], ++offset[e.second + 1];
-    std::partial_sum(offset.begin(), offset.end(), offset.begin());
-    neighbour.resize(offset.back());
-    std::vector<std::uint32_t> next(offset.begin(), offset.end() - 1);
-    for (const DualEdge& e : graph.edges()) {
-      neighbour[next[e.first]++] = e.second;
-      neighbour[next[e.second]++] = e.first;
-    }
-  }
-};
 
 // Connected components (edge-connected through the dual graph) of the clusters of a labelling.
 struct Components {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "face_adjacency.hpp"
 #include "no_index.hpp"
 #include "primseg/error.hpp"
 
@@ -46,26 +47,16 @@ bool valid_primitive(const Primitive& p, const WorkingFrame& frame) {
 void check_tree_parts(const DualGraph& graph, const HierarchyOptions& options,
                       std::span<const Merge> merges) {
   const std::uint32_t f = graph.face_count();
-  // Each face's dual neighbours (compressed rows).
-  std::vector<std::uint32_t> offsets(std::size_t{f} + 1, 0);
-  for (const DualEdge& e : graph.edges()) ++offsets[e.first + 1], ++offsets[e.second + 1];
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  std::vector<std::uint32_t> neighbours(offsets.back());
-  {
-    std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
-    for (const DualEdge& e : graph.edges())
-      neighbours[next[e.first]++] = e.second, neighbours[next[e.second]++] = e.first;
-  }
-  // Live clusters as linked lists of faces; a face's label is its cluster's list. Merging
-  // relabels the smaller list, so each face is relabelled (and its neighbours read) O(log F)
-  // times.
+  const FaceAdjacency adjacency(graph);
+  // Live clusters as linked lists of faces with their face count and weight; a face's label is
+  // its cluster's list. Merging relabels the smaller list, so each face is relabelled (and its
+  // neighbours read) O(log F) times.
   std::vector<std::uint32_t> label(f), next_face(f, kNone), head(f), tail(f), size(f, 1);
-  std::vector<std::uint32_t> list_of_node(2 * std::size_t{f} - 1, kNone);
-  std::vector<std::uint32_t> faces_of_node(2 * std::size_t{f} - 1, 1);
-  std::vector<double> weight_of_node(2 * std::size_t{f} - 1, 0);
+  std::vector<double> list_weight(f, 0);
   for (std::uint32_t face = 0; face < f; ++face)
     for (std::uint32_t t = graph.first_triangle(face); t < graph.first_triangle(face + 1); ++t)
-      for (const double w : graph.corner_weights(t)) weight_of_node[face] += w;
+      for (const double w : graph.corner_weights(t)) list_weight[face] += w;
+  std::vector<std::uint32_t> list_of_node(2 * std::size_t{f} - 1, kNone);
   std::iota(label.begin(), label.end(), 0u);
   std::iota(head.begin(), head.end(), 0u);
   std::iota(tail.begin(), tail.end(), 0u);
@@ -75,24 +66,22 @@ void check_tree_parts(const DualGraph& graph, const HierarchyOptions& options,
   for (std::size_t i = 0; i < merges.size(); ++i) {
     const Merge& m = merges[i];
     if (m.first >= m.second) reject(i, "must give its children as first < second");
-    if (m.face_count != faces_of_node[m.first] + faces_of_node[m.second])
+    std::uint32_t a = list_of_node[m.first], b = list_of_node[m.second];
+    if (m.face_count != size[a] + size[b])
       reject(i, "has " + std::to_string(m.face_count) + " faces, its children " +
-                    std::to_string(faces_of_node[m.first] + faces_of_node[m.second]));
-    faces_of_node[f + i] = m.face_count;
+                    std::to_string(size[a] + size[b]));
     if (!finite_non_negative(m.cost) || !finite_non_negative(m.error) ||
         !finite_non_negative(m.weight))
       reject(i, "has a negative or non-finite cost, error or weight");
-    const double weight = weight_of_node[m.first] + weight_of_node[m.second];
+    const double weight = list_weight[a] + list_weight[b];
     if (std::abs(m.weight - weight) > kWeightTolerance * weight)
       reject(i, "has a weight that is not the sum of its faces' weights");
-    weight_of_node[f + i] = weight;
     if (m.cost > kMaxCost || m.error > m.weight * (kMaxWorkingLength * kMaxWorkingLength))
       reject(i, "has a cost above 1e300 or an RMS error above 1e30 working units");
     if (m.trailing != (i >= real_count))
       reject(i, std::string(m.trailing ? "is trailing" : "is not trailing") + ": the mesh's " +
                     std::to_string(graph.component_count()) + " components need " +
                     std::to_string(real_count) + " real merges, then trailing ones");
-    std::uint32_t a = list_of_node[m.first], b = list_of_node[m.second];
     if (size[a] < size[b]) std::swap(a, b);  // b is the smaller list
     if (!m.trailing) {
       if (std::find(options.primitives.begin(), options.primitives.end(), m.primitive.type) ==
@@ -104,14 +93,15 @@ void check_tree_parts(const DualGraph& graph, const HierarchyOptions& options,
                "non-unit axis");
       bool adjacent = false;
       for (std::uint32_t x = head[b]; x != kNone && !adjacent; x = next_face[x])
-        for (std::uint32_t k = offsets[x]; k < offsets[x + 1] && !adjacent; ++k)
-          adjacent = label[neighbours[k]] == a;
+        for (std::uint32_t k = adjacency.offset[x]; k < adjacency.offset[x + 1] && !adjacent; ++k)
+          adjacent = label[adjacency.neighbour[k]] == a;
       if (!adjacent) reject(i, "joins two clusters that share no mesh edge");
     }
     for (std::uint32_t x = head[b]; x != kNone; x = next_face[x]) label[x] = a;
     next_face[tail[a]] = head[b];
     tail[a] = tail[b];
     size[a] += size[b];
+    list_weight[a] = weight;
     list_of_node[f + i] = a;
   }
 }

@@ -53,6 +53,12 @@ class Reader {
     std::memcpy(&value, raw, sizeof(T));
     return value;
   }
+  // A byte that must be 0 or 1.
+  bool get_flag(const char* field, const char* what) {
+    const auto value = get<std::uint8_t>(what);
+    if (value > 1) fail(std::string(field) + " must be 0 or 1, not " + std::to_string(value));
+    return value == 1;
+  }
   Vec3 get_vec3(const char* what) {
     return {get<double>(what), get<double>(what), get<double>(what)};
   }
@@ -150,9 +156,7 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
   const auto weights = r.get<std::uint8_t>("the options");
   if (weights > 1) r.fail("unknown vertex weighting " + std::to_string(weights));
   options.weights = static_cast<VertexWeights>(weights);
-  const auto exact_costs = r.get<std::uint8_t>("the options");
-  if (exact_costs > 1) r.fail("exact_costs must be 0 or 1, not " + std::to_string(exact_costs));
-  options.exact_costs = exact_costs == 1;
+  options.exact_costs = r.get_flag("exact_costs", "the options");
   const auto type_count = r.get<std::uint8_t>("the options");
   options.primitives.clear();
   for (int i = 0; i < type_count; ++i) {
@@ -192,10 +196,7 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
     m.error = r.get<double>("the merges");
     m.weight = r.get<double>("the merges");
     m.face_count = r.get<std::uint32_t>("the merges");
-    const auto trailing = r.get<std::uint8_t>("the merges");
-    if (trailing > 1)
-      r.fail("a merge's trailing flag must be 0 or 1, not " + std::to_string(trailing));
-    m.trailing = trailing == 1;
+    m.trailing = r.get_flag("a merge's trailing flag", "the merges");
     const auto type = r.get<std::uint8_t>("the merges");
     if (type >= kPrimitiveTypeCount) r.fail("unknown primitive type " + std::to_string(type));
     m.primitive.type = static_cast<PrimitiveType>(type);
