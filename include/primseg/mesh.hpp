@@ -66,7 +66,8 @@ double bounding_box_diagonal(const Mesh& mesh);
 /// Largest coordinate magnitude the geometric operations accept (input units). Some of them work
 /// in input units with fourth powers of lengths (area-weighted second moments) and their squares:
 /// those stay normal doubles from kMinPositiveExtent to here, so that results do not depend on the
-/// units (scaling a mesh by a power of two scales every result exactly).
+/// units: scaling a mesh by a power of two scales every result exactly (fuzz/tools_fuzzer.cpp),
+/// but for round-off zeros that underflow below the normal doubles, which only stay as tiny.
 inline constexpr double kMaxCoordinateMagnitude = 1e32;
 /// Smallest extent (largest side of the bounding box of the vertices used by some face, input
 /// units) the geometric operations accept, other than 0 (every face collapsed to one point): see
