@@ -1,8 +1,10 @@
 #include "denoise_test_support.hpp"
 
+#include <array>
 #include <cmath>
 #include <vector>
 
+#include "primseg/mesh_distance.hpp"
 #include "shape_generator/random.hpp"
 
 namespace primseg::testing {
@@ -42,6 +44,23 @@ std::uint32_t inverted_triangles(const Mesh& reference, const Mesh& after) {
     if (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] < 0) ++count;
   }
   return count;
+}
+
+double vertex_rms_to_surface(const Mesh& mesh, const Mesh& surface) {
+  const TriangleBvh bvh(surface);
+  double sum = 0;
+  for (const Vec3& p : mesh.positions) sum += bvh.closest_point(p).squared_distance;
+  return std::sqrt(sum / static_cast<double>(mesh.vertex_count()));
+}
+
+double least_squares_floor(const Hierarchy& hierarchy, const Segmentation& level, double sigma) {
+  // By PrimitiveType: plane, cylinder, sphere, cone, torus.
+  constexpr std::array<int, kPrimitiveTypeCount> kDegreesOfFreedom{3, 5, 4, 6, 7};
+  int degrees_of_freedom = 0;
+  for (const ClusterReport& cluster : describe_clusters(hierarchy, level))
+    degrees_of_freedom += kDegreesOfFreedom[static_cast<std::size_t>(cluster.primitive.type)];
+  return sigma *
+         std::sqrt(degrees_of_freedom / static_cast<double>(hierarchy.mesh().vertex_count()));
 }
 
 }  // namespace primseg::testing
