@@ -97,6 +97,33 @@ TEST(ReadStl, WeldingUsesExactCoordinates) {
   EXPECT_EQ(mesh.triangles[1], (Triangle{3, 4, 2}));
 }
 
+TEST(ReadStl, TightAsciiOutgrowsTheWeldersFirstGuess) {
+  // The welder's table is sized from the file's bytes (a corner per 64); a tightly written soup
+  // of separate triangles has three new vertices in about 85 bytes, so the table must grow and
+  // still find every vertex: the last facet repeats the first one's.
+  constexpr std::uint32_t kTriangles = 2000;
+  std::string text = "solid s\n";
+  auto facet = [&](std::uint32_t t) {
+    text += "facet normal 0 0 1 outer loop";
+    for (std::uint32_t k = 0; k < 3; ++k)
+      text += " vertex " + std::to_string(t) + " " + std::to_string(k) + " 0";
+    text += " endloop endfacet\n";
+  };
+  for (std::uint32_t t = 0; t < kTriangles; ++t) facet(t);
+  facet(0);
+  text += "endsolid s\n";
+  ASSERT_GT(3 * kTriangles, 2 * (text.size() / 64));
+
+  const Mesh mesh = parse_stl(text);
+  ASSERT_EQ(mesh.vertex_count(), 3 * kTriangles);
+  ASSERT_EQ(mesh.face_count(), kTriangles + 1);
+  for (std::uint32_t t = 0; t < kTriangles; ++t) {
+    EXPECT_EQ(mesh.triangles[t], (Triangle{3 * t, 3 * t + 1, 3 * t + 2}));
+    EXPECT_EQ(mesh.positions[3 * t + 2], (Vec3{double(t), 2, 0}));
+  }
+  EXPECT_EQ(mesh.triangles[kTriangles], (Triangle{0, 1, 2}));
+}
+
 TEST(ReadStl, TruncatedBinary) {
   const std::string file = binary_tetrahedron("binary");
   ASSERT_EQ(file.size(), 284u);
