@@ -49,7 +49,8 @@ struct Primitive {
 
   /// Unsigned Euclidean distance from x to the primitive's surface (input units).
   double distance(const Vec3& x) const;
-  /// The point of the primitive's surface closest to x.
+  /// The point of the primitive's surface closest to x. Where several are (x at a sphere's
+  /// centre, on the axis of a cylinder, cone or torus, on a torus's core circle), one of them.
   Vec3 closest_point(const Vec3& x) const;
 };
 
