@@ -116,6 +116,32 @@ TEST(Denoise, NoisyBoxIsCleanedAndItsEdgesRestored) {
   EXPECT_LE(worst, box.sigma);
 }
 
+// A level by tolerance: clusters within twice the noise are the box's six faces. A vertex that no
+// triangle uses (a stray point of a scan) stays where it is and is counted nowhere.
+TEST(Denoise, LevelByToleranceAndAStrayVertex) {
+  const NoisyShape box = noisy_shape("box", 0.004, 0.04);
+  Mesh with_stray = box.noisy.mesh;
+  const Vec3 stray{0.05, 0.1, 0.15};  // inside the box, near no face
+  with_stray.positions.push_back(stray);
+  Denoiser denoiser(with_stray);
+  std::uint32_t clusters = 0;
+  const SnapReport report = denoiser.iterate([&](const Hierarchy& hierarchy) {
+    const Segmentation level = level_by_tolerance(2 * box.sigma)(hierarchy);
+    clusters = level.cluster_count();
+    return level;
+  });
+  EXPECT_EQ(clusters, 6u);
+  EXPECT_EQ(denoiser.mesh().positions.back(), stray);
+  EXPECT_EQ(report.interior_vertices + report.boundary_vertices, box.noisy.mesh.vertex_count());
+  EXPECT_EQ(report.moved + report.blocked, box.noisy.mesh.vertex_count());
+
+  Mesh denoised = denoiser.mesh();
+  denoised.positions.pop_back();
+  const MeshDistance before = mesh_distance(box.noisy.mesh, box.clean.mesh, measure_options());
+  const MeshDistance after = mesh_distance(denoised, box.clean.mesh, measure_options());
+  EXPECT_LE(after.rms * 5, before.rms);
+}
+
 TEST(Denoise, LeavesANoiseFreeBoxWhereItIs) {
   ShapeOptions options;
   options.tessellation = Tessellation::Uniform;
