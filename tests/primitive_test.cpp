@@ -161,29 +161,23 @@ TEST(Primitive, ClosestPointIsOnTheSurfaceAndNoSampleOfItIsNearer) {
 TEST(Primitive, QueriesWithoutAUniqueNearestPoint) {
   std::mt19937_64 rng(7);
   const std::vector<PlacedPrimitive> placed = placed_primitives(rng);
-  auto expect_nearest = [](const PlacedPrimitive& p, const Eigen::Vector3d& local_query,
-                           double expected_distance) {
-    SCOPED_TRACE(std::string(to_string(p.primitive.type)));
+  auto expect_nearest = [&](PrimitiveType type, const Eigen::Vector3d& local_query,
+                            double expected_distance) {
+    SCOPED_TRACE(std::string(to_string(type)));
+    const PlacedPrimitive& p = placed[static_cast<std::size_t>(type)];
     const Vec3 x = p.to_world(local_query);
     const Vec3 nearest = p.primitive.closest_point(x);
     EXPECT_LE(p.local_distance(p.to_local(nearest)), 1e-12);
     EXPECT_NEAR(p.primitive.distance(x), expected_distance, 1e-12);
   };
-  const Primitive& sphere = placed[static_cast<int>(PrimitiveType::Sphere)].primitive;
-  const Primitive& cone = placed[static_cast<int>(PrimitiveType::Cone)].primitive;
-  const Primitive& torus = placed[static_cast<int>(PrimitiveType::Torus)].primitive;
-  expect_nearest(placed[static_cast<int>(PrimitiveType::Sphere)], {0, 0, 0}, sphere.radius);
-  expect_nearest(placed[static_cast<int>(PrimitiveType::Cylinder)], {0, 0, 0.4},
-                 placed[static_cast<int>(PrimitiveType::Cylinder)].primitive.radius);
+  expect_nearest(PrimitiveType::Sphere, {0, 0, 0}, kRadius);
+  expect_nearest(PrimitiveType::Cylinder, {0, 0, 0.4}, kRadius);
   // On the cone's axis inside it, and behind its apex (the apex is nearest).
-  expect_nearest(placed[static_cast<int>(PrimitiveType::Cone)], {0, 0, 0.8},
-                 0.8 * std::sin(cone.half_angle));
-  expect_nearest(placed[static_cast<int>(PrimitiveType::Cone)], {0, 0, -0.6}, 0.6);
+  expect_nearest(PrimitiveType::Cone, {0, 0, 0.8}, 0.8 * std::sin(kHalfAngle));
+  expect_nearest(PrimitiveType::Cone, {0, 0, -0.6}, 0.6);
   // On the torus's axis, and on the circle at the core of its tube.
-  expect_nearest(placed[static_cast<int>(PrimitiveType::Torus)], {0, 0, 0.25},
-                 std::hypot(torus.radius, 0.25) - torus.minor_radius);
-  expect_nearest(placed[static_cast<int>(PrimitiveType::Torus)], {0, torus.radius, 0},
-                 torus.minor_radius);
+  expect_nearest(PrimitiveType::Torus, {0, 0, 0.25}, std::hypot(kRadius, 0.25) - kMinorRadius);
+  expect_nearest(PrimitiveType::Torus, {0, kRadius, 0}, kMinorRadius);
 }
 
 TEST(Primitive, ParametersAndTypesByName) {

@@ -57,8 +57,9 @@ double least_squares_floor(const Hierarchy& hierarchy, const Segmentation& level
   // By PrimitiveType: plane, cylinder, sphere, cone, torus.
   constexpr std::array<int, kPrimitiveTypeCount> kDegreesOfFreedom{3, 5, 4, 6, 7};
   int degrees_of_freedom = 0;
-  for (const ClusterReport& cluster : describe_clusters(hierarchy, level))
-    degrees_of_freedom += kDegreesOfFreedom[static_cast<std::size_t>(cluster.primitive.type)];
+  for (const std::uint32_t node : level.nodes)
+    degrees_of_freedom +=
+        kDegreesOfFreedom[static_cast<std::size_t>(hierarchy.primitive(node).type)];
   return sigma *
          std::sqrt(degrees_of_freedom / static_cast<double>(hierarchy.mesh().vertex_count()));
 }
