@@ -19,6 +19,7 @@ Command add_denoise_command(CLI::App& app) {
     double max_move = DenoiseOptions{}.max_move_edge_lengths;
     double min_crease_angle = DenoiseOptions{}.min_crease_angle_degrees;
     int relabel_passes = DenoiseOptions{}.relabel_passes;
+    double parallel_significance = DenoiseOptions{}.parallel_significance;
     std::optional<double> noise_factor;
     unsigned threads = 0;
     LevelOptions level;
@@ -65,6 +66,12 @@ Command add_denoise_command(CLI::App& app) {
                    "its corners are nearest to, before snapping (0: keep the hierarchy's labels)")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
+  denoise
+      ->add_option("--parallel-significance", o->parallel_significance,
+                   "Plane normals and cylinder axes within this many standard deviations of their "
+                   "fits (and 20 degrees) are made exactly parallel before snapping (0: off)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   denoise->add_option("--noise-factor", o->noise_factor,
                       "With --clusters auto and no jump in the error curve (or one whose clusters "
                       "fit more than 4.5 times worse): clusters within this multiple of the "
@@ -82,6 +89,7 @@ Command add_denoise_command(CLI::App& app) {
             if (o->bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
             options.min_crease_angle_degrees = o->min_crease_angle;
             options.relabel_passes = o->relabel_passes;
+            options.parallel_significance = o->parallel_significance;
             options.noise_tolerance_factor = o->noise_factor;
             options.hierarchy.primitives = parse_primitives(o->primitives);
             options.hierarchy.threads = o->threads;

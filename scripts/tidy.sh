@@ -18,7 +18,7 @@ if [[ $# -gt 1 ]]; then
 fi
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON \
   -DCMAKE_EXPORT_COMPILE_COMMANDS=ON -DPRIMSEG_BUILD_TESTS=OFF -DPRIMSEG_BUILD_BENCH=OFF \
-  -DPRIMSEG_PYTHON=OFF >/dev/null
+  -DPRIMSEG_PYTHON=OFF -DPRIMSEG_PRECOMPILE_HEADERS=OFF >/dev/null
 # The configuration is passed, not looked up: clang-tidy looks for .clang-tidy above the main file,
 # which here is in BUILD_DIR. bugprone-suspicious-include would report the unity sources' own
 # #includes of .cpp files.

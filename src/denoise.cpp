@@ -14,6 +14,7 @@
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "primseg/geometric_fit.hpp"
+#include "regularity.hpp"
 #include "vertex_triangles.hpp"
 
 namespace primseg {
@@ -215,6 +216,8 @@ void validate(const DenoiseOptions& options) {
   if (options.noise_tolerance_factor &&
       !(*options.noise_tolerance_factor > 0 && std::isfinite(*options.noise_tolerance_factor)))
     throw InvalidInputError("denoise: the noise tolerance factor must be a positive number");
+  if (!(options.parallel_significance >= 0) || !std::isfinite(options.parallel_significance))
+    throw InvalidInputError("denoise: the parallel significance must be a non-negative number");
   if (options.relabel_passes < 0)
     throw InvalidInputError("denoise: the relabelling passes must be a non-negative count");
   if (options.max_solver_steps < 1)
@@ -334,10 +337,12 @@ SnapReport Denoiser::iterate(const LevelSelector& level) {
   return snap(hierarchy, level(hierarchy));
 }
 
-void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const {
+void Denoiser::cluster_vertices(const Segmentation& segmentation, std::size_t cluster_count,
+                                std::vector<std::vector<Vec3>>& points,
+                                std::vector<std::vector<double>>& weights) const {
   // Every vertex of a cluster's faces, weighted by the area of its triangles in the cluster.
-  std::vector<std::vector<Vec3>> points(primitives.size());
-  std::vector<std::vector<double>> weights(primitives.size());
+  points.assign(cluster_count, {});
+  weights.assign(cluster_count, {});
   std::vector<std::pair<std::uint32_t, double>> area_by_cluster;
   for (std::uint32_t v = 0; v < mesh_.vertex_count(); ++v) {
     area_by_cluster.clear();
@@ -361,6 +366,33 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
       weights[c].push_back(area);
     }
   }
+}
+
+void Denoiser::keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
+                            std::span<const double> weights, std::vector<Vec3>& kept_points,
+                            std::vector<double>& kept_weights, double floor) const {
+  // Inliers: residual within the threshold times the robust deviation (1.4826 MAD) of all the
+  // cluster's vertices from the current fit.
+  std::vector<double> residuals;
+  residuals.reserve(points.size());
+  for (const Vec3& p : points) residuals.push_back(primitive.distance(p));
+  std::vector<double> sorted = residuals;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit =
+      std::max(options_.refit_outlier_threshold * 1.4826 * sorted[sorted.size() / 2], floor);
+  kept_points.clear();
+  kept_weights.clear();
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (residuals[i] <= limit) {
+      kept_points.push_back(points[i]);
+      kept_weights.push_back(weights[i]);
+    }
+}
+
+void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const {
+  std::vector<std::vector<Vec3>> points;
+  std::vector<std::vector<double>> weights;
+  cluster_vertices(segmentation, primitives.size(), points, weights);
   const double floor = 1e-12 * bounding_box_diagonal(mesh_);
   // Each cluster on its own: the same result for any thread count.
   const unsigned threads = detail::thread_count(options_.hierarchy.threads);
@@ -368,26 +400,11 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
     const PrimitiveType type = primitives[c].type;
     if (points[c].empty()) return;  // a cluster that relabelling emptied
     Primitive current = primitives[c];
-    std::vector<double> residuals;
     std::vector<Vec3> kept_points;
     std::vector<double> kept_weights;
     constexpr int kRounds = 3;
     for (int round = 0; round < kRounds; ++round) {
-      // Inliers: residual within the threshold times the robust deviation (1.4826 MAD) of all
-      // the cluster's vertices from the current fit.
-      residuals.clear();
-      for (const Vec3& p : points[c]) residuals.push_back(current.distance(p));
-      std::vector<double> sorted = residuals;
-      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-      const double limit =
-          std::max(options_.refit_outlier_threshold * 1.4826 * sorted[sorted.size() / 2], floor);
-      kept_points.clear();
-      kept_weights.clear();
-      for (std::size_t i = 0; i < points[c].size(); ++i)
-        if (residuals[i] <= limit) {
-          kept_points.push_back(points[c][i]);
-          kept_weights.push_back(weights[c][i]);
-        }
+      keep_inliers(current, points[c], weights[c], kept_points, kept_weights, floor);
       const std::optional<Primitive> refit =
           type == PrimitiveType::Plane
               ? fit_plane(kept_points, kept_weights, to_eigen(current.axis))
@@ -397,6 +414,21 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
     }
     primitives[c] = current;
   });
+}
+
+void Denoiser::regularize(const Segmentation& segmentation,
+                          std::vector<Primitive>& primitives) const {
+  std::vector<std::vector<Vec3>> points, inlier_points(primitives.size());
+  std::vector<std::vector<double>> weights, inlier_weights(primitives.size());
+  cluster_vertices(segmentation, primitives.size(), points, weights);
+  const double floor = 1e-12 * bounding_box_diagonal(mesh_);
+  for (std::size_t c = 0; c < primitives.size(); ++c)
+    if (!points[c].empty())
+      keep_inliers(primitives[c], points[c], weights[c], inlier_points[c], inlier_weights[c],
+                   floor);
+  detail::RegularityOptions regularity;
+  regularity.significance = options_.parallel_significance;
+  detail::regularize(primitives, inlier_points, inlier_weights, regularity);
 }
 
 void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
@@ -464,6 +496,8 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
   Segmentation labelled = segmentation;
   relabel(segmented, primitives, labelled);
+  if (options_.parallel_significance > 0 && options_.refit_outlier_threshold > 0)
+    regularize(labelled, primitives);
 
   SnapReport report;
   report.clusters = segmentation.cluster_count();

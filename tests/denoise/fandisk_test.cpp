@@ -101,7 +101,7 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     EXPECT_LE(chosen.noise, 1.05 * sigma);
     EXPECT_EQ(chosen.tolerance, 0.4 * chosen.noise);
     EXPECT_EQ(testing::inverted_triangles(noisy, denoiser.mesh()), 0u);
-    EXPECT_LT(after.rms * 3.5, before.rms);  // measured 3.8x
+    EXPECT_LT(after.rms * 3.5, before.rms);  // measured 3.9x (3.8x with independent directions)
     // What the level's primitives leave at least (least_squares_floor): the vertices end within
     // 1.05 floors of the clean surface (seed 7: 1.13), so the ratio is what the level's number of
     // parameters allows, sqrt(V / (2 P)) = 3.8x (seed 7: 37 clusters, 4.5x).
@@ -111,14 +111,17 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     EXPECT_LE(left, 1.2 * floor);
   }
   {
-    // The target, 5x, is where even the clean segmentation ends: snapped onto the clean mesh's
-    // own level of 30 clusters (129 parameters for 6,475 vertices), the vertices reach the floor
-    // (0.96 floors) and the RMS drops 5.5x (seed 7: 5.3x) against a bound of 5.0x. Each cluster
-    // more costs 3 to 5 parameters, each surface missed costs bias; a noisy segmentation has
-    // both.
+    // The target, 5x, is where even the clean segmentation ends with independent primitives:
+    // snapped onto the clean mesh's own level of 30 clusters (129 parameters for 6,475
+    // vertices), the vertices reach the floor (0.96 floors) and the RMS drops 5.5x (seed 7:
+    // 5.3x) against a bound of 5.0x. Each cluster more costs 3 to 5 parameters, each surface
+    // missed costs bias; a noisy segmentation has both. Parallel directions shared between
+    // primitives (the default) spend fewer: 6.1x.
     const Hierarchy truth = build_hierarchy(std::make_shared<const Mesh>(clean));
     const Segmentation level = cut_by_count(truth, 30);
-    Denoiser denoiser(noisy);
+    DenoiseOptions independent;
+    independent.parallel_significance = 0;
+    Denoiser denoiser(noisy, independent);
     denoiser.snap(truth, level);
     const double floor = testing::least_squares_floor(truth, level, sigma);
     const double left = testing::vertex_rms_to_surface(denoiser.mesh(), clean);
@@ -129,6 +132,13 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     EXPECT_LE(left, 1.1 * floor);
     EXPECT_GE(before.rms / after.rms, 5.0);
     EXPECT_LE(before.rms / after.rms, 6.0);
+
+    Denoiser parallel(noisy);
+    parallel.snap(truth, level);
+    const MeshDistance shared = mesh_distance(parallel.mesh(), clean, measure);
+    std::printf("%8s %12.4g %12.4g %8.2f %12s %8.2f\n", "clean 30", shared.rms, shared.hausdorff,
+                before.rms / shared.rms, "parallel", before.hausdorff / shared.hausdorff);
+    EXPECT_GE(before.rms / shared.rms, 1.05 * before.rms / after.rms);  // measured 1.11
   }
   {
     // Stylization keeps the segmentation's automatic level: the knee, few clusters.

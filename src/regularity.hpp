@@ -1,0 +1,29 @@
+#pragma once
+// Parallel directions between the primitives of a segmentation, and the refit that makes them
+// exact (after GlobFit, Li et al. 2011): planes' normals and cylinders' axes that agree within
+// their fits' uncertainty share one direction, estimated from all of them.
+
+#include <vector>
+
+#include "primseg/primitive.hpp"
+
+namespace primseg::detail {
+
+struct RegularityOptions {
+  /// A direction joins a group when its tilt from the group's direction is within this many
+  /// standard deviations (Mahalanobis, with both estimates' covariances). > 0.
+  double significance = 3;
+  /// ... and never farther than this, whatever the uncertainty (degrees).
+  double max_angle_degrees = 20;
+};
+
+/// Groups the directions of `primitives` (plane normals, cylinder axes; other types are left as
+/// they are) and refits every member of a group of two or more with the group's direction: a
+/// plane through its inliers' weighted centroid, a cylinder by geometric least squares of its
+/// inliers' circle. points[c] and weights[c] are cluster c's inlier vertices (input units) and
+/// their weights; a cluster with too few to estimate its direction's uncertainty is left alone.
+/// Deterministic: clusters are visited by increasing uncertainty, ties by index.
+void regularize(std::vector<Primitive>& primitives, const std::vector<std::vector<Vec3>>& points,
+                const std::vector<std::vector<double>>& weights, const RegularityOptions& options);
+
+}  // namespace primseg::detail

@@ -1,0 +1,168 @@
+// detail::regularize: directions that agree within their fits' uncertainty become one, and the
+// others stay as they were.
+#include "regularity.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "eigen_conversions.hpp"
+#include "primseg/geometric_fit.hpp"
+
+namespace primseg {
+namespace {
+
+using detail::to_eigen;
+using detail::to_vec3;
+
+struct Cluster {
+  std::vector<Vec3> points;
+  std::vector<double> weights;
+};
+
+// An n × n grid of side `size` on the plane through `centre` with normal `normal`, each point
+// moved along the normal by Gaussian noise of deviation `sigma`.
+Cluster noisy_plane(const Eigen::Vector3d& normal, const Eigen::Vector3d& centre, double size,
+                    double sigma, std::mt19937_64& rng, int n = 20) {
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  std::normal_distribution<double> noise(0, sigma);
+  Cluster cluster;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double s = size * (i / (n - 1.0) - 0.5), t = size * (j / (n - 1.0) - 0.5);
+      cluster.points.push_back(to_vec3(centre + s * u + t * v + noise(rng) * normal));
+      cluster.weights.push_back(1);
+    }
+  return cluster;
+}
+
+// A cylinder of radius `radius` around the axis through `centre`, `rings` rings of 24 points over
+// `length`, moved radially by Gaussian noise of deviation `sigma`.
+Cluster noisy_cylinder(const Eigen::Vector3d& axis, const Eigen::Vector3d& centre, double radius,
+                       double length, double sigma, std::mt19937_64& rng, int rings = 20) {
+  const Eigen::Vector3d u = axis.unitOrthogonal(), v = axis.cross(u);
+  std::normal_distribution<double> noise(0, sigma);
+  Cluster cluster;
+  for (int i = 0; i < rings; ++i)
+    for (int k = 0; k < 24; ++k) {
+      const double angle = 2 * std::numbers::pi * k / 24;
+      const Eigen::Vector3d radial = std::cos(angle) * u + std::sin(angle) * v;
+      const double t = length * (i / (rings - 1.0) - 0.5);
+      cluster.points.push_back(to_vec3(centre + t * axis + (radius + noise(rng)) * radial));
+      cluster.weights.push_back(1);
+    }
+  return cluster;
+}
+
+// Least-squares plane (PCA), as the denoiser's refit gives it.
+Primitive fitted_plane(const Cluster& cluster) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Vec3& p : cluster.points) centroid += to_eigen(p);
+  centroid /= static_cast<double>(cluster.points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : cluster.points)
+    scatter += (to_eigen(p) - centroid) * (to_eigen(p) - centroid).transpose();
+  Primitive plane;
+  plane.type = PrimitiveType::Plane;
+  plane.point = to_vec3(centroid);
+  plane.axis =
+      to_vec3(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0));
+  return plane;
+}
+
+double angle_between_lines(const Vec3& a, const Vec3& b) {
+  return std::atan2(to_eigen(a).cross(to_eigen(b)).norm(), std::abs(to_eigen(a).dot(to_eigen(b))));
+}
+
+void regularize(std::vector<Primitive>& primitives, const std::vector<Cluster>& clusters) {
+  std::vector<std::vector<Vec3>> points;
+  std::vector<std::vector<double>> weights;
+  for (const Cluster& c : clusters) {
+    points.push_back(c.points);
+    weights.push_back(c.weights);
+  }
+  detail::regularize(primitives, points, weights, {});
+}
+
+TEST(Regularity, ParallelPlanesShareOneNormalNearerTheTruth) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{noisy_plane(z, {0, 0, 0}, 1, 0.01, rng),
+                                        noisy_plane(-z, {0.3, 0, 1}, 1, 0.01, rng)};
+    std::vector<Primitive> planes{fitted_plane(clusters[0]), fitted_plane(clusters[1])};
+    const double worst = std::max(angle_between_lines(planes[0].axis, to_vec3(z)),
+                                  angle_between_lines(planes[1].axis, to_vec3(z)));
+    const Vec3 before_second = planes[1].axis;
+    regularize(planes, clusters);
+    // One direction, each plane keeping its side.
+    EXPECT_NEAR(angle_between_lines(planes[0].axis, planes[1].axis), 0, 1e-12);
+    EXPECT_GT(to_eigen(planes[1].axis).dot(to_eigen(before_second)), 0);
+    EXPECT_LT(angle_between_lines(planes[0].axis, to_vec3(z)), worst);
+    // Each plane through its points' centroid: the offsets stay.
+    EXPECT_NEAR(planes[0].point[2], 0, 0.005);
+    EXPECT_NEAR(planes[1].point[2], 1, 0.005);
+  }
+}
+
+TEST(Regularity, DirectionsFartherApartThanTheirUncertaintyStayApart) {
+  // A 2 degree draft: with noise of 0.1% of the size the normals are known to about 0.01 degree.
+  std::mt19937_64 rng(3);
+  const double draft = 2 * std::numbers::pi / 180;
+  const Eigen::Vector3d tilted(std::sin(draft), 0, std::cos(draft));
+  const std::vector<Cluster> clusters{
+      noisy_plane(Eigen::Vector3d::UnitZ(), {0, 0, 0}, 1, 0.001, rng),
+      noisy_plane(tilted, {0, 0, 1}, 1, 0.001, rng)};
+  const std::vector<Primitive> fitted{fitted_plane(clusters[0]), fitted_plane(clusters[1])};
+  std::vector<Primitive> planes = fitted;
+  regularize(planes, clusters);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_EQ(planes[c].axis, fitted[c].axis);
+    EXPECT_EQ(planes[c].point, fitted[c].point);
+  }
+}
+
+TEST(Regularity, ACylinderAndItsCapsShareTheAxis) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  std::mt19937_64 rng(5);
+  const std::vector<Cluster> clusters{noisy_cylinder(z, {0.2, 0.1, 0}, 0.5, 1.5, 0.005, rng),
+                                      noisy_plane(z, {0.2, 0.1, 0.75}, 0.8, 0.005, rng),
+                                      noisy_plane(-z, {0.2, 0.1, -0.75}, 0.8, 0.005, rng)};
+  Primitive start;
+  start.type = PrimitiveType::Cylinder;
+  start.point = {0.2, 0.1, 0};
+  start.axis = {0, 0, 1};
+  start.radius = 0.5;
+  const Primitive cylinder =
+      fit_geometric(start, clusters[0].points, clusters[0].weights).primitive;
+  std::vector<Primitive> primitives{cylinder, fitted_plane(clusters[1]), fitted_plane(clusters[2])};
+  regularize(primitives, clusters);
+  EXPECT_NEAR(angle_between_lines(primitives[0].axis, primitives[1].axis), 0, 1e-12);
+  EXPECT_NEAR(angle_between_lines(primitives[0].axis, primitives[2].axis), 0, 1e-12);
+  EXPECT_NEAR(primitives[0].radius, 0.5, 0.002);
+  // The refitted cylinder's axis passes by the true one.
+  const Eigen::Vector3d offset = to_eigen(primitives[0].point) - Eigen::Vector3d(0.2, 0.1, 0);
+  EXPECT_LT(
+      (offset - offset.dot(to_eigen(primitives[0].axis)) * to_eigen(primitives[0].axis)).norm(),
+      0.002);
+}
+
+TEST(Regularity, ClustersTooSmallToMeasureTheirUncertaintyAreLeftAlone) {
+  std::mt19937_64 rng(9);
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  const std::vector<Cluster> clusters{noisy_plane(z, {0, 0, 0}, 1, 0.01, rng),
+                                      noisy_plane(z, {0, 0, 1}, 1, 0.01, rng, 2)};  // 4 points
+  const std::vector<Primitive> fitted{fitted_plane(clusters[0]), fitted_plane(clusters[1])};
+  std::vector<Primitive> planes = fitted;
+  regularize(planes, clusters);
+  EXPECT_EQ(planes[0].axis, fitted[0].axis);
+  EXPECT_EQ(planes[1].axis, fitted[1].axis);
+}
+
+}  // namespace
+}  // namespace primseg
