@@ -19,7 +19,7 @@ Command add_denoise_command(CLI::App& app) {
     double max_move = DenoiseOptions{}.max_move_edge_lengths;
     double min_crease_angle = DenoiseOptions{}.min_crease_angle_degrees;
     int relabel_passes = DenoiseOptions{}.relabel_passes;
-    double parallel_significance = DenoiseOptions{}.parallel_significance;
+    double relation_significance = DenoiseOptions{}.relation_significance;
     std::optional<double> noise_factor;
     unsigned threads = 0;
     LevelOptions level;
@@ -67,9 +67,10 @@ Command add_denoise_command(CLI::App& app) {
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
   denoise
-      ->add_option("--parallel-significance", o->parallel_significance,
-                   "Plane normals and cylinder axes within this many standard deviations of their "
-                   "fits (and 20 degrees) are made exactly parallel before snapping (0: off)")
+      ->add_option("--relation-significance", o->relation_significance,
+                   "Relations the fits agree with within this many standard deviations are made "
+                   "exact before snapping: parallel plane normals and cylinder axes, coaxial "
+                   "cylinders (0: off)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   denoise->add_option("--noise-factor", o->noise_factor,
@@ -89,7 +90,7 @@ Command add_denoise_command(CLI::App& app) {
             if (o->bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
             options.min_crease_angle_degrees = o->min_crease_angle;
             options.relabel_passes = o->relabel_passes;
-            options.parallel_significance = o->parallel_significance;
+            options.relation_significance = o->relation_significance;
             options.noise_tolerance_factor = o->noise_factor;
             options.hierarchy.primitives = parse_primitives(o->primitives);
             options.hierarchy.threads = o->threads;

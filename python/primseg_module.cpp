@@ -1119,7 +1119,7 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
   // denoise, skeleton, distance.
 
   const char* denoise_doc =
-      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, parallel_significance=3.0, noise_tolerance_factor=None, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
 denoise(V, F, *, ...) -> numpy.ndarray
 denoise(hierarchy, *, ...) -> numpy.ndarray
 
@@ -1140,7 +1140,7 @@ times that tolerance, else the clusters within a multiple of the estimated noise
 stylize: --stylize (each vertex onto its own cluster's primitive); max_move: --max-move (in mean
 incident edge lengths); min_crease_angle: --min-crease-angle (degrees); relabel_passes:
 --relabel-passes (faces moved to the nearest refitted neighbouring primitive);
-parallel_significance: --parallel-significance (0: directions not made parallel); smoothing_steps:
+relation_significance: --relation-significance (0: no parallel or coaxial relations); smoothing_steps:
 --smooth (Taubin steps on the copy that is segmented); bilateral: --bilateral (that copy
 smoothed by bilateral normal filtering instead, which keeps edges sharp); primitives (default plane, cylinder, sphere) and weights (default "area"): as in
 segment. The GIL is released while it works.
@@ -1150,7 +1150,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       [](const py::object& first, const py::object& faces, ClusterCount k,
          std::optional<double> tolerance, std::optional<double> relative_tolerance, int iterations,
          int smoothing_steps, bool bilateral, bool stylize, double max_move,
-         double min_crease_angle, int relabel_passes, double parallel_significance,
+         double min_crease_angle, int relabel_passes, double relation_significance,
          std::optional<double> noise_tolerance_factor, const py::object& primitives,
          const py::object& weights, unsigned threads, bool return_rounds) -> py::object {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
@@ -1167,7 +1167,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         options.max_move_edge_lengths = max_move;
         options.min_crease_angle_degrees = min_crease_angle;
         options.relabel_passes = relabel_passes;
-        options.parallel_significance = parallel_significance;
+        options.relation_significance = relation_significance;
         options.noise_tolerance_factor = noise_tolerance_factor;
         options.smoothing_steps = smoothing_steps;
         if (bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
@@ -1220,7 +1220,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       py::arg("max_move") = DenoiseOptions{}.max_move_edge_lengths,
       py::arg("min_crease_angle") = DenoiseOptions{}.min_crease_angle_degrees,
       py::arg("relabel_passes") = DenoiseOptions{}.relabel_passes,
-      py::arg("parallel_significance") = DenoiseOptions{}.parallel_significance,
+      py::arg("relation_significance") = DenoiseOptions{}.relation_significance,
       py::arg("noise_tolerance_factor") = py::none(), py::arg("primitives") = py::none(),
       py::arg("weights") = py::none(), py::arg("threads") = 0u, py::arg("return_rounds") = false,
       join_docs(
@@ -1230,8 +1230,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
            cpp_doc("DenoiseOptions::min_crease_angle_degrees",
                    doc::denoise__DenoiseOptions__min_crease_angle_degrees),
            cpp_doc("DenoiseOptions::relabel_passes", doc::denoise__DenoiseOptions__relabel_passes),
-           cpp_doc("DenoiseOptions::parallel_significance",
-                   doc::denoise__DenoiseOptions__parallel_significance),
+           cpp_doc("DenoiseOptions::relation_significance",
+                   doc::denoise__DenoiseOptions__relation_significance),
            cpp_doc("DenoiseOptions::noise_tolerance_factor",
                    doc::denoise__DenoiseOptions__noise_tolerance_factor),
            cpp_doc("DenoiseOptions::smoothing_steps",

@@ -216,7 +216,7 @@ void validate(const DenoiseOptions& options) {
   if (options.noise_tolerance_factor &&
       !(*options.noise_tolerance_factor > 0 && std::isfinite(*options.noise_tolerance_factor)))
     throw InvalidInputError("denoise: the noise tolerance factor must be a positive number");
-  if (!(options.parallel_significance >= 0) || !std::isfinite(options.parallel_significance))
+  if (!(options.relation_significance >= 0) || !std::isfinite(options.relation_significance))
     throw InvalidInputError("denoise: the parallel significance must be a non-negative number");
   if (options.relabel_passes < 0)
     throw InvalidInputError("denoise: the relabelling passes must be a non-negative count");
@@ -427,7 +427,7 @@ void Denoiser::regularize(const Segmentation& segmentation,
       keep_inliers(primitives[c], points[c], weights[c], inlier_points[c], inlier_weights[c],
                    floor);
   detail::RegularityOptions regularity;
-  regularity.significance = options_.parallel_significance;
+  regularity.significance = options_.relation_significance;
   detail::regularize(primitives, inlier_points, inlier_weights, regularity);
 }
 
@@ -496,7 +496,7 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
   Segmentation labelled = segmentation;
   relabel(segmented, primitives, labelled);
-  if (options_.parallel_significance > 0 && options_.refit_outlier_threshold > 0)
+  if (options_.relation_significance > 0 && options_.refit_outlier_threshold > 0)
     regularize(labelled, primitives);
 
   SnapReport report;

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -115,72 +116,108 @@ std::optional<Oriented> oriented_cylinder(std::size_t cluster, const Primitive& 
   return item;
 }
 
-// The cylinder with axis direction `axis` nearest to the points (geometric least squares, from
-// the projection of `start`): Gauss–Newton on the circle of the projected points.
-Primitive cylinder_with_axis(const Primitive& start, const Eigen::Vector3d& axis,
-                             std::span<const Vec3> points, std::span<const double> weights) {
+// One cylinder of a coaxial set: its inliers and its radius.
+struct CoaxialMember {
+  std::span<const Vec3> points;
+  std::span<const double> weights;
+  double radius = 0;
+};
+
+struct CoaxialFit {
+  Eigen::Vector2d centre;
+  std::vector<double> radii;
+  std::vector<double> rms;  // per member, unweighted
+  Eigen::Matrix2d centre_covariance = Eigen::Matrix2d::Zero();
+};
+
+std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::Vector2d& centre,
+                                      std::span<const CoaxialMember> members) {
   const auto [u, v] = plane_basis(axis);
-  const Eigen::Vector3d origin = to_eigen(start.point);
-  std::vector<Eigen::Vector2d> q(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3d d = to_eigen(points[i]) - origin;
-    q[i] = {u.dot(d), v.dot(d)};
-  }
-  Eigen::Vector3d x(0, 0, start.radius);  // centre (2D) and radius
-  for (int step = 0; step < 30; ++step) {
-    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
-    for (std::size_t i = 0; i < q.size(); ++i) {
-      const Eigen::Vector2d d = q[i] - x.head<2>();
-      const double length = d.norm();
-      if (!(length > 0)) continue;
-      const Eigen::Vector3d j(-d.x() / length, -d.y() / length, -1);
-      const double e = length - x.z();
-      normal += weights[i] * j * j.transpose();
-      gradient += weights[i] * j * e;
+  const Eigen::Index m = static_cast<Eigen::Index>(members.size());
+  Eigen::VectorXd x(2 + m);
+  x.head<2>() = centre;
+  for (Eigen::Index k = 0; k < m; ++k) x(2 + k) = members[k].radius;
+  auto projected = [&](const Vec3& p) {
+    return Eigen::Vector2d(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
+  };
+  Eigen::MatrixXd normal(2 + m, 2 + m);
+  Eigen::VectorXd gradient(2 + m);
+  std::vector<double> member_squares(m);
+  std::vector<std::size_t> member_count(m);
+  std::size_t count = 0;
+  auto linearise = [&](bool weighted) {
+    normal.setZero();
+    gradient.setZero();
+    double squares = 0;
+    count = 0;
+    for (Eigen::Index k = 0; k < m; ++k) {
+      member_squares[k] = 0;
+      member_count[k] = 0;
+      for (std::size_t i = 0; i < members[k].points.size(); ++i) {
+        const Eigen::Vector2d d = projected(members[k].points[i]) - x.head<2>();
+        const double length = d.norm();
+        if (!(length > 0)) continue;
+        const double w = weighted ? members[k].weights[i] : 1.0;
+        const double e = length - x(2 + k);
+        const Eigen::Vector2d j = -d / length;
+        normal.topLeftCorner<2, 2>() += w * j * j.transpose();
+        normal.block(0, 2 + k, 2, 1) -= w * j;
+        normal(2 + k, 2 + k) += w;
+        gradient.head<2>() += w * j * e;
+        gradient(2 + k) -= w * e;
+        squares += e * e;
+        member_squares[k] += e * e;
+        ++member_count[k];
+        ++count;
+      }
     }
-    const Eigen::Vector3d delta = normal.ldlt().solve(-gradient);
-    if (!delta.allFinite()) break;
+    normal.block(2, 0, m, 2) = normal.block(0, 2, 2, m).transpose();
+    return squares;
+  };
+  for (int step = 0; step < 30; ++step) {
+    linearise(true);
+    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
+    if (!delta.allFinite()) return std::nullopt;
     x += delta;
-    if (!(delta.norm() > 1e-14 * (std::abs(x.z()) + x.head<2>().norm()))) break;
+    if (!(delta.norm() > 1e-14 * x.norm())) break;
   }
-  if (!x.allFinite() || !(x.z() != 0)) return start;
-  Primitive cylinder = start;
-  cylinder.axis = to_vec3(axis.dot(to_eigen(start.axis)) < 0 ? -axis : axis);
-  cylinder.point = to_vec3(origin + x.x() * u + x.y() * v);
-  cylinder.radius = std::abs(x.z());
-  return cylinder;
+  if (!x.allFinite() || !(x.tail(m).minCoeff() > 0)) return std::nullopt;
+  const double squares = linearise(false);
+  if (count <= static_cast<std::size_t>(2 + m)) return std::nullopt;
+  CoaxialFit fit;
+  fit.centre = x.head<2>();
+  fit.radii.assign(x.data() + 2, x.data() + 2 + m);
+  for (Eigen::Index k = 0; k < m; ++k)
+    fit.rms.push_back(
+        std::sqrt(member_squares[k] / double(std::max<std::size_t>(member_count[k], 1))));
+  fit.centre_covariance = normal.inverse().topLeftCorner<2, 2>() *
+                          (squares / static_cast<double>(count - static_cast<std::size_t>(2 + m)));
+  return fit;
 }
 
-}  // namespace
+// A cylinder of a direction group, refitted alone with the group's direction.
+struct AlignedCylinder {
+  std::size_t cluster = 0;
+  CoaxialFit fit;
+};
 
-void regularize(std::vector<Primitive>& primitives, const std::vector<std::vector<Vec3>>& points,
-                const std::vector<std::vector<double>>& weights, const RegularityOptions& options) {
-  std::vector<Oriented> items;
-  for (std::size_t c = 0; c < primitives.size(); ++c) {
-    std::optional<Oriented> item;
-    if (primitives[c].type == PrimitiveType::Plane)
-      item = oriented_plane(c, primitives[c], points[c]);
-    else if (primitives[c].type == PrimitiveType::Cylinder)
-      item = oriented_cylinder(c, primitives[c], points[c]);
-    if (item && std::isfinite(item->variance) && item->variance > 0) items.push_back(*item);
-  }
-  // The best-determined directions first.
+// Visited from the best-determined direction, each joins the group it is within the significance
+// of (the best score), else starts one.
+std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
+                                             const RegularityOptions& options) {
   std::vector<std::size_t> order(items.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return items[a].variance < items[b].variance;
   });
   const double max_angle = options.max_angle_degrees * std::numbers::pi / 180;
-  const double significance2 = options.significance * options.significance;
   std::vector<DirectionGroup> groups;
   for (const std::size_t i : order) {
     const Oriented& item = items[i];
     std::size_t best = groups.size();
-    double best_score = significance2;
+    double best_score = options.significance * options.significance;
     for (std::size_t g = 0; g < groups.size(); ++g) {
-      const double angle = angle_between_lines(item.direction, groups[g].direction);
-      if (angle > max_angle) continue;
+      if (angle_between_lines(item.direction, groups[g].direction) > max_angle) continue;
       Eigen::Vector3d direction = groups[g].direction;
       if (direction.dot(item.direction) < 0) direction = -direction;
       const Eigen::Vector2d delta = item.frame.transpose() * direction;
@@ -203,27 +240,149 @@ void regularize(std::vector<Primitive>& primitives, const std::vector<std::vecto
       group.covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
                           eigen.eigenvalues()(k);
   }
-  for (const DirectionGroup& group : groups) {
+  return groups;
+}
+
+// The plane with normal ±`direction` (its own side) through its inliers' weighted centroid.
+void align_plane(Primitive& plane, const Eigen::Vector3d& direction, std::span<const Vec3> points,
+                 std::span<const double> weights) {
+  double total = 0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    total += weights[k];
+    centroid += weights[k] * to_eigen(points[k]);
+  }
+  if (!(total > 0)) return;
+  plane.axis = to_vec3(direction.dot(to_eigen(plane.axis)) < 0 ? -direction : direction);
+  plane.point = to_vec3(centroid / total);
+}
+
+// Sets of cylinders (indices into `cylinders`, sorted best-located first) whose axes are one line
+// within the significance: each joins the first set whose information-weighted axis it is near.
+// An axis known less well than the radius (a nearly flat cylinder) joins none.
+std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCylinder>& cylinders,
+                                                   double significance2) {
+  std::vector<std::vector<std::size_t>> sets;
+  std::vector<Eigen::Matrix2d> information;
+  std::vector<Eigen::Vector2d> weighted_centre;  // Σ information × centre
+  for (std::size_t k = 0; k < cylinders.size(); ++k) {
+    const CoaxialFit& fit = cylinders[k].fit;
+    std::size_t joined = sets.size();
+    const bool located = std::sqrt(fit.centre_covariance.trace()) < fit.radii[0];
+    for (std::size_t s = 0; located && s < sets.size(); ++s) {
+      const Eigen::Matrix2d covariance = information[s].inverse();
+      const Eigen::Vector2d delta = fit.centre - covariance * weighted_centre[s];
+      if (delta.dot((fit.centre_covariance + covariance).ldlt().solve(delta)) <= significance2) {
+        joined = s;
+        break;
+      }
+    }
+    if (joined == sets.size()) {
+      sets.emplace_back();
+      information.push_back(Eigen::Matrix2d::Zero());
+      weighted_centre.push_back(Eigen::Vector2d::Zero());
+    }
+    sets[joined].push_back(k);
+    information[joined] += fit.centre_covariance.inverse();
+    weighted_centre[joined] += fit.centre_covariance.inverse() * fit.centre;
+  }
+  return sets;
+}
+
+// Refits the cylinders of a direction group: each coaxial set around one axis line (each member
+// keeping its own radius), the others alone with the group's direction.
+void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylinder> cylinders,
+                     double significance2, std::vector<Primitive>& primitives,
+                     const std::vector<std::vector<Vec3>>& points,
+                     const std::vector<std::vector<double>>& weights) {
+  const auto [u, v] = plane_basis(direction);
+  std::stable_sort(cylinders.begin(), cylinders.end(),
+                   [](const AlignedCylinder& a, const AlignedCylinder& b) {
+                     return a.fit.centre_covariance.trace() < b.fit.centre_covariance.trace();
+                   });
+  std::vector<std::vector<std::size_t>> sets = coaxial_sets(cylinders, significance2);
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    CoaxialFit joint;
+    // The joint fit must explain each member as its own fit did, within the significance: a
+    // member whose residual sum rises by more than significance² times its residual variance
+    // (it has 2 degrees of freedom fewer) leaves the set, the worst first.
+    while (sets[s].size() > 1) {
+      std::vector<CoaxialMember> members;
+      Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+      Eigen::Vector2d weighted_centre = Eigen::Vector2d::Zero();
+      for (const std::size_t k : sets[s]) {
+        const std::size_t c = cylinders[k].cluster;
+        members.push_back({points[c], weights[c], cylinders[k].fit.radii[0]});
+        information += cylinders[k].fit.centre_covariance.inverse();
+        weighted_centre += cylinders[k].fit.centre_covariance.inverse() * cylinders[k].fit.centre;
+      }
+      const std::optional<CoaxialFit> fit =
+          fit_coaxial(direction, information.ldlt().solve(weighted_centre), members);
+      std::size_t worst = sets[s].size();
+      double worst_excess = 1;
+      for (std::size_t j = 0; j < sets[s].size(); ++j) {
+        const double own = cylinders[sets[s][j]].fit.rms[0];
+        const double n = static_cast<double>(members[j].points.size());
+        const double rise = fit ? n * (fit->rms[j] * fit->rms[j] - own * own)
+                                : std::numeric_limits<double>::infinity();
+        const double excess = rise / (significance2 * own * own * n / (n - 3));
+        if (excess > worst_excess) {
+          worst_excess = excess;
+          worst = j;
+        }
+      }
+      if (worst == sets[s].size()) {
+        joint = *fit;
+        break;
+      }
+      sets.push_back({sets[s][worst]});
+      sets[s].erase(sets[s].begin() + static_cast<std::ptrdiff_t>(worst));
+    }
+    if (sets[s].size() == 1) joint = cylinders[sets[s][0]].fit;
+    for (std::size_t j = 0; j < sets[s].size(); ++j) {
+      Primitive& cylinder = primitives[cylinders[sets[s][j]].cluster];
+      cylinder.axis = to_vec3(direction.dot(to_eigen(cylinder.axis)) < 0 ? -direction : direction);
+      // The axis point nearest to the old one, so that it stays by the cluster.
+      const Eigen::Vector3d on_axis = joint.centre.x() * u + joint.centre.y() * v;
+      cylinder.point =
+          to_vec3(on_axis + direction * direction.dot(to_eigen(cylinder.point) - on_axis));
+      cylinder.radius = joint.radii[j];
+    }
+  }
+}
+
+}  // namespace
+
+void regularize(std::vector<Primitive>& primitives, const std::vector<std::vector<Vec3>>& points,
+                const std::vector<std::vector<double>>& weights, const RegularityOptions& options) {
+  std::vector<Oriented> items;
+  for (std::size_t c = 0; c < primitives.size(); ++c) {
+    std::optional<Oriented> item;
+    if (primitives[c].type == PrimitiveType::Plane)
+      item = oriented_plane(c, primitives[c], points[c]);
+    else if (primitives[c].type == PrimitiveType::Cylinder)
+      item = oriented_cylinder(c, primitives[c], points[c]);
+    if (item && std::isfinite(item->variance) && item->variance > 0) items.push_back(*item);
+  }
+  for (const DirectionGroup& group : group_directions(items, options)) {
     if (group.members.size() < 2) continue;
+    const auto [u, v] = plane_basis(group.direction);
+    std::vector<AlignedCylinder> cylinders;
     for (const std::size_t i : group.members) {
       const std::size_t c = items[i].cluster;
       Primitive& primitive = primitives[c];
       if (primitive.type == PrimitiveType::Plane) {
-        Eigen::Vector3d direction = group.direction;
-        if (direction.dot(to_eigen(primitive.axis)) < 0) direction = -direction;
-        double total = 0;
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        for (std::size_t k = 0; k < points[c].size(); ++k) {
-          total += weights[c][k];
-          centroid += weights[c][k] * to_eigen(points[c][k]);
-        }
-        if (!(total > 0)) continue;
-        primitive.axis = to_vec3(direction);
-        primitive.point = to_vec3(centroid / total);
-      } else {
-        primitive = cylinder_with_axis(primitive, group.direction, points[c], weights[c]);
+        align_plane(primitive, group.direction, points[c], weights[c]);
+        continue;
       }
+      const CoaxialMember alone{points[c], weights[c], primitive.radius};
+      const Eigen::Vector2d centre(u.dot(to_eigen(primitive.point)),
+                                   v.dot(to_eigen(primitive.point)));
+      if (std::optional<CoaxialFit> fit = fit_coaxial(group.direction, centre, {&alone, 1}))
+        cylinders.push_back({c, std::move(*fit)});
     }
+    align_cylinders(group.direction, std::move(cylinders),
+                    options.significance * options.significance, primitives, points, weights);
   }
 }
 

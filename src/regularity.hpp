@@ -1,7 +1,8 @@
 #pragma once
-// Parallel directions between the primitives of a segmentation, and the refit that makes them
-// exact (after GlobFit, Li et al. 2011): planes' normals and cylinders' axes that agree within
-// their fits' uncertainty share one direction, estimated from all of them.
+// Relations between the primitives of a segmentation, and the refit that makes them exact (after
+// GlobFit, Li et al. 2011): planes' normals and cylinders' axes that agree within their fits'
+// uncertainty share one direction, estimated from all of them, and cylinders of one direction
+// whose axes agree share one axis line.
 
 #include <vector>
 
@@ -20,9 +21,10 @@ struct RegularityOptions {
 /// Groups the directions of `primitives` (plane normals, cylinder axes; other types are left as
 /// they are) and refits every member of a group of two or more with the group's direction: a
 /// plane through its inliers' weighted centroid, a cylinder by geometric least squares of its
-/// inliers' circle. points[c] and weights[c] are cluster c's inlier vertices (input units) and
-/// their weights; a cluster with too few to estimate its direction's uncertainty is left alone.
-/// Deterministic: clusters are visited by increasing uncertainty, ties by index.
+/// inliers' circle, jointly with the cylinders coaxial with it (one axis line, one radius each).
+/// points[c] and weights[c] are cluster c's inlier vertices (input units) and their weights; a
+/// cluster with too few to estimate its direction's uncertainty is left alone. Deterministic:
+/// clusters are visited by increasing uncertainty, ties by index.
 void regularize(std::vector<Primitive>& primitives, const std::vector<std::vector<Vec3>>& points,
                 const std::vector<std::vector<double>>& weights, const RegularityOptions& options);
 

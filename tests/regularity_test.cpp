@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -162,6 +163,81 @@ TEST(Regularity, ClustersTooSmallToMeasureTheirUncertaintyAreLeftAlone) {
   regularize(planes, clusters);
   EXPECT_EQ(planes[0].axis, fitted[0].axis);
   EXPECT_EQ(planes[1].axis, fitted[1].axis);
+}
+
+Primitive fitted_cylinder(const Cluster& cluster, const Eigen::Vector3d& axis,
+                          const Eigen::Vector3d& point, double radius) {
+  Primitive start;
+  start.type = PrimitiveType::Cylinder;
+  start.point = to_vec3(point);
+  start.axis = to_vec3(axis);
+  start.radius = radius;
+  return fit_geometric(start, cluster.points, cluster.weights).primitive;
+}
+
+// Distance between the axis lines of two cylinders with parallel axes.
+double axis_offset(const Primitive& a, const Primitive& b) {
+  const Eigen::Vector3d axis = to_eigen(a.axis).normalized();
+  const Eigen::Vector3d d = to_eigen(b.point) - to_eigen(a.point);
+  return (d - d.dot(axis) * axis).norm();
+}
+
+TEST(Regularity, ASteppedShaftSharesOneAxisLine) {
+  // Two cylinders of radii 0.5 and 0.3 end to end on the z axis, with a cap between them.
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  std::mt19937_64 rng(11);
+  const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.5, 1, 0.005, rng),
+                                      noisy_cylinder(z, {0, 0, 1}, 0.3, 1, 0.005, rng),
+                                      noisy_plane(z, {0, 0, 0.5}, 0.5, 0.005, rng)};
+  std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.5),
+                                    fitted_cylinder(clusters[1], z, {0, 0, 1}, 0.3),
+                                    fitted_plane(clusters[2])};
+  const double offset_before = axis_offset(primitives[0], primitives[1]);
+  regularize(primitives, clusters);
+  std::printf("stepped shaft: axes %.2g apart before, %.2g after\n", offset_before,
+              axis_offset(primitives[0], primitives[1]));
+  EXPECT_GT(offset_before, 1e-4);
+  EXPECT_NEAR(angle_between_lines(primitives[0].axis, primitives[1].axis), 0, 1e-12);
+  EXPECT_LT(axis_offset(primitives[0], primitives[1]), 1e-12);
+  EXPECT_LT(axis_offset(primitives[0], Primitive{PrimitiveType::Cylinder, {0, 0, 0}, {0, 0, 1}}),
+            0.002);
+  EXPECT_NEAR(primitives[0].radius, 0.5, 0.002);
+  EXPECT_NEAR(primitives[1].radius, 0.3, 0.002);
+  // Each axis point stays by its own cluster.
+  EXPECT_NEAR(primitives[0].point[2], 0, 0.1);
+  EXPECT_NEAR(primitives[1].point[2], 1, 0.1);
+}
+
+TEST(Regularity, ParallelHolesApartStayOnTheirOwnAxes) {
+  // Two holes of one plate 0.05 apart (ten times the noise): parallel, not coaxial.
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  std::mt19937_64 rng(13);
+  const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.2, 1, 0.005, rng),
+                                      noisy_cylinder(z, {0.45, 0, 0}, 0.2, 1, 0.005, rng)};
+  std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.2),
+                                    fitted_cylinder(clusters[1], z, {0.45, 0, 0}, 0.2)};
+  regularize(primitives, clusters);
+  EXPECT_NEAR(angle_between_lines(primitives[0].axis, primitives[1].axis), 0, 1e-12);
+  EXPECT_NEAR(axis_offset(primitives[0], primitives[1]), 0.45, 0.002);
+}
+
+TEST(Regularity, ANearlyFlatCylinderJoinsNoAxis) {
+  // A cylinder of radius 50 over a patch of width 1 is a plane to the noise: its axis could be
+  // anywhere along its normal, and it must not be pulled onto the shaft's.
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  std::mt19937_64 rng(17);
+  const std::vector<Cluster> clusters{
+      noisy_cylinder(z, {0, 0, 0}, 0.5, 1, 0.005, rng),
+      noisy_plane(Eigen::Vector3d::UnitX(), {2, 0, 0}, 1, 0.005, rng)};
+  Primitive flat;
+  flat.type = PrimitiveType::Cylinder;
+  flat.point = {-48, 0, 0};
+  flat.axis = {0, 0, 1};
+  flat.radius = 50;
+  std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.5), flat};
+  regularize(primitives, clusters);
+  EXPECT_NEAR(primitives[0].radius, 0.5, 0.002);
+  EXPECT_GT(primitives[1].radius, 10);
 }
 
 }  // namespace

@@ -178,7 +178,7 @@ def test_denoise_argument_errors():
             primseg.denoise(mesh, relabel_passes=bad)
     for option in ({"max_move": 0.0}, {"max_move": float("nan")}, {"min_crease_angle": 90.0},
                    {"min_crease_angle": -1.0}, {"smoothing_steps": -1},
-                   {"parallel_significance": -1.0}, {"parallel_significance": float("inf")},
+                   {"relation_significance": -1.0}, {"relation_significance": float("inf")},
                    {"k": "auto", "noise_tolerance_factor": 0.0}):
         with pytest.raises(ValueError):
             primseg.denoise(mesh, **option)

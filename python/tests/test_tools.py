@@ -48,9 +48,9 @@ def man_skeleton(man):
      (("--clusters", "30", "--max-move", "1.5", "--min-crease-angle", "25"),
       {"k": 30, "max_move": 1.5, "min_crease_angle": 25.0}),
      (("--clusters", "30", "--relabel-passes", "0"), {"k": 30, "relabel_passes": 0}),
-     (("--clusters", "30", "--parallel-significance", "0"), {"k": 30, "parallel_significance": 0}),
-     (("--clusters", "auto", "--bilateral", "--parallel-significance", "1.5"),
-      {"k": "auto", "bilateral": True, "parallel_significance": 1.5}),
+     (("--clusters", "30", "--relation-significance", "0"), {"k": 30, "relation_significance": 0}),
+     (("--clusters", "auto", "--bilateral", "--relation-significance", "1.5"),
+      {"k": "auto", "bilateral": True, "relation_significance": 1.5}),
      (("--clusters", "auto", "--noise-factor", "2"), {"k": "auto", "noise_tolerance_factor": 2.0})])
 def test_denoise_matches_the_cli(cli, noisy_fandisk, tmp_path, cli_options, python_options):
     run_cli(cli, "denoise", noisy_fandisk, *cli_options, "-o", tmp_path / "out.off",

@@ -188,7 +188,7 @@ TEST(Denoise, SnappingOntoTheTrueSurfacesReachesTheLeastSquaresFloor) {
       const Segmentation regions = cut_by_count(truth, surfaces);
       // Independent primitives: the floor counts every primitive's own parameters.
       DenoiseOptions independent;
-      independent.parallel_significance = 0;
+      independent.relation_significance = 0;
       Denoiser denoiser(shape.noisy.mesh, independent);
       denoiser.snap(truth, regions);
 
@@ -207,15 +207,15 @@ TEST(Denoise, SnappingOntoTheTrueSurfacesReachesTheLeastSquaresFloor) {
       EXPECT_LE(before.rms / after.rms, 1.05 * bound);
       EXPECT_GE(before.rms / after.rms, 0.85 * bound);
 
-      // Parallel directions shared (the default): the box's opposite faces, the cylinder and its
-      // caps. Fewer parameters leave less noise: below the independent floor, the finer meshes
+      // Relations shared (the default): the box's opposite faces, the cylinder and its caps are
+      // parallel. Fewer parameters leave less noise: below the independent floor, the finer meshes
       // by far (measured: box 6.72x and 17.1x, cylinder 6.92x and 23.9x).
       Denoiser parallel(shape.noisy.mesh);
       parallel.snap(truth, regions);
       const MeshDistance shared =
           mesh_distance(parallel.mesh(), shape.clean.mesh, measure_options());
-      std::printf("%s, edges %.2f, parallel directions shared: RMS %.2fx lower\n", name.c_str(),
-                  edge_length, before.rms / shared.rms);
+      std::printf("%s, edges %.2f, relations shared: RMS %.2fx lower\n", name.c_str(), edge_length,
+                  before.rms / shared.rms);
       EXPECT_GE(after.rms / shared.rms, edge_length < 0.03 ? 1.3 : 1.05);
       EXPECT_EQ(testing::inverted_triangles(shape.noisy.mesh, parallel.mesh()), 0u);
     }
@@ -355,7 +355,7 @@ TEST(Denoise, NearlyParallelPrimitivesAreAveragedNotIntersected) {
   auto largest_move = [&](DenoiseOptions options) {
     options.relabel_passes = 0;
     // Made parallel, the two fits would have no far intersection to guard against.
-    options.parallel_significance = 0;
+    options.relation_significance = 0;
     Denoiser denoiser(box.mesh, options);
     const SnapReport report = denoiser.iterate(level_by_count(14));
     return report.max_move;
@@ -524,10 +524,10 @@ TEST(Denoise, RejectsBadOptionsAndAMismatchedHierarchy) {
          o.bilateral_smoothing = BilateralSmoothingOptions{};
        }},
       {"relabel passes -1", [](DenoiseOptions& o) { o.relabel_passes = -1; }},
-      {"parallel significance -1", [](DenoiseOptions& o) { o.parallel_significance = -1; }},
+      {"parallel significance -1", [](DenoiseOptions& o) { o.relation_significance = -1; }},
       {"parallel significance infinite",
        [](DenoiseOptions& o) {
-         o.parallel_significance = std::numeric_limits<double>::infinity();
+         o.relation_significance = std::numeric_limits<double>::infinity();
        }},
       {"solver steps 0", [](DenoiseOptions& o) { o.max_solver_steps = 0; }},
       {"max move NaN",
@@ -547,7 +547,7 @@ TEST(Denoise, RejectsBadOptionsAndAMismatchedHierarchy) {
   options.smoothing_steps = 0;
   options.refit_outlier_threshold = 0;
   options.min_crease_angle_degrees = 0;
-  options.parallel_significance = 0;
+  options.relation_significance = 0;
   EXPECT_NO_THROW(validate(options));
 
   Denoiser denoiser(box.noisy.mesh);

@@ -115,12 +115,12 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     // snapped onto the clean mesh's own level of 30 clusters (129 parameters for 6,475
     // vertices), the vertices reach the floor (0.96 floors) and the RMS drops 5.5x (seed 7:
     // 5.3x) against a bound of 5.0x. Each cluster more costs 3 to 5 parameters, each surface
-    // missed costs bias; a noisy segmentation has both. Parallel directions shared between
-    // primitives (the default) spend fewer: 6.1x.
+    // missed costs bias; a noisy segmentation has both. Relations between the primitives (the
+    // default: parallel directions, coaxial cylinders) spend fewer: 6.3x.
     const Hierarchy truth = build_hierarchy(std::make_shared<const Mesh>(clean));
     const Segmentation level = cut_by_count(truth, 30);
     DenoiseOptions independent;
-    independent.parallel_significance = 0;
+    independent.relation_significance = 0;
     Denoiser denoiser(noisy, independent);
     denoiser.snap(truth, level);
     const double floor = testing::least_squares_floor(truth, level, sigma);
@@ -133,12 +133,12 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     EXPECT_GE(before.rms / after.rms, 5.0);
     EXPECT_LE(before.rms / after.rms, 6.0);
 
-    Denoiser parallel(noisy);
-    parallel.snap(truth, level);
-    const MeshDistance shared = mesh_distance(parallel.mesh(), clean, measure);
+    Denoiser related(noisy);
+    related.snap(truth, level);
+    const MeshDistance shared = mesh_distance(related.mesh(), clean, measure);
     std::printf("%8s %12.4g %12.4g %8.2f %12s %8.2f\n", "clean 30", shared.rms, shared.hausdorff,
-                before.rms / shared.rms, "parallel", before.hausdorff / shared.hausdorff);
-    EXPECT_GE(before.rms / shared.rms, 1.05 * before.rms / after.rms);  // measured 1.11
+                before.rms / shared.rms, "relations", before.hausdorff / shared.hausdorff);
+    EXPECT_GE(before.rms / shared.rms, 1.1 * before.rms / after.rms);  // measured 1.15
   }
   {
     // Stylization keeps the segmentation's automatic level: the knee, few clusters.
