@@ -132,7 +132,10 @@ struct CoaxialFit {
 
 std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::Vector2d& centre,
                                       std::span<const CoaxialMember> members) {
-  const auto [u, v] = plane_basis(axis);
+  // Named, not bound: a lambda below reads them (clang 14 cannot capture structured bindings).
+  const std::pair<Eigen::Vector3d, Eigen::Vector3d> basis = plane_basis(axis);
+  const Eigen::Vector3d& u = basis.first;
+  const Eigen::Vector3d& v = basis.second;
   const Eigen::Index m = static_cast<Eigen::Index>(members.size());
   Eigen::VectorXd x(2 + m);
   x.head<2>() = centre;
@@ -192,6 +195,7 @@ std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::
         std::sqrt(member_squares[k] / double(std::max<std::size_t>(member_count[k], 1))));
   fit.centre_covariance = normal.inverse().topLeftCorner<2, 2>() *
                           (squares / static_cast<double>(count - static_cast<std::size_t>(2 + m)));
+  if (!fit.centre_covariance.allFinite()) return std::nullopt;
   return fit;
 }
 
@@ -279,8 +283,8 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
     }
     if (joined == sets.size()) {
       sets.emplace_back();
-      information.push_back(Eigen::Matrix2d::Zero());
-      weighted_centre.push_back(Eigen::Vector2d::Zero());
+      information.emplace_back(Eigen::Matrix2d::Zero());
+      weighted_centre.emplace_back(Eigen::Vector2d::Zero());
     }
     sets[joined].push_back(k);
     information[joined] += fit.centre_covariance.inverse();

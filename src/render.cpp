@@ -8,6 +8,7 @@
 
 #include "file_io.hpp"
 #include "primseg/error.hpp"
+#include "shape_generator/vector_math.hpp"
 
 namespace primseg {
 namespace {
@@ -40,12 +41,9 @@ constexpr double kEdgeDarkening = 0.3;
 // darkens its own side, so interior lines come out one pixel wide.
 constexpr double kEdgeHalfWidthPixels = 0.5;
 
-double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
+// The shape generator's (a unity build may put both files in one translation unit).
+using shape_detail::cross;
+using shape_detail::dot;
 Vec3 subtract(const Vec3& a, const Vec3& b) {
   return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
 }
