@@ -197,6 +197,26 @@ std::optional<Primitive> fit_curved(const Primitive& start, std::span<const Vec3
   return fit.primitive;
 }
 
+// A cluster's inliers: its vertices within `threshold` robust deviations (1.4826 × the median
+// distance, at least `floor`) of the primitive.
+void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
+                  std::span<const double> weights, double threshold, double floor,
+                  std::vector<Vec3>& kept_points, std::vector<double>& kept_weights) {
+  std::vector<double> residuals;
+  residuals.reserve(points.size());
+  for (const Vec3& p : points) residuals.push_back(primitive.distance(p));
+  std::vector<double> sorted = residuals;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit = std::max(threshold * 1.4826 * sorted[sorted.size() / 2], floor);
+  kept_points.clear();
+  kept_weights.clear();
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (residuals[i] <= limit) {
+      kept_points.push_back(points[i]);
+      kept_weights.push_back(weights[i]);
+    }
+}
+
 }  // namespace
 
 void validate(const DenoiseOptions& options) {
@@ -217,7 +237,7 @@ void validate(const DenoiseOptions& options) {
       !(*options.noise_tolerance_factor > 0 && std::isfinite(*options.noise_tolerance_factor)))
     throw InvalidInputError("denoise: the noise tolerance factor must be a positive number");
   if (!(options.relation_significance >= 0) || !std::isfinite(options.relation_significance))
-    throw InvalidInputError("denoise: the parallel significance must be a non-negative number");
+    throw InvalidInputError("denoise: the relation significance must be a non-negative number");
   if (options.relabel_passes < 0)
     throw InvalidInputError("denoise: the relabelling passes must be a non-negative count");
   if (options.max_solver_steps < 1)
@@ -368,27 +388,6 @@ void Denoiser::cluster_vertices(const Segmentation& segmentation, std::size_t cl
   }
 }
 
-void Denoiser::keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
-                            std::span<const double> weights, std::vector<Vec3>& kept_points,
-                            std::vector<double>& kept_weights, double floor) const {
-  // Inliers: residual within the threshold times the robust deviation (1.4826 MAD) of all the
-  // cluster's vertices from the current fit.
-  std::vector<double> residuals;
-  residuals.reserve(points.size());
-  for (const Vec3& p : points) residuals.push_back(primitive.distance(p));
-  std::vector<double> sorted = residuals;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double limit =
-      std::max(options_.refit_outlier_threshold * 1.4826 * sorted[sorted.size() / 2], floor);
-  kept_points.clear();
-  kept_weights.clear();
-  for (std::size_t i = 0; i < points.size(); ++i)
-    if (residuals[i] <= limit) {
-      kept_points.push_back(points[i]);
-      kept_weights.push_back(weights[i]);
-    }
-}
-
 void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const {
   std::vector<std::vector<Vec3>> points;
   std::vector<std::vector<double>> weights;
@@ -404,7 +403,8 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
     std::vector<double> kept_weights;
     constexpr int kRounds = 3;
     for (int round = 0; round < kRounds; ++round) {
-      keep_inliers(current, points[c], weights[c], kept_points, kept_weights, floor);
+      keep_inliers(current, points[c], weights[c], options_.refit_outlier_threshold, floor,
+                   kept_points, kept_weights);
       const std::optional<Primitive> refit =
           type == PrimitiveType::Plane
               ? fit_plane(kept_points, kept_weights, to_eigen(current.axis))
@@ -424,8 +424,8 @@ void Denoiser::regularize(const Segmentation& segmentation,
   const double floor = 1e-12 * bounding_box_diagonal(mesh_);
   for (std::size_t c = 0; c < primitives.size(); ++c)
     if (!points[c].empty())
-      keep_inliers(primitives[c], points[c], weights[c], inlier_points[c], inlier_weights[c],
-                   floor);
+      keep_inliers(primitives[c], points[c], weights[c], options_.refit_outlier_threshold, floor,
+                   inlier_points[c], inlier_weights[c]);
   detail::RegularityOptions regularity;
   regularity.significance = options_.relation_significance;
   detail::regularize(primitives, inlier_points, inlier_weights, regularity);

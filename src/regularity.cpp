@@ -49,8 +49,7 @@ double angle_between_lines(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), std::abs(a.dot(b)));
 }
 
-std::optional<Oriented> oriented_plane(std::size_t cluster, const Primitive& plane,
-                                       std::span<const Vec3> points) {
+std::optional<Oriented> oriented_plane(std::size_t cluster, std::span<const Vec3> points) {
   const std::size_t n = points.size();
   if (n < 6) return std::nullopt;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -58,13 +57,16 @@ std::optional<Oriented> oriented_plane(std::size_t cluster, const Primitive& pla
   centroid /= static_cast<double>(n);
   Oriented item;
   item.cluster = cluster;
-  item.direction = to_eigen(plane.axis).normalized();
-  Eigen::Matrix3d plain = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d e = to_eigen(points[i]) - centroid;
-    plain += e * e.transpose();
+  // The unweighted least-squares plane's: its tilt has variance σ̂²/λ along each in-plane
+  // eigenvector of the scatter S (eigenvalue λ), and Σ Fᵢ Cᵢ⁻¹ Fᵢᵀ over a group of planes is their
+  // summed scatter (less the residual terms), whose smallest eigenvector is their joint normal.
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : points) {
+    const Eigen::Vector3d e = to_eigen(p) - centroid;
+    scatter += e * e.transpose();
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(plain);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+  item.direction = eigen.eigenvectors().col(0);
   const double residual_variance = std::max(eigen.eigenvalues()(0), 0.0) / double(n - 3);
   if (!(eigen.eigenvalues()(1) > 0)) return std::nullopt;
   item.frame.col(0) = eigen.eigenvectors().col(1);
@@ -88,7 +90,7 @@ std::optional<Oriented> oriented_cylinder(std::size_t cluster, const Primitive& 
   item.frame.col(0) = u;
   item.frame.col(1) = v;
   // Information of the parameters (tilt along u and v times the radius, so that every column is
-  // in the same units and the tree does not depend on them; shift of the axis along u and v;
+  // in the same units and the result does not depend on them; shift of the axis along u and v;
   // radius) from the residuals' Jacobian: e = |Q(x − p)| − r, Q = I − a aᵀ.
   const double radius = cylinder.radius;
   if (!(radius > 0)) return std::nullopt;
@@ -363,7 +365,7 @@ void regularize(std::vector<Primitive>& primitives, const std::vector<std::vecto
   for (std::size_t c = 0; c < primitives.size(); ++c) {
     std::optional<Oriented> item;
     if (primitives[c].type == PrimitiveType::Plane)
-      item = oriented_plane(c, primitives[c], points[c]);
+      item = oriented_plane(c, points[c]);
     else if (primitives[c].type == PrimitiveType::Cylinder)
       item = oriented_cylinder(c, primitives[c], points[c]);
     if (item && std::isfinite(item->variance) && item->variance > 0) items.push_back(*item);

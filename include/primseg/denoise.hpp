@@ -16,7 +16,6 @@
 #include <functional>
 #include <memory>
 #include <optional>
-#include <span>
 #include <vector>
 
 #include "primseg/auto_level.hpp"
@@ -193,9 +192,7 @@ class Denoiser {
   void cluster_vertices(const Segmentation& segmentation, std::size_t cluster_count,
                         std::vector<std::vector<Vec3>>& points,
                         std::vector<std::vector<double>>& weights) const;
-  void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
-                    std::span<const double> weights, std::vector<Vec3>& kept_points,
-                    std::vector<double>& kept_weights, double floor) const;
+  // Makes the relations the fits agree with exact (DenoiseOptions::relation_significance).
   void regularize(const Segmentation& segmentation, std::vector<Primitive>& primitives) const;
   // Moves faces to the nearest primitive of their neighbourhood, judged on `judged`'s positions
   // (see DenoiseOptions::relabel_passes), and refits.
