@@ -8,6 +8,7 @@
 
 #include "eigen_conversions.hpp"
 #include "geometric_models.hpp"
+#include "orthonormal_pair.hpp"
 #include "primseg/error.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
 #include "small_cholesky.hpp"
@@ -15,14 +16,6 @@
 namespace primseg {
 namespace detail {
 namespace {
-
-// A unit vector orthogonal to the unit vector a, and a third completing a right-handed frame.
-std::pair<Eigen::Vector3d, Eigen::Vector3d> orthonormal_pair(const Eigen::Vector3d& a) {
-  Eigen::Index least;
-  a.cwiseAbs().minCoeff(&least);
-  const Eigen::Vector3d u = a.cross(Eigen::Vector3d::Unit(least)).normalized();
-  return {u, a.cross(u)};
-}
 
 // Parameters: the normal tilted by (α, β) along its two orthogonal directions, the plane
 // shifted by δ along the normal.

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "eigen_conversions.hpp"
+#include "orthonormal_pair.hpp"
 
 namespace primseg::detail {
 namespace {
@@ -36,14 +37,6 @@ struct DirectionGroup {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of the direction's tilt
   std::vector<std::size_t> members;                      // indices into the Oriented items
 };
-
-// An orthonormal basis (u, v) of the plane orthogonal to the unit vector `axis`.
-std::pair<Eigen::Vector3d, Eigen::Vector3d> plane_basis(const Eigen::Vector3d& axis) {
-  Eigen::Index least_aligned;
-  axis.cwiseAbs().minCoeff(&least_aligned);
-  const Eigen::Vector3d u = axis.cross(Eigen::Vector3d::Unit(least_aligned)).normalized();
-  return {u, axis.cross(u)};
-}
 
 double angle_between_lines(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), std::abs(a.dot(b)));
@@ -85,7 +78,7 @@ std::optional<Oriented> oriented_cylinder(std::size_t cluster, const Primitive& 
   Oriented item;
   item.cluster = cluster;
   const Eigen::Vector3d a = to_eigen(cylinder.axis).normalized(), p = to_eigen(cylinder.point);
-  const auto [u, v] = plane_basis(a);
+  const auto [u, v] = orthonormal_pair(a);
   item.direction = a;
   item.frame.col(0) = u;
   item.frame.col(1) = v;
@@ -134,17 +127,16 @@ struct CoaxialFit {
 
 std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::Vector2d& centre,
                                       std::span<const CoaxialMember> members) {
-  // Named, not bound: a lambda below reads them (clang 14 cannot capture structured bindings).
-  const std::pair<Eigen::Vector3d, Eigen::Vector3d> basis = plane_basis(axis);
-  const Eigen::Vector3d& u = basis.first;
-  const Eigen::Vector3d& v = basis.second;
   const Eigen::Index m = static_cast<Eigen::Index>(members.size());
   Eigen::VectorXd x(2 + m);
   x.head<2>() = centre;
   for (Eigen::Index k = 0; k < m; ++k) x(2 + k) = members[k].radius;
-  auto projected = [&](const Vec3& p) {
-    return Eigen::Vector2d(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
-  };
+  // The points in the plane orthogonal to the axis, once for every iteration.
+  const auto [u, v] = orthonormal_pair(axis);
+  std::vector<std::vector<Eigen::Vector2d>> projected(members.size());
+  for (std::size_t k = 0; k < members.size(); ++k)
+    for (const Vec3& p : members[k].points)
+      projected[k].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
   Eigen::MatrixXd normal(2 + m, 2 + m);
   Eigen::VectorXd gradient(2 + m);
   std::vector<double> member_squares(m);
@@ -158,8 +150,8 @@ std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::
     for (Eigen::Index k = 0; k < m; ++k) {
       member_squares[k] = 0;
       member_count[k] = 0;
-      for (std::size_t i = 0; i < members[k].points.size(); ++i) {
-        const Eigen::Vector2d d = projected(members[k].points[i]) - x.head<2>();
+      for (std::size_t i = 0; i < projected[k].size(); ++i) {
+        const Eigen::Vector2d d = projected[k][i] - x.head<2>();
         const double length = d.norm();
         if (!(length > 0)) continue;
         const double w = weighted ? members[k].weights[i] : 1.0;
@@ -205,6 +197,19 @@ std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::
 struct AlignedCylinder {
   std::size_t cluster = 0;
   CoaxialFit fit;
+};
+
+// The information-weighted mean of axis positions: where a coaxial set's axis is, and how well.
+struct PooledCentre {
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d weighted = Eigen::Vector2d::Zero();  // Σ information × centre
+
+  void add(const CoaxialFit& fit) {
+    const Eigen::Matrix2d own = fit.centre_covariance.inverse();
+    information += own;
+    weighted += own * fit.centre;
+  }
+  Eigen::Vector2d centre() const { return information.ldlt().solve(weighted); }
 };
 
 // Visited from the best-determined direction, each joins the group it is within the significance
@@ -269,15 +274,14 @@ void align_plane(Primitive& plane, const Eigen::Vector3d& direction, std::span<c
 std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCylinder>& cylinders,
                                                    double significance2) {
   std::vector<std::vector<std::size_t>> sets;
-  std::vector<Eigen::Matrix2d> information;
-  std::vector<Eigen::Vector2d> weighted_centre;  // Σ information × centre
+  std::vector<PooledCentre> pooled;
   for (std::size_t k = 0; k < cylinders.size(); ++k) {
     const CoaxialFit& fit = cylinders[k].fit;
     std::size_t joined = sets.size();
     const bool located = std::sqrt(fit.centre_covariance.trace()) < fit.radii[0];
     for (std::size_t s = 0; located && s < sets.size(); ++s) {
-      const Eigen::Matrix2d covariance = information[s].inverse();
-      const Eigen::Vector2d delta = fit.centre - covariance * weighted_centre[s];
+      const Eigen::Matrix2d covariance = pooled[s].information.inverse();
+      const Eigen::Vector2d delta = fit.centre - covariance * pooled[s].weighted;
       if (delta.dot((fit.centre_covariance + covariance).ldlt().solve(delta)) <= significance2) {
         joined = s;
         break;
@@ -285,12 +289,10 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
     }
     if (joined == sets.size()) {
       sets.emplace_back();
-      information.emplace_back(Eigen::Matrix2d::Zero());
-      weighted_centre.emplace_back(Eigen::Vector2d::Zero());
+      pooled.emplace_back();
     }
     sets[joined].push_back(k);
-    information[joined] += fit.centre_covariance.inverse();
-    weighted_centre[joined] += fit.centre_covariance.inverse() * fit.centre;
+    pooled[joined].add(fit);
   }
   return sets;
 }
@@ -301,7 +303,7 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
                      double significance2, std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights) {
-  const auto [u, v] = plane_basis(direction);
+  const auto [u, v] = orthonormal_pair(direction);
   std::stable_sort(cylinders.begin(), cylinders.end(),
                    [](const AlignedCylinder& a, const AlignedCylinder& b) {
                      return a.fit.centre_covariance.trace() < b.fit.centre_covariance.trace();
@@ -314,16 +316,13 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
     // (it has 2 degrees of freedom fewer) leaves the set, the worst first.
     while (sets[s].size() > 1) {
       std::vector<CoaxialMember> members;
-      Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
-      Eigen::Vector2d weighted_centre = Eigen::Vector2d::Zero();
+      PooledCentre pooled;
       for (const std::size_t k : sets[s]) {
         const std::size_t c = cylinders[k].cluster;
         members.push_back({points[c], weights[c], cylinders[k].fit.radii[0]});
-        information += cylinders[k].fit.centre_covariance.inverse();
-        weighted_centre += cylinders[k].fit.centre_covariance.inverse() * cylinders[k].fit.centre;
+        pooled.add(cylinders[k].fit);
       }
-      const std::optional<CoaxialFit> fit =
-          fit_coaxial(direction, information.ldlt().solve(weighted_centre), members);
+      const std::optional<CoaxialFit> fit = fit_coaxial(direction, pooled.centre(), members);
       std::size_t worst = sets[s].size();
       double worst_excess = 1;
       for (std::size_t j = 0; j < sets[s].size(); ++j) {
@@ -372,7 +371,7 @@ void regularize(std::vector<Primitive>& primitives, const std::vector<std::vecto
   }
   for (const DirectionGroup& group : group_directions(items, options)) {
     if (group.members.size() < 2) continue;
-    const auto [u, v] = plane_basis(group.direction);
+    const auto [u, v] = orthonormal_pair(group.direction);
     std::vector<AlignedCylinder> cylinders;
     for (const std::size_t i : group.members) {
       const std::size_t c = items[i].cluster;

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "orthonormal_pair.hpp"
 #include "primitives/pratt_fit.hpp"
 #include "symmetric_eigen3.hpp"
 
@@ -38,10 +39,7 @@ PrimitiveFit CylinderFitter::fit(const ClusterView& cluster, double error_to_bea
   const Eigen::Vector3d axis = canonical_axis(dominant.vector);
 
   // Orthonormal basis (u, v) of the plane orthogonal to the axis.
-  Eigen::Index least_aligned;
-  axis.cwiseAbs().minCoeff(&least_aligned);
-  const Eigen::Vector3d u = axis.cross(Eigen::Vector3d::Unit(least_aligned)).normalized();
-  const Eigen::Vector3d v = axis.cross(u);
+  const auto [u, v] = detail::orthonormal_pair(axis);
   Eigen::Matrix<double, 2, 3> basis;
   basis.row(0) = u.transpose();
   basis.row(1) = v.transpose();
