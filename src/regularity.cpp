@@ -210,6 +210,7 @@ struct PooledCentre {
     weighted += own * fit.centre;
   }
   Eigen::Vector2d centre() const { return information.ldlt().solve(weighted); }
+  Eigen::Matrix2d covariance() const { return information.inverse(); }
 };
 
 // Visited from the best-determined direction, each joins the group it is within the significance
@@ -280,7 +281,7 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
     std::size_t joined = sets.size();
     const bool located = std::sqrt(fit.centre_covariance.trace()) < fit.radii[0];
     for (std::size_t s = 0; located && s < sets.size(); ++s) {
-      const Eigen::Matrix2d covariance = pooled[s].information.inverse();
+      const Eigen::Matrix2d covariance = pooled[s].covariance();
       const Eigen::Vector2d delta = fit.centre - covariance * pooled[s].weighted;
       if (delta.dot((fit.centre_covariance + covariance).ldlt().solve(delta)) <= significance2) {
         joined = s;
