@@ -9,6 +9,7 @@
 
 #include "eigen_conversions.hpp"
 #include "parallel.hpp"
+#include "primseg/dual_graph.hpp"
 #include "primseg/error.hpp"
 #include "vertex_triangles.hpp"
 
@@ -54,6 +55,14 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
   const VertexTriangles around = vertex_triangles(mesh);
   const std::vector<std::vector<std::uint32_t>> rings = face_neighbourhoods(mesh, around);
 
+  // Normals are compared with the triangles consistently oriented, as the dual graph orients them:
+  // files often list faces with mixed orientations, and a flipped neighbour would not average
+  // with a face of the same plane, while one across a sharp wedge would look nearly parallel.
+  std::vector<std::uint8_t> flipped(face_count);
+  {
+    const DualGraph graph(mesh, VertexWeights::Area, options.threads);
+    for (std::uint32_t t = 0; t < face_count; ++t) flipped[t] = graph.flipped(t) ? 1 : 0;
+  }
   std::vector<Eigen::Vector3d> centroids(face_count), normals(face_count);
   std::vector<double> areas(face_count);
   const auto update_geometry = [&] {
@@ -62,7 +71,7 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
       const Eigen::Vector3d a = to_eigen(smoothed.positions[c[0]]),
                             b = to_eigen(smoothed.positions[c[1]]),
                             d = to_eigen(smoothed.positions[c[2]]);
-      const Eigen::Vector3d cross = (b - a).cross(d - a);
+      const Eigen::Vector3d cross = flipped[t] ? (d - a).cross(b - a) : (b - a).cross(d - a);
       centroids[t] = (a + b + d) / 3;
       areas[t] = cross.norm() / 2;
       normals[t] = areas[t] > 0 ? Eigen::Vector3d(cross.normalized()) : Eigen::Vector3d::Zero();

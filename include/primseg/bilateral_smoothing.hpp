@@ -38,8 +38,10 @@ struct BilateralSmoothingOptions {
 /// Throws InvalidInputError for options out of range.
 void validate(const BilateralSmoothingOptions& options);
 
-/// A copy of `mesh` with the positions smoothed; same vertices, triangles and order. Faces of
-/// zero area keep no normal and take no part in the filtering. Deterministic; O((normal_iterations
+/// A copy of `mesh` with the positions smoothed; same vertices, triangles and order. Normals are
+/// compared with the triangles consistently oriented, as DualGraph orients them, so the result
+/// does not depend on how the file orients its faces (up to round-off). Faces of zero area keep
+/// no normal and take no part in the filtering. Deterministic; O((normal_iterations
 /// + vertex_iterations) × Σ ring sizes). Throws InvalidInputError for invalid options or a mesh
 /// that fails Mesh::validate().
 Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options = {});
