@@ -14,6 +14,12 @@ namespace {
 // are not enough for the right-hand line.
 constexpr std::size_t kMinKneeRange = 20;
 
+// An exact level finer than F / 2 counts only if joining two of its clusters raises the RMS of
+// the whole level to at least this fraction of the bounding-box diagonal: a polyhedron with few
+// faces, each its own plane. Noise leaves nothing exact above single triangles, and two noisy
+// triangles joined raise the RMS of a mesh of any size far less.
+constexpr double kExactLevelMinJumpRms = 1e-2;
+
 // Sums of a run of points (x, y), for the least-squares line through them in O(1).
 struct LineSums {
   double n = 0, x = 0, y = 0, xx = 0, xy = 0, yy = 0;
@@ -153,7 +159,8 @@ AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& optio
   if (options.max_candidates < 1)
     throw InvalidInputError("auto level: at least one candidate must be asked for");
   const std::vector<ErrorCurvePoint> curve = error_curve(hierarchy);
-  const double floor = options.rms_floor * bounding_box_diagonal(hierarchy.mesh());
+  const double diagonal = bounding_box_diagonal(hierarchy.mesh());
+  const double floor = options.rms_floor * diagonal;
   // The smallest normal double keeps the ratios finite on a degenerate (zero-size) mesh.
   auto floored = [&](double rms) {
     return std::max({rms, floor, std::numeric_limits<double>::min()});
@@ -166,6 +173,16 @@ AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& optio
   for (std::uint32_t k = c + 1; k <= finest && k - c < curve.size(); ++k) {
     const double jump = floored(curve[k - 1 - c].rms) / floored(curve[k - c].rms);
     candidates.push_back({k, curve[k - c].rms, jump});
+  }
+  // Except the coarsest exact level, when it is finer than that and far from noise (a
+  // tetrahedron: four triangles, four planes).
+  if (f > finest) {
+    std::uint32_t exact = f;
+    while (exact > finest + 1 && curve[exact - 1 - c].rms == 0) --exact;
+    const double joined_rms = curve[exact - 1 - c].rms;
+    if (curve[exact - c].rms == 0 && joined_rms > 0 &&
+        joined_rms >= kExactLevelMinJumpRms * diagonal)
+      candidates.push_back({exact, 0.0, floored(joined_rms) / floored(0.0)});
   }
   // The finest significant level: a coarser jump, however large, only says that the regions
   // of the finer level are themselves grouped (a small chamfer merging is a smaller jump than

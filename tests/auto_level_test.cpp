@@ -110,6 +110,52 @@ TEST(AutoLevel, RealPartsWithoutAJumpGetTheKneeOfTheCurve) {
   EXPECT_EQ(components.clusters, 1u);
 }
 
+// Levels finer than F / 2 are left out, except an exact one far above noise: a polyhedron whose
+// every face is a plane of its own (F / 2 would give a tetrahedron one or two clusters).
+TEST(AutoLevel, SmallPolyhedraGetOneClusterPerFace) {
+  const std::vector<Vec3> tetrahedron{{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}};
+  const std::vector<Vec3> octahedron{{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  // A triangular prism: two triangles and three rectangles split in two (8 triangles, 5 planes).
+  const std::vector<Vec3> prism{{0, 0, 0}, {2, 0, 0}, {0, 1, 0}, {0, 0, 3}, {2, 0, 3}, {0, 1, 3}};
+  struct Case {
+    const char* name;
+    Mesh mesh;
+    std::uint32_t planes;
+  };
+  const std::vector<Case> cases{
+      {"tetrahedron",
+       Mesh::from_triangles(tetrahedron, {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}), 4},
+      {"octahedron",
+       Mesh::from_triangles(octahedron, {{0, 2, 4},
+                                         {2, 1, 4},
+                                         {1, 3, 4},
+                                         {3, 0, 4},
+                                         {2, 0, 5},
+                                         {1, 2, 5},
+                                         {3, 1, 5},
+                                         {0, 3, 5}}),
+       8},
+      {"prism",
+       Mesh::from_triangles(prism, {{0, 2, 1},
+                                    {3, 4, 5},
+                                    {0, 1, 4},
+                                    {0, 4, 3},
+                                    {1, 2, 5},
+                                    {1, 5, 4},
+                                    {2, 0, 3},
+                                    {2, 3, 5}}),
+       5},
+  };
+  for (const Case& c : cases) {
+    const Hierarchy h = build_hierarchy(c.mesh);
+    const AutoLevel level = choose_level(h);
+    EXPECT_EQ(level.clusters, c.planes) << c.name;
+    EXPECT_EQ(level.rule, AutoLevelRule::Jump) << c.name;
+    EXPECT_GT(level.clusters, h.face_count() / 2) << c.name;
+  }
+}
+
 // A curve that only wavers has a best split too, but no bend: one noisy sphere stays one cluster.
 TEST(AutoLevel, ANoisySingleSurfaceHasNoKnee) {
   ShapeOptions options;

@@ -87,7 +87,10 @@ struct AutoLevel {
 /// Picks the most significant level of the hierarchy from its error curve, among K from the
 /// number of components C to max(C, F / 2) (finer levels are left out: there the curve rises
 /// from zero, single triangles fitting exactly, and under noise its first ratios are large
-/// without meaning anything). Deterministic; O(F log F). Throws InvalidInputError for options
+/// without meaning anything). One finer level is a candidate too: the coarsest whose every
+/// cluster fits exactly (RMS 0), when the next merge raises the RMS to 1% of the bounding-box
+/// diagonal or more, as on a polyhedron with few faces each a plane of its own (a tetrahedron
+/// gets 4 clusters). Deterministic; O(F log F). Throws InvalidInputError for options
 /// out of range (negative or non-finite floor, min_score below 1, no candidate asked for).
 AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& options = {});
 
