@@ -23,6 +23,7 @@
 #include "primseg/mesh_distance.hpp"
 #include "primseg/render.hpp"
 #include "primseg/shape_generator.hpp"
+#include "support/test_support.hpp"
 
 namespace primseg {
 namespace {
@@ -406,19 +407,18 @@ TEST(Denoise, AutomaticLevelKeepsAJumpOfTheErrorCurve) {
 // tetrahedron with two faces listed inwards estimated a noise of a fifth of its size, and its
 // automatic level was one plane that every corner was snapped onto.
 TEST(Denoise, AutomaticLevelOfACleanTetrahedronWithFacesListedInwards) {
-  const std::vector<Vec3> corners{{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}};
-  const Mesh tetrahedron =
-      Mesh::from_triangles(corners, {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}});
-  EXPECT_LT(estimate_noise(tetrahedron), 0.01);
-  Denoiser denoiser(tetrahedron);
+  const testing::TetrahedronWithInwardFaces tetrahedron;
+  EXPECT_LT(estimate_noise(tetrahedron.mesh), 0.01);
+  Denoiser denoiser(tetrahedron.mesh);
   DenoiseLevel level;
   denoiser.iterate([&](const Hierarchy& hierarchy) {
     level = denoiser.automatic_level(hierarchy);
     return level.segmentation;
   });
   EXPECT_EQ(level.segmentation.cluster_count(), 4u);
-  for (std::size_t v = 0; v < corners.size(); ++v)
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(denoiser.mesh().positions[v][k], corners[v][k], 1e-12);
+  for (std::size_t v = 0; v < tetrahedron.corners.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(denoiser.mesh().positions[v][k], tetrahedron.corners[v][k], 1e-12);
 }
 
 // A jump whose level leaves a surface out is not a denoising level: on the noisy box with a dome

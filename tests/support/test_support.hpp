@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "primseg/mesh.hpp"
 #include "primseg/primitive.hpp"
@@ -68,6 +69,14 @@ Mesh grid_mesh(int rows, int cols, Surface&& p, bool alternate = false) {
 /// A generated shape (shape_generator.hpp) in its Uniform tessellation with random vertex motion
 /// and Gaussian noise of 0.3% of its size along the normals: a small scan-like input.
 Mesh noisy_uniform_shape(const std::string& name);
+
+/// The tetrahedron with corners (0, 0, 0), (0, 1, 0), (1, 1, 0) and (0, 0, 1) (its `corners`),
+/// its four faces listed in that order of corners, two of them facing inwards: files often mix
+/// orientations.
+struct TetrahedronWithInwardFaces {
+  std::vector<Vec3> corners{{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}};
+  Mesh mesh = Mesh::from_triangles(corners, {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}});
+};
 
 /// Statistics of the whole mesh as one cluster, accumulated face by face and edge by edge the way
 /// the engine does (corner samples included), with moments centred at the centroid.
