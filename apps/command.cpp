@@ -76,18 +76,20 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
                   "the bounding-box diagonal (default ") +
           kDefaultTolerance + ")");
   clusters->excludes(tolerance);
-  command.add_option("--labels", options.files.labels, "Write one cluster label per input face");
-  command.add_option("--json", options.files.json, "Write clusters and primitives as JSON");
+  command.add_option("--labels", options.files.labels,
+                     "Write one cluster label per input face (- for standard output)");
+  command.add_option("--json", options.files.json,
+                     "Write clusters and primitives as JSON (- for standard output)");
   command.add_option("--colored", options.files.colored,
                      "Write the mesh coloured by cluster (.ply colours or .obj groups)");
   command.add_option("--curve", options.files.curve,
                      "Write the error curve as CSV: k,rms for every number of clusters k (rms: "
-                     "input units)");
+                     "input units; - for standard output)");
   command.add_option("--png", options.files.png,
                      "Render the clusters to a PNG picture (800x600, three-quarter view)");
   command.add_option("--linkage", options.files.linkage,
                      "Write the whole tree as a SciPy linkage matrix (text: a b cost size per "
-                     "merge, numpy.loadtxt)");
+                     "merge, numpy.loadtxt; - for standard output)");
   command
       .add_option("--refine", options.refine,
                   "Boundary refinement passes after the cut: border faces move to the adjacent "
@@ -95,6 +97,11 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
       ->check(CLI::Range(0u, 1000u))
       ->capture_default_str();
   command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
+}
+
+void validate_level_outputs(LevelOptions& options) {
+  validate_output_files(options.files);
+  if (writes_to_standard_output(options.files)) options.quiet = true;
 }
 
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,

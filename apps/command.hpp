@@ -70,6 +70,10 @@ struct LevelOptions {
 /// Adds --clusters, --tolerance, the per-level output files and --quiet to a command.
 void add_level_options(CLI::App& command, LevelOptions& options);
 
+/// Checks the output names before any work (validate_output_files) and turns `quiet` on when an
+/// output goes to standard output ('-'), which must then carry that output alone.
+void validate_level_outputs(LevelOptions& options);
+
 /// Cuts the chosen level and writes its outputs (and the tree when asked).
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
                   Clock::time_point cut_start);

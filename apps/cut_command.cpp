@@ -20,7 +20,7 @@ Command add_cut_command(CLI::App& app) {
             if (!o->level.level.clusters && !o->level.level.tolerance)
               throw InvalidInputError(
                   "cut: give the level with --clusters K, --clusters auto or --tolerance T");
-            validate_output_files(o->level.files);
+            validate_level_outputs(o->level);
             const auto read_start = Clock::now();
             const Hierarchy hierarchy = read_tree(o->tree_path);
             validate_level(o->level.level, hierarchy.face_count());

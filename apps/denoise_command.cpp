@@ -95,7 +95,7 @@ Command add_denoise_command(CLI::App& app) {
             options.hierarchy.primitives = parse_primitives(o->primitives);
             options.hierarchy.threads = o->threads;
             validate(options);
-            validate_output_files(o->level.files);
+            validate_level_outputs(o->level);
             mesh_format_from_path(o->output_path);  // an unknown extension fails before any work
             const auto start = Clock::now();
             Mesh mesh = read_geometry(o->mesh_path);

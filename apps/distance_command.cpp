@@ -1,7 +1,6 @@
 #include <cstdio>
 #include <memory>
 
-#include "../src/file_io.hpp"
 #include "command.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_distance.hpp"
@@ -72,11 +71,8 @@ Command add_distance_command(CLI::App& app) {
                           d.diagonal)},
                 {"seed", o->seed},
                 {"timing", {{"seconds", seconds}}}};
-            if (o->json && *o->json == "-")
-              std::printf("%s\n", json.dump(2).c_str());
-            else if (o->json)
-              detail::write_file_atomically(*o->json, json.dump(2) + "\n");
-            if (o->quiet || (o->json && *o->json == "-")) return;
+            if (o->json) write_text_output(*o->json, json.dump(2) + "\n");
+            if (o->quiet || o->json == kStandardOutput) return;
             const double percent = d.diagonal > 0 ? 100 / d.diagonal : 0;
             std::printf("bounding-box diagonal %.6g; %llu + %llu samples\n", d.diagonal,
                         static_cast<unsigned long long>(d.a_to_b.samples),

@@ -4,7 +4,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "../src/file_io.hpp"
 #include "command.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_info.hpp"
@@ -50,11 +49,8 @@ Command add_info_command(CLI::App& app) {
                   {"bbox_max", i.bbox_max},
                   {"bbox_diagonal", i.bbox_diagonal},
                   {"out_of_range", out_of_range ? nlohmann::json(*out_of_range) : nullptr}};
-              if (*o->json == "-") {
-                std::printf("%s\n", json.dump(2).c_str());
-                return;
-              }
-              detail::write_file_atomically(*o->json, json.dump(2) + "\n");
+              write_text_output(*o->json, json.dump(2) + "\n");
+              if (*o->json == kStandardOutput) return;
             }
             std::printf("%s\n", o->path.c_str());
             std::printf("  vertices            %u (%u isolated)\n", i.vertices,

@@ -1,8 +1,11 @@
 #include "outputs.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <string>
+#include <utility>
 
 #include "../src/file_io.hpp"
 #include "primseg/auto_level.hpp"
@@ -16,6 +19,20 @@ nlohmann::json vec3_json(const Vec3& v) {
 }
 
 void validate_output_files(const OutputFiles& files) {
+  const std::pair<const char*, const std::optional<std::string>*> binary[] = {
+      {"--colored", &files.colored}, {"--png", &files.png}, {"--tree", &files.tree}};
+  for (const auto& [option, path] : binary)
+    if (*path == kStandardOutput)
+      throw InvalidInputError(std::string(option) +
+                              ": cannot write to standard output ('-'); only --labels, --json, "
+                              "--curve and --linkage can (to write a file named '-', give ./-)");
+  const std::optional<std::string>* text[] = {&files.labels, &files.json, &files.linkage,
+                                              &files.curve};
+  if (std::count_if(std::begin(text), std::end(text), [](const std::optional<std::string>* path) {
+        return *path == kStandardOutput;
+      }) > 1)
+    throw InvalidInputError(
+        "only one of --labels, --json, --curve and --linkage can write to standard output ('-')");
   if (files.colored) {
     bool supported = false;
     try {
@@ -27,6 +44,18 @@ void validate_output_files(const OutputFiles& files) {
     if (!supported)
       throw InvalidInputError("--colored: '" + *files.colored + "' must end in .ply or .obj");
   }
+}
+
+bool writes_to_standard_output(const OutputFiles& files) {
+  return files.labels == kStandardOutput || files.json == kStandardOutput ||
+         files.linkage == kStandardOutput || files.curve == kStandardOutput;
+}
+
+void write_text_output(const std::string& path, std::string_view text) {
+  if (path == kStandardOutput)
+    detail::write_standard_output(text);
+  else
+    detail::write_file_atomically(path, text);
 }
 
 nlohmann::json primitive_params(const Primitive& primitive) {
@@ -46,7 +75,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
       text += std::to_string(label);
       text += '\n';
     }
-    detail::write_file_atomically(*files.labels, text);
+    write_text_output(*files.labels, text);
   }
   if (files.json) {
     nlohmann::json json = summary;
@@ -61,8 +90,8 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
                           {"params", primitive_params(r.primitive)}});
     json["clusters"] = std::move(clusters);
     // File names need not be UTF-8: replace what JSON cannot hold rather than fail.
-    detail::write_file_atomically(
-        *files.json, json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+    write_text_output(*files.json,
+                      json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   if (files.colored) {
     const std::filesystem::path path(*files.colored);
@@ -79,7 +108,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
                                   row[2], row[3]);
       text.append(line, static_cast<std::size_t>(n));
     }
-    detail::write_file_atomically(*files.linkage, text);
+    write_text_output(*files.linkage, text);
   }
   if (files.curve) {
     std::string text = "k,rms\n";
@@ -88,7 +117,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
       const int n = std::snprintf(line, sizeof line, "%u,%.17g\n", point.clusters, point.rms);
       text.append(line, static_cast<std::size_t>(n));
     }
-    detail::write_file_atomically(*files.curve, text);
+    write_text_output(*files.curve, text);
   }
   if (files.png) {
     write_png(*files.png, hierarchy.mesh(), group_face_colors(segmentation.labels));

@@ -4,10 +4,15 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "primseg/cut.hpp"
 
 namespace primseg::cli {
+
+/// The output name that stands for standard output. Only the text outputs (labels, json, linkage,
+/// curve) accept it, one at a time; a file literally named '-' is still reachable as ./-.
+inline constexpr std::string_view kStandardOutput = "-";
 
 struct OutputFiles {
   std::optional<std::string> labels;   // one label per line, per input face
@@ -19,8 +24,17 @@ struct OutputFiles {
   std::optional<std::string> curve;    // error curve of the whole tree, CSV k,rms
 };
 
-/// Throws InvalidInputError for output names that cannot be written (checked before any work).
+/// Throws InvalidInputError for output names that cannot be written (checked before any work):
+/// a coloured mesh that is neither .ply nor .obj, '-' for a binary output, or '-' twice.
 void validate_output_files(const OutputFiles& files);
+
+/// True when a text output goes to standard output: the command must then print nothing else
+/// there (its summary is suppressed as by --quiet).
+bool writes_to_standard_output(const OutputFiles& files);
+
+/// Writes `text` to the file `path` atomically, or to standard output when `path` is "-".
+/// Throws IoError.
+void write_text_output(const std::string& path, std::string_view text);
 
 /// A point or direction as the JSON array [x, y, z].
 nlohmann::json vec3_json(const Vec3& v);

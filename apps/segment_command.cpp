@@ -47,7 +47,7 @@ Command add_segment_command(CLI::App& app) {
         options.threads = o->threads;
         options.evaluation = o->eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
         validate(options);
-        validate_output_files(o->level.files);
+        validate_level_outputs(o->level);
         check_file_limits(o->mesh_path, o->limits);
         const auto read_start = Clock::now();
         auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path));

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
@@ -138,6 +139,15 @@ std::filesystem::path temporary_name_for(const std::filesystem::path& path) {
 }
 
 }  // namespace
+
+void write_standard_output(std::string_view bytes) {
+  errno = 0;
+  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), stdout) == bytes.size();
+  if (!written || std::fflush(stdout) != 0) {
+    const int error_number = errno != 0 ? errno : EIO;
+    throw IoError("cannot write to standard output: " + std::string(std::strerror(error_number)));
+  }
+}
 
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
                            const std::function<void()>& while_named) {

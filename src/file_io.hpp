@@ -37,6 +37,10 @@ FileImage read_file(const std::filesystem::path& path);
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
                            const std::function<void()>& while_named = {});
 
+/// Writes `bytes` to standard output and flushes it. Throws IoError when the write fails (a full
+/// disk, a closed pipe whose SIGPIPE is ignored), so that a truncated output is never silent.
+void write_standard_output(std::string_view bytes);
+
 /// For programs (the CLI's main()), not for a library user's process: installs handlers for
 /// SIGINT, SIGTERM and SIGHUP that leave their default action (termination) immediate, except
 /// while write_file_atomically() is between naming its temporary file and renaming it, in any

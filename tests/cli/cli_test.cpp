@@ -918,6 +918,14 @@ TEST(Cli, BadOptionsAreRejectedWithAMessage) {
       {"--tree into a missing directory",
        "segment " + mesh + " --tree " + dir.q("no/such/dir/t.tree"),
        {"t.tree"}},
+      {"--json - and --labels -",
+       "segment " + mesh + " --clusters 2 --json - --labels -",
+       {"only one", "standard output"}},
+      {"--png -", "segment " + mesh + " --clusters 2 --png -", {"--png", "standard output"}},
+      {"--colored -",
+       "segment " + mesh + " --clusters 2 --colored -",
+       {"--colored", "standard output"}},
+      {"--tree -", "segment " + mesh + " --tree -", {"--tree", "standard output"}},
       {"unknown option", "segment " + mesh + " --frobnicate", {"frobnicate"}, false},
       {"missing mesh argument", "segment --clusters 3", {"MESH"}, false},
       {"unknown subcommand", "frobnicate " + mesh, {"frobnicate"}, false},
@@ -1291,6 +1299,57 @@ TEST(Cli, OutputsOverwriteExistingFiles) {
   ASSERT_EXIT_OK(
       run("segment " + dir.q("in.off") + " --quiet --clusters 6 --labels " + dir.q("l.txt")));
   expect_valid_labels(read_labels(dir / "l.txt"), 12, 6);
+}
+
+// Drops the timing entries, the only part of a level's JSON that changes from run to run.
+json without_timing(json j) {
+  j.erase("timing");
+  return j;
+}
+
+TEST(Cli, DashWritesATextOutputToStandardOutputAlone) {
+  TempDir dir("stdout");
+  write_mesh(dir / "in.off", make_shape("box_with_hole").mesh);
+  const std::string level = " --clusters 7";
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + level + " --quiet --tree " + dir.q("t.tree") +
+                     " --labels " + dir.q("l.txt") + " --json " + dir.q("j.json") + " --curve " +
+                     dir.q("c.csv") + " --linkage " + dir.q("k.txt")));
+  // run() captures stdout and stderr together: a summary or a message would spoil the output.
+  const std::pair<const char*, const char*> outputs[] = {
+      {"--labels", "l.txt"}, {"--curve", "c.csv"}, {"--linkage", "k.txt"}};
+  for (const auto& [option, file] : outputs) {
+    SCOPED_TRACE(option);
+    const CliRun r = run("segment " + dir.q("in.off") + level + " " + option + " -");
+    ASSERT_EXIT_OK(r);
+    EXPECT_EQ(r.output, testing::file_contents(dir / file));
+  }
+  for (const std::string& command : {"segment " + dir.q("in.off"), "cut " + dir.q("t.tree")}) {
+    SCOPED_TRACE(command);
+    const CliRun r = run(command + level + " --json -");
+    ASSERT_EXIT_OK(r);
+    const json parsed = json::parse(r.output, nullptr, /*allow_exceptions=*/false);
+    ASSERT_FALSE(parsed.is_discarded()) << r.output.substr(0, 400);
+    EXPECT_EQ(parsed["clusters"], read_json(dir / "j.json")["clusters"]);
+  }
+  const CliRun denoised =
+      run("denoise " + dir.q("in.off") + level + " -o " + dir.q("d.off") + " --json -");
+  ASSERT_EXIT_OK(denoised);
+  EXPECT_EQ(json::parse(denoised.output)["clusters"].size(), 7u);
+  const CliRun labelled =
+      run("segment " + dir.q("in.off") + level + " --json " + dir.q("j2.json") + " --labels -");
+  ASSERT_EXIT_OK(labelled);
+  EXPECT_EQ(labelled.output, testing::file_contents(dir / "l.txt"));
+  EXPECT_EQ(without_timing(read_json(dir / "j2.json")), without_timing(read_json(dir / "j.json")));
+  EXPECT_FALSE(fs::exists("-")) << "'-' named a file in the working directory";
+
+  // A write that fails is an error, not a silently truncated output.
+  CliRun full;
+  full.status = run_command(
+      "( " + quote(cli_path()) + " segment " + dir.q("in.off") + level + " --json - >/dev/full )",
+      &full.output);
+  EXPECT_EQ(full.status, 1) << full.output;
+  EXPECT_NE(full.output.find("primseg: error: cannot write to standard output"), std::string::npos)
+      << full.output;
 }
 
 TEST(Cli, ThreadCountDoesNotChangeTheTree) {
