@@ -125,7 +125,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
 }
 
 void print_summary(const std::vector<ClusterReport>& reports, std::size_t max_rows) {
-  std::printf("%zu clusters\n", reports.size());
+  std::printf("%zu cluster%s\n", reports.size(), plural_s(reports.size()));
   std::printf("%6s  %-8s  %8s  %12s  %12s  %12s\n", "id", "type", "faces", "area", "rms", "max");
   for (std::size_t i = 0; i < reports.size() && i < max_rows; ++i) {
     const ClusterReport& r = reports[i];

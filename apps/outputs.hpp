@@ -1,6 +1,7 @@
 #pragma once
 // The per-level outputs shared by `segment` and `cut`: labels, JSON, coloured mesh, summary.
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -23,6 +24,11 @@ struct OutputFiles {
   std::optional<std::string> linkage;  // SciPy linkage matrix of the whole tree, as text
   std::optional<std::string> curve;    // error curve of the whole tree, CSV k,rms
 };
+
+/// The plural ending of a count's noun in messages: "1 cluster", "2 clusters".
+inline const char* plural_s(std::uint64_t count) {
+  return count == 1 ? "" : "s";
+}
 
 /// Throws InvalidInputError for output names that cannot be written (checked before any work):
 /// a coloured mesh that is neither .ply nor .obj, '-' for a binary output, or '-' twice.
