@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "../src/file_io.hpp"
 #include "command.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
@@ -15,12 +16,31 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-Mesh read_geometry(const std::filesystem::path& path) {
+std::string input_name(const std::filesystem::path& path) {
+  return path.native() == kStandardInput ? std::string("standard input") : path.string();
+}
+
+Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes) {
+  if (path.native() == kStandardInput) {
+    const detail::FileImage image = detail::read_standard_input();
+    if (bytes) *bytes = image.size;
+    return read_mesh_detecting_format({image.bytes.get(), image.size}, "standard input");
+  }
   Mesh mesh = read_mesh(path);
+  if (bytes) {
+    std::error_code ignored;  // the file was just read; a size that vanished since counts as 0
+    const std::uintmax_t size = std::filesystem::file_size(path, ignored);
+    *bytes = size == static_cast<std::uintmax_t>(-1) ? 0 : size;
+  }
+  return mesh;
+}
+
+Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes) {
+  Mesh mesh = read_input_mesh(path, bytes);
   try {
     check_geometric_range(mesh);
   } catch (const InvalidInputError& error) {
-    throw InvalidInputError(path.string() + ": " + error.what());
+    throw InvalidInputError(input_name(path) + ": " + error.what());
   }
   return mesh;
 }

@@ -37,9 +37,22 @@ Command add_view_command(CLI::App& app);
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start);
 
-/// read_mesh(), then check_geometric_range(), whose message gets the file's name: the commands
-/// that compute geometry read their meshes through this (`info` reads any finite coordinates).
-Mesh read_geometry(const std::filesystem::path& path);
+/// The input path that stands for standard input.
+inline constexpr std::string_view kStandardInput = "-";
+
+/// How messages name an input: its path, or "standard input" for "-".
+std::string input_name(const std::filesystem::path& path);
+
+/// A mesh named on the command line: the file `path` (its format from the extension), or standard
+/// input when `path` is "-" (its format detected from the content: detect_mesh_format). `bytes`,
+/// if set, receives the input's size. Throws as read_mesh; ParseError when standard input holds
+/// no format primseg can tell.
+Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes = nullptr);
+
+/// read_input_mesh(), then check_geometric_range(), whose message gets the input's name: the
+/// commands that compute geometry read their meshes through this (`info` reads any finite
+/// coordinates).
+Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes = nullptr);
 
 /// Parses "plane,sphere,cylinder" into types that have a fitter; throws InvalidInputError
 /// naming the unknown one and the available ones.

@@ -20,7 +20,10 @@ Command add_deform_command(CLI::App& app) {
   auto* command = app.add_subcommand(
       "deform",
       "Pose a mesh: rotate joints of its skeleton, move vertices by linear blend skinning");
-  command->add_option("MESH", o->mesh_path, "The mesh the skeleton was extracted from")->required();
+  command
+      ->add_option("MESH", o->mesh_path,
+                   "The mesh the skeleton was extracted from (- for standard input)")
+      ->required();
   command->add_option("SKELETON", o->skeleton_path, "Skeleton file of primseg skeleton")
       ->required();
   command
@@ -45,8 +48,9 @@ Command add_deform_command(CLI::App& app) {
             const std::vector<JointRotation> pose = read_pose_file(o->pose_path);
             if (skeleton.face_labels.size() != mesh.face_count())
               throw InvalidInputError("'" + o->skeleton_path + "' was made from a mesh of " +
-                                      std::to_string(skeleton.face_labels.size()) + " faces, '" +
-                                      o->mesh_path + "' has " + std::to_string(mesh.face_count()));
+                                      std::to_string(skeleton.face_labels.size()) + " faces, " +
+                                      input_name(o->mesh_path) + " has " +
+                                      std::to_string(mesh.face_count()));
             SkinningOptions skinning;
             skinning.band = o->band;
             const SkinWeights weights = compute_skin_weights(mesh, skeleton, skinning);

@@ -28,7 +28,9 @@ Command add_denoise_command(CLI::App& app) {
   auto* denoise = app.add_subcommand(
       "denoise",
       "Snap every vertex onto the primitives of a level: denoising and sharp-edge recovery");
-  denoise->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl)")->required();
+  denoise
+      ->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl; - for standard input)")
+      ->required();
   denoise->add_option("-o,--output", o->output_path, "Output mesh (same vertex and face order)")
       ->required();
   add_level_options(*denoise, o->level);

@@ -35,8 +35,8 @@ Command add_distance_command(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* distance = app.add_subcommand(
       "distance", "Metro-style distances between two surfaces: mean, RMS and Hausdorff");
-  distance->add_option("A", o->first, "First mesh")->required();
-  distance->add_option("B", o->second, "Second mesh")->required();
+  distance->add_option("A", o->first, "First mesh (- for standard input)")->required();
+  distance->add_option("B", o->second, "Second mesh (- for standard input)")->required();
   auto* samples = distance->add_option("--samples", o->samples,
                                        "Area-uniform samples on each surface (default " +
                                            std::to_string(DistanceOptions{}.samples) + ")");
@@ -55,6 +55,8 @@ Command add_distance_command(CLI::App& app) {
             if (o->density) options.density = *o->density;
             options.seed = o->seed;
             options.threads = o->threads;
+            if (o->first == kStandardInput && o->second == kStandardInput)
+              throw InvalidInputError("distance: only one of A and B can be standard input ('-')");
             const Mesh a = read_geometry(o->first);
             const Mesh b = read_geometry(o->second);
             const auto start = Clock::now();

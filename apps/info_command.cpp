@@ -18,12 +18,12 @@ Command add_info_command(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   auto* info = app.add_subcommand("info", "Print counts and defects of a mesh");
-  info->add_option("MESH", o->path, "Input mesh")->required();
+  info->add_option("MESH", o->path, "Input mesh (- for standard input)")->required();
   info->add_option("--json", o->json,
                    "Write the counts as JSON (- for standard output, instead of the text)");
 
   return {info, [o] {
-            const Mesh mesh = read_mesh(o->path);
+            const Mesh mesh = read_input_mesh(o->path);
             const MeshInfo i = describe_mesh(mesh);
             // Reported, not refused: info is where a user finds out why the others refuse.
             std::optional<std::string> out_of_range;
@@ -52,7 +52,7 @@ Command add_info_command(CLI::App& app) {
               write_text_output(*o->json, json.dump(2) + "\n");
               if (*o->json == kStandardOutput) return;
             }
-            std::printf("%s\n", o->path.c_str());
+            std::printf("%s\n", input_name(o->path).c_str());
             std::printf("  vertices            %u (%u isolated)\n", i.vertices,
                         i.isolated_vertices);
             std::printf("  faces               %u (%u polygons), %u triangles\n", i.faces,

@@ -18,7 +18,9 @@ Command add_segment_command(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   auto* segment = app.add_subcommand("segment", "Build the hierarchy of a mesh and report a level");
-  segment->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl)")->required();
+  segment
+      ->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl; - for standard input)")
+      ->required();
   add_level_options(*segment, o->level);
   add_limit_options(*segment, o->limits);
   segment->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
@@ -50,9 +52,10 @@ Command add_segment_command(CLI::App& app) {
         validate_level_outputs(o->level);
         check_file_limits(o->mesh_path, o->limits);
         const auto read_start = Clock::now();
-        auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path));
+        std::uint64_t file_bytes = 0;
+        auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path, &file_bytes));
         const double read_seconds = seconds_since(read_start);
-        check_mesh_limits(*mesh, std::filesystem::file_size(o->mesh_path), o->limits);
+        check_mesh_limits(*mesh, file_bytes, o->limits);
         validate_level(o->level.level, mesh->face_count());
         const auto build_start = Clock::now();
         HierarchyBuilder builder(mesh, options);
@@ -64,9 +67,10 @@ Command add_segment_command(CLI::App& app) {
         summary["weights"] = o->weights;
         summary["timing"] = {{"read_seconds", read_seconds}, {"hierarchy_seconds", build_seconds}};
         if (!o->level.quiet)
-          std::printf("%s: %u faces, %u component%s, hierarchy in %.3f s\n", o->mesh_path.c_str(),
-                      mesh->face_count(), hierarchy.component_count(),
-                      plural_s(hierarchy.component_count()), build_seconds);
+          std::printf("%s: %u faces, %u component%s, hierarchy in %.3f s\n",
+                      input_name(o->mesh_path).c_str(), mesh->face_count(),
+                      hierarchy.component_count(), plural_s(hierarchy.component_count()),
+                      build_seconds);
         report_level(hierarchy, o->level, summary, Clock::now());
       }};
 }

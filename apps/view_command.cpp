@@ -284,7 +284,8 @@ Command add_view_command(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* view = app.add_subcommand(
       "view", "Write a self-contained HTML page to browse the whole hierarchy in a browser");
-  view->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl)")->required();
+  view->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl; - for standard input)")
+      ->required();
   view->add_option("--tree", o->tree_path,
                    "Hierarchy written by segment --tree for this mesh (else it is built)");
   view->add_option("--clusters", o->clusters,
@@ -333,8 +334,8 @@ Command add_view_command(CLI::App& app) {
             return HierarchyBuilder(mesh, options).finish(Progress("hierarchy", o->quiet));
           Hierarchy tree = read_tree(*o->tree_path);
           if (!same_mesh(tree.mesh(), *mesh))
-            throw InvalidInputError("view: the tree '" + *o->tree_path + "' was not built from '" +
-                                    o->mesh_path + "'");
+            throw InvalidInputError("view: the tree '" + *o->tree_path + "' was not built from " +
+                                    input_name(o->mesh_path));
           return tree;
         }();
         const double build_seconds = seconds_since(build_start);
@@ -355,7 +356,7 @@ Command add_view_command(CLI::App& app) {
         }
         std::string html(page.substr(0, marker));
         double fit_seconds = 0;
-        html += page_data(hierarchy, std::filesystem::path(o->mesh_path).filename().string(),
+        html += page_data(hierarchy, input_name(std::filesystem::path(o->mesh_path).filename()),
                           initial, automatic, skeleton, o->threads, fit_seconds);
         html += page.substr(marker + kViewerDataMarker.size());
         detail::write_file_atomically(o->output, html);
@@ -367,7 +368,7 @@ Command add_view_command(CLI::App& app) {
           std::printf(
               "%s: %u faces, hierarchy %s in %.3f s, geometric fits in %.3f s; %s: %.1f MB, opens "
               "at %u clusters (automatic level %u)%s\n",
-              o->mesh_path.c_str(), mesh->face_count(), o->tree_path ? "read" : "built",
+              input_name(o->mesh_path).c_str(), mesh->face_count(), o->tree_path ? "read" : "built",
               build_seconds, fit_seconds, o->output.c_str(), static_cast<double>(html.size()) / 1e6,
               initial, automatic.clusters, bones.c_str());
         }

@@ -33,6 +33,37 @@ std::uint64_t physical_memory_bytes() {
   return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
 }
 
+namespace {
+
+// Reads what is left of `fd` until end of file into a buffer of at least `expected` + 1 bytes
+// (the size from fstat may be stale: a growing file, or a pipe, whose size is 0).
+FileImage read_to_end(int fd, const std::filesystem::path& name, std::uint64_t expected) {
+  const std::uint64_t memory = physical_memory_bytes();
+  std::size_t capacity = static_cast<std::size_t>(expected) + 1;
+  FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
+  while (true) {
+    if (image.size == capacity) {
+      if (memory != 0 && image.size > memory)
+        throw IoError("cannot read '" + name.string() + "': more than this machine's memory (" +
+                      std::to_string(memory) + " bytes)");
+      const std::size_t grown = capacity + capacity / 2 + 4096;
+      auto larger = std::make_unique_for_overwrite<char[]>(grown);
+      std::memcpy(larger.get(), image.bytes.get(), image.size);
+      image.bytes = std::move(larger);
+      capacity = grown;
+    }
+    const ssize_t got = ::read(fd, image.bytes.get() + image.size, capacity - image.size);
+    if (got < 0) {
+      if (errno == EINTR) continue;
+      io_failure(name, "read", errno);
+    }
+    if (got == 0) return image;
+    image.size += static_cast<std::size_t>(got);
+  }
+}
+
+}  // namespace
+
 FileImage read_file(const std::filesystem::path& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) io_failure(path, "open", errno);
@@ -51,26 +82,17 @@ FileImage read_file(const std::filesystem::path& path) {
     throw IoError("cannot read '" + path.string() + "': the file has " +
                   std::to_string(status.st_size) + " bytes, more than this machine's memory (" +
                   std::to_string(memory) + " bytes)");
+  return read_to_end(fd, path, static_cast<std::uint64_t>(status.st_size));
+}
 
-  // The size from fstat may be stale (a growing file): read until end of file regardless.
-  std::size_t capacity = static_cast<std::size_t>(status.st_size) + 1;
-  FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
-  while (true) {
-    if (image.size == capacity) {
-      const std::size_t grown = capacity + capacity / 2 + 4096;
-      auto larger = std::make_unique_for_overwrite<char[]>(grown);
-      std::memcpy(larger.get(), image.bytes.get(), image.size);
-      image.bytes = std::move(larger);
-      capacity = grown;
-    }
-    const ssize_t got = ::read(fd, image.bytes.get() + image.size, capacity - image.size);
-    if (got < 0) {
-      if (errno == EINTR) continue;
-      io_failure(path, "read", errno);
-    }
-    if (got == 0) return image;
-    image.size += static_cast<std::size_t>(got);
-  }
+FileImage read_standard_input() {
+  struct stat status {};
+  if (::fstat(STDIN_FILENO, &status) != 0) io_failure("standard input", "stat", errno);
+  if (S_ISDIR(status.st_mode)) io_failure("standard input", "read", EISDIR);
+  // A pipe has no size: start with a block, the buffer grows by half as it fills.
+  const bool sized = S_ISREG(status.st_mode);
+  return read_to_end(STDIN_FILENO, "standard input",
+                     sized ? static_cast<std::uint64_t>(status.st_size) : std::uint64_t{65536});
 }
 
 namespace {

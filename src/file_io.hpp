@@ -28,6 +28,10 @@ std::uint64_t physical_memory_bytes();
 /// machine's physical memory).
 FileImage read_file(const std::filesystem::path& path);
 
+/// Reads standard input to its end (a pipe, a terminal or a redirected file). Throws IoError
+/// (unreadable, or more bytes than the machine's physical memory).
+FileImage read_standard_input();
+
 /// Writes to an unnamed file in the target's directory (O_TMPFILE; a hidden named one where the
 /// filesystem lacks it), then names it and renames it over the target: readers see the old file
 /// or the complete new one, never a partial write, and a process killed while writing leaves

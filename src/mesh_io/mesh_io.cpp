@@ -117,6 +117,7 @@ std::optional<MeshFormat> detect_mesh_format(std::span<const char> bytes) {
 }
 
 Mesh read_mesh_detecting_format(std::span<const char> bytes, std::string_view name) {
+  if (bytes.empty()) throw ParseError(std::string(name) + ": empty, no mesh data");
   const std::optional<MeshFormat> format = detect_mesh_format(bytes);
   if (!format)
     throw ParseError(std::string(name) +

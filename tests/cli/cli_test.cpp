@@ -51,10 +51,12 @@ struct CliRun {
   std::string output;  // stdout + stderr, or stderr alone for run_stderr()
 };
 
-// Runs `primseg ARGS` and captures stdout and stderr together.
-CliRun run(const std::string& args) {
+// Runs `primseg ARGS` and captures stdout and stderr together; with `piped_from`, a shell command
+// whose output is primseg's standard input.
+CliRun run(const std::string& args, const std::string& piped_from = "") {
   CliRun r;
-  r.status = run_command(quote(cli_path()) + " " + args, &r.output);
+  const std::string pipe = piped_from.empty() ? "" : piped_from + " | ";
+  r.status = run_command(pipe + quote(cli_path()) + " " + args, &r.output);
   return r;
 }
 
@@ -89,11 +91,11 @@ void write_file(const fs::path& path, const std::string& bytes) {
   out << bytes;
 }
 
-// Reads a labels file, checking its syntax strictly: one non-negative decimal integer per line,
-// every line terminated by '\n', nothing else.
-std::vector<std::uint32_t> read_labels(const fs::path& path) {
+// Parses labels, checking their syntax strictly: one non-negative decimal integer per line, every
+// line terminated by '\n', nothing else. `path` names them in failure messages.
+std::vector<std::uint32_t> parse_labels(const std::string& text,
+                                        const fs::path& path = "standard output") {
   std::vector<std::uint32_t> labels;
-  const std::string text = testing::file_contents(path);
   EXPECT_FALSE(text.empty()) << path;
   if (!text.empty()) {
     EXPECT_EQ(text.back(), '\n') << path << ": last line not terminated";
@@ -111,6 +113,11 @@ std::vector<std::uint32_t> read_labels(const fs::path& path) {
     begin = end + 1;
   }
   return labels;
+}
+
+// Reads a labels file (parse_labels).
+std::vector<std::uint32_t> read_labels(const fs::path& path) {
+  return parse_labels(testing::file_contents(path), path);
 }
 
 json read_json(const fs::path& path) {
@@ -1350,6 +1357,55 @@ TEST(Cli, DashWritesATextOutputToStandardOutputAlone) {
   EXPECT_EQ(full.status, 1) << full.output;
   EXPECT_NE(full.output.find("primseg: error: cannot write to standard output"), std::string::npos)
       << full.output;
+}
+
+TEST(Cli, DashReadsTheMeshFromStandardInputInAnyFormat) {
+  TempDir dir("stdin");
+  const Mesh mesh = make_shape("box_with_hole").mesh;
+  const std::string level = " --clusters 7 --labels -";
+  for (const char* name : {"in.off", "in.obj", "in.ply", "in.stl"}) {
+    SCOPED_TRACE(name);
+    write_mesh(dir / name, mesh);
+    const CliRun by_path = run("segment " + dir.q(name) + level);
+    ASSERT_EXIT_OK(by_path);
+    const CliRun piped = run("segment -" + level + " < " + dir.q(name));
+    ASSERT_EXIT_OK(piped);
+    EXPECT_EQ(piped.output, by_path.output);
+    const CliRun through_cat =
+        run("segment -" + level + " --primitives plane", "cat " + dir.q(name));
+    ASSERT_EXIT_OK(through_cat);  // a pipe, whose size is unknown until its end
+    expect_valid_labels(parse_labels(through_cat.output), mesh.face_count(), 7);
+  }
+  const CliRun info = run("info - < " + dir.q("in.off"));
+  ASSERT_EXIT_OK(info);
+  EXPECT_EQ(info.output.rfind("standard input\n", 0), 0u) << info.output;
+  const CliRun summary = run("segment - --clusters 7 < " + dir.q("in.ply"));
+  ASSERT_EXIT_OK(summary);
+  EXPECT_EQ(summary.output.rfind(
+                "standard input: " + std::to_string(mesh.face_count()) + " faces, 1 component,", 0),
+            0u)
+      << summary.output;
+  const CliRun distance =
+      run("distance - " + dir.q("in.obj") + " -q --json - < " + dir.q("in.off"));
+  ASSERT_EXIT_OK(distance);
+  EXPECT_LT(json::parse(distance.output)["symmetric"]["max"].get<double>(), 1e-9);  // one shape
+  ASSERT_EXIT_OK(run("denoise - --clusters 7 -o " + dir.q("d.off") + " < " + dir.q("in.off")));
+  EXPECT_EQ(read_mesh(dir / "d.off").face_count(), mesh.face_count());
+
+  // Standard input that holds no mesh: exit 1 with a message naming it.
+  write_file(dir / "empty", "");
+  write_file(dir / "page.html", "<html>not a mesh</html>\n");
+  const std::pair<std::string, std::string> bad[] = {
+      {"segment - --clusters 2 < " + dir.q("empty"), "standard input: empty"},
+      {"segment - --clusters 2 < " + dir.q("page.html"), "standard input: not a mesh file"},
+      {"info - < " + dir.q("page.html"), "standard input: not a mesh file"},
+      {"distance - - < " + dir.q("in.off"), "distance: only one of A and B"}};
+  for (const auto& [args, message] : bad) {
+    SCOPED_TRACE(args);
+    const CliRun r = run(args);
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("primseg: error: " + message), std::string::npos) << r.output;
+  }
 }
 
 TEST(Cli, ThreadCountDoesNotChangeTheTree) {

@@ -107,5 +107,14 @@ TEST(DetectMeshFormat, UnknownContentIsAParseErrorNamingTheInput) {
   }
 }
 
+TEST(DetectMeshFormat, EmptyContentIsAParseErrorSayingSo) {
+  try {
+    read_mesh_detecting_format(std::span<const char>(), "standard input");
+    ADD_FAILURE() << "no exception";
+  } catch (const ParseError& error) {
+    EXPECT_EQ(std::string(error.what()), "standard input: empty, no mesh data");
+  }
+}
+
 }  // namespace
 }  // namespace primseg
