@@ -136,9 +136,10 @@ namespace {
 void append_corners(const Hierarchy& hierarchy, std::uint32_t t, std::vector<Vec3>& points,
                     std::vector<double>& weights) {
   const DualGraph& graph = hierarchy.graph();
+  const Triangle corners = graph.corners(t);
   const std::array<double, 3> w = graph.corner_weights(t);
   for (int corner = 0; corner < 3; ++corner) {
-    const Eigen::Vector3d& x = graph.position(hierarchy.mesh().triangles[t][corner]);
+    const Eigen::Vector3d& x = graph.position(corners[corner]);
     points.push_back({x.x(), x.y(), x.z()});
     weights.push_back(w[corner]);
   }

@@ -22,6 +22,22 @@ std::uint32_t side_end(const Triangle& tri, unsigned c) {
   return tri[c == 2 ? 0 : c + 1];
 }
 
+// The triangle's corners from the one whose position is lexicographically smallest (the lowest
+// index among equal positions) on, in their cyclic order, so the orientation is kept. Every sum
+// over a triangle's corners runs in this order: a file that lists a triangle from another corner
+// gives the same statistics, costs and tree, bit for bit (round-off would otherwise settle the
+// ties of symmetric parts differently).
+Triangle canonical_corners(const Triangle& tri, std::span<const Eigen::Vector3d> positions) {
+  auto before = [&](std::uint32_t a, std::uint32_t b) {
+    const Eigen::Vector3d& p = positions[a];
+    const Eigen::Vector3d& q = positions[b];
+    return std::tie(p.x(), p.y(), p.z(), a) < std::tie(q.x(), q.y(), q.z(), b);
+  };
+  unsigned first = before(tri[1], tri[0]) ? 1 : 0;
+  if (before(tri[2], tri[first])) first = 2;
+  return {tri[first], tri[(first + 1) % 3], tri[(first + 2) % 3]};
+}
+
 // Sorts [begin, end) stably: by insertion when tiny (as nearly all ranges are here).
 template <typename Iterator, typename Less>
 void stable_sort_small(Iterator begin, Iterator end, Less less) {
@@ -198,15 +214,21 @@ Links link_triangles(const Mesh& mesh, const SideBuckets& buckets,
 // The dual edges of ranges of faces, each face's links in the order (other face, edge, lower
 // triangle): the edges come sorted by face pair, and the links of one pair add in increasing edge
 // order, as they would after a stable sort of all links in edge order.
+// The normal of a triangle given by its canonical corners, of length twice its area, negated when
+// `flipped`.
+inline Eigen::Vector3d oriented_normal(const Triangle& corners,
+                                       std::span<const Eigen::Vector3d> positions, bool flipped) {
+  const Eigen::Vector3d n = (positions[corners[1]] - positions[corners[0]])
+                                .cross(positions[corners[2]] - positions[corners[0]]);
+  return flipped ? Eigen::Vector3d(-n) : n;
+}
+
 // Triangle t's normal, oriented (negated where the orientation was flipped), of length twice its
 // area.
 inline Eigen::Vector3d oriented_normal(std::span<const Triangle> triangles,
                                        std::span<const Eigen::Vector3d> positions,
                                        std::span<const std::uint8_t> flipped, std::uint32_t t) {
-  const Triangle& tri = triangles[t];
-  const Eigen::Vector3d n =
-      (positions[tri[1]] - positions[tri[0]]).cross(positions[tri[2]] - positions[tri[0]]);
-  return flipped[t] ? Eigen::Vector3d(-n) : n;
+  return oriented_normal(canonical_corners(triangles[t], positions), positions, flipped[t] != 0);
 }
 
 class FaceLinks {
@@ -517,7 +539,7 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
     for (std::uint32_t t = 0; t < triangle_count; ++t) {
       if (t + 16 < triangle_count)
         for (std::uint32_t u : mesh.triangles[t + 16]) __builtin_prefetch(&positions_[u]);
-      const Triangle& tri = mesh.triangles[t];
+      const Triangle tri = canonical_corners(mesh.triangles[t], positions_);
       const double v = positions_[tri[0]].dot(positions_[tri[1]].cross(positions_[tri[2]]));
       volume[orient_component[t]] += flipped_[t] ? -v : v;
       const TriangleSlots& slots = neighbours[t];
@@ -568,11 +590,12 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
   }
 }
 
+Triangle DualGraph::corners(std::uint32_t t) const {
+  return canonical_corners(mesh_->triangles[t], positions_);
+}
+
 double DualGraph::triangle_area(std::uint32_t t) const {
-  const Triangle& tri = mesh_->triangles[t];
-  return 0.5 * (positions_[tri[1]] - positions_[tri[0]])
-                   .cross(positions_[tri[2]] - positions_[tri[0]])
-                   .norm();
+  return 0.5 * oriented_normal(corners(t), positions_, false).norm();
 }
 
 void DualGraph::prefetch_face(std::uint32_t f) const {
@@ -592,21 +615,24 @@ std::array<double, 3> DualGraph::corner_weights(std::uint32_t t) const {
 }
 
 std::array<double, 3> DualGraph::corner_weights(std::uint32_t t, double area) const {
-  const Triangle& tri = mesh_->triangles[t];
+  return corner_weights_of(corners(t), area);
+}
+
+inline std::array<double, 3> DualGraph::corner_weights_of(const Triangle& corners,
+                                                          double area) const {
   if (weights_ == VertexWeights::Uniform)
-    return {1.0 / valence_[tri[0]], 1.0 / valence_[tri[1]], 1.0 / valence_[tri[2]]};
+    return {1.0 / valence_[corners[0]], 1.0 / valence_[corners[1]], 1.0 / valence_[corners[2]]};
   return {area / 3, area / 3, area / 3};
 }
 
-inline Eigen::Vector3d DualGraph::triangle_centroid(std::uint32_t t) const {
-  const Triangle& tri = mesh_->triangles[t];
-  return (positions_[tri[0]] + positions_[tri[1]] + positions_[tri[2]]) / 3;
+inline Eigen::Vector3d DualGraph::centroid_of(const Triangle& corners) const {
+  return (positions_[corners[0]] + positions_[corners[1]] + positions_[corners[2]]) / 3;
 }
 
 inline Eigen::Vector3d DualGraph::face_origin(std::uint32_t f, const Eigen::Vector3d& weighted_sum,
                                               double weight) const {
   if (weight > 0) return weighted_sum / weight;
-  return triangle_centroid(first_triangle_[f]);
+  return centroid_of(corners(first_triangle_[f]));
 }
 
 inline EdgeStats DualGraph::internal_edges_of(std::uint32_t f) const {
@@ -626,13 +652,14 @@ bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
   Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
   double weight = 0;
   corners.triangle_count = end - begin;
+  std::array<Triangle, FaceCorners::kMaxTriangles> triangles;
   for (std::uint32_t t = begin; t < end; ++t) {
-    const Triangle& tri = mesh_->triangles[t];
     const std::uint32_t i = t - begin;
-    const Eigen::Vector3d normal = oriented_normal(mesh_->triangles, positions_, flipped_, t);
+    const Triangle& tri = triangles[i] = this->corners(t);
+    const Eigen::Vector3d normal = oriented_normal(tri, positions_, flipped_[t] != 0);
     corners.areas[i] = 0.5 * normal.norm();
     corners.area_normals[i] = 0.5 * normal;
-    const std::array<double, 3> w = corner_weights(t, corners.areas[i]);
+    const std::array<double, 3> w = corner_weights_of(tri, corners.areas[i]);
     for (int k = 0; k < 3; ++k) {
       corners.weights[3 * i + k] = w[k];
       weighted_sum += w[k] * positions_[tri[k]];
@@ -645,15 +672,14 @@ bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
   corners.normal_sum.setZero();
   corners.normal_position.setZero();
   corners.area = 0;
-  for (std::uint32_t t = begin; t < end; ++t) {
-    const Triangle& tri = mesh_->triangles[t];
-    const std::uint32_t i = t - begin;
+  for (std::uint32_t i = 0; i < corners.triangle_count; ++i) {
+    const Triangle& tri = triangles[i];
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d y = positions_[tri[k]] - corners.centroid;
       corners.offsets[3 * i + k] = y;
       corners.second_moment.noalias() += (corners.weights[3 * i + k] * y) * y.transpose();
     }
-    corners.triangle_offsets[i] = triangle_centroid(t) - corners.centroid;
+    corners.triangle_offsets[i] = centroid_of(tri) - corners.centroid;
     corners.normal_position += corners.triangle_offsets[i] * corners.area_normals[i].transpose();
     corners.normal_sum += corners.area_normals[i];
     corners.area += corners.areas[i];
@@ -675,6 +701,7 @@ void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_sampl
   // the corners (the first triangle's centroid if they weigh nothing), so that the statistics are
   // centred as the fitters and unions expect. Most faces are one triangle.
   struct Corners {
+    Triangle corners;        // canonical
     Eigen::Vector3d normal;  // oriented, length twice the area
     std::array<double, 3> weights;
   };
@@ -689,10 +716,10 @@ void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_sampl
   Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
   double weight = 0;
   for (std::uint32_t t = begin; t < end; ++t) {
-    const Triangle& tri = mesh_->triangles[t];
     Corners& c = corners[t - begin];
-    c.normal = oriented_normal(mesh_->triangles, positions_, flipped_, t);
-    c.weights = corner_weights(t, 0.5 * c.normal.norm());
+    const Triangle& tri = c.corners = this->corners(t);
+    c.normal = oriented_normal(tri, positions_, flipped_[t] != 0);
+    c.weights = corner_weights_of(tri, 0.5 * c.normal.norm());
     for (int k = 0; k < 3; ++k) {
       weighted_sum += c.weights[k] * positions_[tri[k]];
       weight += c.weights[k];
@@ -707,12 +734,12 @@ void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_sampl
   stats.triangle_count = 0;
   stats.samples.samples.clear();
   for (std::uint32_t t = begin; t < end; ++t) {
-    const Triangle& tri = mesh_->triangles[t];
     const Corners& c = corners[t - begin];
+    const Triangle& tri = c.corners;
     for (int k = 0; k < 3; ++k)
       stats.moments.add_point(positions_[tri[k]], c.weights[k], max_degree);
     const Eigen::Vector3d& n = c.normal;
-    const Eigen::Vector3d centroid = triangle_centroid(t);
+    const Eigen::Vector3d centroid = centroid_of(tri);
     stats.normal_position += (centroid - stats.moments.origin()) * (0.5 * n).transpose();
     stats.normal_sum += 0.5 * n;
     const double area = 0.5 * n.norm();

@@ -589,9 +589,10 @@ class HierarchyBuilder::Impl {
         for (std::uint32_t f = face_list_head_[slot]; f != kNone; f = next_face_[f])
           for (std::uint32_t t = graph_->first_triangle(f); t < graph_->first_triangle(f + 1);
                ++t) {
+            const Triangle corners = graph_->corners(t);
             const std::array<double, 3> w = graph_->corner_weights(t);
             for (int c = 0; c < 3; ++c) {
-              const Eigen::Vector3d& x = graph_->position(mesh_->triangles[t][c]);
+              const Eigen::Vector3d& x = graph_->position(corners[c]);
               const double d = primitive.distance({x.x(), x.y(), x.z()});
               sum += w[c] * d * d;
             }

@@ -107,11 +107,10 @@ void undo_splitting_moves(const Adjacency& adjacency, const std::vector<std::uin
 // ∫ d² over face f's triangles (working frame), by the edge-midpoint rule.
 double face_error(const Hierarchy& hierarchy, std::uint32_t f, const Primitive& working,
                   const std::vector<std::uint32_t>& first_triangle) {
-  const Mesh& mesh = hierarchy.mesh();
   const DualGraph& graph = hierarchy.graph();
   double sum = 0;
   for (std::uint32_t t = first_triangle[f]; t < first_triangle[f + 1]; ++t) {
-    const Triangle& tri = mesh.triangles[t];
+    const Triangle tri = graph.corners(t);
     double squares = 0;
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d m = 0.5 * (graph.position(tri[k]) + graph.position(tri[(k + 1) % 3]));

@@ -53,7 +53,7 @@ TEST(ClusterStats, RandomMergeSequencesEqualTheWholeMeshStatistics) {
   Moments direct(Eigen::Vector3d::Zero());
   for (std::uint32_t t = 0; t < shape.mesh.triangle_count(); ++t) {
     const auto w = graph.corner_weights(t);
-    for (int c = 0; c < 3; ++c) direct.add_point(graph.position(shape.mesh.triangles[t][c]), w[c]);
+    for (int c = 0; c < 3; ++c) direct.add_point(graph.position(graph.corners(t)[c]), w[c]);
   }
   EdgeStats all_edges;
   for (const DualEdge& e : graph.edges()) all_edges += e.shared;
@@ -96,7 +96,7 @@ TEST(ClusterStats, RandomMergeSequencesEqualTheWholeMeshStatistics) {
     Eigen::Vector3d n_offset = Eigen::Vector3d::Zero();
     double offset_square = 0;
     for (std::uint32_t t = 0; t < shape.mesh.triangle_count(); ++t) {
-      const Triangle& tri = shape.mesh.triangles[t];
+      const Triangle tri = graph.corners(t);
       Eigen::Vector3d n = (graph.position(tri[1]) - graph.position(tri[0]))
                               .cross(graph.position(tri[2]) - graph.position(tri[0]));
       if (graph.flipped(t)) n = -n;

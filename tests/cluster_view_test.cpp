@@ -26,7 +26,7 @@ struct Corners {
       for (std::uint32_t t = graph.first_triangle(f); t < graph.first_triangle(f + 1); ++t) {
         const auto w = graph.corner_weights(t);
         for (int c = 0; c < 3; ++c) {
-          points.push_back(graph.position(graph.mesh().triangles[t][c]));
+          points.push_back(graph.position(graph.corners(t)[c]));
           weights.push_back(w[c]);
         }
       }

@@ -14,6 +14,7 @@
 #include <numeric>
 #include <random>
 #include <string>
+#include <tuple>
 
 #include "primseg/mesh_io.hpp"
 #include "primseg/shape_generator.hpp"
@@ -23,6 +24,19 @@ namespace primseg {
 namespace {
 
 // What DualGraph's constructor computes, by the algorithm it first used (kept as the reference).
+// Of the three rotations of a triangle's corners, the one that lists first the corner with the
+// smallest (x, y, z, index), compared as a whole tuple.
+Triangle canonical_rotation(const Triangle& tri, const std::vector<Eigen::Vector3d>& positions) {
+  auto key = [&](std::uint32_t v) {
+    return std::make_tuple(positions[v].x(), positions[v].y(), positions[v].z(), v);
+  };
+  const int first = static_cast<int>(
+      std::min_element(tri.begin(), tri.end(),
+                       [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); }) -
+      tri.begin());
+  return {tri[first], tri[(first + 1) % 3], tri[(first + 2) % 3]};
+}
+
 struct ReferenceGraph {
   std::vector<Eigen::Vector3d> positions;
   std::vector<std::uint32_t> first_triangle;
@@ -144,7 +158,7 @@ ReferenceGraph reference_graph(const Mesh& mesh) {
   }
   std::vector<double> volume(component_open.size(), 0.0);
   for (std::uint32_t t = 0; t < triangle_count; ++t) {
-    const Triangle& tri = mesh.triangles[t];
+    const Triangle tri = canonical_rotation(mesh.triangles[t], g.positions);
     const double v = g.positions[tri[0]].dot(g.positions[tri[1]].cross(g.positions[tri[2]]));
     volume[orient_component[t]] += g.flipped[t] ? -v : v;
   }
@@ -154,7 +168,7 @@ ReferenceGraph reference_graph(const Mesh& mesh) {
   }
 
   auto oriented_normal = [&](std::uint32_t t) {
-    const Triangle& tri = mesh.triangles[t];
+    const Triangle tri = canonical_rotation(mesh.triangles[t], g.positions);
     const Eigen::Vector3d n = (g.positions[tri[1]] - g.positions[tri[0]])
                                   .cross(g.positions[tri[2]] - g.positions[tri[0]]);
     return g.flipped[t] ? Eigen::Vector3d(-n) : n;
@@ -212,9 +226,7 @@ ReferenceGraph reference_graph(const Mesh& mesh) {
   return g;
 }
 
-bool same_bits(double a, double b) {
-  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
-}
+using testing::same_bits;
 
 bool same_bits(const EdgeStats& a, const EdgeStats& b) {
   for (int i = 0; i < 6; ++i)
@@ -238,9 +250,11 @@ void expect_reference_graph(const Mesh& mesh, const std::string& what, unsigned 
     ASSERT_EQ(graph.first_triangle(f), expected.first_triangle[f]) << "face " << f;
   for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     ASSERT_EQ(graph.flipped(t), expected.flipped[t] != 0) << "triangle " << t;
+    const Triangle corners = canonical_rotation(mesh.triangles[t], expected.positions);
+    ASSERT_EQ(graph.corners(t), corners) << "triangle " << t;
     const std::array<double, 3> weights = graph.corner_weights(t);
     for (int c = 0; c < 3; ++c)
-      ASSERT_TRUE(same_bits(weights[c], 1.0 / expected.valence[mesh.triangles[t][c]]))
+      ASSERT_TRUE(same_bits(weights[c], 1.0 / expected.valence[corners[c]]))
           << "triangle " << t << " corner " << c;
   }
 

@@ -83,9 +83,13 @@ class DualGraph {
   const Eigen::Vector3d& position(std::uint32_t v) const { return positions_[v]; }
   /// Whether triangle t was flipped to orient its component consistently (outward when closed).
   bool flipped(std::uint32_t t) const { return flipped_[t] != 0; }
+  /// Triangle t's vertices in the order every computation visits them: from the corner whose
+  /// position is lexicographically smallest (the lowest index among equal positions), orientation
+  /// kept. A file that lists a triangle from another corner thus gives the same tree, bit for bit.
+  Triangle corners(std::uint32_t t) const;
   /// Area of triangle t (working frame; input area = ldexp(area, 2 · frame().exponent)).
   double triangle_area(std::uint32_t t) const;
-  /// Weight of each corner of triangle t (working frame).
+  /// Weight of each corner of triangle t, in the order of corners(t) (working frame).
   std::array<double, 3> corner_weights(std::uint32_t t) const;
   /// The same, with the triangle's area (triangle_area(t)) already known.
   std::array<double, 3> corner_weights(std::uint32_t t, double area) const;
@@ -106,10 +110,12 @@ class DualGraph {
   bool face_corners(std::uint32_t f, FaceCorners& corners) const;
 
  private:
-  // What face_stats() and face_corners() share: triangle t's centroid; the origin of face f's
-  // statistics (its corners' weighted centroid from their weighted sum, or its first triangle's
-  // centroid when they weigh nothing); the mesh edges between f's own triangles.
-  Eigen::Vector3d triangle_centroid(std::uint32_t t) const;
+  // What face_stats() and face_corners() share: a triangle's centroid and corner weights from its
+  // corners(); the origin of face f's statistics (its corners' weighted centroid from their
+  // weighted sum, or its first triangle's centroid when they weigh nothing); the mesh edges
+  // between f's own triangles.
+  Eigen::Vector3d centroid_of(const Triangle& corners) const;
+  std::array<double, 3> corner_weights_of(const Triangle& corners, double area) const;
   Eigen::Vector3d face_origin(std::uint32_t f, const Eigen::Vector3d& weighted_sum,
                               double weight) const;
   EdgeStats internal_edges_of(std::uint32_t f) const;

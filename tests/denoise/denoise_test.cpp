@@ -234,7 +234,9 @@ Mesh marching_box() {
 // spheres and cylinders (fit_geometric from the hierarchy's fit): the hierarchy's torus is fitted
 // to a sample of 33 corners, far noisier than a fit to every vertex. The noisy fillet is a torus
 // cluster of its own from K = 6 (at the true 4 it takes part of the flat cap; see README), where
-// the refit takes the RMS ratio from 2.15x (the hierarchy's torus kept) to 2.49x.
+// the refit took the RMS ratio from 2.15x (the hierarchy's torus kept) to 2.49x. Which corners the
+// sample holds changes the tree of these noisy parts: measured 3.13x and 4.32x since the corners
+// are visited from the same one whatever the file's order (2.54x and 5.65x before).
 TEST(Denoise, NoisyConesAndToriAreRefittedOnAllTheirVertices) {
   struct Case {
     const char* name;
@@ -242,7 +244,7 @@ TEST(Denoise, NoisyConesAndToriAreRefittedOnAllTheirVertices) {
     double min_ratio;
   };
   for (const auto& [name, clusters, min_ratio] :
-       {Case{"filleted_cylinder", 6, 2.3}, Case{"box_with_countersink", 8, 4.5}}) {
+       {Case{"filleted_cylinder", 6, 2.3}, Case{"box_with_countersink", 8, 4.0}}) {
     const NoisyShape shape = noisy_shape(name, 0.004, 0.04);
     DenoiseOptions options;
     options.hierarchy.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder,

@@ -1,6 +1,8 @@
 #pragma once
 // Shared helpers of the test suite.
 
+#include <bit>
+#include <cstdint>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -27,6 +29,12 @@ std::string file_contents(const std::filesystem::path& path);
 
 /// Runs a shell command, returns its exit status; stdout+stderr go to *output if given.
 int run_command(const std::string& command, std::string* output = nullptr);
+
+/// True when a and b are the same double, bit for bit (so 0 and −0 differ, and a NaN equals
+/// itself).
+inline bool same_bits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
 
 /// A uniformly random rotation (deterministic for a given engine state).
 std::array<std::array<double, 3>, 3> random_rotation(std::mt19937_64& rng);
