@@ -127,12 +127,12 @@ void check_reports(const Hierarchy& hierarchy, const Segmentation& level,
   const double diagonal = bounding_box_diagonal(mesh);
   for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
     const std::uint32_t label = level.labels[mesh.face_of_triangle[t]];
+    const Triangle corners = graph.corners(t);
     const std::array<double, 3> weights = graph.corner_weights(t);
     for (int k = 0; k < 3; ++k)
       if (weights[k] > 0)
         largest[label] =
-            std::max(largest[label],
-                     reports[label].primitive.distance(mesh.positions[mesh.triangles[t][k]]));
+            std::max(largest[label], reports[label].primitive.distance(mesh.positions[corners[k]]));
   }
   for (const std::uint32_t label : level.labels) ++faces[label];
   for (std::size_t c = 0; c < reports.size(); ++c) {
