@@ -317,7 +317,10 @@ class FaceLinks {
       link.angled = true;
       link.y = n1.cross(n2).norm();
       link.x = n1.dot(n2);
-      link.concave = (positions_[link.opposite] - positions_[link.low]).dot(n1) > 0;
+      // From the edge's midpoint rather than an end: which end has the lower index must not
+      // decide a nearly flat edge's sign (round-off), or renumbered vertices would change trees.
+      const Eigen::Vector3d midpoint = (positions_[link.low] + positions_[link.high]) / 2;
+      link.concave = (positions_[link.opposite] - midpoint).dot(n1) > 0;
     }
     for (const Link& link : block) {
       double beta = 0;

@@ -183,7 +183,8 @@ ReferenceGraph reference_graph(const Mesh& mesh) {
       if (v != link.low && v != link.high) opposite = v;
     if (opposite != UINT32_MAX && n1.squaredNorm() > 0 && n2.squaredNorm() > 0) {
       beta = std::atan2(n1.cross(n2).norm(), n1.dot(n2));
-      if ((g.positions[opposite] - g.positions[link.low]).dot(n1) > 0) beta = -beta;
+      const Eigen::Vector3d midpoint = (g.positions[link.low] + g.positions[link.high]) / 2;
+      if ((g.positions[opposite] - midpoint).dot(n1) > 0) beta = -beta;
     }
     EdgeStats stats;
     stats.add_edge(edge, beta);
