@@ -211,9 +211,6 @@ Links link_triangles(const Mesh& mesh, const SideBuckets& buckets,
   return links;
 }
 
-// The dual edges of ranges of faces, each face's links in the order (other face, edge, lower
-// triangle): the edges come sorted by face pair, and the links of one pair add in increasing edge
-// order, as they would after a stable sort of all links in edge order.
 // The normal of a triangle given by its canonical corners, of length twice its area, negated when
 // `flipped`.
 inline Eigen::Vector3d oriented_normal(const Triangle& corners,
@@ -231,6 +228,9 @@ inline Eigen::Vector3d oriented_normal(std::span<const Triangle> triangles,
   return oriented_normal(canonical_corners(triangles[t], positions), positions, flipped[t] != 0);
 }
 
+// The dual edges of ranges of faces, each face's links in the order (other face, edge, lower
+// triangle): the edges come sorted by face pair, and the links of one pair add in increasing edge
+// order, as they would after a stable sort of all links in edge order.
 class FaceLinks {
  public:
   FaceLinks(const Mesh& mesh, std::span<const Eigen::Vector3d> positions,
