@@ -1,6 +1,8 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <optional>
+#include <span>
 
 #include "../src/file_io.hpp"
 #include "command.hpp"
@@ -21,18 +23,16 @@ std::string input_name(const std::filesystem::path& path) {
 }
 
 Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes) {
-  if (path.native() == kStandardInput) {
-    const detail::FileImage image = detail::read_standard_input();
-    if (bytes) *bytes = image.size;
-    return read_mesh_detecting_format({image.bytes.get(), image.size}, "standard input");
-  }
-  Mesh mesh = read_mesh(path);
-  if (bytes) {
-    std::error_code ignored;  // the file was just read; a size that vanished since counts as 0
-    const std::uintmax_t size = std::filesystem::file_size(path, ignored);
-    *bytes = size == static_cast<std::uintmax_t>(-1) ? 0 : size;
-  }
-  return mesh;
+  const bool standard_input = path.native() == kStandardInput;
+  // As read_mesh(path): an unknown extension fails before the file is read.
+  const std::optional<MeshFormat> format =
+      standard_input ? std::nullopt : std::optional(mesh_format_from_path(path));
+  const detail::FileImage image =
+      standard_input ? detail::read_standard_input() : detail::read_file(path);
+  if (bytes) *bytes = image.size;
+  const std::span<const char> content(image.bytes.get(), image.size);
+  return format ? read_mesh(content, *format, path.string())
+                : read_mesh_detecting_format(content, input_name(path));
 }
 
 Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes) {

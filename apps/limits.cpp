@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "command.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg::cli {
@@ -47,7 +48,7 @@ void add_limit_options(CLI::App& command, ResourceLimits& limits) {
 
 void check_file_limits(const std::filesystem::path& path, const ResourceLimits& limits) {
   // Standard input has no size before it is read: check_mesh_limits() counts its bytes.
-  if (!limits.max_memory || path.native() == "-") return;
+  if (!limits.max_memory || path.native() == kStandardInput) return;
   std::error_code error;
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   if (!error && size > *limits.max_memory)

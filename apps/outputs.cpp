@@ -1,9 +1,9 @@
 #include "outputs.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
-#include <iterator>
 #include <string>
 #include <utility>
 
@@ -18,6 +18,19 @@ nlohmann::json vec3_json(const Vec3& v) {
   return nlohmann::json::array({v[0], v[1], v[2]});
 }
 
+namespace {
+
+// The outputs that may go to standard output.
+std::array<const std::optional<std::string>*, 4> text_outputs(const OutputFiles& files) {
+  return {&files.labels, &files.json, &files.linkage, &files.curve};
+}
+
+bool to_standard_output(const std::optional<std::string>* path) {
+  return *path == kStandardOutput;
+}
+
+}  // namespace
+
 void validate_output_files(const OutputFiles& files) {
   const std::pair<const char*, const std::optional<std::string>*> binary[] = {
       {"--colored", &files.colored}, {"--png", &files.png}, {"--tree", &files.tree}};
@@ -26,11 +39,8 @@ void validate_output_files(const OutputFiles& files) {
       throw InvalidInputError(std::string(option) +
                               ": cannot write to standard output ('-'); only --labels, --json, "
                               "--curve and --linkage can (to write a file named '-', give ./-)");
-  const std::optional<std::string>* text[] = {&files.labels, &files.json, &files.linkage,
-                                              &files.curve};
-  if (std::count_if(std::begin(text), std::end(text), [](const std::optional<std::string>* path) {
-        return *path == kStandardOutput;
-      }) > 1)
+  const auto text = text_outputs(files);
+  if (std::count_if(text.begin(), text.end(), to_standard_output) > 1)
     throw InvalidInputError(
         "only one of --labels, --json, --curve and --linkage can write to standard output ('-')");
   if (files.colored) {
@@ -47,8 +57,8 @@ void validate_output_files(const OutputFiles& files) {
 }
 
 bool writes_to_standard_output(const OutputFiles& files) {
-  return files.labels == kStandardOutput || files.json == kStandardOutput ||
-         files.linkage == kStandardOutput || files.curve == kStandardOutput;
+  const auto text = text_outputs(files);
+  return std::any_of(text.begin(), text.end(), to_standard_output);
 }
 
 void write_text_output(const std::string& path, std::string_view text) {

@@ -598,7 +598,11 @@ Triangle DualGraph::corners(std::uint32_t t) const {
 }
 
 double DualGraph::triangle_area(std::uint32_t t) const {
-  return 0.5 * oriented_normal(corners(t), positions_, false).norm();
+  return area_of(corners(t));
+}
+
+inline double DualGraph::area_of(const Triangle& corners) const {
+  return 0.5 * oriented_normal(corners, positions_, false).norm();
 }
 
 void DualGraph::prefetch_face(std::uint32_t f) const {
@@ -614,11 +618,8 @@ void DualGraph::prefetch_face_corners(std::uint32_t f) const {
 }
 
 std::array<double, 3> DualGraph::corner_weights(std::uint32_t t) const {
-  return corner_weights(t, weights_ == VertexWeights::Area ? triangle_area(t) : 0.0);
-}
-
-std::array<double, 3> DualGraph::corner_weights(std::uint32_t t, double area) const {
-  return corner_weights_of(corners(t), area);
+  const Triangle tri = corners(t);
+  return corner_weights_of(tri, weights_ == VertexWeights::Area ? area_of(tri) : 0.0);
 }
 
 inline std::array<double, 3> DualGraph::corner_weights_of(const Triangle& corners,

@@ -91,8 +91,6 @@ class DualGraph {
   double triangle_area(std::uint32_t t) const;
   /// Weight of each corner of triangle t, in the order of corners(t) (working frame).
   std::array<double, 3> corner_weights(std::uint32_t t) const;
-  /// The same, with the triangle's area (triangle_area(t)) already known.
-  std::array<double, 3> corner_weights(std::uint32_t t, double area) const;
   /// Cache hints for a coming face_stats(f): prefetch_face() asks for the face's triangles,
   /// prefetch_face_corners(), a while later, for their corners' positions (it reads the
   /// triangles).
@@ -110,10 +108,11 @@ class DualGraph {
   bool face_corners(std::uint32_t f, FaceCorners& corners) const;
 
  private:
-  // What face_stats() and face_corners() share: a triangle's centroid and corner weights from its
-  // corners(); the origin of face f's statistics (its corners' weighted centroid from their
-  // weighted sum, or its first triangle's centroid when they weigh nothing); the mesh edges
-  // between f's own triangles.
+  // A triangle's area, centroid and corner weights from its corners(), for the accessors above
+  // and for face_stats() and face_corners(); what the last two also share: the origin of face f's
+  // statistics (its corners' weighted centroid from their weighted sum, or its first triangle's
+  // centroid when they weigh nothing) and the mesh edges between f's own triangles.
+  double area_of(const Triangle& corners) const;
   Eigen::Vector3d centroid_of(const Triangle& corners) const;
   std::array<double, 3> corner_weights_of(const Triangle& corners, double area) const;
   Eigen::Vector3d face_origin(std::uint32_t f, const Eigen::Vector3d& weighted_sum,

@@ -259,9 +259,10 @@ TEST(ConeFitter, JitteredVerticesOnTheConeAndNoiseAlongTheNormals) {
         const DualGraph graph(mesh, VertexWeights::Area);
         double exact = 0;
         for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+          const Triangle corners = graph.corners(t);
           const auto w = graph.corner_weights(t);
           for (int c = 0; c < 3; ++c) {
-            const Eigen::Vector3d& x = graph.position(mesh.triangles[t][c]);
+            const Eigen::Vector3d& x = graph.position(corners[c]);
             exact += w[c] * std::pow(fit.primitive.distance({x.x(), x.y(), x.z()}), 2);
           }
         }
@@ -355,9 +356,10 @@ TEST(TorusFitter, NoisyTorusErrorEstimatesTheExactError) {
     const DualGraph graph(mesh, VertexWeights::Area);
     double exact = 0;
     for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      const Triangle corners = graph.corners(t);
       const auto w = graph.corner_weights(t);
       for (int c = 0; c < 3; ++c) {
-        const Eigen::Vector3d& x = graph.position(mesh.triangles[t][c]);
+        const Eigen::Vector3d& x = graph.position(corners[c]);
         exact += w[c] * std::pow(fit.primitive.distance({x.x(), x.y(), x.z()}), 2);
       }
     }
