@@ -189,9 +189,11 @@ Result process(const Item& item, const BatchOptions& o, const HierarchyOptions& 
   }
   try {
     check_file_limits(item.input, o.limits);
-    auto mesh = std::make_shared<const Mesh>(read_geometry(item.input));
+    std::uint64_t file_bytes = 0;
+    auto mesh =
+        std::make_shared<const Mesh>(read_geometry(item.input, &file_bytes, o.limits.max_memory));
     result.faces = mesh->face_count();
-    check_mesh_limits(*mesh, fs::file_size(item.input), o.limits);
+    check_mesh_limits(*mesh, file_bytes, o.limits);
     validate_level(o.level, mesh->face_count());
     fs::create_directories(base.parent_path());
     const Hierarchy hierarchy = build_hierarchy(mesh, options);

@@ -22,21 +22,34 @@ std::string input_name(const std::filesystem::path& path) {
   return path.native() == kStandardInput ? std::string("standard input") : path.string();
 }
 
-Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes) {
+Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes,
+                     std::optional<std::uint64_t> max_memory) {
   const bool standard_input = path.native() == kStandardInput;
   // As read_mesh(path): an unknown extension fails before the file is read.
   const std::optional<MeshFormat> format =
       standard_input ? std::nullopt : std::optional(mesh_format_from_path(path));
+  const std::string name = input_name(path);
+  detail::ReadLimits limits;
+  if (max_memory) {
+    limits.max_bytes = *max_memory;
+    limits.limit_name = "--max-memory";
+  }
+  if (standard_input)
+    limits.check_prefix = [&name](std::span<const char> prefix, std::uint64_t most_bytes) {
+      // Data that could be a mesh only if it were larger than can be read is no mesh here either.
+      // Throws the error the whole input would get.
+      if (mesh_format_ruled_out(prefix, most_bytes)) read_mesh_detecting_format(prefix, name);
+    };
   const detail::FileImage image =
-      standard_input ? detail::read_standard_input() : detail::read_file(path);
+      standard_input ? detail::read_standard_input(limits) : detail::read_file(path, limits);
   if (bytes) *bytes = image.size;
   const std::span<const char> content(image.bytes.get(), image.size);
-  return format ? read_mesh(content, *format, path.string())
-                : read_mesh_detecting_format(content, input_name(path));
+  return format ? read_mesh(content, *format, name) : read_mesh_detecting_format(content, name);
 }
 
-Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes) {
-  Mesh mesh = read_input_mesh(path, bytes);
+Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes,
+                   std::optional<std::uint64_t> max_memory) {
+  Mesh mesh = read_input_mesh(path, bytes, max_memory);
   try {
     check_geometric_range(mesh);
   } catch (const InvalidInputError& error) {

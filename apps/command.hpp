@@ -6,6 +6,7 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,13 +47,18 @@ std::string input_name(const std::filesystem::path& path);
 /// A mesh named on the command line: the file `path` (its format from the extension), or standard
 /// input when `path` is "-" (its format detected from the content: detect_mesh_format). `bytes`,
 /// if set, receives the input's size. Throws as read_mesh; ParseError when standard input holds
-/// no format primseg can tell.
-Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes = nullptr);
+/// no format primseg can tell, as soon as its first bytes show it (mesh_format_ruled_out: an
+/// endless stream of anything else is not read to its end); InvalidInputError as soon as the
+/// input has more bytes than `max_memory` (--max-memory), which bounds what a pipe, whose size
+/// is unknown before its end, can make primseg read.
+Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes = nullptr,
+                     std::optional<std::uint64_t> max_memory = std::nullopt);
 
 /// read_input_mesh(), then check_geometric_range(), whose message gets the input's name: the
 /// commands that compute geometry read their meshes through this (`info` reads any finite
 /// coordinates).
-Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes = nullptr);
+Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes = nullptr,
+                   std::optional<std::uint64_t> max_memory = std::nullopt);
 
 /// Parses "plane,sphere,cylinder" into types that have a fitter; throws InvalidInputError
 /// naming the unknown one and the available ones.

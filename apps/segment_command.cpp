@@ -53,7 +53,8 @@ Command add_segment_command(CLI::App& app) {
         check_file_limits(o->mesh_path, o->limits);
         const auto read_start = Clock::now();
         std::uint64_t file_bytes = 0;
-        auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path, &file_bytes));
+        auto mesh = std::make_shared<const Mesh>(
+            read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory));
         const double read_seconds = seconds_since(read_start);
         check_mesh_limits(*mesh, file_bytes, o->limits);
         validate_level(o->level.level, mesh->face_count());

@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <csignal>
@@ -37,16 +38,26 @@ namespace {
 
 // Reads what is left of `fd` until end of file into a buffer of at least `expected` + 1 bytes
 // (the size from fstat may be stale: a growing file, or a pipe, whose size is 0).
-FileImage read_to_end(int fd, const std::filesystem::path& name, std::uint64_t expected) {
+FileImage read_to_end(int fd, const std::filesystem::path& name, std::uint64_t expected,
+                      const ReadLimits& limits) {
   const std::uint64_t memory = physical_memory_bytes();
-  std::size_t capacity = static_cast<std::size_t>(expected) + 1;
+  // The buffer never holds more than one byte past a limit: that byte is what tells.
+  const std::uint64_t most = std::min(limits.max_bytes, memory == 0 ? UINT64_MAX : memory);
+  const std::uint64_t largest_buffer = most == UINT64_MAX ? most : most + 1;
+  std::size_t capacity = static_cast<std::size_t>(std::min(expected + 1, largest_buffer));
   FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
   while (true) {
+    if (image.size > limits.max_bytes)
+      throw InvalidInputError(
+          name.string() + ": more than " +
+          (limits.limit_name.empty() ? "" : std::string(limits.limit_name) + " ") +
+          std::to_string(limits.max_bytes) + " bytes");
+    if (image.size > most)
+      throw IoError("cannot read '" + name.string() + "': more than this machine's memory (" +
+                    std::to_string(memory) + " bytes)");
     if (image.size == capacity) {
-      if (memory != 0 && image.size > memory)
-        throw IoError("cannot read '" + name.string() + "': more than this machine's memory (" +
-                      std::to_string(memory) + " bytes)");
-      const std::size_t grown = capacity + capacity / 2 + 4096;
+      const std::size_t grown = static_cast<std::size_t>(
+          std::min<std::uint64_t>(capacity + capacity / 2 + 4096, largest_buffer));
       auto larger = std::make_unique_for_overwrite<char[]>(grown);
       std::memcpy(larger.get(), image.bytes.get(), image.size);
       image.bytes = std::move(larger);
@@ -59,12 +70,13 @@ FileImage read_to_end(int fd, const std::filesystem::path& name, std::uint64_t e
     }
     if (got == 0) return image;
     image.size += static_cast<std::size_t>(got);
+    if (limits.check_prefix) limits.check_prefix({image.bytes.get(), image.size}, most);
   }
 }
 
 }  // namespace
 
-FileImage read_file(const std::filesystem::path& path) {
+FileImage read_file(const std::filesystem::path& path, const ReadLimits& limits) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) io_failure(path, "open", errno);
   struct FdCloser {
@@ -82,17 +94,18 @@ FileImage read_file(const std::filesystem::path& path) {
     throw IoError("cannot read '" + path.string() + "': the file has " +
                   std::to_string(status.st_size) + " bytes, more than this machine's memory (" +
                   std::to_string(memory) + " bytes)");
-  return read_to_end(fd, path, static_cast<std::uint64_t>(status.st_size));
+  return read_to_end(fd, path, static_cast<std::uint64_t>(status.st_size), limits);
 }
 
-FileImage read_standard_input() {
+FileImage read_standard_input(const ReadLimits& limits) {
   struct stat status {};
   if (::fstat(STDIN_FILENO, &status) != 0) io_failure("standard input", "stat", errno);
   if (S_ISDIR(status.st_mode)) io_failure("standard input", "read", EISDIR);
   // A pipe has no size: start with a block, the buffer grows by half as it fills.
   const bool sized = S_ISREG(status.st_mode);
   return read_to_end(STDIN_FILENO, "standard input",
-                     sized ? static_cast<std::uint64_t>(status.st_size) : std::uint64_t{65536});
+                     sized ? static_cast<std::uint64_t>(status.st_size) : std::uint64_t{65536},
+                     limits);
 }
 
 namespace {

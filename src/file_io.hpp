@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string_view>
 
 namespace primseg::detail {
@@ -24,13 +25,25 @@ struct FileImage {
 /// Physical memory of the machine in bytes (0 if unknown).
 std::uint64_t physical_memory_bytes();
 
+/// Bounds on a read whose size is known only at its end (standard input, a pipe, a device).
+struct ReadLimits {
+  /// Most bytes accepted: one more stops the read with InvalidInputError "<name>: more than
+  /// <limit_name> <max_bytes> bytes" (limit_name: the option that set it, if any).
+  std::uint64_t max_bytes = UINT64_MAX;
+  std::string_view limit_name;
+  /// Called after each read with the bytes read so far and the most the read accepts (max_bytes,
+  /// or the machine's memory if lower); throws to stop reading (data that already cannot be what
+  /// the caller expects).
+  std::function<void(std::span<const char> prefix, std::uint64_t most_bytes)> check_prefix;
+};
+
 /// Reads a whole file. Throws IoError (missing, a directory, unreadable, larger than the
-/// machine's physical memory).
-FileImage read_file(const std::filesystem::path& path);
+/// machine's physical memory), or what `limits` throws.
+FileImage read_file(const std::filesystem::path& path, const ReadLimits& limits = {});
 
 /// Reads standard input to its end (a pipe, a terminal or a redirected file). Throws IoError
-/// (unreadable, or more bytes than the machine's physical memory).
-FileImage read_standard_input();
+/// (unreadable, or more bytes than the machine's physical memory), or what `limits` throws.
+FileImage read_standard_input(const ReadLimits& limits = {});
 
 /// Writes to an unnamed file in the target's directory (O_TMPFILE; a hidden named one where the
 /// filesystem lacks it), then names it and renames it over the target: readers see the old file

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -37,6 +38,16 @@ Mesh read_mesh(std::span<const char> bytes, MeshFormat format, std::string_view 
 /// starting with "solid"; a first token that is an OBJ statement (v, vt, vn, f, o, g, s, l,
 /// mtllib, usemtl). Empty when none applies.
 std::optional<MeshFormat> detect_mesh_format(std::span<const char> bytes);
+
+/// For data that arrives in pieces (a pipe): true when its first bytes, `prefix`, already rule out
+/// every format detect_mesh_format() could find in the whole data, if the data has at most
+/// `max_size` bytes, whatever follows. Text signatures are read from the first 64 KiB, a binary
+/// STL is told by its size: true once `prefix` holds 64 KiB or more without a text signature, and
+/// the binary STL its first 84 bytes would declare is shorter than `prefix` or longer than
+/// `max_size` (say, what the reader can hold). A reader can then stop at once instead of at the
+/// end of the data.
+bool mesh_format_ruled_out(std::span<const char> prefix,
+                           std::uint64_t max_size = std::numeric_limits<std::uint64_t>::max());
 
 /// Reads a mesh whose format is detected from its content (detect_mesh_format). Throws
 /// ParseError naming `name` when the format cannot be told, else as read_mesh.

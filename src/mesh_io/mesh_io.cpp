@@ -8,8 +8,10 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -65,10 +67,13 @@ bool is_space(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
 }
 
+// Text signatures are read from this many first bytes at most.
+constexpr std::size_t kSignatureBytes = std::size_t{64} << 10;
+
 /// The first whitespace-separated token of the text, skipping lines whose first token starts
-/// with '#' (comments of OFF and OBJ). Looks at the first 64 KiB only.
+/// with '#' (comments of OFF and OBJ). Looks at the first kSignatureBytes only.
 std::string_view first_token(std::string_view text) {
-  text = text.substr(0, std::min<std::size_t>(text.size(), std::size_t{64} << 10));
+  text = text.substr(0, std::min(text.size(), kSignatureBytes));
   std::size_t at = 0;
   while (at < text.size()) {
     while (at < text.size() && is_space(text[at])) ++at;
@@ -94,18 +99,19 @@ bool starts_with_ignoring_case(std::string_view text, std::string_view prefix) {
   return true;
 }
 
-}  // namespace
+// The size of the binary STL whose header `text` would be (an 80-byte header, a little-endian
+// triangle count, 50 bytes per triangle); none before the count.
+std::optional<std::uint64_t> binary_stl_size(std::string_view text) {
+  if (text.size() < 84) return std::nullopt;
+  std::uint32_t count = 0;
+  for (int i = 3; i >= 0; --i)
+    count = count << 8 | static_cast<unsigned char>(text[80 + static_cast<std::size_t>(i)]);
+  return 84 + 50 * static_cast<std::uint64_t>(count);
+}
 
-std::optional<MeshFormat> detect_mesh_format(std::span<const char> bytes) {
-  const std::string_view text(bytes.data(), bytes.size());
+// The format named by the start of the text (every signature but binary STL's, which is its size).
+std::optional<MeshFormat> text_signature(std::string_view text) {
   if (text.starts_with("ply\n") || text.starts_with("ply\r")) return MeshFormat::Ply;
-  // Binary STL: an 80-byte header, a little-endian triangle count, 50 bytes per triangle.
-  if (text.size() >= 84) {
-    std::uint32_t count = 0;
-    for (int i = 3; i >= 0; --i)
-      count = count << 8 | static_cast<unsigned char>(text[80 + static_cast<std::size_t>(i)]);
-    if (84 + 50 * static_cast<std::uint64_t>(count) == text.size()) return MeshFormat::Stl;
-  }
   if (starts_with_ignoring_case(text, "solid")) return MeshFormat::Stl;
   const std::string_view token = first_token(text);
   if (token.size() >= 3 && token.ends_with("OFF")) return MeshFormat::Off;
@@ -114,6 +120,26 @@ std::optional<MeshFormat> detect_mesh_format(std::span<const char> bytes) {
   for (const std::string_view statement : kObjStatements)
     if (token == statement) return MeshFormat::Obj;
   return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<MeshFormat> detect_mesh_format(std::span<const char> bytes) {
+  const std::string_view text(bytes.data(), bytes.size());
+  const std::optional<MeshFormat> signature = text_signature(text);
+  if (signature == MeshFormat::Ply) return signature;
+  // Before "solid": the header of a binary STL may start with that word too.
+  if (binary_stl_size(text) == text.size()) return MeshFormat::Stl;
+  return signature;
+}
+
+bool mesh_format_ruled_out(std::span<const char> prefix, std::uint64_t max_size) {
+  const std::string_view text(prefix.data(), prefix.size());
+  // Past the bytes text signatures are read from, only a binary STL could still be detected, and
+  // only if the data can still end at the size its header declares.
+  if (text.size() < kSignatureBytes || text_signature(text)) return false;
+  const std::optional<std::uint64_t> stl_size = binary_stl_size(text);
+  return !(stl_size >= text.size() && stl_size <= max_size);
 }
 
 Mesh read_mesh_detecting_format(std::span<const char> bytes, std::string_view name) {

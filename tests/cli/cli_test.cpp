@@ -1408,6 +1408,42 @@ TEST(Cli, DashReadsTheMeshFromStandardInputInAnyFormat) {
   }
 }
 
+// Blocks of 64 KiB that `dd` wrote into a pipe before its reader closed it: its "N+0 records out"
+// (dd ignores SIGPIPE here so that it reports the write that failed).
+int records_written(const fs::path& dd_report) {
+  const std::string text = testing::file_contents(dd_report);
+  const std::size_t at = text.find("+0 records out");
+  EXPECT_NE(at, std::string::npos) << text;
+  if (at == std::string::npos) return -1;
+  const std::size_t line = text.rfind('\n', at);
+  return std::stoi(text.substr(line == std::string::npos ? 0 : line + 1));
+}
+
+TEST(Cli, AStreamOnStandardInputIsReadOnlyWhileItCanBeAMeshWithinMaxMemory) {
+  TempDir dir("stream");
+  // 256 MiB offered in blocks of 64 KiB; primseg must stop after a few of them.
+  const std::string offered = " bs=65536 count=4096 2> " + dir.q("dd.txt") + ")";
+  // Zeros (a device or a corrupt upload) are no format from their first 64 KiB on.
+  CliRun zeros = run("info -", "(trap '' PIPE; dd if=/dev/zero" + offered);
+  EXPECT_EQ(zeros.status, 1) << zeros.output;
+  EXPECT_NE(zeros.output.find("primseg: error: standard input: not a mesh file"), std::string::npos)
+      << zeros.output;
+  EXPECT_LT(records_written(dir / "dd.txt"), 16);
+  // Text that reads as OBJ is read up to --max-memory, not to its end.
+  CliRun vertices = run("segment - --max-memory 1M",
+                        "(trap '' PIPE; yes 'v 1 2 3' 2>/dev/null | dd iflag=fullblock" + offered);
+  EXPECT_EQ(vertices.status, 1) << vertices.output;
+  EXPECT_NE(vertices.output.find("primseg: error: standard input: more than --max-memory 1048576 "
+                                 "bytes"),
+            std::string::npos)
+      << vertices.output;
+  EXPECT_LT(records_written(dir / "dd.txt"), 32);
+  // A mesh within the limit is read whole, by pieces of any size.
+  write_mesh(dir / "in.ply", make_shape("box_with_hole").mesh);
+  ASSERT_EXIT_OK(run("segment - --max-memory 1M --clusters 7 --quiet",
+                     "dd bs=1000 2>/dev/null < " + dir.q("in.ply")));
+}
+
 TEST(Cli, ThreadCountDoesNotChangeTheTree) {
   TempDir dir("threads");
   write_mesh(dir / "in.off", read_mesh(testing::cgal_mesh("fandisk.off")));

@@ -5,12 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "../src/file_io.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/shape_generator.hpp"
+#include "support/test_support.hpp"
 
 namespace primseg {
 namespace {
@@ -95,6 +98,62 @@ TEST(DetectMeshFormat, TellsFormatsApartByContent) {
   EXPECT_EQ(detect(""), std::nullopt);
   EXPECT_EQ(detect("plywood\n"), std::nullopt);
   EXPECT_EQ(detect("# only a comment\n"), std::nullopt);
+}
+
+TEST(DetectMeshFormat, APrefixRulesFormatsOutOnlyWhenNothingThatFollowsCouldBeDetected) {
+  const auto ruled_out = [](std::string_view text,
+                            std::uint64_t max_size = std::numeric_limits<std::uint64_t>::max()) {
+    return mesh_format_ruled_out(std::span<const char>(text.data(), text.size()), max_size);
+  };
+  const auto detect = [](std::string_view text) {
+    return detect_mesh_format(std::span<const char>(text.data(), text.size()));
+  };
+  constexpr std::size_t kSignatureBytes = 64 << 10;
+  // A binary STL header declaring `triangles`, then zeros up to `size` bytes.
+  const auto binary_stl = [](std::uint32_t triangles, std::size_t size) {
+    std::string text(std::max<std::size_t>(size, 84), '\0');
+    for (int i = 0; i < 4; ++i) text[80 + i] = static_cast<char>(triangles >> (8 * i) & 0xff);
+    return text;
+  };
+  // Endless zeros or markup: decided once the signature bytes are in, not at the end.
+  EXPECT_FALSE(ruled_out(std::string(kSignatureBytes - 1, '\0')));
+  EXPECT_TRUE(ruled_out(std::string(kSignatureBytes, '\0')));
+  std::string page;
+  while (page.size() < kSignatureBytes) page += "<p>not a mesh</p>\n";
+  // Bytes 80 to 83 of the page, "mesh", would be the triangle count of a binary STL of 87 GB.
+  EXPECT_FALSE(ruled_out(page));
+  EXPECT_TRUE(ruled_out(page, std::uint64_t{1} << 30));
+  // A binary STL stays possible while the data is not longer than its header declares.
+  EXPECT_FALSE(ruled_out(binary_stl(10000, kSignatureBytes)));  // 500,084 bytes declared
+  EXPECT_TRUE(ruled_out(binary_stl(10000, kSignatureBytes), 500083));
+  EXPECT_TRUE(ruled_out(binary_stl(1000, kSignatureBytes)));  // 50,084
+  // What it claims: when a prefix is ruled out, no continuation is detected as a mesh.
+  const std::string continuations[] = {"", "OFF\n", std::string(1 << 20, '\0'),
+                                       std::string(500084 - kSignatureBytes, '\0')};
+  for (const std::string& prefix :
+       {std::string(kSignatureBytes, '\0'), page, binary_stl(1000, kSignatureBytes)}) {
+    ASSERT_TRUE(ruled_out(prefix, std::uint64_t{1} << 30));
+    for (const std::string& rest : continuations) EXPECT_EQ(detect(prefix + rest), std::nullopt);
+  }
+  EXPECT_EQ(detect(binary_stl(10000, kSignatureBytes) + continuations[3]), MeshFormat::Stl);
+  // No prefix of a mesh file of any format is ruled out (files larger than the signature bytes).
+  const fs::path dir = testing::temp_directory("ruled-out");
+  const Mesh mesh =
+      make_shape("box_with_hole", {.tessellation = Tessellation::Uniform, .edge_length = 0.01})
+          .mesh;
+  for (const char* name : {"m.off", "m.obj", "m.ply", "m.stl"}) {
+    SCOPED_TRACE(name);
+    write_mesh(dir / name, mesh);
+    const std::string text(detail::read_file(dir / name).view());
+    ASSERT_GT(text.size(), 2 * kSignatureBytes);
+    ASSERT_TRUE(detect(text));
+    for (std::size_t size = 0; size <= text.size(); size += size < 2 * kSignatureBytes ? 1 : 4099)
+      if (ruled_out(std::string_view(text).substr(0, size))) {
+        ADD_FAILURE() << "prefix of " << size << " bytes ruled out";
+        break;
+      }
+  }
+  fs::remove_all(dir);
 }
 
 TEST(DetectMeshFormat, UnknownContentIsAParseErrorNamingTheInput) {
