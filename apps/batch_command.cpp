@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "../src/file_io.hpp"
+#include "../src/parallel.hpp"
 #include "command.hpp"
 #include "limits.hpp"
 #include "primseg/error.hpp"
@@ -267,12 +268,13 @@ void run_batch(const BatchOptions& o) {
       bar.update(done, failed);
     }
   };
-  const unsigned jobs = o.jobs ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
-  std::vector<std::jthread> threads;
-  for (unsigned t = 1; t < std::min<std::size_t>(jobs, items.size()); ++t)
-    threads.emplace_back(worker);
+  const unsigned jobs = detail::thread_count(o.jobs);
+  std::vector<std::thread> threads;
+  const auto workers = static_cast<unsigned>(std::min<std::size_t>(jobs, items.size()));
+  threads.reserve(workers);
+  detail::start_threads(threads, workers, [&worker](unsigned) { worker(); });
   worker();
-  threads.clear();
+  for (std::thread& t : threads) t.join();
 
   const std::string report_name =
       shards == 1 ? "summary"

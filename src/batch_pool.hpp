@@ -25,6 +25,8 @@
 #include <thread>
 #include <vector>
 
+#include "parallel.hpp"
+
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
@@ -33,9 +35,11 @@ namespace primseg::detail {
 
 class BatchPool {
  public:
-  /// A pool for `threads` threads in all: the caller and threads − 1 helpers (none for 0 or 1).
+  /// A pool for `threads` threads in all: the caller and threads − 1 helpers (none for 0 or 1),
+  /// or fewer helpers if the system refuses to start them all (thread_count() tells).
   explicit BatchPool(unsigned threads) {
-    for (unsigned t = 1; t < threads; ++t) helpers_.emplace_back([this, t] { serve(t); });
+    helpers_.reserve(threads > 1 ? threads - 1 : 0);
+    start_threads(helpers_, threads, [this](unsigned t) { serve(t); });
   }
   ~BatchPool() {
     stopping_.store(true, std::memory_order_seq_cst);

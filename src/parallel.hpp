@@ -6,15 +6,36 @@
 #include <atomic>
 #include <cstddef>
 #include <exception>
+#include <system_error>
 #include <thread>
 #include <vector>
 
 namespace primseg::detail {
 
-/// Threads to use for `requested` (0: all hardware threads), at least 1.
+/// Most threads one parallel loop uses. Results are the same for any count, and beyond this many
+/// threads only contend (a merge's batch holds about five jobs).
+inline constexpr unsigned kMaxThreads = 256;
+
+/// Threads to use for `requested` (0: all hardware threads), from 1 to kMaxThreads.
 inline unsigned thread_count(unsigned requested) {
-  if (requested > 0) return requested;
-  return std::max(1u, std::thread::hardware_concurrency());
+  if (requested > 0) return std::min(requested, kMaxThreads);
+  return std::clamp(std::thread::hardware_concurrency(), 1u, kMaxThreads);
+}
+
+/// Starts `workers.emplace_back(start, t)` for t in [1, threads), until the system refuses a thread
+/// (std::system_error: a process, thread or memory limit). Returns the number of threads that run,
+/// the caller included: callers give the work of the others to those, which changes no result.
+/// `workers` must have room for threads − 1 more without reallocating (reserve).
+template <typename Start>
+unsigned start_threads(std::vector<std::thread>& workers, unsigned threads, const Start& start) {
+  for (unsigned t = 1; t < threads; ++t) {
+    try {
+      workers.emplace_back(start, t);
+    } catch (const std::system_error&) {
+      return t;
+    }
+  }
+  return std::max(threads, 1u);
 }
 
 /// Calls body(i) for i in [0, count), in contiguous chunks on `threads` threads. The first
@@ -37,8 +58,9 @@ void parallel_for(std::size_t count, unsigned threads, Body&& body) {
       errors[t] = std::current_exception();
     }
   };
-  for (unsigned t = 1; t < threads; ++t) workers.emplace_back(run_chunk, t);
+  const unsigned started = start_threads(workers, threads, run_chunk);
   run_chunk(0);
+  for (unsigned t = started; t < threads; ++t) run_chunk(t);  // chunks no thread could take
   for (std::thread& w : workers) w.join();
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
@@ -66,7 +88,7 @@ void parallel_for_threads(std::size_t count, unsigned threads, Body&& body) {
       next = count;
     }
   };
-  for (unsigned t = 1; t < threads; ++t) workers.emplace_back(run, t);
+  start_threads(workers, threads, run);
   run(0);
   for (std::thread& w : workers) w.join();
   for (const std::exception_ptr& e : errors)

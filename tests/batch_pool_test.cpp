@@ -1,5 +1,7 @@
 // The helper-thread pool runs every job exactly once, on thread indices in range, for batches of
 // any size, rethrows a job's exception, and needs no helper to show up (an overloaded machine).
+// The pool and the parallel loops (parallel.hpp) run on the threads the system starts, if it
+// refuses some.
 #include "batch_pool.hpp"
 
 #include <gtest/gtest.h>
@@ -7,6 +9,9 @@
 #include <atomic>
 #include <stdexcept>
 #include <vector>
+
+#include "parallel.hpp"
+#include "support/test_support.hpp"
 
 namespace primseg::detail {
 namespace {
@@ -56,6 +61,28 @@ TEST(BatchPool, RethrowsAJobsExceptionAfterTheBatch) {
   auto fine = [&](std::size_t, unsigned) { runs.fetch_add(1); };
   pool.run(10, fine);
   EXPECT_EQ(runs.load(), 20);
+}
+
+TEST(Threads, ThreadCountsAreBounded) {
+  EXPECT_EQ(thread_count(3), 3u);
+  EXPECT_EQ(thread_count(100000), kMaxThreads);
+  EXPECT_GE(thread_count(0), 1u);
+  EXPECT_LE(thread_count(0), kMaxThreads);
+}
+
+// Before, a refused thread (std::system_error) ended the process in std::terminate: `primseg
+// segment --threads 100000`.
+TEST(Threads, WorkRunsOnTheThreadsThatStartedWhenTheSystemRefusesOthers) {
+  const testing::RefuseNewThreads refused;
+  BatchPool pool(8);
+  EXPECT_EQ(pool.thread_count(), 1u);
+  std::vector<int> runs(1000, 0);
+  auto job = [&](std::size_t i, unsigned thread) { runs[i] += thread == 0 ? 1 : 100; };
+  pool.run(runs.size(), job);
+  parallel_for(100000, 4, [&](std::size_t i) { runs[i % runs.size()] += 1000; });
+  parallel_for_threads(
+      runs.size(), 4, [&](std::size_t i, unsigned thread) { runs[i] += thread == 0 ? 100000 : 1; });
+  for (std::size_t i = 0; i < runs.size(); ++i) ASSERT_EQ(runs[i], 1 + 100 * 1000 + 100000) << i;
 }
 
 }  // namespace

@@ -198,6 +198,13 @@ TEST(Hierarchy, AnyThreadCountGivesTheSameTreeBitForBit) {
     parallel.threads = threads;
     EXPECT_EQ(serialize_tree(build_hierarchy(shape.mesh, parallel)), reference) << threads;
   }
+  // Threads the system refuses to start (a process limit): the work runs on the others.
+  const testing::RefuseNewThreads refused;
+  for (unsigned threads : {2u, 100000u}) {
+    HierarchyOptions parallel = one_thread;
+    parallel.threads = threads;
+    EXPECT_EQ(serialize_tree(build_hierarchy(shape.mesh, parallel)), reference) << threads;
+  }
 }
 
 // The tree depends on the geometry and the order of the faces only: the same triangles listed

@@ -60,7 +60,9 @@ struct HierarchyOptions {
   /// the new cluster's candidates and its own fit (helper threads spin between merges, then
   /// sleep once the loop ends); 0 uses all hardware threads. The tree is the same, bit for bit,
   /// for any number of threads. On a machine already loaded by other processes one thread can
-  /// be the fastest.
+  /// be the fastest. At most 256 threads are used, and fewer if the system refuses to start more
+  /// (a process or memory limit): the work then runs on those that started. The same holds for
+  /// the `threads` of every other options struct.
   unsigned threads = 0;
   /// Candidate evaluation scheme (exact_costs forces Eager: Euclidean errors of algebraic fits
   /// are not minima, so no bound holds).

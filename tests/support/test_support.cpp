@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <pthread.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <array>
@@ -45,6 +46,34 @@ std::filesystem::path temp_directory(const std::string& tag) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+namespace {
+
+// Sets the default stack size of new threads; false if the system refuses the value.
+bool set_default_stack_size(std::size_t bytes) {
+  pthread_attr_t attributes;
+  if (::pthread_getattr_default_np(&attributes) != 0) return false;
+  const bool set = ::pthread_attr_setstacksize(&attributes, bytes) == 0 &&
+                   ::pthread_setattr_default_np(&attributes) == 0;
+  ::pthread_attr_destroy(&attributes);
+  return set;
+}
+
+}  // namespace
+
+RefuseNewThreads::RefuseNewThreads() {
+  pthread_attr_t attributes;
+  if (::pthread_getattr_default_np(&attributes) == 0) {
+    ::pthread_attr_getstacksize(&attributes, &previous_stack_size_);
+    ::pthread_attr_destroy(&attributes);
+  }
+  // 64 TiB: no address space (47 bits) and no memory holds it.
+  EXPECT_TRUE(set_default_stack_size(std::size_t{1} << 46));
+}
+
+RefuseNewThreads::~RefuseNewThreads() {
+  EXPECT_TRUE(set_default_stack_size(previous_stack_size_));
 }
 
 std::string file_contents(const std::filesystem::path& path) {

@@ -2,6 +2,7 @@
 // Shared helpers of the test suite.
 
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <random>
@@ -35,6 +36,20 @@ int run_command(const std::string& command, std::string* output = nullptr);
 inline bool same_bits(double a, double b) {
   return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
 }
+
+/// While alive, the system refuses to start threads, as a process or memory limit would: their
+/// default stack is made larger than the address space (pthread_setattr_default_np). Restores
+/// the previous default when destroyed.
+class RefuseNewThreads {
+ public:
+  RefuseNewThreads();
+  ~RefuseNewThreads();
+  RefuseNewThreads(const RefuseNewThreads&) = delete;
+  RefuseNewThreads& operator=(const RefuseNewThreads&) = delete;
+
+ private:
+  std::size_t previous_stack_size_ = 0;
+};
 
 /// A uniformly random rotation (deterministic for a given engine state).
 std::array<std::array<double, 3>, 3> random_rotation(std::mt19937_64& rng);
