@@ -145,7 +145,7 @@ class NamedTemporaryScope {
   NamedTemporaryScope& operator=(const NamedTemporaryScope&) = delete;
 };
 
-/// Writes all bytes to fd and flushes them to disk; false with errno set on failure.
+/// Writes all bytes to fd; false with errno set on failure.
 bool write_all(int fd, std::string_view bytes) {
   std::size_t written = 0;
   while (written < bytes.size()) {
@@ -156,7 +156,27 @@ bool write_all(int fd, std::string_view bytes) {
     }
     written += static_cast<std::size_t>(result);
   }
-  return ::fsync(fd) == 0;
+  return true;
+}
+
+/// write_all(), then flushes the bytes to disk.
+bool write_all_to_disk(int fd, std::string_view bytes) {
+  return write_all(fd, bytes) && ::fsync(fd) == 0;
+}
+
+// Writes into an existing file that is not a regular one (a device such as /dev/null, a FIFO), as
+// it is: putting a regular file in its place would replace the device.
+void write_in_place(const std::filesystem::path& path, std::string_view bytes,
+                    const std::filesystem::path& name) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) io_failure(name, "open", errno);
+  const bool written = write_all(fd, bytes);
+  const int error_number = errno;
+  if (!written) {
+    ::close(fd);
+    io_failure(name, "write", error_number);
+  }
+  if (::close(fd) != 0) io_failure(name, "write", errno);
 }
 
 std::filesystem::path temporary_name_for(const std::filesystem::path& path) {
@@ -186,16 +206,28 @@ void write_standard_output(std::string_view bytes) {
 
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
                            const std::function<void()>& while_named) {
-  std::filesystem::path directory = path.parent_path();
+  // A symbolic link keeps pointing where it did: the file it names is replaced, not the link.
+  std::error_code unresolved;
+  const std::filesystem::path resolved = std::filesystem::canonical(path, unresolved);
+  const std::filesystem::path& target = unresolved ? path : resolved;
+  struct stat status {};
+  if (::stat(target.c_str(), &status) == 0) {
+    if (S_ISDIR(status.st_mode)) io_failure(path, "write", EISDIR);
+    if (!S_ISREG(status.st_mode)) {
+      write_in_place(target, bytes, path);
+      return;
+    }
+  }
+  std::filesystem::path directory = target.parent_path();
   if (directory.empty()) directory = ".";
   // An unnamed file (O_TMPFILE) vanishes by itself if the process is killed while writing: only
   // the final link-and-rename, microseconds long, ever gives it a name. Filesystems without
   // O_TMPFILE get a named temporary file from the start.
   const int fd = ::open(directory.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
-  const std::filesystem::path temporary = temporary_name_for(path);
+  const std::filesystem::path temporary = temporary_name_for(target);
   std::optional<NamedTemporaryScope> named_temporary;
   if (fd >= 0) {
-    if (!write_all(fd, bytes)) {
+    if (!write_all_to_disk(fd, bytes)) {
       const int error_number = errno;
       ::close(fd);
       io_failure(path, "write", error_number);
@@ -212,7 +244,7 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
     named_temporary.emplace();
     const int named = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (named < 0) io_failure(path, "create a temporary file for", errno);
-    const bool written = write_all(named, bytes);
+    const bool written = write_all_to_disk(named, bytes);
     const int error_number = errno;
     if (::close(named) != 0 || !written) {
       ::unlink(temporary.c_str());
@@ -220,7 +252,7 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
     }
   }
   if (while_named) while_named();
-  if (::rename(temporary.c_str(), path.c_str()) != 0) {
+  if (::rename(temporary.c_str(), target.c_str()) != 0) {
     const int error_number = errno;
     ::unlink(temporary.c_str());
     io_failure(path, "rename a temporary file onto", error_number);

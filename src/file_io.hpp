@@ -48,7 +48,9 @@ FileImage read_standard_input(const ReadLimits& limits = {});
 /// Writes to an unnamed file in the target's directory (O_TMPFILE; a hidden named one where the
 /// filesystem lacks it), then names it and renames it over the target: readers see the old file
 /// or the complete new one, never a partial write, and a process killed while writing leaves
-/// nothing behind. Throws IoError.
+/// nothing behind. A symbolic link is followed (the file it names is replaced, the link stays),
+/// and an existing file that is not a regular one (a device such as /dev/null, a FIFO) is written
+/// as it is, never replaced. Throws IoError (also for a directory).
 /// `while_named`, if set, runs once the temporary file has its name and before the rename (for
 /// tests of what an interruption there leaves).
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,

@@ -261,10 +261,13 @@ std::uint64_t sample_count(const DistanceOptions& options, double area) {
   if (options.density == 0) {
     if (options.samples == 0)
       throw InvalidInputError("distance: the sample count must be positive");
+    if (options.samples > kMaxDistanceSamples)
+      throw InvalidInputError("distance: " + std::to_string(options.samples) +
+                              " samples asked for, more than 10^9");
     return options.samples;
   }
   const double count = std::ceil(options.density * area);
-  if (count > 1e9)
+  if (count > static_cast<double>(kMaxDistanceSamples))
     throw InvalidInputError("distance: a density of " + std::to_string(options.density) +
                             " asks for more than 10^9 samples on a surface of area " +
                             std::to_string(area));

@@ -1,9 +1,11 @@
 // Atomic writes under interruption: a program that calls defer_termination_during_writes() and is
 // interrupted leaves each output whole or absent, never a temporary file. Each case runs in a
-// child process, since the signals terminate it.
+// child process, since the signals terminate it. Targets that are not regular files (symbolic
+// links, FIFOs, directories) are written through or refused, never replaced.
 #include "file_io.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,7 +15,9 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <thread>
 
+#include "primseg/error.hpp"
 #include "support/test_support.hpp"
 
 namespace primseg {
@@ -92,6 +96,49 @@ TEST(WriteFileAtomically, AnIgnoredInterruptStaysIgnored) {
     std::raise(SIGHUP);
   });
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 3) << "wait status " << status;
+}
+
+TEST(WriteFileAtomically, ASymbolicLinkIsFollowedAndKept) {
+  const fs::path dir = testing::temp_directory("file-io-link");
+  detail::write_file_atomically(dir / "real.txt", "old");
+  fs::create_symlink("real.txt", dir / "link.txt");
+  detail::write_file_atomically(dir / "link.txt", "new");
+  EXPECT_TRUE(fs::is_symlink(dir / "link.txt"));
+  EXPECT_EQ(testing::file_contents(dir / "real.txt"), "new");
+  EXPECT_EQ(names_in(dir), (std::set<std::string>{"link.txt", "real.txt"}));
+  fs::remove_all(dir);
+}
+
+// Before, the rename put a regular file in place of the target: `primseg skeleton ...
+// --skin-weights /dev/full`, run as root, replaced the device /dev/full with the weights.
+TEST(WriteFileAtomically, AFifoIsWrittenAsItIsNotReplaced) {
+  const fs::path dir = testing::temp_directory("file-io-fifo");
+  const fs::path fifo = dir / "out.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string received;
+  std::thread reader([&] { received = testing::file_contents(fifo); });
+  detail::write_file_atomically(fifo, "through the pipe");
+  reader.join();
+  EXPECT_EQ(received, "through the pipe");
+  struct stat status {};
+  ASSERT_EQ(::lstat(fifo.c_str(), &status), 0);
+  EXPECT_TRUE(S_ISFIFO(status.st_mode));
+  EXPECT_EQ(names_in(dir), std::set<std::string>{"out.fifo"});
+  fs::remove_all(dir);
+}
+
+TEST(WriteFileAtomically, ADirectoryIsAnErrorNamingIt) {
+  const fs::path dir = testing::temp_directory("file-io-directory");
+  fs::create_directory(dir / "out");
+  try {
+    detail::write_file_atomically(dir / "out", "bytes");
+    ADD_FAILURE() << "no exception";
+  } catch (const IoError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "cannot write '" + (dir / "out").string() + "': Is a directory");
+  }
+  EXPECT_TRUE(fs::is_directory(dir / "out"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -140,6 +140,9 @@ TEST(MeshDistance, RejectsEmptyMeshesAndBadOptions) {
   DistanceOptions options;
   options.samples = 0;
   EXPECT_THROW(mesh_distance(rectangle(1, 0), rectangle(1, 0), options), InvalidInputError);
+  // As many samples as a density may ask for, and no more (before, days of queries).
+  options.samples = kMaxDistanceSamples + 1;
+  EXPECT_THROW(mesh_distance(rectangle(1, 0), rectangle(1, 0), options), InvalidInputError);
   options.samples = 10;
   options.density = -1;
   EXPECT_THROW(mesh_distance(rectangle(1, 0), rectangle(1, 0), options), InvalidInputError);

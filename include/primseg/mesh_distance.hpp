@@ -42,9 +42,14 @@ class TriangleBvh {
 /// The point of triangle (a, b, c) closest to x (degenerate triangles included).
 Vec3 closest_point_on_triangle(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c);
 
+/// Most area samples mesh_distance takes on one surface: more, from `samples` or `density`, is an
+/// InvalidInputError. (fandisk against itself with 10^7 samples each way: 15 s on two cores.)
+inline constexpr std::uint64_t kMaxDistanceSamples = 1'000'000'000;
+
 /// How mesh_distance samples the surfaces.
 struct DistanceOptions {
-  /// Area-uniform random samples on each mesh. Ignored when `density` is positive.
+  /// Area-uniform random samples on each mesh, 1 to kMaxDistanceSamples. Ignored when `density`
+  /// is positive.
   std::uint64_t samples = 200000;
   /// Samples per unit area (input units⁻²) instead of a fixed count; 0: use `samples`.
   double density = 0;
