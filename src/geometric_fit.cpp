@@ -255,12 +255,21 @@ using detail::to_vec3;
 struct Normalised {
   std::vector<Eigen::Vector3d> points;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  int exponent = 0;  // one normalised unit is 2^exponent input units
+  int exponent = 0;      // one normalised unit is 2^exponent input units
+  bool widened = false;  // the scale is the starting primitive's, not the points'
 };
 
+// A primitive's offset from the points or its radii may be at most this many normalised units:
+// distances up to it square without overflow.
+constexpr int kMaxPrimitiveExponent = 256;
+
 // Points centred on their weighted centroid and scaled by a power of two to within the unit
-// ball: conditioning of the normal equations, and no overflow of squared distances.
-Normalised normalise(std::span<const Vec3> points, std::span<const double> weights) {
+// ball: conditioning of the normal equations, and no overflow of squared distances. If the
+// starting primitive lies much farther than the points' own size (a tree file may pair a cluster
+// of subnormal coordinates with a plane at distance 2), the scale is set by it instead, at
+// 2^kMaxPrimitiveExponent units, where its distances stay finite.
+Normalised normalise(std::span<const Vec3> points, std::span<const double> weights,
+                     const Primitive& initial) {
   Normalised n;
   double total = 0;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -273,6 +282,14 @@ Normalised normalise(std::span<const Vec3> points, std::span<const double> weigh
   for (const Vec3& p : points)
     for (int k = 0; k < 3; ++k) extent = std::max(extent, std::abs(p[k] - n.centre[k]));
   if (extent > 0) std::frexp(extent, &n.exponent);
+  double reach = std::max(std::abs(initial.radius), std::abs(initial.minor_radius));
+  for (int k = 0; k < 3; ++k) reach = std::max(reach, std::abs(initial.point[k] - n.centre[k]));
+  int reach_exponent = 0;
+  std::frexp(reach, &reach_exponent);
+  if (std::isfinite(reach) && reach_exponent - n.exponent > kMaxPrimitiveExponent) {
+    n.exponent = reach_exponent - kMaxPrimitiveExponent;
+    n.widened = true;
+  }
   // Multiplying by a power of two rounds as ldexp does (both round the exact product once), at a
   // fraction of its cost; ldexp only where 2^−exponent itself overflows (subnormal extents).
   const double scale = std::ldexp(1.0, -n.exponent);
@@ -393,15 +410,14 @@ bool has_geometric_model(PrimitiveType type) {
   return detail::geometric_model_for(p) != nullptr;
 }
 
-GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> points,
-                           std::span<const double> weights, const GeometricFitOptions& options) {
-  if (points.size() != weights.size())
-    throw InvalidInputError("fit_geometric: " + std::to_string(points.size()) + " points but " +
-                            std::to_string(weights.size()) + " weights");
-  for (double w : weights)
-    if (!(w >= 0) || !std::isfinite(w))
-      throw InvalidInputError("fit_geometric: weights must be finite and non-negative");
-  const Normalised n = normalise(points, weights);
+namespace {
+
+// fit_geometric() in one frame; `widened` tells whether the frame was scaled to the start.
+GeometricFit fit_in_one_frame(const Primitive& initial, std::span<const Vec3> points,
+                              std::span<const double> weights, const GeometricFitOptions& options,
+                              bool& widened) {
+  const Normalised n = normalise(points, weights, initial);
+  widened = n.widened;
   const Primitive start = to_normalised(initial, n);
   std::unique_ptr<GeometricModel> model = detail::geometric_model_for(start);
   GeometricFit result;
@@ -460,6 +476,28 @@ GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> point
   result.rms = total > 0 ? std::ldexp(std::sqrt(sum / total), n.exponent) : 0.0;
   result.max = std::ldexp(largest, n.exponent);
   return result;
+}
+
+}  // namespace
+
+GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> points,
+                           std::span<const double> weights, const GeometricFitOptions& options) {
+  if (points.size() != weights.size())
+    throw InvalidInputError("fit_geometric: " + std::to_string(points.size()) + " points but " +
+                            std::to_string(weights.size()) + " weights");
+  for (double w : weights)
+    if (!(w >= 0) || !std::isfinite(w))
+      throw InvalidInputError("fit_geometric: weights must be finite and non-negative");
+  bool widened = false;
+  GeometricFit fit = fit_in_one_frame(initial, points, weights, options, widened);
+  if (!widened || fit.iterations == 0 || fit.iterations >= options.max_iterations) return fit;
+  // A frame scaled to a faraway start resolves the points only to its own round-off: once the fit
+  // has come to them, it goes on in their frame.
+  GeometricFitOptions rest = options;
+  rest.max_iterations -= fit.iterations;
+  GeometricFit closer = fit_in_one_frame(fit.primitive, points, weights, rest, widened);
+  closer.iterations += fit.iterations;
+  return closer.rms <= fit.rms ? closer : fit;
 }
 
 }  // namespace primseg

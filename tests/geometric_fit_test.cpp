@@ -272,6 +272,27 @@ TEST(GeometricFit, NoisyFitsReachTheLeastSquaresMinimum) {
   }
 }
 
+// A start far beyond the points' own size: points with subnormal coordinates (a tree file's
+// cluster, found by the tree fuzzer) and a plane 2 units away. Measured in a frame scaled to the
+// points alone, the plane's distance overflowed and the RMS came out NaN.
+TEST(GeometricFit, AStartFarBeyondThePointsSizeKeepsDistancesFinite) {
+  Primitive plane;
+  plane.point = {2, 0, 0};
+  plane.axis = {1, 0, 0};
+  const std::vector<Vec3> points{
+      {1e-311, 0, 0}, {0, 3e-311, 0}, {0, 0, 2e-311}, {1e-311, 1e-311, 0}};
+  const std::vector<double> weights(points.size(), 1.0);
+  GeometricFitOptions stay;
+  stay.max_iterations = 0;
+  const GeometricFit at_start = fit_geometric(plane, points, weights, stay);
+  EXPECT_DOUBLE_EQ(at_start.rms, 2);
+  EXPECT_DOUBLE_EQ(at_start.max, 2);
+  const GeometricFit fitted = fit_geometric(plane, points, weights);
+  EXPECT_TRUE(std::isfinite(fitted.rms));
+  EXPECT_LE(fitted.rms, 1e-310);
+  EXPECT_LE(fitted.max, 1e-310);
+}
+
 TEST(GeometricFit, RejectsBadInput) {
   Primitive plane;
   plane.axis = {0, 0, 1};

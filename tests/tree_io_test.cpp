@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -133,12 +134,13 @@ TEST(TreeIo, BadContentIsRejectedBehindAValidChecksum) {
   expect_parse_error(with_checksum(self_merge), "invalid tree");
 }
 
-// The tree fuzzer's inputs in fuzz/<folder>/tree/, by file name: tree files without their
+// The tree fuzzer's inputs in fuzz/<folder>/<kind>/, by file name: tree files without their
 // checksum (the fuzzer appends it), returned with it.
-std::vector<std::pair<std::string, std::string>> fuzz_tree_inputs(const char* folder) {
+std::vector<std::pair<std::string, std::string>> fuzz_tree_inputs(const char* folder,
+                                                                  const char* kind = "tree") {
   std::vector<std::pair<std::string, std::string>> inputs;
   for (const auto& entry : std::filesystem::directory_iterator(
-           std::filesystem::path(PRIMSEG_FUZZ_DIR) / folder / "tree")) {
+           std::filesystem::path(PRIMSEG_FUZZ_DIR) / folder / kind)) {
     std::ifstream in(entry.path(), std::ios::binary);
     std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     inputs.emplace_back(entry.path().filename().string(), with_checksum(std::move(body)));
@@ -164,6 +166,24 @@ TEST(TreeIo, TheFuzzersFindingsAreRefused) {
   for (const auto& [name, image] : findings) {
     SCOPED_TRACE(name);
     expect_parse_error(image, "x.tree: invalid tree: merge");
+  }
+}
+
+// Tree files the fuzzer found that are valid as files but whose primitives lie far from their
+// clusters (a cube's planes over a mesh of subnormal coordinates): read, and every level's cluster
+// reports are finite (fit_geometric scales its frame to the start primitive too).
+TEST(TreeIo, TheFuzzersAcceptedFindingsGiveFiniteReports) {
+  const auto findings = fuzz_tree_inputs("regressions", "tree-accepted");
+  EXPECT_GE(findings.size(), 1u);
+  for (const auto& [name, image] : findings) {
+    SCOPED_TRACE(name);
+    const Hierarchy hierarchy = deserialize_tree(image);
+    for (std::uint32_t k = 1; k <= hierarchy.face_count(); ++k)
+      for (const ClusterReport& report :
+           describe_clusters(hierarchy, cut_by_count(hierarchy, k), DescribeOptions{})) {
+        EXPECT_TRUE(std::isfinite(report.rms)) << k;
+        EXPECT_TRUE(std::isfinite(report.max)) << k;
+      }
   }
 }
 
