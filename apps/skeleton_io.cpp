@@ -161,7 +161,8 @@ std::vector<JointRotation> read_pose_file(const std::string& path) {
       const json& degrees = member(rotations[i], "degrees", where);
       if (!degrees.is_number() || !std::isfinite(degrees.get<double>()))
         throw InvalidInputError(where + ": degrees must be a finite number");
-      rotation.angle = degrees.get<double>() * std::numbers::pi / 180;
+      // (π / 180) first: finite for every finite number of degrees.
+      rotation.angle = degrees.get<double>() * (std::numbers::pi / 180);
       pose.push_back(rotation);
     }
     return pose;

@@ -500,7 +500,7 @@ std::vector<JointRotation> pose_argument(const py::handle& pose) {
     const double angle_degrees = number_argument(degrees, where + ": degrees");
     if (!std::isfinite(angle_degrees))
       throw InvalidInputError(where + ": degrees must be a finite number");
-    rotation.angle = angle_degrees * std::numbers::pi / 180;  // as the CLI's pose file
+    rotation.angle = angle_degrees * (std::numbers::pi / 180);  // as the CLI's pose file
     result.push_back(rotation);
   }
   return result;

@@ -256,12 +256,17 @@ std::vector<RigidTransform> pose_bones(const Skeleton& skeleton,
     if (posed[rotation.joint])
       throw InvalidInputError("joint " + std::to_string(rotation.joint) + " is rotated twice");
     posed[rotation.joint] = true;
-    const double axis_length = norm(rotation.axis);
-    if (!(std::isfinite(axis_length) && axis_length > 0) || !std::isfinite(rotation.angle))
+    // Of any length: scaled to its largest component first, so that its norm neither overflows
+    // nor underflows.
+    const double largest = std::max(
+        {std::abs(rotation.axis[0]), std::abs(rotation.axis[1]), std::abs(rotation.axis[2])});
+    if (!(std::isfinite(largest) && largest > 0) || !std::isfinite(rotation.angle))
       throw InvalidInputError("joint " + std::to_string(rotation.joint) +
                               ": the axis must be finite and non-zero, the angle finite");
-    local[child] = RigidTransform::rotation_about(skeleton.joints[rotation.joint].position,
-                                                  rotation.axis, rotation.angle);
+    const Vec3 axis{rotation.axis[0] / largest, rotation.axis[1] / largest,
+                    rotation.axis[2] / largest};
+    local[child] = RigidTransform::rotation_about(skeleton.joints[rotation.joint].position, axis,
+                                                  rotation.angle);
   }
   std::vector<RigidTransform> world(skeleton.bones.size());
   for (const std::uint32_t b : tree.order)

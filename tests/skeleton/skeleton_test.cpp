@@ -359,6 +359,23 @@ TEST(Skinning, ShoulderRotationCarriesTheWholeArm) {
   EXPECT_EQ(bones[s.bone("torso")].apply(x), x);
 }
 
+// An axis of any finite, non-zero length: before, one whose norm overflowed (1e308) or underflowed
+// (subnormal components) was rejected as not finite or zero.
+TEST(Skinning, AnAxisOfAnyLengthGivesTheSameRotation) {
+  const FigureSkeleton& s = figure_skeleton();
+  const std::uint32_t shoulder = s.joint_between(s.bone("torso"), s.bone("upper_arm_left"));
+  const std::uint32_t upper = s.bone("upper_arm_left");
+  const auto transform = [&](Vec3 axis) {
+    const JointRotation rotation{shoulder, axis, 0.7};
+    return pose_bones(s.skeleton, {&rotation, 1})[upper];
+  };
+  const Vec3 x{-3, 0.2, 2.5};
+  const Vec3 reference = transform({1, 1, 0}).apply(x);
+  EXPECT_EQ(transform({1e308, 1e308, 0}).apply(x), reference);
+  EXPECT_EQ(transform({4e-320, 4e-320, 0}).apply(x), reference);
+  EXPECT_EQ(transform({2, 2, 0}).apply(x), reference);
+}
+
 TEST(Skinning, PosesThatCannotBeAppliedAreRejected) {
   const FigureSkeleton& s = figure_skeleton();
   std::uint32_t virtual_joint = 0;
@@ -372,6 +389,7 @@ TEST(Skinning, PosesThatCannotBeAppliedAreRejected) {
   EXPECT_THROW(rejects({9999, {0, 0, 1}, 1})(), InvalidInputError);
   EXPECT_THROW(rejects({shoulder, {0, 0, 0}, 1})(), InvalidInputError);
   EXPECT_THROW(rejects({shoulder, {0, 0, 1}, NAN})(), InvalidInputError);
+  EXPECT_THROW(rejects({shoulder, {0, INFINITY, 1}, 1})(), InvalidInputError);
   const JointRotation twice[] = {{shoulder, {0, 0, 1}, 1}, {shoulder, {0, 1, 0}, 1}};
   EXPECT_THROW(pose_bones(s.skeleton, twice), InvalidInputError);
   SkinningOptions bad;
