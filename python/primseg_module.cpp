@@ -55,6 +55,11 @@ std::string cpp_doc(const char* name, const char* text) {
   return std::string("C++ ") + name + ":\n" + text;
 }
 
+// "1 face", "2 faces" (for the reprs).
+std::string count_of(std::uint64_t count, const std::string& noun, const std::string& plural = "") {
+  return std::to_string(count) + " " + (count == 1 ? noun : plural.empty() ? noun + "s" : plural);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Arrays in: read in place with their own dtype and strides (no converted copy), checked with
 // messages that name the array and the offending entry.
@@ -808,9 +813,9 @@ or too spread out to fit reliably.)",
                      cpp_doc("check_geometric_range", doc::mesh__check_geometric_range)})
               .c_str())
       .def("__repr__", [](const PyMesh& self) {
-        return "<primseg.Mesh: " + std::to_string(self.mesh->vertex_count()) + " vertices, " +
-               std::to_string(self.mesh->face_count()) + " faces, " +
-               std::to_string(self.mesh->triangle_count()) + " triangles>";
+        return "<primseg.Mesh: " + count_of(self.mesh->vertex_count(), "vertex", "vertices") +
+               ", " + count_of(self.mesh->face_count(), "face") + ", " +
+               count_of(self.mesh->triangle_count(), "triangle") + ">";
       });
 
   m.def(
@@ -1111,8 +1116,8 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
           },
           doc::hierarchy__HierarchyOptions__weights)
       .def("__repr__", [](const PyHierarchy& self) {
-        return "<primseg.Hierarchy: " + std::to_string(self.hierarchy->face_count()) + " faces, " +
-               std::to_string(self.hierarchy->component_count()) + " components>";
+        return "<primseg.Hierarchy: " + count_of(self.hierarchy->face_count(), "face") + ", " +
+               count_of(self.hierarchy->component_count(), "component") + ">";
       });
 
   // ------------------------------------------------------------------------------------------
@@ -1387,8 +1392,8 @@ repeated joint, or a zero axis.)",
                      cpp_doc("bones_beyond", doc::skinning__bones_beyond)})
               .c_str())
       .def("__repr__", [](const PySkeleton& self) {
-        return "<primseg.Skeleton: " + std::to_string(self.skeleton->cluster_count()) + " bones, " +
-               std::to_string(self.skeleton->joints.size()) + " joints>";
+        return "<primseg.Skeleton: " + count_of(self.skeleton->cluster_count(), "bone") + ", " +
+               count_of(self.skeleton->joints.size(), "joint") + ">";
       });
 
   m.def(

@@ -94,6 +94,14 @@ def test_lists_are_accepted():
     assert mesh.face_count == 1
 
 
+def test_reprs_count_in_words(fandisk):
+    one = primseg.Mesh([[0.0, 0, 0], [1.0, 0, 0], [0.0, 1, 0]], [[0, 1, 2]])
+    assert repr(one) == "<primseg.Mesh: 3 vertices, 1 face, 1 triangle>"
+    assert repr(primseg.segment(one)) == "<primseg.Hierarchy: 1 face, 1 component>"
+    mesh = primseg.read_mesh(fandisk)
+    assert repr(mesh) == "<primseg.Mesh: 6475 vertices, 12946 faces, 12946 triangles>"
+
+
 @pytest.mark.parametrize("extension, binary", [(".off", True), (".obj", True), (".ply", True),
                                                (".ply", False), (".stl", True), (".stl", False)])
 def test_write_mesh_round_trips(fandisk, tmp_path, extension, binary):
