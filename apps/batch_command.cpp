@@ -283,13 +283,12 @@ void run_batch(const BatchOptions& o) {
   const auto skipped = static_cast<std::size_t>(std::count_if(
       results.begin(), results.end(), [](const Result& r) { return r.status == "skipped"; }));
   if (!o.quiet)
-    std::printf("%zu files: %zu ok, %zu skipped, %zu failed; report %s.csv\n", items.size(),
-                items.size() - failed - skipped, skipped, failed,
-                (fs::path(o.out) / report_name).c_str());
+    std::printf("%s: %zu ok, %zu skipped, %zu failed; report %s.csv\n",
+                count_of(items.size(), "file").c_str(), items.size() - failed - skipped, skipped,
+                failed, (fs::path(o.out) / report_name).c_str());
   if (failed)
-    throw InvalidInputError(std::to_string(failed) + " of " + std::to_string(items.size()) +
-                            " files failed (see " + (fs::path(o.out) / report_name).string() +
-                            ".csv)");
+    throw InvalidInputError(std::to_string(failed) + " of " + count_of(items.size(), "file") +
+                            " failed (see " + (fs::path(o.out) / report_name).string() + ".csv)");
 }
 
 }  // namespace

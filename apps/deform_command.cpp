@@ -65,8 +65,9 @@ Command add_deform_command(CLI::App& app) {
               o->picture.write(posed, posed_skeleton);
             }
             if (!o->quiet)
-              std::printf("%s: %zu joint rotations applied, %u vertices\n", o->output.c_str(),
-                          pose.size(), posed.vertex_count());
+              std::printf("%s: %s applied, %s\n", o->output.c_str(),
+                          count_of(pose.size(), "joint rotation").c_str(),
+                          count_of(posed.vertex_count(), "vertex", "vertices").c_str());
           }};
 }
 

@@ -134,9 +134,10 @@ Command add_denoise_command(CLI::App& app) {
                                 {"max_move", r.max_move}});
               if (!o->level.quiet)
                 std::printf(
-                    "round %d: %u cluster%s, %u vertices moved (%u on cluster borders, %u onto "
-                    "fewer primitives), %u blocked; mean move %.6g, max %.6g\n",
-                    i + 1, r.clusters, plural_s(r.clusters), r.moved, r.boundary_vertices,
+                    "round %d: %s, %s moved (%u on cluster borders, %u onto fewer primitives), "
+                    "%u blocked; mean move %.6g, max %.6g\n",
+                    i + 1, count_of(r.clusters, "cluster").c_str(),
+                    count_of(r.moved, "vertex", "vertices").c_str(), r.boundary_vertices,
                     r.fallbacks, r.blocked, r.mean_move, r.max_move);
             }
             write_mesh(o->output_path, denoiser.mesh());

@@ -56,6 +56,13 @@ void validate_output_files(const OutputFiles& files) {
   }
 }
 
+std::string count_of(std::uint64_t count, std::string_view noun, std::string_view plural) {
+  std::string text = std::to_string(count) + " ";
+  if (count == 1 || plural.empty()) text += noun;
+  if (count != 1) text += plural.empty() ? std::string_view("s") : plural;
+  return text;
+}
+
 bool writes_to_standard_output(const OutputFiles& files) {
   const auto text = text_outputs(files);
   return std::any_of(text.begin(), text.end(), to_standard_output);
@@ -135,7 +142,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
 }
 
 void print_summary(const std::vector<ClusterReport>& reports, std::size_t max_rows) {
-  std::printf("%zu cluster%s\n", reports.size(), plural_s(reports.size()));
+  std::printf("%s\n", count_of(reports.size(), "cluster").c_str());
   std::printf("%6s  %-8s  %8s  %12s  %12s  %12s\n", "id", "type", "faces", "area", "rms", "max");
   for (std::size_t i = 0; i < reports.size() && i < max_rows; ++i) {
     const ClusterReport& r = reports[i];

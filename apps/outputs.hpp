@@ -25,10 +25,9 @@ struct OutputFiles {
   std::optional<std::string> curve;    // error curve of the whole tree, CSV k,rms
 };
 
-/// The plural ending of a count's noun in messages: "1 cluster", "2 clusters".
-inline const char* plural_s(std::uint64_t count) {
-  return count == 1 ? "" : "s";
-}
+/// A count and its noun for messages: "1 cluster", "2 clusters"; `plural` for irregular nouns
+/// ("vertices").
+std::string count_of(std::uint64_t count, std::string_view noun, std::string_view plural = {});
 
 /// Throws InvalidInputError for output names that cannot be written (checked before any work):
 /// a coloured mesh that is neither .ply nor .obj, '-' for a binary output, or '-' twice.

@@ -68,10 +68,9 @@ Command add_segment_command(CLI::App& app) {
         summary["weights"] = o->weights;
         summary["timing"] = {{"read_seconds", read_seconds}, {"hierarchy_seconds", build_seconds}};
         if (!o->level.quiet)
-          std::printf("%s: %u faces, %u component%s, hierarchy in %.3f s\n",
-                      input_name(o->mesh_path).c_str(), mesh->face_count(),
-                      hierarchy.component_count(), plural_s(hierarchy.component_count()),
-                      build_seconds);
+          std::printf("%s: %s, %s, hierarchy in %.3f s\n", input_name(o->mesh_path).c_str(),
+                      count_of(mesh->face_count(), "face").c_str(),
+                      count_of(hierarchy.component_count(), "component").c_str(), build_seconds);
         report_level(hierarchy, o->level, summary, Clock::now());
       }};
 }

@@ -90,10 +90,10 @@ Command add_skeleton_command(CLI::App& app) {
           std::size_t counts[3] = {0, 0, 0};
           for (const Joint& joint : skeleton.joints) ++counts[static_cast<int>(joint.kind)];
           std::printf(
-              "%s: %u faces, hierarchy in %.3f s; %u bones, %zu joints (%zu sensitive, %zu "
-              "locked, %zu virtual)\n",
-              input_name(o->mesh_path).c_str(), mesh->face_count(), build_seconds,
-              skeleton.cluster_count(), skeleton.joints.size(), counts[0], counts[1], counts[2]);
+              "%s: %s, hierarchy in %.3f s; %s, %s (%zu sensitive, %zu locked, %zu virtual)\n",
+              input_name(o->mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
+              build_seconds, count_of(skeleton.cluster_count(), "bone").c_str(),
+              count_of(skeleton.joints.size(), "joint").c_str(), counts[0], counts[1], counts[2]);
         }
       }};
 }

@@ -1444,6 +1444,25 @@ TEST(Cli, AStreamOnStandardInputIsReadOnlyWhileItCanBeAMeshWithinMaxMemory) {
                      "dd bs=1000 2>/dev/null < " + dir.q("in.ply")));
 }
 
+TEST(Cli, SummariesCountInWords) {
+  TempDir dir("words");
+  write_file(dir / "one.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const CliRun segment = run("segment " + dir.q("one.off") + " --clusters 1");
+  ASSERT_EXIT_OK(segment);
+  EXPECT_NE(segment.output.find("one.off: 1 face, 1 component, hierarchy in"), std::string::npos)
+      << segment.output;
+  EXPECT_NE(segment.output.find("\n1 cluster\n"), std::string::npos) << segment.output;
+  const CliRun denoise = run("denoise " + dir.q("one.off") + " --clusters 1 -o " + dir.q("d.off"));
+  ASSERT_EXIT_OK(denoise);
+  EXPECT_NE(denoise.output.find("round 1: 1 cluster, 3 vertices moved"), std::string::npos)
+      << denoise.output;
+  fs::create_directory(dir / "in");
+  write_file(dir / "in" / "one.off", testing::file_contents(dir / "one.off"));
+  const CliRun batch = run("batch " + dir.q("in") + " --out " + dir.q("out") + " --clusters 1");
+  ASSERT_EXIT_OK(batch);
+  EXPECT_EQ(batch.output.rfind("1 file: 1 ok,", 0), 0u) << batch.output;
+}
+
 TEST(Cli, ThreadCountDoesNotChangeTheTree) {
   TempDir dir("threads");
   write_mesh(dir / "in.off", read_mesh(testing::cgal_mesh("fandisk.off")));
