@@ -196,7 +196,7 @@ Result process(const Item& item, const BatchOptions& o, const HierarchyOptions& 
     result.faces = mesh->face_count();
     check_mesh_limits(*mesh, file_bytes, o.limits);
     validate_level(o.level, mesh->face_count());
-    fs::create_directories(base.parent_path());
+    detail::create_directories(base.parent_path());
     const Hierarchy hierarchy = build_hierarchy(mesh, options);
     nlohmann::json summary;
     summary["mesh"] = mesh_summary(item.input.string(), hierarchy);
@@ -251,7 +251,7 @@ void run_batch(const BatchOptions& o) {
     std::vector<Item> all = collect_inputs(o.input);
     for (std::size_t i = shard; i < all.size(); i += shards) items.push_back(std::move(all[i]));
   }
-  fs::create_directories(o.out);
+  detail::create_directories(o.out);
   const std::string signature = options_signature(o);
   std::vector<Result> results(items.size());
   std::atomic<std::size_t> next{0};

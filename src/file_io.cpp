@@ -195,6 +195,13 @@ std::filesystem::path temporary_name_for(const std::filesystem::path& path) {
 
 }  // namespace
 
+void create_directories(const std::filesystem::path& path) {
+  std::error_code error;
+  std::filesystem::create_directories(path, error);
+  if (error)
+    throw IoError("cannot create the directory '" + path.string() + "': " + error.message());
+}
+
 void write_standard_output(std::string_view bytes) {
   errno = 0;
   const bool written = std::fwrite(bytes.data(), 1, bytes.size(), stdout) == bytes.size();

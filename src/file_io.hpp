@@ -56,6 +56,10 @@ FileImage read_standard_input(const ReadLimits& limits = {});
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
                            const std::function<void()>& while_named = {});
 
+/// Creates a directory and its missing parents (std::filesystem::create_directories); throws
+/// IoError "cannot create the directory '<path>': <reason>" (a file in the way, no permission).
+void create_directories(const std::filesystem::path& path);
+
 /// Writes `bytes` to standard output and flushes it. Throws IoError when the write fails (a full
 /// disk, a closed pipe whose SIGPIPE is ignored), so that a truncated output is never silent.
 void write_standard_output(std::string_view bytes);

@@ -202,6 +202,10 @@ TEST(Batch, BadArgumentsAreRejectedWithAMessage) {
            {"batch '" + (dir / "missing").string() + "' --out '" + (dir / "out").string() + "'",
             "missing"},
            {"batch '" + (in / "parts").string() + "/..' --out x --max-memory 0", "--max-memory"},
+           // A file where the output directory should be: exit 1, not an internal error.
+           {"batch '" + in.string() + "' --out '" + (in / "box.off" / "out").string() + "'",
+            "cannot create the directory '" + (in / "box.off" / "out").string() +
+                "': Not a directory"},
        }) {
     std::string output;
     EXPECT_EQ(primseg(c.args + " 2>&1", &output), 1) << c.args << "\n" << output;
