@@ -3,19 +3,48 @@
 //
 // Any input must either give a mesh that satisfies Mesh's invariants or throw primseg::Error:
 // a crash, a sanitizer report, another exception, a hang or an allocation beyond libFuzzer's
-// -rss_limit_mb is a finding.
+// -rss_limit_mb is a finding. The detecting target also checks what mesh_format_ruled_out()
+// promises to a reader of a stream.
 
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <span>
+#include <string>
+#include <string_view>
 
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 
+#ifdef PRIMSEG_FUZZ_DETECT
+namespace {
+
+// mesh_format_ruled_out() claims that no data starting with a ruled-out prefix, up to its
+// max_size, is detected as a mesh. Checked on the input padded with zeros to the 64 KiB the text
+// signatures are read from, then followed by nothing or by the input again.
+void check_ruled_out_prefix(std::span<const char> bytes) {
+  std::string prefix(bytes.begin(), bytes.end());
+  if (prefix.size() < (std::size_t{64} << 10)) prefix.resize(std::size_t{64} << 10, '\0');
+  if (!primseg::mesh_format_ruled_out(prefix, prefix.size() + bytes.size())) return;
+  for (const std::string_view rest :
+       {std::string_view(), std::string_view(bytes.data(), bytes.size())}) {
+    const std::string data = prefix + std::string(rest);
+    if (primseg::detect_mesh_format(data)) {
+      std::fprintf(stderr, "a ruled-out prefix was detected as a mesh once continued\n");
+      std::abort();
+    }
+  }
+}
+
+}  // namespace
+#endif
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::span<const char> bytes(reinterpret_cast<const char*>(data), size);
+#ifdef PRIMSEG_FUZZ_DETECT
+  check_ruled_out_prefix(bytes);
+#endif
   try {
 #ifdef PRIMSEG_FUZZ_DETECT
     const primseg::Mesh mesh = primseg::read_mesh_detecting_format(bytes, "fuzz");
