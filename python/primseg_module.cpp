@@ -253,9 +253,35 @@ HierarchyOptions hierarchy_options(const py::object& primitives, const std::stri
   return options;
 }
 
-PyHierarchy segment_mesh(std::shared_ptr<const Mesh> mesh, const HierarchyOptions& options) {
-  py::gil_scoped_release release;
-  return {std::make_shared<const Hierarchy>(build_hierarchy(std::move(mesh), options))};
+// Thrown from a build's progress callback to stop it once Python has an exception to raise: a
+// signal's (Ctrl-C: KeyboardInterrupt) or the user's progress callable's. The Python error stays
+// set, and the binding raises it once it holds the GIL again.
+struct PythonErrorPending {};
+
+// Builds the whole hierarchy without the GIL. About every percent of the merges it takes the GIL
+// to let Python handle signals and to call `progress` (None, or a callable taking the fraction
+// done): either can stop the build by raising.
+PyHierarchy segment_mesh(std::shared_ptr<const Mesh> mesh, const HierarchyOptions& options,
+                         const py::object& progress) {
+  // Made, and destroyed, while the GIL is held: it holds a reference to `progress`.
+  const std::function<void(double)> report = [progress](double fraction) {
+    const py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) throw PythonErrorPending{};
+    if (progress.is_none()) return;
+    try {
+      progress(fraction);
+    } catch (py::error_already_set& error) {
+      error.restore();
+      throw PythonErrorPending{};
+    }
+  };
+  try {
+    const py::gil_scoped_release release;
+    HierarchyBuilder builder(std::move(mesh), options);
+    return {std::make_shared<const Hierarchy>(builder.finish(report))};
+  } catch (const PythonErrorPending&) {
+    throw py::error_already_set();  // the GIL is held again here
+  }
 }
 
 // The CLI's default level (--tolerance 0.1%): as a fraction of the bounding-box diagonal.
@@ -914,10 +940,13 @@ OSError) when the PNG cannot be written.)",
           .c_str());
 
   const char* segment_doc =
-      R"(segment(mesh, *, primitives=("plane", "cylinder", "sphere"), weights="area", threads=0, exact_costs=False, eager=False) -> Hierarchy
+      R"(segment(mesh, *, primitives=("plane", "cylinder", "sphere"), weights="area", threads=0, exact_costs=False, eager=False, progress=None) -> Hierarchy
 segment(V, F, *, ...) -> Hierarchy
 
-Builds the whole hierarchy, with the GIL released. The input is a Mesh (read_mesh: labels are
+Builds the whole hierarchy, with the GIL released. About every percent of the merges it takes the
+GIL back for a moment: Ctrl-C (KeyboardInterrupt) stops the build there, and progress, if given,
+is called with the fraction done (0 to 1; a progress bar); an exception it raises stops the
+build and propagates. The input is a Mesh (read_mesh: labels are
 per input polygon, like the CLI's) or arrays V (n, 3) float32/float64 and F (m, 3)
 int32/int64/uint32/uint64, C- or Fortran-ordered, read in place without a converted copy
 (labels are per row of F).
@@ -929,15 +958,19 @@ coordinates, index out of range, no faces) or bad options.)";
   m.def(
       "segment",
       [](const py::object& first, const py::object& faces, const py::object& primitives,
-         const std::string& weights, unsigned threads, bool exact_costs, bool eager) {
+         const std::string& weights, unsigned threads, bool exact_costs, bool eager,
+         const py::object& progress) {
         const HierarchyOptions options =
             hierarchy_options(primitives, weights, threads, exact_costs, eager);
-        return segment_mesh(mesh_argument("segment", first, faces), options);
+        if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+          throw InvalidInputError("progress must be None or callable, not " +
+                                  py::repr(progress).cast<std::string>());
+        return segment_mesh(mesh_argument("segment", first, faces), options, progress);
       },
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(),
       py::arg("primitives") = py::make_tuple("plane", "cylinder", "sphere"),
       py::arg("weights") = "area", py::arg("threads") = 0u, py::arg("exact_costs") = false,
-      py::arg("eager") = false,
+      py::arg("eager") = false, py::arg("progress") = py::none(),
       join_docs(
           {segment_doc, cpp_doc("build_hierarchy", doc::hierarchy__build_hierarchy_2),
            cpp_doc("HierarchyOptions::primitives", doc::hierarchy__HierarchyOptions__primitives),

@@ -1,6 +1,10 @@
 """segment, cut, clusters, save/read_tree: the same results as the CLI, from any array layout."""
 
 import json
+import os
+import signal
+import threading
+import time
 import tracemalloc
 
 import numpy as np
@@ -167,6 +171,48 @@ def test_deterministic_for_any_thread_count(fandisk_tree):
 def test_segment_releases_the_gil(fandisk_tree):
     mesh = fandisk_tree.mesh
     assert_releases_the_gil(lambda: primseg.segment(mesh, threads=1))
+
+
+def test_progress_reports_the_fraction_done_and_can_stop_the_build(fandisk_tree):
+    mesh = fandisk_tree.mesh
+    fractions = []
+    tree = primseg.segment(mesh, progress=fractions.append)
+    assert fractions[0] == 0 and fractions[-1] == 1
+    assert fractions == sorted(fractions) and len(fractions) >= 50
+    np.testing.assert_array_equal(tree.linkage(), fandisk_tree.linkage())
+
+    seen = []
+
+    def stop_at_a_tenth(fraction):
+        seen.append(fraction)
+        if fraction >= 0.1:
+            raise RuntimeError("stopped by the user")
+
+    with pytest.raises(RuntimeError, match="stopped by the user"):
+        primseg.segment(mesh, progress=stop_at_a_tenth)
+    assert seen[-1] >= 0.1 and all(f < 0.1 for f in seen[:-1])  # no call after the one that raised
+    with pytest.raises(ValueError, match="progress must be None or callable, not 3"):
+        primseg.segment(mesh, progress=3)
+
+
+def test_ctrl_c_stops_the_build(cgal_mesh):
+    # SIGINT from another thread while the C++ loop runs without the GIL, as Ctrl-C in a terminal
+    # or a notebook: Python's handler runs at the next percent of merges and its KeyboardInterrupt
+    # stops the build there. Before, the build ran to its end and the interrupt came after it.
+    # (progress is a builtin: calling it runs no Python code, so no handler either.)
+    mesh = primseg.read_mesh(cgal_mesh("bunny00.off"))
+
+    def interrupt_soon():
+        time.sleep(0.1)  # the whole build takes about 0.6 s on one thread
+        os.kill(os.getpid(), signal.SIGINT)
+
+    fractions = []
+    killer = threading.Thread(target=interrupt_soon)
+    killer.start()
+    with pytest.raises(KeyboardInterrupt):
+        primseg.segment(mesh, threads=1, progress=fractions.append)
+    killer.join()
+    assert 1 not in fractions, len(fractions)  # stopped before the end (maybe before any call)
 
 
 def test_polygon_file_labels_match_the_cli(cli, tmp_path):
