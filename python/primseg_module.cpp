@@ -946,10 +946,9 @@ segment(V, F, *, ...) -> Hierarchy
 Builds the whole hierarchy, with the GIL released. About every percent of the merges it takes the
 GIL back for a moment: Ctrl-C (KeyboardInterrupt) stops the build there, and progress, if given,
 is called with the fraction done (0 to 1; a progress bar); an exception it raises stops the
-build and propagates. The input is a Mesh (read_mesh: labels are
-per input polygon, like the CLI's) or arrays V (n, 3) float32/float64 and F (m, 3)
-int32/int64/uint32/uint64, C- or Fortran-ordered, read in place without a converted copy
-(labels are per row of F).
+build and propagates. The input is a Mesh (read_mesh: labels are per input polygon, like the
+CLI's) or arrays V (n, 3) float32/float64 and F (m, 3) int32/int64/uint32/uint64, C- or
+Fortran-ordered, read in place without a converted copy (labels are per row of F).
 primitives: names or one name ("plane", "cylinder", "sphere"); weights: "area" or "uniform";
 threads: 0 for all cores (the tree does not depend on it); exact_costs: slow reference mode;
 eager: evaluate every candidate at once (reference mode, the same tree).
