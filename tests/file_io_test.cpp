@@ -4,6 +4,7 @@
 // links, FIFOs, directories) are written through or refused, never replaced.
 #include "file_io.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -15,7 +16,6 @@
 #include <functional>
 #include <set>
 #include <string>
-#include <thread>
 
 #include "primseg/error.hpp"
 #include "support/test_support.hpp"
@@ -115,11 +115,14 @@ TEST(WriteFileAtomically, AFifoIsWrittenAsItIsNotReplaced) {
   const fs::path dir = testing::temp_directory("file-io-fifo");
   const fs::path fifo = dir / "out.fifo";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  std::string received;
-  std::thread reader([&] { received = testing::file_contents(fifo); });
+  // Its reader opens first, without waiting for a writer: a regression then fails, never hangs.
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(reader, 0);
   detail::write_file_atomically(fifo, "through the pipe");
-  reader.join();
-  EXPECT_EQ(received, "through the pipe");
+  char received[64] = {};
+  const ssize_t got = ::read(reader, received, sizeof received - 1);
+  ::close(reader);
+  EXPECT_EQ(std::string(received, got > 0 ? static_cast<std::size_t>(got) : 0), "through the pipe");
   struct stat status {};
   ASSERT_EQ(::lstat(fifo.c_str(), &status), 0);
   EXPECT_TRUE(S_ISFIFO(status.st_mode));
