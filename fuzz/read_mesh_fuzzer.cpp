@@ -21,17 +21,28 @@
 namespace {
 
 // mesh_format_ruled_out() claims that no data starting with a ruled-out prefix, up to its
-// max_size, is detected as a mesh. Checked on the input padded with zeros to the 64 KiB the text
-// signatures are read from, then followed by nothing or by the input again.
+// max_size, is detected as a mesh. Checked on the input padded to the 64 KiB the text signatures
+// are read from, then followed by nothing or by the input again. The padding, "x x x ...", is
+// copied from one string made once: padding with zeros made each input's first token 64 KiB long,
+// and reading it (instrumented) made this target 8 times slower (105k executions in 20 s against
+// 800k; 590k like this).
 void check_ruled_out_prefix(std::span<const char> bytes) {
-  std::string prefix(bytes.begin(), bytes.end());
-  if (prefix.size() < (std::size_t{64} << 10)) prefix.resize(std::size_t{64} << 10, '\0');
-  if (!primseg::mesh_format_ruled_out(prefix, prefix.size() + bytes.size())) return;
-  for (const std::string_view rest :
-       {std::string_view(), std::string_view(bytes.data(), bytes.size())}) {
-    const std::string data = prefix + std::string(rest);
+  constexpr std::size_t kSignatureBytes = std::size_t{64} << 10;
+  static const std::string padding = [] {
+    std::string text;
+    for (std::size_t i = 0; i < kSignatureBytes / 2; ++i) text += "x ";
+    return text;
+  }();
+  static std::string data;
+  data.assign(bytes.begin(), bytes.end());
+  if (data.size() < kSignatureBytes) data.append(padding, 0, kSignatureBytes - data.size());
+  const std::size_t prefix = data.size();
+  if (!primseg::mesh_format_ruled_out(data, prefix + bytes.size())) return;
+  for (const bool continued : {false, true}) {
+    if (continued) data.append(bytes.begin(), bytes.end());
     if (primseg::detect_mesh_format(data)) {
-      std::fprintf(stderr, "a ruled-out prefix was detected as a mesh once continued\n");
+      std::fprintf(stderr, "a ruled-out prefix of %zu bytes was detected as a mesh with %zu more\n",
+                   prefix, data.size() - prefix);
       std::abort();
     }
   }
