@@ -189,7 +189,6 @@ Result process(const Item& item, const BatchOptions& o, const HierarchyOptions& 
     }
   }
   try {
-    check_file_limits(item.input, o.limits);
     std::uint64_t file_bytes = 0;
     auto mesh =
         std::make_shared<const Mesh>(read_geometry(item.input, &file_bytes, o.limits.max_memory));

@@ -2,7 +2,6 @@
 
 #include <string>
 
-#include "command.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg::cli {
@@ -44,16 +43,6 @@ void add_limit_options(CLI::App& command, ResourceLimits& limits) {
           "Refuse inputs whose estimated peak memory exceeds this (bytes, or with a K, M, G "
           "suffix; about 1 KB per face)")
       ->type_name("SIZE");
-}
-
-void check_file_limits(const std::filesystem::path& path, const ResourceLimits& limits) {
-  // Standard input has no size before it is read: check_mesh_limits() counts its bytes.
-  if (!limits.max_memory || path.native() == kStandardInput) return;
-  std::error_code error;
-  const std::uintmax_t size = std::filesystem::file_size(path, error);
-  if (!error && size > *limits.max_memory)
-    throw InvalidInputError("'" + path.string() + "': the file has " + std::to_string(size) +
-                            " bytes, more than --max-memory " + std::to_string(*limits.max_memory));
 }
 
 void check_mesh_limits(const Mesh& mesh, std::uint64_t file_bytes, const ResourceLimits& limits) {

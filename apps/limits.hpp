@@ -1,10 +1,10 @@
 #pragma once
 // --max-faces and --max-memory: bounds a service puts on one run, checked before the work they
-// bound (the file size before reading, the face count and the estimated peak before building).
+// bound: the input's size by the read itself (read_input_mesh: a file's before it is read, a
+// pipe's as it comes), the face count and the estimated peak before building.
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
-#include <filesystem>
 #include <optional>
 
 #include "primseg/mesh.hpp"
@@ -23,9 +23,6 @@ struct ResourceLimits {
 
 /// Adds --max-faces and --max-memory (bytes, or with a K, M, G suffix: powers of 1024).
 void add_limit_options(CLI::App& command, ResourceLimits& limits);
-
-/// Throws InvalidInputError if the file alone exceeds --max-memory (before reading it).
-void check_file_limits(const std::filesystem::path& path, const ResourceLimits& limits);
 
 /// Throws InvalidInputError if the mesh exceeds --max-faces, or if the estimated peak of building
 /// its hierarchy (file bytes + kBytesPerFace per face) exceeds --max-memory.

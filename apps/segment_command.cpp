@@ -50,7 +50,6 @@ Command add_segment_command(CLI::App& app) {
         options.evaluation = o->eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
         validate(options);
         validate_level_outputs(o->level);
-        check_file_limits(o->mesh_path, o->limits);
         const auto read_start = Clock::now();
         std::uint64_t file_bytes = 0;
         auto mesh = std::make_shared<const Mesh>(

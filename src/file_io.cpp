@@ -36,6 +36,12 @@ std::uint64_t physical_memory_bytes() {
 
 namespace {
 
+// "--max-memory 1048576 bytes", or "1048576 bytes" for a limit without a name.
+std::string limit_phrase(const ReadLimits& limits) {
+  return (limits.limit_name.empty() ? "" : std::string(limits.limit_name) + " ") +
+         std::to_string(limits.max_bytes) + " bytes";
+}
+
 // Reads what is left of `fd` until end of file into a buffer of at least `expected` + 1 bytes
 // (the size from fstat may be stale: a growing file, or a pipe, whose size is 0).
 FileImage read_to_end(int fd, const std::filesystem::path& name, std::uint64_t expected,
@@ -48,10 +54,7 @@ FileImage read_to_end(int fd, const std::filesystem::path& name, std::uint64_t e
   FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
   while (true) {
     if (image.size > limits.max_bytes)
-      throw InvalidInputError(
-          name.string() + ": more than " +
-          (limits.limit_name.empty() ? "" : std::string(limits.limit_name) + " ") +
-          std::to_string(limits.max_bytes) + " bytes");
+      throw InvalidInputError(name.string() + ": more than " + limit_phrase(limits));
     if (image.size > most)
       throw IoError("cannot read '" + name.string() + "': more than this machine's memory (" +
                     std::to_string(memory) + " bytes)");
@@ -88,13 +91,18 @@ FileImage read_file(const std::filesystem::path& path, const ReadLimits& limits)
   if (::fstat(fd, &status) != 0) io_failure(path, "stat", errno);
   if (S_ISDIR(status.st_mode)) io_failure(path, "read", EISDIR);
 
-  // Refused before any allocation: a file larger than the machine's memory cannot be parsed.
+  // Refused before any allocation: a file over the limit, or larger than the machine's memory
+  // (which could not be parsed). A pipe or a device has no size here: read_to_end() bounds it.
+  const auto size = static_cast<std::uint64_t>(status.st_size);
+  if (size > limits.max_bytes)
+    throw InvalidInputError("'" + path.string() + "': the file has " + std::to_string(size) +
+                            " bytes, more than " + limit_phrase(limits));
   const std::uint64_t memory = physical_memory_bytes();
-  if (memory != 0 && static_cast<std::uint64_t>(status.st_size) > memory)
+  if (memory != 0 && size > memory)
     throw IoError("cannot read '" + path.string() + "': the file has " +
                   std::to_string(status.st_size) + " bytes, more than this machine's memory (" +
                   std::to_string(memory) + " bytes)");
-  return read_to_end(fd, path, static_cast<std::uint64_t>(status.st_size), limits);
+  return read_to_end(fd, path, size, limits);
 }
 
 FileImage read_standard_input(const ReadLimits& limits) {

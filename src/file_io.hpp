@@ -38,7 +38,8 @@ struct ReadLimits {
 };
 
 /// Reads a whole file. Throws IoError (missing, a directory, unreadable, larger than the
-/// machine's physical memory), or what `limits` throws.
+/// machine's physical memory), InvalidInputError "'<path>': the file has N bytes, more than
+/// <limit>" before reading a file over `limits.max_bytes`, or what `limits` throws.
 FileImage read_file(const std::filesystem::path& path, const ReadLimits& limits = {});
 
 /// Reads standard input to its end (a pipe, a terminal or a redirected file). Throws IoError

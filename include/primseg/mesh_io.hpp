@@ -5,6 +5,7 @@
 /// every failure as a ParseError naming the file and the line (text) or byte offset (binary).
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -32,6 +33,10 @@ Mesh read_mesh(const std::filesystem::path& path);
 /// Reads a mesh from an in-memory file image. `name` is only used in error messages.
 Mesh read_mesh(std::span<const char> bytes, MeshFormat format, std::string_view name = "<memory>");
 
+/// detect_mesh_format() reads text signatures (a first token after comment lines) from at most
+/// this many first bytes (64 KiB).
+inline constexpr std::size_t kMeshSignatureBytes = std::size_t{64} << 10;
+
 /// Format from the content of a file image, for data without a trustworthy extension (uploads,
 /// pipes): "ply" on the first line; a first token (after '#' comment lines) of the OFF family
 /// (OFF, COFF, NOFF, STOFF, ...); a binary STL whose size matches its triangle count, or text
@@ -41,8 +46,9 @@ std::optional<MeshFormat> detect_mesh_format(std::span<const char> bytes);
 
 /// For data that arrives in pieces (a pipe): true when its first bytes, `prefix`, already rule out
 /// every format detect_mesh_format() could find in the whole data, if the data has at most
-/// `max_size` bytes, whatever follows. Text signatures are read from the first 64 KiB, a binary
-/// STL is told by its size: true once `prefix` holds 64 KiB or more without a text signature, and
+/// `max_size` bytes, whatever follows. Text signatures are read from the first kMeshSignatureBytes,
+/// a binary STL is told by its size: true once `prefix` holds that many or more without a text
+/// signature, and
 /// the binary STL its first 84 bytes would declare is shorter than `prefix` or longer than
 /// `max_size` (say, what the reader can hold). A reader can then stop at once instead of at the
 /// end of the data.

@@ -67,13 +67,10 @@ bool is_space(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
 }
 
-// Text signatures are read from this many first bytes at most.
-constexpr std::size_t kSignatureBytes = std::size_t{64} << 10;
-
 /// The first whitespace-separated token of the text, skipping lines whose first token starts
-/// with '#' (comments of OFF and OBJ). Looks at the first kSignatureBytes only.
+/// with '#' (comments of OFF and OBJ). Looks at the first kMeshSignatureBytes only.
 std::string_view first_token(std::string_view text) {
-  text = text.substr(0, std::min(text.size(), kSignatureBytes));
+  text = text.substr(0, std::min(text.size(), kMeshSignatureBytes));
   std::size_t at = 0;
   while (at < text.size()) {
     while (at < text.size() && is_space(text[at])) ++at;
@@ -137,7 +134,7 @@ bool mesh_format_ruled_out(std::span<const char> prefix, std::uint64_t max_size)
   const std::string_view text(prefix.data(), prefix.size());
   // Past the bytes text signatures are read from, only a binary STL could still be detected, and
   // only if the data can still end at the size its header declares.
-  if (text.size() < kSignatureBytes || text_signature(text)) return false;
+  if (text.size() < kMeshSignatureBytes || text_signature(text)) return false;
   const std::optional<std::uint64_t> stl_size = binary_stl_size(text);
   return !(stl_size >= text.size() && stl_size <= max_size);
 }

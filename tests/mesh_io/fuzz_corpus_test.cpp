@@ -108,7 +108,6 @@ TEST(DetectMeshFormat, APrefixRulesFormatsOutOnlyWhenNothingThatFollowsCouldBeDe
   const auto detect = [](std::string_view text) {
     return detect_mesh_format(std::span<const char>(text.data(), text.size()));
   };
-  constexpr std::size_t kSignatureBytes = 64 << 10;
   // A binary STL header declaring `triangles`, then zeros up to `size` bytes.
   const auto binary_stl = [](std::uint32_t triangles, std::size_t size) {
     std::string text(std::max<std::size_t>(size, 84), '\0');
@@ -116,26 +115,26 @@ TEST(DetectMeshFormat, APrefixRulesFormatsOutOnlyWhenNothingThatFollowsCouldBeDe
     return text;
   };
   // Endless zeros or markup: decided once the signature bytes are in, not at the end.
-  EXPECT_FALSE(ruled_out(std::string(kSignatureBytes - 1, '\0')));
-  EXPECT_TRUE(ruled_out(std::string(kSignatureBytes, '\0')));
+  EXPECT_FALSE(ruled_out(std::string(kMeshSignatureBytes - 1, '\0')));
+  EXPECT_TRUE(ruled_out(std::string(kMeshSignatureBytes, '\0')));
   std::string page;
-  while (page.size() < kSignatureBytes) page += "<p>not a mesh</p>\n";
+  while (page.size() < kMeshSignatureBytes) page += "<p>not a mesh</p>\n";
   // Bytes 80 to 83 of the page, "mesh", would be the triangle count of a binary STL of 87 GB.
   EXPECT_FALSE(ruled_out(page));
   EXPECT_TRUE(ruled_out(page, std::uint64_t{1} << 30));
   // A binary STL stays possible while the data is not longer than its header declares.
-  EXPECT_FALSE(ruled_out(binary_stl(10000, kSignatureBytes)));  // 500,084 bytes declared
-  EXPECT_TRUE(ruled_out(binary_stl(10000, kSignatureBytes), 500083));
-  EXPECT_TRUE(ruled_out(binary_stl(1000, kSignatureBytes)));  // 50,084
+  EXPECT_FALSE(ruled_out(binary_stl(10000, kMeshSignatureBytes)));  // 500,084 bytes declared
+  EXPECT_TRUE(ruled_out(binary_stl(10000, kMeshSignatureBytes), 500083));
+  EXPECT_TRUE(ruled_out(binary_stl(1000, kMeshSignatureBytes)));  // 50,084
   // What it claims: when a prefix is ruled out, no continuation is detected as a mesh.
   const std::string continuations[] = {"", "OFF\n", std::string(1 << 20, '\0'),
-                                       std::string(500084 - kSignatureBytes, '\0')};
+                                       std::string(500084 - kMeshSignatureBytes, '\0')};
   for (const std::string& prefix :
-       {std::string(kSignatureBytes, '\0'), page, binary_stl(1000, kSignatureBytes)}) {
+       {std::string(kMeshSignatureBytes, '\0'), page, binary_stl(1000, kMeshSignatureBytes)}) {
     ASSERT_TRUE(ruled_out(prefix, std::uint64_t{1} << 30));
     for (const std::string& rest : continuations) EXPECT_EQ(detect(prefix + rest), std::nullopt);
   }
-  EXPECT_EQ(detect(binary_stl(10000, kSignatureBytes) + continuations[3]), MeshFormat::Stl);
+  EXPECT_EQ(detect(binary_stl(10000, kMeshSignatureBytes) + continuations[3]), MeshFormat::Stl);
   // No prefix of a mesh file of any format is ruled out (files larger than the signature bytes).
   const fs::path dir = testing::temp_directory("ruled-out");
   const Mesh mesh =
@@ -145,9 +144,10 @@ TEST(DetectMeshFormat, APrefixRulesFormatsOutOnlyWhenNothingThatFollowsCouldBeDe
     SCOPED_TRACE(name);
     write_mesh(dir / name, mesh);
     const std::string text(detail::read_file(dir / name).view());
-    ASSERT_GT(text.size(), 2 * kSignatureBytes);
+    ASSERT_GT(text.size(), 2 * kMeshSignatureBytes);
     ASSERT_TRUE(detect(text));
-    for (std::size_t size = 0; size <= text.size(); size += size < 2 * kSignatureBytes ? 1 : 4099)
+    for (std::size_t size = 0; size <= text.size();
+         size += size < 2 * kMeshSignatureBytes ? 1 : 4099)
       if (ruled_out(std::string_view(text).substr(0, size))) {
         ADD_FAILURE() << "prefix of " << size << " bytes ruled out";
         break;
