@@ -324,7 +324,7 @@ Command add_batch_command(CLI::App& app) {
       ->check(CLI::IsMember({"area", "uniform"}))
       ->capture_default_str();
   batch->add_flag("--exact-costs", o->exact_costs, "Reference mode: exact Euclidean errors");
-  add_limit_options(*batch, o->limits);
+  add_limit_options(*batch, o->limits, kHierarchyBytesPerFace);
   batch->add_flag("--quiet,-q", o->quiet, "No progress or summary output");
   return {batch, [o] { run_batch(*o); }};
 }

@@ -22,6 +22,19 @@ std::string input_name(const std::filesystem::path& path) {
   return path.native() == kStandardInput ? std::string("standard input") : path.string();
 }
 
+namespace {
+
+detail::ReadLimits memory_limits(std::optional<std::uint64_t> max_memory) {
+  detail::ReadLimits limits;
+  if (max_memory) {
+    limits.max_bytes = *max_memory;
+    limits.limit_name = "--max-memory";
+  }
+  return limits;
+}
+
+}  // namespace
+
 Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes,
                      std::optional<std::uint64_t> max_memory) {
   const bool standard_input = path.native() == kStandardInput;
@@ -29,11 +42,7 @@ Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes,
   const std::optional<MeshFormat> format =
       standard_input ? std::nullopt : std::optional(mesh_format_from_path(path));
   const std::string name = input_name(path);
-  detail::ReadLimits limits;
-  if (max_memory) {
-    limits.max_bytes = *max_memory;
-    limits.limit_name = "--max-memory";
-  }
+  detail::ReadLimits limits = memory_limits(max_memory);
   if (standard_input)
     limits.check_prefix = [&name](std::span<const char> prefix, std::uint64_t most_bytes) {
       // Data that could be a mesh only if it were larger than can be read is no mesh here either.
@@ -56,6 +65,13 @@ Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes,
     throw InvalidInputError(input_name(path) + ": " + error.what());
   }
   return mesh;
+}
+
+Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* bytes,
+                          std::optional<std::uint64_t> max_memory) {
+  const detail::FileImage image = detail::read_file(path, memory_limits(max_memory));
+  if (bytes) *bytes = image.size;
+  return deserialize_tree({image.bytes.get(), image.size}, path.string());
 }
 
 std::vector<PrimitiveType> parse_primitives(const std::string& list) {

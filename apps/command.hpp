@@ -60,6 +60,11 @@ Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes = n
 Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes = nullptr,
                    std::optional<std::uint64_t> max_memory = std::nullopt);
 
+/// read_tree(path), whose read stops with InvalidInputError as soon as the file has more bytes
+/// than `max_memory` (--max-memory); `bytes`, if set, receives the file's size.
+Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* bytes = nullptr,
+                          std::optional<std::uint64_t> max_memory = std::nullopt);
+
 /// Parses "plane,sphere,cylinder" into types that have a fitter; throws InvalidInputError
 /// naming the unknown one and the available ones.
 std::vector<PrimitiveType> parse_primitives(const std::string& list);

@@ -1,6 +1,7 @@
 #include <memory>
 
 #include "command.hpp"
+#include "limits.hpp"
 #include "primseg/error.hpp"
 #include "primseg/tree_io.hpp"
 
@@ -10,11 +11,13 @@ Command add_cut_command(CLI::App& app) {
   struct Options {
     std::string tree_path;
     LevelOptions level;
+    ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
   auto* cut_command = app.add_subcommand("cut", "Report a level of a saved hierarchy");
   cut_command->add_option("TREE", o->tree_path, "Tree file written by segment --tree")->required();
   add_level_options(*cut_command, o->level);
+  add_limit_options(*cut_command, o->limits, kMeshBytesPerFace);
 
   return {cut_command, [o] {
             if (!o->level.level.clusters && !o->level.level.tolerance)
@@ -22,7 +25,11 @@ Command add_cut_command(CLI::App& app) {
                   "cut: give the level with --clusters K, --clusters auto or --tolerance T");
             validate_level_outputs(o->level);
             const auto read_start = Clock::now();
-            const Hierarchy hierarchy = read_tree(o->tree_path);
+            std::uint64_t file_bytes = 0;
+            const Hierarchy hierarchy =
+                read_input_tree(o->tree_path, &file_bytes, o->limits.max_memory);
+            o->limits.fixed_bytes = o->level.files.png ? kPictureBytes : 0;
+            check_mesh_limits(hierarchy.mesh(), file_bytes, o->limits);
             validate_level(o->level.level, hierarchy.face_count());
             nlohmann::json summary;
             summary["mesh"] = mesh_summary(o->tree_path, hierarchy);

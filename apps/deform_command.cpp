@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "command.hpp"
+#include "limits.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/skinning.hpp"
@@ -15,6 +16,7 @@ Command add_deform_command(CLI::App& app) {
     double band = SkinningOptions{}.band;
     SkeletonPicture picture;
     bool quiet = false;
+    ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
   auto* command = app.add_subcommand(
@@ -38,12 +40,16 @@ Command add_deform_command(CLI::App& app) {
       ->capture_default_str();
   o->picture.add_options(*command, "the posed mesh and skeleton");
   command->add_flag("--quiet,-q", o->quiet, "No summary output");
+  add_limit_options(*command, o->limits, kMeshBytesPerFace);
 
   return {command, [o] {
             if (!(std::isfinite(o->band) && o->band >= 0))
               throw InvalidInputError("--band: must be a finite number >= 0");
             mesh_format_from_path(o->output);  // an unknown extension fails before any work
-            const Mesh mesh = read_geometry(o->mesh_path);
+            std::uint64_t file_bytes = 0;
+            const Mesh mesh = read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory);
+            o->limits.fixed_bytes = o->picture.png ? kPictureBytes : 0;
+            check_mesh_limits(mesh, file_bytes, o->limits);
             const Skeleton skeleton = read_skeleton_file(o->skeleton_path);
             const std::vector<JointRotation> pose = read_pose_file(o->pose_path);
             if (skeleton.face_labels.size() != mesh.face_count())

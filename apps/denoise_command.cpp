@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "command.hpp"
+#include "limits.hpp"
 #include "primseg/denoise.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
@@ -23,6 +24,7 @@ Command add_denoise_command(CLI::App& app) {
     std::optional<double> noise_factor;
     unsigned threads = 0;
     LevelOptions level;
+    ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
   auto* denoise = app.add_subcommand(
@@ -83,6 +85,7 @@ Command add_denoise_command(CLI::App& app) {
       ->capture_default_str();
   denoise->add_option("--threads", o->threads, "Threads for the hierarchy (0: all cores)")
       ->capture_default_str();
+  add_limit_options(*denoise, o->limits, kDenoiseBytesPerFace);
 
   return {denoise, [o] {
             DenoiseOptions options;
@@ -100,7 +103,10 @@ Command add_denoise_command(CLI::App& app) {
             validate_level_outputs(o->level);
             mesh_format_from_path(o->output_path);  // an unknown extension fails before any work
             const auto start = Clock::now();
-            Mesh mesh = read_geometry(o->mesh_path);
+            std::uint64_t file_bytes = 0;
+            Mesh mesh = read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory);
+            o->limits.fixed_bytes = o->level.files.png ? kPictureBytes : 0;
+            check_mesh_limits(mesh, file_bytes, o->limits);
             validate_level(o->level.level, mesh.face_count());
             Denoiser denoiser(std::move(mesh), options);
             const bool automatic =

@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "command.hpp"
+#include "limits.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_distance.hpp"
 #include "primseg/mesh_io.hpp"
@@ -31,6 +32,7 @@ Command add_distance_command(CLI::App& app) {
     unsigned threads = 0;
     std::optional<std::string> json;
     bool quiet = false;
+    ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
   auto* distance = app.add_subcommand(
@@ -48,6 +50,7 @@ Command add_distance_command(CLI::App& app) {
       ->capture_default_str();
   distance->add_option("--json", o->json, "Write the figures as JSON (- for standard output)");
   distance->add_flag("--quiet,-q", o->quiet, "No table on standard output");
+  add_limit_options(*distance, o->limits, kMeshBytesPerFace);
 
   return {distance, [o] {
             DistanceOptions options;
@@ -57,8 +60,10 @@ Command add_distance_command(CLI::App& app) {
             options.threads = o->threads;
             if (o->first == kStandardInput && o->second == kStandardInput)
               throw InvalidInputError("distance: only one of A and B can be standard input ('-')");
-            const Mesh a = read_geometry(o->first);
-            const Mesh b = read_geometry(o->second);
+            std::uint64_t bytes_a = 0, bytes_b = 0;
+            const Mesh a = read_geometry(o->first, &bytes_a, o->limits.max_memory);
+            const Mesh b = read_geometry(o->second, &bytes_b, o->limits.max_memory);
+            check_mesh_limits({&a, &b}, bytes_a + bytes_b, o->limits);
             const auto start = Clock::now();
             const MeshDistance d = mesh_distance(a, b, options);
             const double seconds = seconds_since(start);

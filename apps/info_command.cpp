@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "limits.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_info.hpp"
 #include "primseg/mesh_io.hpp"
@@ -15,15 +16,19 @@ Command add_info_command(CLI::App& app) {
   struct Options {
     std::string path;
     std::optional<std::string> json;
+    ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
   auto* info = app.add_subcommand("info", "Print counts and defects of a mesh");
   info->add_option("MESH", o->path, "Input mesh (- for standard input)")->required();
   info->add_option("--json", o->json,
                    "Write the counts as JSON (- for standard output, instead of the text)");
+  add_limit_options(*info, o->limits, kMeshBytesPerFace);
 
   return {info, [o] {
-            const Mesh mesh = read_input_mesh(o->path);
+            std::uint64_t file_bytes = 0;
+            const Mesh mesh = read_input_mesh(o->path, &file_bytes, o->limits.max_memory);
+            check_mesh_limits(mesh, file_bytes, o->limits);
             const MeshInfo i = describe_mesh(mesh);
             // Reported, not refused: info is where a user finds out why the others refuse.
             std::optional<std::string> out_of_range;

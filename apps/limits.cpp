@@ -1,5 +1,6 @@
 #include "limits.hpp"
 
+#include <cstdio>
 #include <string>
 
 #include "primseg/error.hpp"
@@ -33,27 +34,40 @@ std::uint64_t parse_byte_size(const std::string& text) {
 
 }  // namespace
 
-void add_limit_options(CLI::App& command, ResourceLimits& limits) {
+void add_limit_options(CLI::App& command, ResourceLimits& limits, std::uint64_t bytes_per_face) {
+  limits.bytes_per_face = bytes_per_face;
   command.add_option("--max-faces", limits.max_faces, "Refuse meshes with more input faces")
       ->check(CLI::PositiveNumber);
+  const double kilobytes = static_cast<double>(bytes_per_face) / 1024;
+  char per_face[32];
+  std::snprintf(per_face, sizeof per_face, "%g", kilobytes);
   command
       .add_option_function<std::string>(
           "--max-memory",
           [&limits](const std::string& text) { limits.max_memory = parse_byte_size(text); },
           "Refuse inputs whose estimated peak memory exceeds this (bytes, or with a K, M, G "
-          "suffix; about 1 KB per face)")
+          "suffix; about " +
+              std::string(per_face) + " KB per face)")
       ->type_name("SIZE");
 }
 
-void check_mesh_limits(const Mesh& mesh, std::uint64_t file_bytes, const ResourceLimits& limits) {
-  if (limits.max_faces && mesh.face_count() > *limits.max_faces)
-    throw InvalidInputError("the mesh has " + std::to_string(mesh.face_count()) +
-                            " faces, more than --max-faces " + std::to_string(*limits.max_faces));
-  const std::uint64_t estimate = file_bytes + kBytesPerFace * mesh.face_count();
+void check_mesh_limits(std::initializer_list<const Mesh*> meshes, std::uint64_t file_bytes,
+                       const ResourceLimits& limits) {
+  std::uint64_t faces = 0;
+  for (const Mesh* mesh : meshes) {
+    if (limits.max_faces && mesh->face_count() > *limits.max_faces)
+      throw InvalidInputError("the mesh has " + std::to_string(mesh->face_count()) +
+                              " faces, more than --max-faces " + std::to_string(*limits.max_faces));
+    faces += mesh->face_count();
+  }
+  const std::uint64_t estimate =
+      kProcessBytes + limits.fixed_bytes + file_bytes + limits.bytes_per_face * faces;
   if (limits.max_memory && estimate > *limits.max_memory)
-    throw InvalidInputError("the mesh has " + std::to_string(mesh.face_count()) +
-                            " faces, which need about " + std::to_string(estimate) +
-                            " bytes, more than --max-memory " + std::to_string(*limits.max_memory));
+    throw InvalidInputError((meshes.size() == 1 ? "the mesh has " : "the meshes have ") +
+                            std::to_string(faces) + " faces" +
+                            (meshes.size() == 1 ? "" : " in all") + ", which need about " +
+                            std::to_string(estimate) + " bytes, more than --max-memory " +
+                            std::to_string(*limits.max_memory));
 }
 
 }  // namespace primseg::cli

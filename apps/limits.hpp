@@ -1,31 +1,60 @@
 #pragma once
 // --max-faces and --max-memory: bounds a service puts on one run, checked before the work they
 // bound: the input's size by the read itself (read_input_mesh: a file's before it is read, a
-// pipe's as it comes), the face count and the estimated peak before building.
+// pipe's as it comes), the face count and the estimated peak before the work.
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 
 #include "primseg/mesh.hpp"
 
 namespace primseg::cli {
 
-/// Peak memory of `segment` per input face, with a margin: measured with bench/scaling.sh (whole
-/// process, 532 to 784 bytes per face from 1.2M down to 13k faces).
-inline constexpr std::uint64_t kBytesPerFace = 1024;
+// The peak memory --max-memory's estimate uses: kProcessBytes + the input files' bytes + the
+// command's bytes per input face, with a margin over the peak RSS measured on fandisk, bunny00 and
+// bunny00 midpoint-subdivided to 302k and 1.2M faces (figures below: whole process, per face).
+
+/// The process before any input: 5 to 6 MB.
+inline constexpr std::uint64_t kProcessBytes = 8ull << 20;
+/// A --png picture's buffers (800 x 600, supersampled), whatever the mesh: 16 MB.
+inline constexpr std::uint64_t kPictureBytes = 24ull << 20;
+/// view's page: the viewer's code and the JSON of the tree, levels and skeleton it embeds (the
+/// per-face part is in kViewBytesPerFace).
+inline constexpr std::uint64_t kViewerPageBytes = 24ull << 20;
+/// segment, batch, skeleton: 542 to 933 bytes per face.
+inline constexpr std::uint64_t kHierarchyBytesPerFace = 1024;
+/// view (with --skeleton): 807 to 2,821 bytes per face, kViewerPageBytes included.
+inline constexpr std::uint64_t kViewBytesPerFace = 1280;
+/// denoise: a second copy of the mesh to segment, refits and, with --iterations, a tree per
+/// round: 764 to 1,207 bytes per face, 1,424 with two rounds on fandisk.
+inline constexpr std::uint64_t kDenoiseBytesPerFace = 1536;
+/// info, distance (per face of both meshes), deform, cut (beside its tree file's bytes): the mesh
+/// and its adjacency, search tree, skinning weights or level: 222 to 633 bytes per face, 130 to
+/// 400 per face of distance's two meshes, 339 to 748 for cut (its tree file has 154 per face).
+inline constexpr std::uint64_t kMeshBytesPerFace = 512;
 
 struct ResourceLimits {
   std::optional<std::uint32_t> max_faces;  ///< refuse meshes with more input faces
   std::optional<std::uint64_t>
       max_memory;  ///< bytes; refuse inputs whose estimated peak exceeds it
+  std::uint64_t bytes_per_face = kHierarchyBytesPerFace;  ///< the command's peak per face
+  std::uint64_t fixed_bytes = 0;  ///< buffers whatever the mesh: kPictureBytes for a --png
 };
 
-/// Adds --max-faces and --max-memory (bytes, or with a K, M, G suffix: powers of 1024).
-void add_limit_options(CLI::App& command, ResourceLimits& limits);
+/// Adds --max-faces and --max-memory (bytes, or with a K, M, G suffix: powers of 1024) to a
+/// command whose peak is about `bytes_per_face` per input face (kept in `limits`).
+void add_limit_options(CLI::App& command, ResourceLimits& limits, std::uint64_t bytes_per_face);
 
-/// Throws InvalidInputError if the mesh exceeds --max-faces, or if the estimated peak of building
-/// its hierarchy (file bytes + kBytesPerFace per face) exceeds --max-memory.
-void check_mesh_limits(const Mesh& mesh, std::uint64_t file_bytes, const ResourceLimits& limits);
+/// Throws InvalidInputError if a mesh exceeds --max-faces, or if the estimated peak of the run
+/// (kProcessBytes + the input files' bytes + bytes_per_face per face of all the meshes, and
+/// fixed_bytes) exceeds --max-memory.
+void check_mesh_limits(std::initializer_list<const Mesh*> meshes, std::uint64_t file_bytes,
+                       const ResourceLimits& limits);
+inline void check_mesh_limits(const Mesh& mesh, std::uint64_t file_bytes,
+                              const ResourceLimits& limits) {
+  check_mesh_limits({&mesh}, file_bytes, limits);
+}
 
 }  // namespace primseg::cli

@@ -22,7 +22,7 @@ Command add_segment_command(CLI::App& app) {
       ->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl; - for standard input)")
       ->required();
   add_level_options(*segment, o->level);
-  add_limit_options(*segment, o->limits);
+  add_limit_options(*segment, o->limits, kHierarchyBytesPerFace);
   segment->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
       ->capture_default_str();
   segment->add_option("--weights", o->weights, "Vertex weights of the fitting error")
@@ -55,6 +55,7 @@ Command add_segment_command(CLI::App& app) {
         auto mesh = std::make_shared<const Mesh>(
             read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory));
         const double read_seconds = seconds_since(read_start);
+        o->limits.fixed_bytes = o->level.files.png ? kPictureBytes : 0;
         check_mesh_limits(*mesh, file_bytes, o->limits);
         validate_level(o->level.level, mesh->face_count());
         const auto build_start = Clock::now();

@@ -4,6 +4,7 @@
 
 #include "../src/file_io.hpp"
 #include "command.hpp"
+#include "limits.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/skeleton.hpp"
@@ -21,6 +22,7 @@ Command add_skeleton_command(CLI::App& app) {
     double band = SkinningOptions{}.band;
     unsigned threads = 0;
     bool quiet = false;
+    ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
   auto* command = app.add_subcommand(
@@ -45,6 +47,7 @@ Command add_skeleton_command(CLI::App& app) {
   o->picture.add_options(*command, "the skeleton over the clusters");
   command->add_option("--threads", o->threads, "Threads (0: all cores)")->capture_default_str();
   command->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
+  add_limit_options(*command, o->limits, kHierarchyBytesPerFace);
 
   return {
       command, [o] {
@@ -54,7 +57,11 @@ Command add_skeleton_command(CLI::App& app) {
         validate(options);
         if (!(std::isfinite(o->band) && o->band >= 0))
           throw InvalidInputError("--band: must be a finite number >= 0");
-        auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path));
+        std::uint64_t file_bytes = 0;
+        auto mesh = std::make_shared<const Mesh>(
+            read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory));
+        o->limits.fixed_bytes = o->picture.png ? kPictureBytes : 0;
+        check_mesh_limits(*mesh, file_bytes, o->limits);
         validate_level(o->level, mesh->face_count());
         const auto build_start = Clock::now();
         HierarchyBuilder builder(mesh, options);

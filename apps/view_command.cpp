@@ -16,6 +16,7 @@
 
 #include "../src/file_io.hpp"
 #include "command.hpp"
+#include "limits.hpp"
 #include "primseg/auto_level.hpp"
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
@@ -280,6 +281,7 @@ Command add_view_command(CLI::App& app) {
     double band = SkinningOptions{}.band;
     unsigned threads = 0;
     bool quiet = false;
+    ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
   auto* view = app.add_subcommand(
@@ -308,6 +310,8 @@ Command add_view_command(CLI::App& app) {
   view->add_option("--threads", o->threads, "Threads when the hierarchy is built (0: all cores)")
       ->capture_default_str();
   view->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
+  add_limit_options(*view, o->limits, kViewBytesPerFace);
+  o->limits.fixed_bytes = kViewerPageBytes;
 
   return {view, [o] {
             const std::string_view page = viewer_template();
@@ -321,7 +325,10 @@ Command add_view_command(CLI::App& app) {
             options.primitives = parse_primitives(o->primitives);
             options.threads = o->threads;
             validate(options);
-            auto mesh = std::make_shared<const Mesh>(read_geometry(o->mesh_path));
+            std::uint64_t file_bytes = 0;
+            auto mesh = std::make_shared<const Mesh>(
+                read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory));
+            check_mesh_limits(*mesh, file_bytes, o->limits);
             if (!(std::isfinite(o->band) && o->band >= 0))
               throw InvalidInputError("--band: must be a finite number >= 0");
             if (o->clusters) validate_level({o->clusters, std::nullopt}, mesh->face_count());
@@ -331,7 +338,7 @@ Command add_view_command(CLI::App& app) {
             const Hierarchy hierarchy = [&] {
               if (!o->tree_path)
                 return HierarchyBuilder(mesh, options).finish(Progress("hierarchy", o->quiet));
-              Hierarchy tree = read_tree(*o->tree_path);
+              Hierarchy tree = read_input_tree(*o->tree_path, nullptr, o->limits.max_memory);
               if (!same_mesh(tree.mesh(), *mesh))
                 throw InvalidInputError("view: the tree '" + *o->tree_path +
                                         "' was not built from " + input_name(o->mesh_path));

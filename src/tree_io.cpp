@@ -131,6 +131,7 @@ std::string serialize_tree(const Hierarchy& hierarchy) {
 }
 
 Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name) {
+  if (bytes.empty()) throw ParseError(name + ": empty file");
   Reader r(bytes, name);
   r.need(sizeof kMagic, "the header");
   if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
@@ -220,7 +221,6 @@ void write_tree(const std::filesystem::path& path, const Hierarchy& hierarchy) {
 
 Hierarchy read_tree(const std::filesystem::path& path) {
   const detail::FileImage file = detail::read_file(path);
-  if (file.size == 0) throw ParseError(path.string() + ": empty file");
   return deserialize_tree({file.bytes.get(), file.size}, path.string());
 }
 

@@ -1,7 +1,12 @@
-// End-to-end tests of `primseg batch`, the resource limits of `segment` and interruption: run
+// End-to-end tests of `primseg batch`, the resource limits of every command and interruption: run
 // the built executable, check exit codes, output files and reports.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -251,22 +256,144 @@ TEST(Limits, MaxFacesAndMaxMemoryRefuseBeforeTheBuild) {
   fs::remove_all(dir);
 }
 
+bool under_address_sanitizer() {
+#if defined(__SANITIZE_ADDRESS__)
+  return true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  return true;
+#else
+  return false;
+#endif
+#else
+  return false;
+#endif
+}
+
+// Runs the CLI with `args` (no shell), its output discarded; returns the exit status, and the peak
+// resident memory of the run in bytes in `peak`.
+int primseg_peak(const std::vector<std::string>& args, std::uint64_t* peak) {
+  std::vector<std::string> arguments = {testing::cli_path().string()};
+  arguments.insert(arguments.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& argument : arguments) argv.push_back(argument.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return -1;
+  int status = 0;
+  rusage usage{};
+  if (wait4(pid, &status, 0, &usage) != pid) return -1;
+  *peak = static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // kilobytes on Linux
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(Limits, EveryCommandThatReadsAMeshHasThemAndItsEstimateBoundsItsPeak) {
+  const fs::path dir = testing::temp_directory("limits-commands");
+  const std::string mesh = testing::cgal_mesh("fandisk.off").string();
+  const auto out = [&dir](const char* name) { return (dir / name).string(); };
+  ASSERT_EQ(primseg("skeleton '" + mesh + "' --clusters 5 -q -o '" + out("skeleton.json") + "'"),
+            0);
+  ASSERT_EQ(primseg("segment '" + mesh + "' -q --tree '" + out("fandisk.tree") + "'"), 0);
+  std::ofstream(dir / "pose.json") << R"({"rotations": []})";
+  // Each command with its heaviest options, its last output last; the estimate is the one
+  // --max-memory uses (apps/limits.hpp): kProcessBytes (8 MiB) + the input files' bytes + the
+  // command's bytes per face of its meshes + 24 MiB for a picture's buffers (--png) or view's
+  // page.
+  struct Case {
+    std::vector<std::string> args;
+    std::uint64_t bytes_per_face;
+    std::uint64_t input_bytes;
+    std::uint64_t meshes = 1;
+    std::uint64_t fixed_bytes = 0;
+  };
+  const std::uint64_t buffers = 24u << 20;  // a picture's, or view's page
+  const std::uint64_t faces = 12946, mesh_bytes = fs::file_size(mesh);
+  const std::uint64_t tree_bytes = fs::file_size(dir / "fandisk.tree");
+  const std::vector<Case> cases = {
+      {{"segment", mesh, "--clusters", "30", "-q", "--tree", out("t.tree"), "--png", out("s.png")},
+       1024,
+       mesh_bytes,
+       1,
+       buffers},
+      {{"cut", out("fandisk.tree"), "--clusters", "30", "--refine", "3", "-q", "--json",
+        out("c.json"), "--png", out("c.png")},
+       512,
+       tree_bytes,
+       1,
+       buffers},
+      {{"denoise", mesh, "--clusters", "auto", "--bilateral", "--iterations", "2", "-q", "-o",
+        out("d.ply")},
+       1536,
+       mesh_bytes},
+      {{"skeleton", mesh, "--clusters", "auto", "-q", "-o", out("s.json"), "--skin-weights",
+        out("w.txt")},
+       1024,
+       mesh_bytes},
+      {{"view", mesh, "--skeleton", "-q", "-o", out("v.html")}, 1280, mesh_bytes, 1, buffers},
+      {{"distance", mesh, mesh, "-q", "--json", out("distance.json")}, 512, 2 * mesh_bytes, 2},
+      {{"info", mesh, "--json", out("info.json")}, 512, mesh_bytes},
+      {{"deform", mesh, out("skeleton.json"), out("pose.json"), "-q", "-o", out("posed.ply"),
+        "--png", out("posed.png")},
+       512,
+       mesh_bytes,
+       1,
+       buffers}};
+  for (const Case& c : cases) {
+    const std::string& name = c.args[0];
+    std::string command;
+    for (const std::string& arg : c.args) command += "'" + arg + "' ";
+    std::string output;
+    const int status = primseg(command + "2>&1", &output);
+    if (name == "view" && output.find("without the web viewer") != std::string::npos) continue;
+    ASSERT_EQ(status, 0) << output;
+    const std::string written = c.args[c.args.size() - 1];
+    fs::remove(written);
+
+    EXPECT_EQ(primseg(command + "--max-faces 12945 2>&1", &output), 1) << name;
+    EXPECT_NE(output.find("the mesh has 12946 faces, more than --max-faces 12945"),
+              std::string::npos)
+        << output;
+    const std::uint64_t estimate =
+        (8u << 20) + c.fixed_bytes + c.input_bytes + c.meshes * c.bytes_per_face * faces;
+    EXPECT_EQ(primseg(command + "--max-memory " + std::to_string(estimate - 1) + " 2>&1", &output),
+              1)
+        << name;
+    EXPECT_NE(output.find("need about " + std::to_string(estimate) +
+                          " bytes, more than "
+                          "--max-memory " +
+                          std::to_string(estimate - 1)),
+              std::string::npos)
+        << output;
+    EXPECT_FALSE(fs::exists(written)) << name;
+    // Smaller than the file itself: refused before reading.
+    EXPECT_EQ(primseg(command + "--max-memory 1K 2>&1", &output), 1) << name;
+    EXPECT_NE(output.find("the file has"), std::string::npos) << output;
+
+    std::vector<std::string> within = c.args;
+    within.insert(within.end(), {"--max-memory", std::to_string(estimate)});
+    std::uint64_t peak = 0;
+    EXPECT_EQ(primseg_peak(within, &peak), 0) << name;
+    EXPECT_TRUE(fs::exists(written)) << name;
+    // AddressSanitizer's shadow memory and quarantine are no part of the estimate.
+    if (!under_address_sanitizer()) {
+      EXPECT_LE(peak, estimate) << name << ": the estimate is no bound of the peak";
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // A shell prefix under which an attempt to allocate for a declared count fails. `ulimit -v` does
 // it, but AddressSanitizer reserves terabytes of shadow address space at start and cannot run
 // under it; its own cap on one allocation does the same there.
 std::string memory_limit_prefix() {
-#if defined(__SANITIZE_ADDRESS__)
-  constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-  constexpr bool kAddressSanitizer = true;
-#else
-  constexpr bool kAddressSanitizer = false;
-#endif
-#else
-  constexpr bool kAddressSanitizer = false;
-#endif
-  if (kAddressSanitizer) return "ASAN_OPTIONS=abort_on_error=1:max_allocation_size_mb=1000 ";
+  if (under_address_sanitizer())
+    return "ASAN_OPTIONS=abort_on_error=1:max_allocation_size_mb=1000 ";
   return "ulimit -v 1000000; ";
 }
 

@@ -1438,9 +1438,10 @@ TEST(Cli, AStreamOnStandardInputIsReadOnlyWhileItCanBeAMeshWithinMaxMemory) {
             std::string::npos)
       << vertices.output;
   EXPECT_LT(records_written(dir / "dd.txt"), 32);
-  // A mesh within the limit is read whole, by pieces of any size.
+  // A mesh within the limit (the process and its 208 faces: about 8.6 MB) is read whole, by
+  // pieces of any size.
   write_mesh(dir / "in.ply", make_shape("box_with_hole").mesh);
-  ASSERT_EXIT_OK(run("segment - --max-memory 1M --clusters 7 --quiet",
+  ASSERT_EXIT_OK(run("segment - --max-memory 16M --clusters 7 --quiet",
                      "dd bs=1000 2>/dev/null < " + dir.q("in.ply")));
 }
 

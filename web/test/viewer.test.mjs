@@ -321,6 +321,11 @@ test('bad input: a clear error and exit status 1', () => {
     [['view', fandisk], /output/i],
     [['view', fandisk, '--skeleton-clusters', 'many', '-o', join(work, 'x.html')], /--clusters: 'many'/],
     [['view', fandisk, '--skeleton', '--band', '-1', '-o', join(work, 'x.html')], /--band/],
+    // --max-faces and --max-memory, as segment has them (tests/cli/batch_test.cpp, without viewer).
+    [['view', fandisk, '--max-faces', '12945', '-o', join(work, 'x.html')],
+      /the mesh has 12946 faces, more than --max-faces 12945/],
+    [['view', fandisk, '--max-memory', '16M', '-o', join(work, 'x.html')],
+      /the mesh has 12946 faces, which need about \d+ bytes, more than --max-memory 16777216/],
   ];
   for (const [args, message] of cases) {
     const run = spawnSync(cli, args, { encoding: 'utf8' });
