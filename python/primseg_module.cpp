@@ -258,13 +258,15 @@ HierarchyOptions hierarchy_options(const py::object& primitives, const std::stri
 // set, and the binding raises it once it holds the GIL again.
 struct PythonErrorPending {};
 
-// Builds the whole hierarchy without the GIL. About every percent of the merges it takes the GIL
-// to let Python handle signals and to call `progress` (None, or a callable taking the fraction
-// done): either can stop the build by raising.
-PyHierarchy segment_mesh(std::shared_ptr<const Mesh> mesh, const HierarchyOptions& options,
-                         const py::object& progress) {
-  // Made, and destroyed, while the GIL is held: it holds a reference to `progress`.
-  const std::function<void(double)> report = [progress](double fraction) {
+// The progress callback of a hierarchy built without the GIL: it takes the GIL (about every
+// percent of the merges) to let Python handle signals and to call `progress` (None, or a callable
+// taking the fraction done): either can stop the build by raising, through PythonErrorPending.
+// Made, and destroyed, while the GIL is held: it holds a reference to `progress`.
+std::function<void(double)> python_progress(const py::object& progress) {
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+    throw InvalidInputError("progress must be None or callable, not " +
+                            py::repr(progress).cast<std::string>());
+  return [progress](double fraction) {
     const py::gil_scoped_acquire acquire;
     if (PyErr_CheckSignals() != 0) throw PythonErrorPending{};
     if (progress.is_none()) return;
@@ -275,13 +277,27 @@ PyHierarchy segment_mesh(std::shared_ptr<const Mesh> mesh, const HierarchyOption
       throw PythonErrorPending{};
     }
   };
+}
+
+// Runs `work` without the GIL; a PythonErrorPending it throws (from python_progress) becomes the
+// pending Python exception, raised once the GIL is held again.
+template <class Work>
+auto without_gil(Work&& work) {
   try {
     const py::gil_scoped_release release;
-    HierarchyBuilder builder(std::move(mesh), options);
-    return {std::make_shared<const Hierarchy>(builder.finish(report))};
+    return work();
   } catch (const PythonErrorPending&) {
-    throw py::error_already_set();  // the GIL is held again here
+    throw py::error_already_set();
   }
+}
+
+PyHierarchy segment_mesh(std::shared_ptr<const Mesh> mesh, const HierarchyOptions& options,
+                         const py::object& progress) {
+  const std::function<void(double)> report = python_progress(progress);
+  return without_gil([&] {
+    HierarchyBuilder builder(std::move(mesh), options);
+    return PyHierarchy{std::make_shared<const Hierarchy>(builder.finish(report))};
+  });
 }
 
 // The CLI's default level (--tolerance 0.1%): as a fraction of the bounding-box diagonal.
@@ -961,9 +977,6 @@ coordinates, index out of range, no faces) or bad options.)";
          const py::object& progress) {
         const HierarchyOptions options =
             hierarchy_options(primitives, weights, threads, exact_costs, eager);
-        if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
-          throw InvalidInputError("progress must be None or callable, not " +
-                                  py::repr(progress).cast<std::string>());
         return segment_mesh(mesh_argument("segment", first, faces), options, progress);
       },
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(),
@@ -1156,7 +1169,7 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
   // denoise, skeleton, distance.
 
   const char* denoise_doc =
-      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, primitives=None, weights=None, threads=0, return_rounds=False) -> numpy.ndarray
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, primitives=None, weights=None, threads=0, return_rounds=False, progress=None) -> numpy.ndarray
 denoise(V, F, *, ...) -> numpy.ndarray
 denoise(hierarchy, *, ...) -> numpy.ndarray
 
@@ -1180,7 +1193,9 @@ incident edge lengths); min_crease_angle: --min-crease-angle (degrees); relabel_
 relation_significance: --relation-significance (0: no parallel or coaxial relations); smoothing_steps:
 --smooth (Taubin steps on the copy that is segmented); bilateral: --bilateral (that copy
 smoothed by bilateral normal filtering instead, which keeps edges sharp); primitives (default plane, cylinder, sphere) and weights (default "area"): as in
-segment. The GIL is released while it works.
+segment. The GIL is released while it works; as in segment, Ctrl-C (KeyboardInterrupt) stops a
+round's hierarchy build, and progress, if given, is called during the builds with the fraction
+of all rounds done (0 to 1).
 Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)";
   m.def(
       "denoise",
@@ -1189,7 +1204,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
          int smoothing_steps, bool bilateral, bool stylize, double max_move,
          double min_crease_angle, int relabel_passes, double relation_significance,
          std::optional<double> noise_tolerance_factor, const py::object& primitives,
-         const py::object& weights, unsigned threads, bool return_rounds) -> py::object {
+         const py::object& weights, unsigned threads, bool return_rounds,
+         const py::object& progress) -> py::object {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
@@ -1225,25 +1241,30 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         const std::shared_ptr<const Mesh> mesh =
             given ? given->hierarchy->shared_mesh() : mesh_argument("denoise", first, faces);
         validate_level(level, mesh->face_count());
+        const std::function<void(double)> progress_of_all = python_progress(progress);
         std::vector<SnapReport> reports;
         std::vector<Vec3> positions;
-        {
-          py::gil_scoped_release release;
+        without_gil([&] {
           Denoiser denoiser(*mesh, options);
           // k="auto": denoising's own automatic level, as `primseg denoise --clusters auto`.
           const bool automatic = level.k && std::holds_alternative<std::string>(*level.k);
           for (int round = 0; round < iterations; ++round) {
             // As `primseg denoise`: each round segments the previous round's result.
+            const auto report_round = [&](double fraction) {
+              progress_of_all((round + fraction) / iterations);
+            };
             const std::shared_ptr<const Hierarchy> hierarchy =
-                round == 0 && given ? given->hierarchy
-                                    : std::make_shared<const Hierarchy>(build_hierarchy(
-                                          denoiser.segmented_mesh(), options.hierarchy));
+                round == 0 && given
+                    ? given->hierarchy
+                    : std::make_shared<const Hierarchy>(
+                          HierarchyBuilder(denoiser.segmented_mesh(), options.hierarchy)
+                              .finish(report_round));
             reports.push_back(denoiser.snap(
                 *hierarchy, automatic ? denoiser.automatic_level(*hierarchy).segmentation
                                       : cut_level(*hierarchy, level)));
           }
           positions = denoiser.mesh().positions;
-        }
+        });
         py::array V = positions_array(std::move(positions));
         if (!return_rounds) return V;
         py::list rounds;
@@ -1260,6 +1281,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       py::arg("relation_significance") = DenoiseOptions{}.relation_significance,
       py::arg("noise_tolerance_factor") = py::none(), py::arg("primitives") = py::none(),
       py::arg("weights") = py::none(), py::arg("threads") = 0u, py::arg("return_rounds") = false,
+      py::arg("progress") = py::none(),
       join_docs(
           {denoise_doc, cpp_doc("denoise.hpp", doc::denoise__file),
            cpp_doc("DenoiseOptions::max_move_edge_lengths",
@@ -1432,7 +1454,8 @@ repeated joint, or a zero axis.)",
       "skeleton",
       [](const py::object& first, const py::object& faces, ClusterCount k,
          std::optional<double> tolerance, std::optional<double> relative_tolerance,
-         const py::object& primitives, const py::object& weights, unsigned threads) {
+         const py::object& primitives, const py::object& weights, unsigned threads,
+         const py::object& progress) {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
@@ -1443,21 +1466,25 @@ repeated joint, or a zero axis.)",
         const std::shared_ptr<const Mesh> mesh =
             given ? given->hierarchy->shared_mesh() : mesh_argument("skeleton", first, faces);
         validate_level(level, mesh->face_count());
-        py::gil_scoped_release release;
-        const std::shared_ptr<const Hierarchy> hierarchy =
-            given ? given->hierarchy
-                  : std::make_shared<const Hierarchy>(build_hierarchy(mesh, options));
-        PySkeleton skeleton;
-        skeleton.mesh = mesh;
-        skeleton.skeleton = std::make_shared<const Skeleton>(
-            extract_skeleton(*hierarchy, cut_level(*hierarchy, level)));
-        return skeleton;
+        const std::function<void(double)> report = python_progress(progress);
+        return without_gil([&] {
+          const std::shared_ptr<const Hierarchy> hierarchy =
+              given ? given->hierarchy
+                    : std::make_shared<const Hierarchy>(
+                          HierarchyBuilder(mesh, options).finish(report));
+          PySkeleton skeleton;
+          skeleton.mesh = mesh;
+          skeleton.skeleton = std::make_shared<const Skeleton>(
+              extract_skeleton(*hierarchy, cut_level(*hierarchy, level)));
+          return skeleton;
+        });
       },
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(), py::arg("k") = py::none(),
       py::arg("tolerance") = py::none(), py::arg("relative_tolerance") = py::none(),
       py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
+      py::arg("progress") = py::none(),
       join_docs(
-          {R"(skeleton(mesh, *, k=None, tolerance=None, relative_tolerance=None, primitives=None, weights=None, threads=0) -> Skeleton
+          {R"(skeleton(mesh, *, k=None, tolerance=None, relative_tolerance=None, primitives=None, weights=None, threads=0, progress=None) -> Skeleton
 skeleton(V, F, *, ...) -> Skeleton
 skeleton(hierarchy, *, ...) -> Skeleton
 
@@ -1465,7 +1492,8 @@ skeleton(hierarchy, *, ...) -> Skeleton
 Mesh, arrays V and F, or a Hierarchy (its tree, not built again). Level: k (count or "auto"),
 tolerance or relative_tolerance as in Hierarchy.cut (the CLI asks for --clusters K|auto).
 primitives: cylinders only by default, as the CLI (and the paper) do; weights: "area" by
-default. The GIL is released while it works.)",
+default. The GIL is released while it works; Ctrl-C (KeyboardInterrupt) stops the hierarchy's
+build, and progress, if given, is called during it with the fraction done, as in segment.)",
            cpp_doc("skeleton.hpp", doc::skeleton__file)})
           .c_str());
 

@@ -195,7 +195,12 @@ def test_progress_reports_the_fraction_done_and_can_stop_the_build(fandisk_tree)
         primseg.segment(mesh, progress=3)
 
 
-def test_ctrl_c_stops_the_build(cgal_mesh):
+@pytest.mark.parametrize("build", [
+    lambda mesh, **kw: primseg.segment(mesh, **kw),
+    lambda mesh, **kw: primseg.skeleton(mesh, k=10, **kw),
+    lambda mesh, **kw: primseg.denoise(mesh, k=10, iterations=2, **kw)],
+    ids=["segment", "skeleton", "denoise"])
+def test_ctrl_c_stops_the_build(cgal_mesh, build):
     # SIGINT from another thread while the C++ loop runs without the GIL, as Ctrl-C in a terminal
     # or a notebook: Python's handler runs at the next percent of merges and its KeyboardInterrupt
     # stops the build there. Before, the build ran to its end and the interrupt came after it.
@@ -210,7 +215,7 @@ def test_ctrl_c_stops_the_build(cgal_mesh):
     killer = threading.Thread(target=interrupt_soon)
     killer.start()
     with pytest.raises(KeyboardInterrupt):
-        primseg.segment(mesh, threads=1, progress=fractions.append)
+        build(mesh, threads=1, progress=fractions.append)
     killer.join()
     assert 1 not in fractions, len(fractions)  # stopped before the end (maybe before any call)
 

@@ -106,6 +106,33 @@ def distance_to_capped_cylinder(V, radius, bottom, top):
     return np.minimum(tube, caps)
 
 
+def test_denoise_and_skeleton_report_progress(noisy_fandisk, man):
+    noisy_fandisk, man = primseg.read_mesh(noisy_fandisk), primseg.read_mesh(man)
+    # denoise: the fraction of all rounds, each round's build a half of it with two rounds.
+    fractions = []
+    V = primseg.denoise(noisy_fandisk, k=30, iterations=2, progress=fractions.append)
+    np.testing.assert_array_equal(V, primseg.denoise(noisy_fandisk, k=30, iterations=2))
+    assert fractions[0] == 0 and fractions[-1] == 1 and fractions == sorted(fractions)
+    assert 0.5 in fractions and any(0 < f < 0.5 for f in fractions) and any(f > 0.5 for f in fractions)
+
+    fractions = []
+    skeleton = primseg.skeleton(man, k=10, progress=fractions.append)
+    assert fractions[0] == 0 and fractions[-1] == 1 and fractions == sorted(fractions)
+    np.testing.assert_array_equal(skeleton.joint_positions, primseg.skeleton(man, k=10).joint_positions)
+
+    def stop(fraction):
+        if fraction > 0.2:
+            raise RuntimeError("stopped by the user")
+
+    for call in (lambda: primseg.denoise(noisy_fandisk, k=30, progress=stop),
+                 lambda: primseg.skeleton(man, k=10, progress=stop)):
+        with pytest.raises(RuntimeError, match="stopped by the user"):
+            call()
+    for call in (primseg.denoise, primseg.skeleton):
+        with pytest.raises(ValueError, match="progress must be None or callable, not 'x'"):
+            call(man, k=10, progress="x")
+
+
 def test_denoise_restores_a_noisy_cylinder_and_its_sharp_rims():
     center = np.array([1.0, -2.0, 0.5])
     V, F, _ = capped_cylinder(radius=2.0, height=5.0, around=64, rings=16, center=center)
