@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
 # Pathological but valid inputs, at growing scale: N triangles sharing one edge (a non-manifold
-# "book"), and a fan of N triangles around one vertex (a flat disc). Prints, per input, the
-# median over RUNS of wall-clock seconds and peak RSS of `primseg segment` (GNU time).
+# "book"), a fan of N triangles around one vertex (a flat disc), and one polygon of N vertices:
+# a wavy outline (7 lobes, a third of its vertices reflex) and a spiral strip (arms 0.2 apart,
+# laps 0.63 apart; its inner wall is reflex and a lap of the loop clips a few ears: the worst
+# case of ear clipping, fanned past its budget from about 100,000 vertices). Prints,
+# per input, the median over RUNS of wall-clock seconds and peak RSS of `primseg segment` (GNU
+# time); bytes per triangle.
 #
 #   bench/pathological.sh BUILD_DIR [N...]     (default N: 10000 100000 1000000; RUNS=3)
 set -euo pipefail
@@ -20,15 +24,26 @@ with open(path, "w") as out:
         out.write("OFF\n%d %d 0\n0 0 0\n0 0 1\n" % (n + 2, n))
         out.writelines("%.9f %.9f 0.5\n" % (math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n)) for i in range(n))
         out.writelines("3 0 1 %d\n" % (i + 2) for i in range(n))
+    elif kind in ("polygon", "spiral"):  # one face of n vertices
+        if kind == "polygon":
+            points = [((1 + 0.3 * math.sin(7 * a)) * math.cos(a), (1 + 0.3 * math.sin(7 * a)) * math.sin(a))
+                      for a in (2 * math.pi * i / n for i in range(n))]
+        else:
+            arm = [0.05 * i for i in range(n // 2)]
+            points = [((1.2 + 0.1 * a) * math.cos(a), (1.2 + 0.1 * a) * math.sin(a)) for a in arm]
+            points += [((1 + 0.1 * a) * math.cos(a), (1 + 0.1 * a) * math.sin(a)) for a in reversed(arm)]
+        out.write("OFF\n%d 1 0\n" % len(points))
+        out.writelines("%.12g %.12g 0\n" % p for p in points)
+        out.write("%d %s\n" % (len(points), " ".join(map(str, range(len(points))))))
     else:  # fan: centre 0, rim 1..n, closed
         out.write("OFF\n%d %d 0\n0 0 0\n" % (n + 1, n))
         out.writelines("%.9f %.9f 0\n" % (math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n)) for i in range(n))
         out.writelines("3 0 %d %d\n" % (i + 1, (i + 1) % n + 1) for i in range(n))
 PY
 }
-printf "%-6s %9s %10s %12s %14s\n" input faces seconds peak_rss_MB bytes_per_face
+printf "%-7s %9s %10s %12s %14s\n" input n seconds peak_rss_MB bytes_per_tri
 for n in ${sizes[@]}; do
-  for kind in book fan; do
+  for kind in book fan polygon spiral; do
     file=$work/$kind-$n.off
     generate "$kind" "$n" "$file"
     samples=()
@@ -38,6 +53,6 @@ for n in ${sizes[@]}; do
     done
     median=$(printf "%s\n" "${samples[@]}" | sort -n | sed -n "$(((runs + 1) / 2))p")
     read -r seconds rss_kb <<<"$median"
-    printf "%-6s %9d %10s %12d %14d\n" "$kind" "$n" "$seconds" $((rss_kb / 1024)) $((rss_kb * 1024 / n))
+    printf "%-7s %9d %10s %12d %14d\n" "$kind" "$n" "$seconds" $((rss_kb / 1024)) $((rss_kb * 1024 / n))
   done
 done

@@ -49,6 +49,13 @@ Vec3 newell_normal(std::span<const std::uint32_t> loop, const std::vector<Vec3>&
 
 /// Triangulates polygons by ear clipping; owns scratch buffers so that a mesh of many polygons
 /// triggers no per-polygon allocation.
+///
+/// An ear is blocked by a reflex vertex inside it. Scanning the whole loop for one made large
+/// polygons quadratic (a wavy outline of 100,000 vertices took 11 s, and a spiral strip of
+/// 20,000 ran out of budget after 13 s and was fanned into overlapping triangles). The reflex
+/// vertices of a large polygon are filed in a uniform grid over its projection, about one vertex
+/// per cell, and an ear looks only in the cells its triangle covers. The test, and so the
+/// triangulation, is the same either way (bench/pathological.sh times both shapes).
 class EarClipper {
  public:
   /// Appends loop.size() - 2 triangles of `loop` to `triangles`, oriented like the loop.
@@ -67,6 +74,7 @@ class EarClipper {
         std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
     if (length > 0.0 && std::isfinite(length)) {
       project(normal, length, loop, positions);
+      build_grid();
       clip_ears(n, triangles);
     } else {
       // Zero-area polygon: no plane to clip in, and every split is as good as another.
@@ -102,42 +110,169 @@ class EarClipper {
     }
   }
 
+  // Below this many vertices the scan of the loop costs less than filing them.
+  static constexpr std::size_t kGridMinVertices = 64;
+
+  void build_grid() {
+    const std::size_t n = projected_.size();
+    grid_columns_ = 0;
+    if (n < kGridMinVertices) return;
+    Point2 low = projected_[0], high = low;
+    for (const Point2& p : projected_) {
+      low = {std::min(low.x, p.x), std::min(low.y, p.y)};
+      high = {std::max(high.x, p.x), std::max(high.y, p.y)};
+    }
+    const double width = high.x - low.x, height = high.y - low.y;
+    if (!(width > 0.0 && height > 0.0 && std::isfinite(width) && std::isfinite(height))) return;
+    // About one vertex per cell, the cells as square as the box allows.
+    const double columns =
+        std::clamp(std::round(std::sqrt(double(n) * width / height)), 1.0, double(n));
+    grid_columns_ = static_cast<std::size_t>(columns);
+    grid_rows_ = std::max<std::size_t>(1, n / grid_columns_);
+    grid_low_ = low;
+    grid_scale_ = {double(grid_columns_) / width, double(grid_rows_) / height};
+    // Room in each cell for every vertex that falls in it; the reflex ones are filed as they
+    // become reflex (update_reflex), and taken out when they stop being (or are clipped).
+    cell_start_.assign(grid_columns_ * grid_rows_ + 1, 0);
+    for (const Point2& p : projected_) ++cell_start_[cell(p) + 1];
+    for (std::size_t c = 0; c + 1 < cell_start_.size(); ++c) cell_start_[c + 1] += cell_start_[c];
+    cell_vertices_.resize(n);
+    cell_size_.assign(grid_columns_ * grid_rows_, 0);
+    slot_.resize(n);
+  }
+
+  void file_in_grid(std::uint32_t j) {
+    const std::size_t c = cell(projected_[j]);
+    slot_[j] = cell_start_[c] + cell_size_[c]++;
+    cell_vertices_[slot_[j]] = j;
+  }
+  void take_out_of_grid(std::uint32_t j) {
+    const std::size_t c = cell(projected_[j]);
+    const std::size_t last = cell_start_[c] + --cell_size_[c];
+    cell_vertices_[slot_[j]] = cell_vertices_[last];
+    slot_[cell_vertices_[last]] = slot_[j];
+  }
+
+  // The column or row of a coordinate, clamped to the grid (a monotone map, so that every point
+  // of a box is filed in a cell between those of the box's corners).
+  static std::size_t grid_index(double coordinate, double low, double scale, std::size_t count) {
+    const double index = (coordinate - low) * scale;
+    if (!(index > 0.0)) return 0;
+    return index >= double(count - 1) ? count - 1 : static_cast<std::size_t>(index);
+  }
+  std::size_t column(double x) const {
+    return grid_index(x, grid_low_.x, grid_scale_.x, grid_columns_);
+  }
+  std::size_t row(double y) const { return grid_index(y, grid_low_.y, grid_scale_.y, grid_rows_); }
+  std::size_t cell(const Point2& p) const { return row(p.y) * grid_columns_ + column(p.x); }
+
+  // Boxes of more cells than this are walked over the triangle's own columns, row by row.
+  static constexpr std::size_t kSpanMinCells = 16;
+
+  // The smallest and largest x of triangle (a, b, c) between heights y0 < y1: its corners in the
+  // band and where its edges cross the band's sides. Empty (low > high) if it misses the band.
+  static std::pair<double, double> triangle_span(const Point2& a, const Point2& b, const Point2& c,
+                                                 double y0, double y1) {
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    const auto take = [&](double x) {
+      low = std::min(low, x);
+      high = std::max(high, x);
+    };
+    for (const Point2* corner : {&a, &b, &c})
+      if (corner->y >= y0 && corner->y <= y1) take(corner->x);
+    for (const auto& [p, q] : {std::pair{&a, &b}, std::pair{&b, &c}, std::pair{&c, &a}})
+      for (const double y : {y0, y1})
+        if ((p->y < y) != (q->y < y)) take(p->x + (y - p->y) * (q->x - p->x) / (q->y - p->y));
+    return {low, high};
+  }
+
+  // Whether reflex vertex j, other than the ear's corners and their copies, blocks ear (a, i, c).
+  bool blocks(std::uint32_t j, std::uint32_t i, const Point2& a, const Point2& b,
+              const Point2& c) const {
+    if (!reflex_[j] || j == i || j == previous_[i] || j == next_[i]) return false;
+    const Point2& p = projected_[j];
+    // Copies of a corner (e.g. a bridge to a hole) do not block the ear.
+    if (same_point(p, a) || same_point(p, b) || same_point(p, c)) return false;
+    return inside_or_on_triangle(p, a, b, c);
+  }
+
   double turn(std::uint32_t i) const {
     return cross(projected_[previous_[i]], projected_[i], projected_[next_[i]]);
   }
 
   // Only reflex (or flat) vertices can lie in an ear, so convex stretches cost nothing to check.
   bool is_ear(std::uint32_t i, bool allow_flat, std::size_t remaining) {
+    ++work_;  // The walk itself: a spiral's is quadratic, its ears clipped a few per lap.
     const double t = turn(i);
     if (allow_flat ? t < 0.0 : t <= 0.0) return false;
     if (reflex_count_ == 0) return true;
     const Point2& a = projected_[previous_[i]];
     const Point2& b = projected_[i];
     const Point2& c = projected_[next_[i]];
-    work_ += remaining;
-    for (std::uint32_t j = next_[next_[i]]; j != previous_[i]; j = next_[j]) {
-      if (!reflex_[j]) continue;
-      const Point2& p = projected_[j];
-      // Copies of a corner (e.g. a bridge to a hole) do not block the ear.
-      if (same_point(p, a) || same_point(p, b) || same_point(p, c)) continue;
-      if (inside_or_on_triangle(p, a, b, c)) return false;
+    if (grid_columns_ > 0) {
+      const std::size_t first_column = column(std::min({a.x, b.x, c.x}));
+      const std::size_t last_column = column(std::max({a.x, b.x, c.x}));
+      const std::size_t first_row = row(std::min({a.y, b.y, c.y}));
+      const std::size_t last_row = row(std::max({a.y, b.y, c.y}));
+      const std::size_t rows = last_row - first_row + 1;
+      const std::size_t cells = (last_column - first_column + 1) * rows;
+      // A large box (the fan a convex stretch of the outline grows into is a long sliver) is
+      // walked row by row over the triangle's own columns. Once few vertices are left, the loop
+      // is the shorter walk.
+      const bool by_span = cells > kSpanMinCells;
+      if (2 * (by_span ? 3 * rows : cells) < remaining) {
+        for (std::size_t r = first_row; r <= last_row; ++r) {
+          std::size_t from = first_column, to = last_column;
+          if (by_span) {
+            // The triangle's part in the row's band widened by a row on each side, and its
+            // columns by one, so that round-off never leaves a point of the triangle out.
+            const auto [low_x, high_x] =
+                triangle_span(a, b, c, grid_low_.y + (double(r) - 1.0) / grid_scale_.y,
+                              grid_low_.y + (double(r) + 2.0) / grid_scale_.y);
+            if (low_x <= high_x) {
+              const std::size_t low_column = column(low_x);
+              from = std::max(first_column, low_column > 0 ? low_column - 1 : 0);
+              to = std::min(last_column, column(high_x) + 1);
+            }
+          }
+          const std::size_t row_start = r * grid_columns_;
+          work_ += (by_span ? 4 : 0) + 1 + to - from;
+          for (std::size_t cell = row_start + from; cell <= row_start + to; ++cell)
+            for (std::size_t k = cell_start_[cell]; k < cell_start_[cell] + cell_size_[cell]; ++k) {
+              ++work_;
+              if (blocks(cell_vertices_[k], i, a, b, c)) return false;
+            }
+        }
+        return true;
+      }
     }
+    work_ += remaining;
+    for (std::uint32_t j = next_[next_[i]]; j != previous_[i]; j = next_[j])
+      if (blocks(j, i, a, b, c)) return false;
     return true;
   }
 
-  void update_reflex(std::uint32_t i) {
-    const bool reflex = turn(i) <= 0.0;
-    reflex_count_ += static_cast<std::size_t>(reflex) - static_cast<std::size_t>(reflex_[i]);
+  void set_reflex(std::uint32_t i, bool reflex) {
+    if (reflex == reflex_[i]) return;
     reflex_[i] = reflex;
+    if (reflex) {
+      ++reflex_count_;
+      if (grid_columns_ > 0) file_in_grid(i);
+    } else {
+      --reflex_count_;
+      if (grid_columns_ > 0) take_out_of_grid(i);
+    }
   }
+  void update_reflex(std::uint32_t i) { set_reflex(i, turn(i) <= 0.0); }
 
   void clip_ears(std::size_t n, std::vector<Triangle>& triangles) {
     reflex_.assign(n, false);
     reflex_count_ = 0;
     for (std::uint32_t i = 0; i < n; ++i) update_reflex(i);
-    // The budget bounds pathological polygons (thousands of reflex vertices), which then get
-    // the fan fallback for what is left of them.
-    const std::size_t bounded_n = std::min<std::size_t>(n, std::size_t{1} << 24);
+    // The budget bounds pathological polygons (a spiral strip of 100,000 vertices clips a few
+    // ears per lap of the loop), which then get the fan fallback for what is left of them: at
+    // most 2^32 steps and vertex tests, about 25 s.
+    const std::size_t bounded_n = std::min<std::size_t>(n, std::size_t{1} << 14);
     const std::size_t budget =
         std::max<std::size_t>(std::size_t{1} << 22, 16 * bounded_n * bounded_n);
     work_ = 0;
@@ -160,8 +295,7 @@ class EarClipper {
       triangles.push_back({corners_[before], corners_[i], corners_[after]});
       next_[before] = after;
       previous_[after] = before;
-      if (reflex_[i]) --reflex_count_;
-      reflex_[i] = false;
+      set_reflex(i, false);
       --remaining;
       update_reflex(before);
       update_reflex(after);
@@ -188,6 +322,16 @@ class EarClipper {
   std::vector<bool> reflex_;  // Turn <= 0: blocks ears it lies in.
   std::size_t reflex_count_ = 0;
   std::size_t work_ = 0;
+  // The grid: cell (row, column) holds cell_vertices_[cell_start_[c] .. cell_start_[c + 1]),
+  // c = row * grid_columns_ + column. No grid when grid_columns_ is 0.
+  std::size_t grid_columns_ = 0;
+  std::size_t grid_rows_ = 0;
+  Point2 grid_low_{0.0, 0.0};
+  Point2 grid_scale_{0.0, 0.0};
+  std::vector<std::size_t> cell_start_;
+  std::vector<std::uint32_t> cell_size_;      // reflex vertices filed in each cell
+  std::vector<std::uint32_t> cell_vertices_;  // filed vertices, each cell's from its start
+  std::vector<std::size_t> slot_;             // where a filed vertex is in cell_vertices_
 };
 
 [[noreturn]] void invalid(const std::string& message) {

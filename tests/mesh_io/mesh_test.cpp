@@ -141,6 +141,80 @@ TEST(MeshFromPolygons, LargeStarPolygonIsTiledQuickly) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
 }
 
+double shoelace_area(const std::vector<Vec3>& loop) {
+  double area = 0.0;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const Vec3& a = loop[i];
+    const Vec3& b = loop[(i + 1) % loop.size()];
+    area += (a[0] * b[1] - a[1] * b[0]) / 2;
+  }
+  return area;
+}
+
+/// For polygons too large for expect_tiles_polygon's inside test: loop.size() - 2 triangles, all
+/// facing +z, that add up to the polygon's area. Overlapping triangles (a fan of what is left of
+/// a polygon) face both ways.
+void expect_covers_polygon(const std::vector<Vec3>& loop) {
+  const auto n = static_cast<std::uint32_t>(loop.size());
+  std::vector<std::uint32_t> vertices(n);
+  for (std::uint32_t i = 0; i < n; ++i) vertices[i] = i;
+  const Mesh mesh = Mesh::from_polygons(loop, {0, n}, vertices);
+  ASSERT_EQ(mesh.triangle_count(), n - 2);
+  double area = 0.0;
+  std::size_t reversed = 0;
+  for (const Triangle& t : mesh.triangles) {
+    const double z = triangle_normal(mesh, t)[2];
+    reversed += z <= 0.0;
+    area += z;
+  }
+  EXPECT_EQ(reversed, 0u);
+  EXPECT_NEAR(area, shoelace_area(loop), 1e-11 * std::abs(shoelace_area(loop)));
+}
+
+TEST(MeshFromPolygons, SpiralStripIsTiled) {
+  // A strip 0.2 wide between two arms of a spiral whose laps are 0.63 apart, 20,000 vertices,
+  // counter-clockwise. The ears along the outer wall grow into fans that the next lap blocks, and
+  // the inner wall is reflex, so each lap of the loop clips a few ears: scanning the loop for
+  // every ear ran out of budget after 13 s and fanned the rest into overlapping triangles.
+  std::vector<Vec3> loop;
+  const int per_arm = 10000;
+  for (int i = 0; i < per_arm; ++i) {  // out along the outer arm, back along the inner one
+    const double angle = 0.05 * i, radius = 1.2 + 0.1 * angle;
+    loop.push_back({radius * std::cos(angle), radius * std::sin(angle), 0.0});
+  }
+  for (int i = per_arm; i-- > 0;) {
+    const double angle = 0.05 * i, radius = 1.0 + 0.1 * angle;
+    loop.push_back({radius * std::cos(angle), radius * std::sin(angle), 0.0});
+  }
+  expect_covers_polygon(loop);
+}
+
+TEST(MeshFromPolygons, LargePolygonWithAHoleThroughABridgeIsTiled) {
+  // A disc of 300 vertices with a hole of 200, joined by a bridge whose two ends appear twice:
+  // the grid of reflex vertices holds copies of one point, which must not block each other's ears.
+  std::vector<Vec3> loop;
+  for (int i = 0; i <= 300; ++i) {
+    const double angle = 2 * std::numbers::pi * i / 300;
+    loop.push_back({2 * std::cos(angle), 2 * std::sin(angle), 0.0});
+  }
+  for (int i = 0; i <= 200; ++i) {  // clockwise
+    const double angle = -2 * std::numbers::pi * i / 200;
+    loop.push_back({1 + 0.5 * std::cos(angle), 0.5 * std::sin(angle), 0.0});
+  }
+  expect_tiles_polygon(loop, shoelace_area(loop));
+}
+
+TEST(MeshFromPolygons, LargeWavyOutlineIsTiled) {
+  // 60,000 vertices on seven lobes, a third of them reflex.
+  const int n = 60000;
+  std::vector<Vec3> loop;
+  for (int i = 0; i < n; ++i) {
+    const double angle = 2 * std::numbers::pi * i / n, radius = 1 + 0.3 * std::sin(7 * angle);
+    loop.push_back({radius * std::cos(angle), radius * std::sin(angle), 0.0});
+  }
+  expect_covers_polygon(loop);
+}
+
 TEST(MeshFromPolygons, TiltedConcavePolygonKeepsItsOrientation) {
   // The L hexagon rotated out of the xy plane, listed clockwise as seen from +n.
   const double c = std::cos(0.7), s = std::sin(0.7);
