@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string>
 
+#include "outputs.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg::cli {
@@ -53,21 +54,23 @@ void add_limit_options(CLI::App& command, ResourceLimits& limits, std::uint64_t 
 
 void check_mesh_limits(std::initializer_list<const Mesh*> meshes, std::uint64_t file_bytes,
                        const ResourceLimits& limits) {
-  std::uint64_t faces = 0;
+  std::uint64_t faces = 0, triangles = 0;
   for (const Mesh* mesh : meshes) {
     if (limits.max_faces && mesh->face_count() > *limits.max_faces)
-      throw InvalidInputError("the mesh has " + std::to_string(mesh->face_count()) +
-                              " faces, more than --max-faces " + std::to_string(*limits.max_faces));
+      throw InvalidInputError("the mesh has " + count_of(mesh->face_count(), "face") +
+                              ", more than --max-faces " + std::to_string(*limits.max_faces));
     faces += mesh->face_count();
+    triangles += mesh->triangle_count();
   }
+  // Per triangle: a polygon of n vertices is one face, but n - 2 triangles to store and read.
   const std::uint64_t estimate =
-      kProcessBytes + limits.fixed_bytes + file_bytes + limits.bytes_per_face * faces;
+      kProcessBytes + limits.fixed_bytes + file_bytes + limits.bytes_per_face * triangles;
   if (limits.max_memory && estimate > *limits.max_memory)
-    throw InvalidInputError((meshes.size() == 1 ? "the mesh has " : "the meshes have ") +
-                            std::to_string(faces) + " faces" +
-                            (meshes.size() == 1 ? "" : " in all") + ", which need about " +
-                            std::to_string(estimate) + " bytes, more than --max-memory " +
-                            std::to_string(*limits.max_memory));
+    throw InvalidInputError(
+        (meshes.size() == 1 ? "the mesh has " : "the meshes have ") + count_of(faces, "face") +
+        (triangles > faces ? " (" + count_of(triangles, "triangle") + ")" : "") +
+        (meshes.size() == 1 ? "" : " in all") + ", which need about " + std::to_string(estimate) +
+        " bytes, more than --max-memory " + std::to_string(*limits.max_memory));
 }
 
 }  // namespace primseg::cli

@@ -13,8 +13,9 @@
 namespace primseg::cli {
 
 // The peak memory --max-memory's estimate uses: kProcessBytes + the input files' bytes + the
-// command's bytes per input face, with a margin over the peak RSS measured on fandisk, bunny00 and
-// bunny00 midpoint-subdivided to 302k and 1.2M faces (figures below: whole process, per face).
+// command's bytes per input triangle (face, on the triangle meshes measured), with a margin over
+// the peak RSS measured on fandisk, bunny00 and bunny00 midpoint-subdivided to 302k and 1.2M faces
+// (figures below: whole process, per face).
 
 /// The process before any input: 5 to 6 MB.
 inline constexpr std::uint64_t kProcessBytes = 8ull << 20;
@@ -39,7 +40,7 @@ struct ResourceLimits {
   std::optional<std::uint32_t> max_faces;  ///< refuse meshes with more input faces
   std::optional<std::uint64_t>
       max_memory;  ///< bytes; refuse inputs whose estimated peak exceeds it
-  std::uint64_t bytes_per_face = kHierarchyBytesPerFace;  ///< the command's peak per face
+  std::uint64_t bytes_per_face = kHierarchyBytesPerFace;  ///< the command's peak per triangle
   std::uint64_t fixed_bytes = 0;  ///< buffers whatever the mesh: kPictureBytes for a --png
 };
 
@@ -48,8 +49,8 @@ struct ResourceLimits {
 void add_limit_options(CLI::App& command, ResourceLimits& limits, std::uint64_t bytes_per_face);
 
 /// Throws InvalidInputError if a mesh exceeds --max-faces, or if the estimated peak of the run
-/// (kProcessBytes + the input files' bytes + bytes_per_face per face of all the meshes, and
-/// fixed_bytes) exceeds --max-memory.
+/// (kProcessBytes + the input files' bytes + bytes_per_face per triangle of all the meshes, and
+/// fixed_bytes) exceeds --max-memory. Per triangle: a face of n corners is n - 2 triangles.
 void check_mesh_limits(std::initializer_list<const Mesh*> meshes, std::uint64_t file_bytes,
                        const ResourceLimits& limits);
 inline void check_mesh_limits(const Mesh& mesh, std::uint64_t file_bytes,

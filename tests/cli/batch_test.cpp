@@ -10,10 +10,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
 #include <sstream>
 #include <string>
@@ -385,6 +387,30 @@ TEST(Limits, EveryCommandThatReadsAMeshHasThemAndItsEstimateBoundsItsPeak) {
       EXPECT_LE(peak, estimate) << name << ": the estimate is no bound of the peak";
     }
   }
+  fs::remove_all(dir);
+}
+
+TEST(Limits, ThePeakEstimateCountsTheTrianglesOfPolygons) {
+  // One face of 10,000 corners: 9,998 triangles to store, read and fit, 1 KB each in the estimate.
+  const fs::path dir = testing::temp_directory("limits-polygon");
+  std::ofstream off(dir / "disc.off");
+  off << "OFF\n10000 1 0\n";
+  for (int i = 0; i < 10000; ++i)
+    off << std::cos(i * 2 * std::numbers::pi / 10000) << ' '
+        << std::sin(i * 2 * std::numbers::pi / 10000) << " 0\n";
+  off << 10000;
+  for (int i = 0; i < 10000; ++i) off << ' ' << i;
+  off << '\n';
+  off.close();
+  const std::uint64_t estimate = (8u << 20) + fs::file_size(dir / "disc.off") + 1024 * 9998;
+  const std::string base = "segment '" + (dir / "disc.off").string() + "' -q --max-memory ";
+  std::string output;
+  EXPECT_EQ(primseg(base + std::to_string(estimate - 1) + " 2>&1", &output), 1);
+  EXPECT_NE(output.find("the mesh has 1 face (9998 triangles), which need about " +
+                        std::to_string(estimate) + " bytes"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(primseg(base + std::to_string(estimate)), 0);
   fs::remove_all(dir);
 }
 
