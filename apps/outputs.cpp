@@ -4,8 +4,10 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "../src/file_io.hpp"
 #include "primseg/auto_level.hpp"
@@ -82,6 +84,42 @@ nlohmann::json primitive_params(const Primitive& primitive) {
   return params;
 }
 
+std::string dump_document(const nlohmann::json& document, std::span<const StreamedArray> arrays) {
+  // File names need not be UTF-8: replace what JSON cannot hold rather than fail.
+  const auto dump = [](const nlohmann::json& json) {
+    return json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+  };
+  const std::string head = dump(document) + "\n";
+  // Each array's place in the head, where the document prints it empty at the top level.
+  std::vector<std::pair<std::size_t, const StreamedArray*>> places;
+  for (const StreamedArray& array : arrays) {
+    if (array.size == 0) continue;
+    const std::size_t at = head.find("\n  \"" + std::string(array.name) + "\": []");
+    if (at == std::string::npos)
+      throw std::logic_error("dump_document: no empty top-level array " + std::string(array.name));
+    places.emplace_back(at, &array);
+  }
+  std::sort(places.begin(), places.end());
+  std::string text;
+  std::size_t copied = 0;
+  for (const auto& [at, array] : places) {
+    const std::string opening = "\n  \"" + std::string(array->name) + "\": [";
+    text.append(head, copied, at - copied).append(opening);
+    // Each element as the whole document would print it, two levels in.
+    for (std::size_t i = 0; i < array->size; ++i) {
+      text += i == 0 ? "\n    " : ",\n    ";
+      for (const char c : dump(array->element(i))) {
+        text += c;
+        if (c == '\n') text += "    ";
+      }
+    }
+    text += "\n  ]";
+    copied = at + opening.size() + 1;  // past the empty array's "]"
+  }
+  text.append(head, copied);
+  return text;
+}
+
 void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
                          const std::vector<ClusterReport>& reports, const OutputFiles& files,
                          const nlohmann::json& summary) {
@@ -95,20 +133,22 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     write_text_output(*files.labels, text);
   }
   if (files.json) {
+    // A level of a cluster per face (a triangle soup at --clusters auto) held about 1.6 KB per
+    // cluster as a document, 0.4 KB as text.
     nlohmann::json json = summary;
-    nlohmann::json clusters = nlohmann::json::array();
-    for (const ClusterReport& r : reports)
-      clusters.push_back({{"id", r.id},
-                          {"type", std::string(to_string(r.primitive.type))},
-                          {"faces", r.face_count},
-                          {"area", r.area},
-                          {"rms", r.rms},
-                          {"max", r.max},
-                          {"params", primitive_params(r.primitive)}});
-    json["clusters"] = std::move(clusters);
-    // File names need not be UTF-8: replace what JSON cannot hold rather than fail.
-    write_text_output(*files.json,
-                      json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+    json["clusters"] = nlohmann::json::array();
+    const StreamedArray clusters{"clusters", reports.size(), [&reports](std::size_t i) {
+                                   const ClusterReport& r = reports[i];
+                                   return nlohmann::json{
+                                       {"id", r.id},
+                                       {"type", std::string(to_string(r.primitive.type))},
+                                       {"faces", r.face_count},
+                                       {"area", r.area},
+                                       {"rms", r.rms},
+                                       {"max", r.max},
+                                       {"params", primitive_params(r.primitive)}};
+                                 }};
+    write_text_output(*files.json, dump_document(json, {&clusters, 1}));
   }
   if (files.colored) {
     const std::filesystem::path path(*files.colored);

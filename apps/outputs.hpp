@@ -2,8 +2,10 @@
 // The per-level outputs shared by `segment` and `cut`: labels, JSON, coloured mesh, summary.
 
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -40,6 +42,18 @@ bool writes_to_standard_output(const OutputFiles& files);
 /// Writes `text` to the file `path` atomically, or to standard output when `path` is "-".
 /// Throws IoError.
 void write_text_output(const std::string& path, std::string_view text);
+
+/// A member of a JSON document that is a large array: dump_document prints its elements, made
+/// one at a time, instead of holding them all as a document (about 4 times their text).
+struct StreamedArray {
+  std::string_view name;                               ///< a top-level member of the document
+  std::size_t size = 0;                                ///< elements
+  std::function<nlohmann::json(std::size_t)> element;  ///< element i
+};
+
+/// `document` as document.dump(2) prints it (invalid UTF-8 replaced), and a newline, with each of
+/// `arrays`, an empty array in `document`, holding its elements.
+std::string dump_document(const nlohmann::json& document, std::span<const StreamedArray> arrays);
 
 /// A point or direction as the JSON array [x, y, z].
 nlohmann::json vec3_json(const Vec3& v);

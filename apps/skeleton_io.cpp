@@ -53,29 +53,35 @@ const json& member(const json& object, const char* key, const std::string& where
 
 }  // namespace
 
-json skeleton_to_json(const Skeleton& skeleton) {
-  json joints = json::array();
-  for (const Joint& j : skeleton.joints)
-    joints.push_back({{"id", j.id},
-                      {"position", vec3_json(j.position)},
-                      {"kind", std::string(to_string(j.kind))},
-                      {"visible", j.visible},
-                      {"bones", j.bones}});
-  json bones = json::array();
-  for (const Bone& b : skeleton.bones)
-    bones.push_back({{"id", b.id},
-                     {"cluster", b.cluster},
-                     {"joints", b.joints},
-                     {"visible", b.visible},
-                     {"axis", vec3_json(b.axis)},
-                     {"point", vec3_json(b.point)},
-                     {"radius", b.radius},
-                     {"area", b.area}});
-  return {{"cluster_count", skeleton.cluster_count()},
-          {"root_bone", skeleton.root_bone()},
-          {"joints", std::move(joints)},
-          {"bones", std::move(bones)},
-          {"face_labels", skeleton.face_labels}};
+std::string skeleton_file_text(const Skeleton& skeleton, json summary) {
+  summary["cluster_count"] = skeleton.cluster_count();
+  summary["root_bone"] = skeleton.root_bone();
+  summary["face_labels"] = skeleton.face_labels;
+  summary["joints"] = json::array();
+  summary["bones"] = json::array();
+  // A bone per cluster: a level of many (a triangle soup's) held about 4 KB per bone as a
+  // document.
+  const StreamedArray arrays[] = {{"joints", skeleton.joints.size(),
+                                   [&skeleton](std::size_t i) {
+                                     const Joint& j = skeleton.joints[i];
+                                     return json{{"id", j.id},
+                                                 {"position", vec3_json(j.position)},
+                                                 {"kind", std::string(to_string(j.kind))},
+                                                 {"visible", j.visible},
+                                                 {"bones", j.bones}};
+                                   }},
+                                  {"bones", skeleton.bones.size(), [&skeleton](std::size_t i) {
+                                     const Bone& b = skeleton.bones[i];
+                                     return json{{"id", b.id},
+                                                 {"cluster", b.cluster},
+                                                 {"joints", b.joints},
+                                                 {"visible", b.visible},
+                                                 {"axis", vec3_json(b.axis)},
+                                                 {"point", vec3_json(b.point)},
+                                                 {"radius", b.radius},
+                                                 {"area", b.area}};
+                                   }}};
+  return dump_document(summary, arrays);
 }
 
 Skeleton read_skeleton_file(const std::string& path) {

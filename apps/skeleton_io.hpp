@@ -15,10 +15,11 @@
 
 namespace primseg::cli {
 
-/// {"joints": [{"id", "position", "kind", "visible", "bones"}], "bones": [{"id", "cluster",
-/// "joints", "visible", "axis", "point", "radius", "area"}], "cluster_count", "root_bone",
-/// "face_labels"}, input units. The caller adds "mesh" and the rest of its summary.
-nlohmann::json skeleton_to_json(const Skeleton& skeleton);
+/// The skeleton file: `summary` (the caller's "mesh", "timing"...) with {"joints": [{"id",
+/// "position", "kind", "visible", "bones"}], "bones": [{"id", "cluster", "joints", "visible",
+/// "axis", "point", "radius", "area"}], "cluster_count", "root_bone", "face_labels"}, input
+/// units, as JSON text.
+std::string skeleton_file_text(const Skeleton& skeleton, nlohmann::json summary);
 
 /// Reads a skeleton file. Throws ParseError naming the file and what is wrong.
 Skeleton read_skeleton_file(const std::string& path);
