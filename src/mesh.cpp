@@ -165,6 +165,18 @@ class EarClipper {
   }
   std::size_t row(double y) const { return grid_index(y, grid_low_.y, grid_scale_.y, grid_rows_); }
   std::size_t cell(const Point2& p) const { return row(p.y) * grid_columns_ + column(p.x); }
+  static std::size_t widened_down(std::size_t index) { return index > 0 ? index - 1 : 0; }
+
+  // Ears whose smallest angle has a sine below this (t / longest side squared bounds it) are
+  // tested along the loop.
+  static constexpr double kFlatEar = 1e-8;
+
+  static double longest_squared_side(const Point2& a, const Point2& b, const Point2& c) {
+    const auto squared = [](const Point2& p, const Point2& q) {
+      return (p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y);
+    };
+    return std::max({squared(a, b), squared(b, c), squared(c, a)});
+  }
 
   // Boxes of more cells than this are walked over the triangle's own columns, row by row.
   static constexpr std::size_t kSpanMinCells = 16;
@@ -209,11 +221,16 @@ class EarClipper {
     const Point2& a = projected_[previous_[i]];
     const Point2& b = projected_[i];
     const Point2& c = projected_[next_[i]];
-    if (grid_columns_ > 0) {
-      const std::size_t first_column = column(std::min({a.x, b.x, c.x}));
-      const std::size_t last_column = column(std::max({a.x, b.x, c.x}));
-      const std::size_t first_row = row(std::min({a.y, b.y, c.y}));
-      const std::size_t last_row = row(std::max({a.y, b.y, c.y}));
+    // The closed test holds the points of the triangle and, through round-off, points within
+    // about 1e-16 / sin(smallest angle) of its sides' lines. A cell around its box takes in
+    // those of a proper triangle; a flat or nearly flat one (allow_flat, collinear corners up to
+    // round-off) holds points all along its line, which only the loop has.
+    if (grid_columns_ > 0 && t > kFlatEar * longest_squared_side(a, b, c)) {
+      const std::size_t first_column = widened_down(column(std::min({a.x, b.x, c.x})));
+      const std::size_t last_column =
+          std::min(column(std::max({a.x, b.x, c.x})) + 1, grid_columns_ - 1);
+      const std::size_t first_row = widened_down(row(std::min({a.y, b.y, c.y})));
+      const std::size_t last_row = std::min(row(std::max({a.y, b.y, c.y})) + 1, grid_rows_ - 1);
       const std::size_t rows = last_row - first_row + 1;
       const std::size_t cells = (last_column - first_column + 1) * rows;
       // A large box (the fan a convex stretch of the outline grows into is a long sliver) is
@@ -230,8 +247,7 @@ class EarClipper {
                 triangle_span(a, b, c, grid_low_.y + (double(r) - 1.0) / grid_scale_.y,
                               grid_low_.y + (double(r) + 2.0) / grid_scale_.y);
             if (low_x <= high_x) {
-              const std::size_t low_column = column(low_x);
-              from = std::max(first_column, low_column > 0 ? low_column - 1 : 0);
+              from = std::max(first_column, widened_down(column(low_x)));
               to = std::min(last_column, column(high_x) + 1);
             }
           }
