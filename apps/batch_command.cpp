@@ -189,11 +189,8 @@ Result process(const Item& item, const BatchOptions& o, const HierarchyOptions& 
     }
   }
   try {
-    std::uint64_t file_bytes = 0;
-    auto mesh =
-        std::make_shared<const Mesh>(read_geometry(item.input, &file_bytes, o.limits.max_memory));
+    auto mesh = std::make_shared<const Mesh>(read_geometry_within(item.input, o.limits));
     result.faces = mesh->face_count();
-    check_mesh_limits(*mesh, file_bytes, o.limits);
     validate_level(o.level, mesh->face_count());
     detail::create_directories(base.parent_path());
     const Hierarchy hierarchy = build_hierarchy(mesh, options);

@@ -28,8 +28,8 @@ Command add_cut_command(CLI::App& app) {
             std::uint64_t file_bytes = 0;
             const Hierarchy hierarchy =
                 read_input_tree(o->tree_path, &file_bytes, o->limits.max_memory);
-            o->limits.fixed_bytes = o->level.files.png ? kPictureBytes : 0;
-            check_mesh_limits(hierarchy.mesh(), file_bytes, o->limits);
+            check_mesh_limits({&hierarchy.mesh()}, file_bytes, o->limits,
+                              o->level.files.png ? kPictureBytes : 0);
             validate_level(o->level.level, hierarchy.face_count());
             nlohmann::json summary;
             summary["mesh"] = mesh_summary(o->tree_path, hierarchy);

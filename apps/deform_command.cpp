@@ -46,10 +46,8 @@ Command add_deform_command(CLI::App& app) {
             if (!(std::isfinite(o->band) && o->band >= 0))
               throw InvalidInputError("--band: must be a finite number >= 0");
             mesh_format_from_path(o->output);  // an unknown extension fails before any work
-            std::uint64_t file_bytes = 0;
-            const Mesh mesh = read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory);
-            o->limits.fixed_bytes = o->picture.png ? kPictureBytes : 0;
-            check_mesh_limits(mesh, file_bytes, o->limits);
+            const Mesh mesh =
+                read_geometry_within(o->mesh_path, o->limits, o->picture.png ? kPictureBytes : 0);
             const Skeleton skeleton = read_skeleton_file(o->skeleton_path);
             const std::vector<JointRotation> pose = read_pose_file(o->pose_path);
             if (skeleton.face_labels.size() != mesh.face_count())

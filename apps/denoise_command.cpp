@@ -103,10 +103,8 @@ Command add_denoise_command(CLI::App& app) {
             validate_level_outputs(o->level);
             mesh_format_from_path(o->output_path);  // an unknown extension fails before any work
             const auto start = Clock::now();
-            std::uint64_t file_bytes = 0;
-            Mesh mesh = read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory);
-            o->limits.fixed_bytes = o->level.files.png ? kPictureBytes : 0;
-            check_mesh_limits(mesh, file_bytes, o->limits);
+            Mesh mesh = read_geometry_within(o->mesh_path, o->limits,
+                                             o->level.files.png ? kPictureBytes : 0);
             validate_level(o->level.level, mesh.face_count());
             Denoiser denoiser(std::move(mesh), options);
             const bool automatic =

@@ -28,7 +28,7 @@ Command add_info_command(CLI::App& app) {
   return {info, [o] {
             std::uint64_t file_bytes = 0;
             const Mesh mesh = read_input_mesh(o->path, &file_bytes, o->limits.max_memory);
-            check_mesh_limits(mesh, file_bytes, o->limits);
+            check_mesh_limits({&mesh}, file_bytes, o->limits);
             const MeshInfo i = describe_mesh(mesh);
             // Reported, not refused: info is where a user finds out why the others refuse.
             std::optional<std::string> out_of_range;

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string>
 
+#include "command.hpp"
 #include "outputs.hpp"
 #include "primseg/error.hpp"
 
@@ -53,7 +54,7 @@ void add_limit_options(CLI::App& command, ResourceLimits& limits, std::uint64_t 
 }
 
 void check_mesh_limits(std::initializer_list<const Mesh*> meshes, std::uint64_t file_bytes,
-                       const ResourceLimits& limits) {
+                       const ResourceLimits& limits, std::uint64_t fixed_bytes) {
   std::uint64_t faces = 0, triangles = 0;
   for (const Mesh* mesh : meshes) {
     if (limits.max_faces && mesh->face_count() > *limits.max_faces)
@@ -64,13 +65,21 @@ void check_mesh_limits(std::initializer_list<const Mesh*> meshes, std::uint64_t 
   }
   // Per triangle: a polygon of n vertices is one face, but n - 2 triangles to store and read.
   const std::uint64_t estimate =
-      kProcessBytes + limits.fixed_bytes + file_bytes + limits.bytes_per_face * triangles;
+      kProcessBytes + fixed_bytes + file_bytes + limits.bytes_per_face * triangles;
   if (limits.max_memory && estimate > *limits.max_memory)
     throw InvalidInputError(
         (meshes.size() == 1 ? "the mesh has " : "the meshes have ") + count_of(faces, "face") +
         (triangles > faces ? " (" + count_of(triangles, "triangle") + ")" : "") +
         (meshes.size() == 1 ? "" : " in all") + ", which need about " + std::to_string(estimate) +
         " bytes, more than --max-memory " + std::to_string(*limits.max_memory));
+}
+
+Mesh read_geometry_within(const std::filesystem::path& path, const ResourceLimits& limits,
+                          std::uint64_t fixed_bytes) {
+  std::uint64_t file_bytes = 0;
+  Mesh mesh = read_geometry(path, &file_bytes, limits.max_memory);
+  check_mesh_limits({&mesh}, file_bytes, limits, fixed_bytes);
+  return mesh;
 }
 
 }  // namespace primseg::cli

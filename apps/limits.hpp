@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <filesystem>
 #include <initializer_list>
 #include <optional>
 
@@ -41,7 +42,6 @@ struct ResourceLimits {
   std::optional<std::uint64_t>
       max_memory;  ///< bytes; refuse inputs whose estimated peak exceeds it
   std::uint64_t bytes_per_face = kHierarchyBytesPerFace;  ///< the command's peak per triangle
-  std::uint64_t fixed_bytes = 0;  ///< buffers whatever the mesh: kPictureBytes for a --png
 };
 
 /// Adds --max-faces and --max-memory (bytes, or with a K, M, G suffix: powers of 1024) to a
@@ -49,13 +49,14 @@ struct ResourceLimits {
 void add_limit_options(CLI::App& command, ResourceLimits& limits, std::uint64_t bytes_per_face);
 
 /// Throws InvalidInputError if a mesh exceeds --max-faces, or if the estimated peak of the run
-/// (kProcessBytes + the input files' bytes + bytes_per_face per triangle of all the meshes, and
-/// fixed_bytes) exceeds --max-memory. Per triangle: a face of n corners is n - 2 triangles.
+/// (kProcessBytes + the input files' bytes + bytes_per_face per triangle of all the meshes +
+/// `fixed_bytes`, buffers whatever the mesh: kPictureBytes for a --png) exceeds --max-memory.
+/// Per triangle: a face of n corners is n - 2 triangles.
 void check_mesh_limits(std::initializer_list<const Mesh*> meshes, std::uint64_t file_bytes,
-                       const ResourceLimits& limits);
-inline void check_mesh_limits(const Mesh& mesh, std::uint64_t file_bytes,
-                              const ResourceLimits& limits) {
-  check_mesh_limits({&mesh}, file_bytes, limits);
-}
+                       const ResourceLimits& limits, std::uint64_t fixed_bytes = 0);
+
+/// read_geometry(path), its read stopped past --max-memory, then check_mesh_limits().
+Mesh read_geometry_within(const std::filesystem::path& path, const ResourceLimits& limits,
+                          std::uint64_t fixed_bytes = 0);
 
 }  // namespace primseg::cli

@@ -51,12 +51,9 @@ Command add_segment_command(CLI::App& app) {
         validate(options);
         validate_level_outputs(o->level);
         const auto read_start = Clock::now();
-        std::uint64_t file_bytes = 0;
         auto mesh = std::make_shared<const Mesh>(
-            read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory));
+            read_geometry_within(o->mesh_path, o->limits, o->level.files.png ? kPictureBytes : 0));
         const double read_seconds = seconds_since(read_start);
-        o->limits.fixed_bytes = o->level.files.png ? kPictureBytes : 0;
-        check_mesh_limits(*mesh, file_bytes, o->limits);
         validate_level(o->level.level, mesh->face_count());
         const auto build_start = Clock::now();
         HierarchyBuilder builder(mesh, options);

@@ -56,11 +56,8 @@ Command add_skeleton_command(CLI::App& app) {
             validate(options);
             if (!(std::isfinite(o->band) && o->band >= 0))
               throw InvalidInputError("--band: must be a finite number >= 0");
-            std::uint64_t file_bytes = 0;
             auto mesh = std::make_shared<const Mesh>(
-                read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory));
-            o->limits.fixed_bytes = o->picture.png ? kPictureBytes : 0;
-            check_mesh_limits(*mesh, file_bytes, o->limits);
+                read_geometry_within(o->mesh_path, o->limits, o->picture.png ? kPictureBytes : 0));
             validate_level(o->level, mesh->face_count());
             const auto build_start = Clock::now();
             HierarchyBuilder builder(mesh, options);

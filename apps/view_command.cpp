@@ -311,7 +311,6 @@ Command add_view_command(CLI::App& app) {
       ->capture_default_str();
   view->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
   add_limit_options(*view, o->limits, kViewBytesPerFace);
-  o->limits.fixed_bytes = kViewerPageBytes;
 
   return {view, [o] {
             const std::string_view page = viewer_template();
@@ -325,10 +324,8 @@ Command add_view_command(CLI::App& app) {
             options.primitives = parse_primitives(o->primitives);
             options.threads = o->threads;
             validate(options);
-            std::uint64_t file_bytes = 0;
             auto mesh = std::make_shared<const Mesh>(
-                read_geometry(o->mesh_path, &file_bytes, o->limits.max_memory));
-            check_mesh_limits(*mesh, file_bytes, o->limits);
+                read_geometry_within(o->mesh_path, o->limits, kViewerPageBytes));
             if (!(std::isfinite(o->band) && o->band >= 0))
               throw InvalidInputError("--band: must be a finite number >= 0");
             if (o->clusters) validate_level({o->clusters, std::nullopt}, mesh->face_count());
