@@ -131,6 +131,7 @@ Command add_denoise_command(CLI::App& app) {
                     i + 1, level.by_noise->noise, level.by_noise->tolerance);
               rounds.push_back({{"clusters", r.clusters},
                                 {"boundary_vertices", r.boundary_vertices},
+                                {"snapped", r.snapped},
                                 {"moved", r.moved},
                                 {"fallbacks", r.fallbacks},
                                 {"blocked", r.blocked},
@@ -138,11 +139,11 @@ Command add_denoise_command(CLI::App& app) {
                                 {"max_move", r.max_move}});
               if (!o->level.quiet)
                 std::printf(
-                    "round %d: %s, %s moved (%u on cluster borders, %u onto fewer primitives), "
-                    "%u blocked; mean move %.6g, max %.6g\n",
+                    "round %d: %s, %s snapped (%u on cluster borders, %u onto fewer "
+                    "primitives), %u moved, %u blocked; mean move %.6g, max %.6g\n",
                     i + 1, count_of(r.clusters, "cluster").c_str(),
-                    count_of(r.moved, "vertex", "vertices").c_str(), r.boundary_vertices,
-                    r.fallbacks, r.blocked, r.mean_move, r.max_move);
+                    count_of(r.snapped, "vertex", "vertices").c_str(), r.boundary_vertices,
+                    r.fallbacks, r.moved, r.blocked, r.mean_move, r.max_move);
             }
             write_mesh(o->output_path, denoiser.mesh());
             nlohmann::json summary;

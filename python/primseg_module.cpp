@@ -646,6 +646,7 @@ py::dict snap_report_dict(const SnapReport& r) {
   py::dict round;
   round["clusters"] = r.clusters;
   round["boundary_vertices"] = r.boundary_vertices;
+  round["snapped"] = r.snapped;
   round["moved"] = r.moved;
   round["fallbacks"] = r.fallbacks;
   round["blocked"] = r.blocked;
@@ -1177,7 +1178,7 @@ denoise(hierarchy, *, ...) -> numpy.ndarray
 round segments the previous round's result), and returns the new positions, float64 (n, 3), in
 the input's vertex order (the faces do not change): the CLI's output mesh, bit for bit. With
 return_rounds=True it returns (V, rounds), rounds a list of dicts like the CLI's --json
-"denoise" "rounds" (clusters, boundary_vertices, moved, fallbacks, blocked, mean_move,
+"denoise" "rounds" (clusters, boundary_vertices, snapped, moved, fallbacks, blocked, mean_move,
 max_move).
 The input is a Mesh, arrays V and F (as segment takes them), or a Hierarchy: its first round
 then snaps onto that tree's level without building it again (smoothing_steps must be 0, and the

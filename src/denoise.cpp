@@ -539,8 +539,9 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
     return true;
   };
 
+  constexpr double kRoundOffMove = 1e-12;
   const std::uint32_t n = mesh_.vertex_count();
-  // 0: not yet settled, 1: moved, 2: has no triangle.
+  // 0: not yet settled, 1: snapped, 2: has no triangle.
   std::vector<char> settled(n, 0);
   std::vector<std::uint32_t> used_primitive_count(n, 0), incident_count(n, 0);
   std::vector<std::uint32_t> clusters;
@@ -570,8 +571,13 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
       for (std::size_t count = most; count >= fewest; --count) {
         chosen.clear();
         for (std::size_t i = 0; i < count; ++i) chosen.push_back(&primitives[clusters[i]]);
-        const Eigen::Vector3d target = least_squares_point(
+        Eigen::Vector3d target = least_squares_point(
             x, chosen, eigenvalue_ratio, options_.max_solver_steps, local_edge_length_[v]);
+        // A move at the round-off level of the fits and the solve is no move: a vertex already
+        // on its primitives keeps its position bit for bit, and is not counted as moved.
+        if ((target - x).norm() <=
+            kRoundOffMove * (local_edge_length_[v] + x.lpNorm<Eigen::Infinity>()))
+          target = x;
         if (!target.allFinite() || (bounded && (target - x).norm() > bound) ||
             !keeps_orientation(v, target))
           continue;
@@ -592,10 +598,12 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
       ++report.blocked;
       continue;
     }
-    ++report.moved;
+    ++report.snapped;
     if (used_primitive_count[v] < incident_count[v] && options_.mode == SnapMode::AllIncident)
       ++report.fallbacks;
     const double move = (to_eigen(mesh_.positions[v]) - to_eigen(start[v])).norm();
+    if (move == 0) continue;
+    ++report.moved;
     move_sum += move;
     report.max_move = std::max(report.max_move, move);
   }

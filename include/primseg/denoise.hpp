@@ -137,13 +137,16 @@ struct SnapReport {
   std::uint32_t clusters = 0;
   std::uint32_t interior_vertices = 0;  ///< vertices of one cluster only
   std::uint32_t boundary_vertices = 0;  ///< vertices shared by two or more clusters
-  std::uint32_t moved = 0;              ///< vertices that moved onto their target
+  /// Vertices placed onto their target (all but the blocked ones and those of no triangle).
+  std::uint32_t snapped = 0;
+  /// Snapped vertices whose position changed: a vertex already on its target is not counted.
+  std::uint32_t moved = 0;
   /// Boundary vertices that were snapped onto fewer primitives than incident ones because the
   /// full move broke a safeguard.
   std::uint32_t fallbacks = 0;
   /// Vertices left where they were: every candidate move was too long or inverted a triangle.
   std::uint32_t blocked = 0;
-  double mean_move = 0;  ///< over moved vertices, input units
+  double mean_move = 0;  ///< over moved vertices, input units (0 when none moved)
   double max_move = 0;   ///< input units
 };
 
