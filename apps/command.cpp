@@ -69,9 +69,12 @@ Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes,
 
 Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* bytes,
                           std::optional<std::uint64_t> max_memory) {
-  const detail::FileImage image = detail::read_file(path, memory_limits(max_memory));
+  const detail::ReadLimits limits = memory_limits(max_memory);
+  const detail::FileImage image = path.native() == kStandardInput
+                                      ? detail::read_standard_input(limits)
+                                      : detail::read_file(path, limits);
   if (bytes) *bytes = image.size;
-  return deserialize_tree({image.bytes.get(), image.size}, path.string());
+  return deserialize_tree({image.bytes.get(), image.size}, input_name(path));
 }
 
 std::vector<PrimitiveType> parse_primitives(const std::string& list) {

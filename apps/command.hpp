@@ -60,8 +60,9 @@ Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes = n
 Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes = nullptr,
                    std::optional<std::uint64_t> max_memory = std::nullopt);
 
-/// read_tree(path), whose read stops with InvalidInputError as soon as the file has more bytes
-/// than `max_memory` (--max-memory); `bytes`, if set, receives the file's size.
+/// read_tree(path), or the tree on standard input for "-", whose read stops with
+/// InvalidInputError as soon as the input has more bytes than `max_memory` (--max-memory);
+/// `bytes`, if set, receives the input's size.
 Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* bytes = nullptr,
                           std::optional<std::uint64_t> max_memory = std::nullopt);
 

@@ -15,7 +15,10 @@ Command add_cut_command(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   auto* cut_command = app.add_subcommand("cut", "Report a level of a saved hierarchy");
-  cut_command->add_option("TREE", o->tree_path, "Tree file written by segment --tree")->required();
+  cut_command
+      ->add_option("TREE", o->tree_path,
+                   "Tree file written by segment --tree (- for standard input)")
+      ->required();
   add_level_options(*cut_command, o->level);
   add_limit_options(*cut_command, o->limits, kMeshBytesPerFace);
 

@@ -289,7 +289,8 @@ Command add_view_command(CLI::App& app) {
   view->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl; - for standard input)")
       ->required();
   view->add_option("--tree", o->tree_path,
-                   "Hierarchy written by segment --tree for this mesh (else it is built)");
+                   "Hierarchy written by segment --tree for this mesh (else it is built; - for "
+                   "standard input)");
   view->add_option("--clusters", o->clusters,
                    std::string("Level shown when the page opens (default: the --tolerance ") +
                        kDefaultTolerance + " level)");
@@ -312,71 +313,73 @@ Command add_view_command(CLI::App& app) {
   view->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
   add_limit_options(*view, o->limits, kViewBytesPerFace);
 
-  return {view, [o] {
-            const std::string_view page = viewer_template();
-            const std::size_t marker = page.find(kViewerDataMarker);
-            if (page.empty() || marker == std::string_view::npos)
-              throw InvalidInputError(
-                  "view: this primseg was built without the web viewer (npm was not available). "
-                  "To enable it: cd web && npm ci, then configure and build primseg again "
-                  "(CMake bundles web/ with esbuild and embeds the page)");
-            HierarchyOptions options;
-            options.primitives = parse_primitives(o->primitives);
-            options.threads = o->threads;
-            validate(options);
-            auto mesh = std::make_shared<const Mesh>(
-                read_geometry_within(o->mesh_path, o->limits, kViewerPageBytes));
-            if (!(std::isfinite(o->band) && o->band >= 0))
-              throw InvalidInputError("--band: must be a finite number >= 0");
-            if (o->clusters) validate_level({o->clusters, std::nullopt}, mesh->face_count());
-            if (o->skeleton_clusters)
-              validate_level({o->skeleton_clusters, std::nullopt}, mesh->face_count());
-            const auto build_start = Clock::now();
-            const Hierarchy hierarchy = [&] {
-              if (!o->tree_path)
-                return HierarchyBuilder(mesh, options).finish(Progress("hierarchy", o->quiet));
-              Hierarchy tree = read_input_tree(*o->tree_path, nullptr, o->limits.max_memory);
-              if (!same_mesh(tree.mesh(), *mesh))
-                throw InvalidInputError("view: the tree '" + *o->tree_path +
-                                        "' was not built from " + input_name(o->mesh_path));
-              return tree;
-            }();
-            const double build_seconds = seconds_since(build_start);
-            const ChosenLevel level = cut(hierarchy, {o->clusters, std::nullopt});
-            const std::uint32_t initial = level.segmentation.cluster_count();
-            const AutoLevel automatic =
-                level.automatic ? *level.automatic : choose_level(hierarchy);
-            std::optional<PageSkeleton> skeleton;
-            if (o->skeleton || o->skeleton_clusters) {
-              const Segmentation bones =
-                  o->skeleton_clusters
-                      ? cut(hierarchy, {o->skeleton_clusters, std::nullopt}).segmentation
-                      : level.segmentation;
-              SkinningOptions skinning;
-              skinning.band = o->band;
-              Skeleton extracted = extract_skeleton(hierarchy, bones);
-              SkinWeights weights = compute_skin_weights(*mesh, extracted, skinning);
-              skeleton = PageSkeleton{std::move(extracted), std::move(weights), o->band};
-            }
-            std::string html(page.substr(0, marker));
-            double fit_seconds = 0;
-            html += page_data(hierarchy, input_name(std::filesystem::path(o->mesh_path).filename()),
-                              initial, automatic, skeleton, o->threads, fit_seconds);
-            html += page.substr(marker + kViewerDataMarker.size());
-            detail::write_file_atomically(o->output, html);
-            if (!o->quiet) {
-              const std::string bones =
-                  skeleton ? ", skeleton of " + count_of(skeleton->skeleton.cluster_count(), "bone")
-                           : "";
-              std::printf(
-                  "%s: %s, hierarchy %s in %.3f s, geometric fits in %.3f s; %s: %.1f MB, opens "
-                  "at %s (automatic level %u)%s\n",
-                  input_name(o->mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
-                  o->tree_path ? "read" : "built", build_seconds, fit_seconds, o->output.c_str(),
-                  static_cast<double>(html.size()) / 1e6, count_of(initial, "cluster").c_str(),
-                  automatic.clusters, bones.c_str());
-            }
-          }};
+  return {
+      view, [o] {
+        const std::string_view page = viewer_template();
+        const std::size_t marker = page.find(kViewerDataMarker);
+        if (page.empty() || marker == std::string_view::npos)
+          throw InvalidInputError(
+              "view: this primseg was built without the web viewer (npm was not available). "
+              "To enable it: cd web && npm ci, then configure and build primseg again "
+              "(CMake bundles web/ with esbuild and embeds the page)");
+        HierarchyOptions options;
+        options.primitives = parse_primitives(o->primitives);
+        options.threads = o->threads;
+        validate(options);
+        if (o->tree_path == kStandardInput && o->mesh_path == kStandardInput)
+          throw InvalidInputError("view: only one of MESH and --tree can be standard input ('-')");
+        auto mesh = std::make_shared<const Mesh>(
+            read_geometry_within(o->mesh_path, o->limits, kViewerPageBytes));
+        if (!(std::isfinite(o->band) && o->band >= 0))
+          throw InvalidInputError("--band: must be a finite number >= 0");
+        if (o->clusters) validate_level({o->clusters, std::nullopt}, mesh->face_count());
+        if (o->skeleton_clusters)
+          validate_level({o->skeleton_clusters, std::nullopt}, mesh->face_count());
+        const auto build_start = Clock::now();
+        const Hierarchy hierarchy = [&] {
+          if (!o->tree_path)
+            return HierarchyBuilder(mesh, options).finish(Progress("hierarchy", o->quiet));
+          Hierarchy tree = read_input_tree(*o->tree_path, nullptr, o->limits.max_memory);
+          if (!same_mesh(tree.mesh(), *mesh))
+            throw InvalidInputError("view: the tree from " + input_name(*o->tree_path) +
+                                    " was not built from " + input_name(o->mesh_path));
+          return tree;
+        }();
+        const double build_seconds = seconds_since(build_start);
+        const ChosenLevel level = cut(hierarchy, {o->clusters, std::nullopt});
+        const std::uint32_t initial = level.segmentation.cluster_count();
+        const AutoLevel automatic = level.automatic ? *level.automatic : choose_level(hierarchy);
+        std::optional<PageSkeleton> skeleton;
+        if (o->skeleton || o->skeleton_clusters) {
+          const Segmentation bones =
+              o->skeleton_clusters
+                  ? cut(hierarchy, {o->skeleton_clusters, std::nullopt}).segmentation
+                  : level.segmentation;
+          SkinningOptions skinning;
+          skinning.band = o->band;
+          Skeleton extracted = extract_skeleton(hierarchy, bones);
+          SkinWeights weights = compute_skin_weights(*mesh, extracted, skinning);
+          skeleton = PageSkeleton{std::move(extracted), std::move(weights), o->band};
+        }
+        std::string html(page.substr(0, marker));
+        double fit_seconds = 0;
+        html += page_data(hierarchy, input_name(std::filesystem::path(o->mesh_path).filename()),
+                          initial, automatic, skeleton, o->threads, fit_seconds);
+        html += page.substr(marker + kViewerDataMarker.size());
+        detail::write_file_atomically(o->output, html);
+        if (!o->quiet) {
+          const std::string bones =
+              skeleton ? ", skeleton of " + count_of(skeleton->skeleton.cluster_count(), "bone")
+                       : "";
+          std::printf(
+              "%s: %s, hierarchy %s in %.3f s, geometric fits in %.3f s; %s: %.1f MB, opens "
+              "at %s (automatic level %u)%s\n",
+              input_name(o->mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
+              o->tree_path ? "read" : "built", build_seconds, fit_seconds, o->output.c_str(),
+              static_cast<double>(html.size()) / 1e6, count_of(initial, "cluster").c_str(),
+              automatic.clusters, bones.c_str());
+        }
+      }};
 }
 
 }  // namespace primseg::cli

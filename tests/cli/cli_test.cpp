@@ -498,6 +498,10 @@ TEST(Cli, CutFromTreeReproducesSegmentAtEveryLevel) {
     const std::vector<std::uint32_t> c = read_labels(dir / "c.txt");
     ASSERT_EQ(s.size(), f);
     EXPECT_EQ(c, s);
+    // The tree piped on standard input ('-') cuts the same.
+    const CliRun piped = run("cut - " + level + " --labels -", "cat " + dir.q("t.tree"));
+    ASSERT_EXIT_OK(piped);
+    EXPECT_EQ(piped.output, testing::file_contents(dir / "s.txt"));
     const json sj = read_json(dir / "s.json"), cj = read_json(dir / "c.json");
     ASSERT_TRUE(sj.contains("clusters") && cj.contains("clusters"));
     EXPECT_EQ(cj["clusters"], sj["clusters"]);
@@ -976,6 +980,16 @@ TEST(Cli, BadTreeFilesAreRejectedWithAMessage) {
       {"trailing bytes", "cut " + dir.q("extended.tree") + " --clusters 2", {"extended.tree"}},
       {"mesh passed as a tree", "cut " + dir.q("in.off") + " --clusters 2", {"in.off"}},
       {"missing tree", "cut " + dir.q("missing.tree") + " --clusters 2", {"missing.tree"}},
+      {"truncated on standard input",
+       "cut - --clusters 2 < " + dir.q("truncated.tree"),
+       {"standard input", "truncated"}},
+      {"nothing on standard input",
+       "cut - --clusters 2 < " + dir.q("empty.tree"),
+       {"standard input", "empty"}},
+      {"a mesh on standard input", "cut - --clusters 2 < " + dir.q("in.off"), {"standard input"}},
+      {"a tree on standard input beyond --max-memory",
+       "cut - --clusters 2 --max-memory 1K < " + dir.q("t.tree"),
+       {"standard input", "--max-memory"}},
       {"tree passed as a mesh", "segment " + dir.q("t.tree"), {"t.tree"}},
       {"cut --clusters 0", "cut " + dir.q("t.tree") + " --clusters 0", {"clusters"}},
       {"cut --clusters F+1",

@@ -311,6 +311,11 @@ test('the page is the same bytes from the mesh alone or with its tree', () => {
   const html = join(work, 'again.html');
   primseg('view', fandisk, '--clusters', '27', '-o', html, '--quiet');
   assert.ok(readFileSync(html).equals(readFileSync(join(work, 'fandisk.html'))));
+  // The tree piped on standard input ('-').
+  const piped = join(work, 'piped.html');
+  execFileSync(cli, ['view', fandisk, '--tree', '-', '--clusters', '27', '-o', piped, '--quiet'],
+    { input: readFileSync(join(work, 'fandisk.tree')) });
+  assert.ok(readFileSync(piped).equals(readFileSync(join(work, 'fandisk.html'))));
 });
 
 test('bad input: a clear error and exit status 1', () => {
@@ -327,8 +332,10 @@ test('bad input: a clear error and exit status 1', () => {
     [['view', fandisk, '--max-memory', '16M', '-o', join(work, 'x.html')],
       /the mesh has 12946 faces, which need about \d+ bytes, more than --max-memory 16777216/],
   ];
+  const both = ['view', '-', '--tree', '-', '-o', join(work, 'x.html')];
+  cases.push([both, /only one of MESH and --tree can be standard input/]);
   for (const [args, message] of cases) {
-    const run = spawnSync(cli, args, { encoding: 'utf8' });
+    const run = spawnSync(cli, args, { encoding: 'utf8', input: '' });
     assert.equal(run.status, 1, args.join(' ') + ': ' + run.stderr);
     assert.match(run.stderr, message);
   }
