@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <string>
 #include <utility>
@@ -15,6 +17,8 @@
 
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
+#include "primseg/hierarchy.hpp"
+#include "primseg/mesh_io.hpp"
 #include "primseg/shape_generator.hpp"
 #include "support/test_support.hpp"
 
@@ -185,6 +189,49 @@ TEST(TreeIo, TheFuzzersAcceptedFindingsGiveFiniteReports) {
         EXPECT_TRUE(std::isfinite(report.max)) << k;
       }
   }
+}
+
+// The tree of an input is the same, bit for bit, on every build: the floating-point contract
+// (IEEE doubles, no contraction into FMA, no fast-math) leaves the compiler no freedom that could
+// change a cost. CI runs this with g++ in Release and with clang++ under the sanitizers; builds
+// with LTO and profile-guided optimisation gave the same trees too. (On x86-64 with glibc: the
+// generated shapes call the C library's sin and cos.) A change that alters trees on purpose
+// updates these (bench/compare_revisions.sh reports which levels moved).
+TEST(TreeIo, TreesHaveTheSameChecksumOnEveryBuild) {
+  const auto checksum = [](const Hierarchy& hierarchy) {
+    const std::string bytes = serialize_tree(hierarchy);
+    std::uint64_t value = 0;  // the file's last 8 bytes: FNV-1a 64 of all the others
+    for (int i = 0; i < 8; ++i)
+      value |= std::uint64_t{static_cast<unsigned char>(bytes[bytes.size() - 8 + i])} << (8 * i);
+    return value;
+  };
+  struct Case {
+    std::string name;
+    std::function<Hierarchy()> build;
+    std::uint64_t expected;
+  };
+  HierarchyOptions every_type;
+  every_type.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
+                           PrimitiveType::Cone, PrimitiveType::Torus};
+  every_type.weights = VertexWeights::Uniform;
+  ShapeOptions noisy;
+  noisy.noise = 0.002;
+  noisy.seed = 5;
+  const std::vector<Case> cases = {
+      {"fandisk", [] { return build_hierarchy(read_mesh(testing::cgal_mesh("fandisk.off"))); },
+       0x2026b6c97adfd56d},
+      {"noise-free box_with_countersink (zero-cost ties)",
+       [] { return build_hierarchy(make_shape("box_with_countersink").mesh); }, 0x845afa13e73a9a53},
+      {"noisy filleted_cylinder, every type, uniform weights",
+       [&] { return build_hierarchy(make_shape("filleted_cylinder", noisy).mesh, every_type); },
+       0x131553050e030e27},
+  };
+  const auto hex = [](std::uint64_t value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(value));
+    return std::string(text);
+  };
+  for (const Case& c : cases) EXPECT_EQ(hex(checksum(c.build())), hex(c.expected)) << c.name;
 }
 
 }  // namespace
