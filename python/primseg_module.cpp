@@ -211,6 +211,46 @@ struct PyHierarchy {
   std::shared_ptr<const Hierarchy> hierarchy;
 };
 
+// A Mesh's pickled state: its arrays' bytes, as stored (native byte order: pickles are read on
+// machines like the one that wrote them, as numpy's own are).
+template <typename T>
+py::bytes array_bytes(const std::vector<T>& values) {
+  return py::bytes(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+}
+
+template <typename T>
+std::vector<T> array_from_bytes(const py::handle& bytes, const char* what) {
+  if (!py::isinstance<py::bytes>(bytes))
+    throw InvalidInputError(std::string("Mesh: pickled ") + what + " is not bytes");
+  const std::string_view data = bytes.cast<std::string_view>();
+  if (data.size() % sizeof(T) != 0)
+    throw InvalidInputError(std::string("Mesh: pickled ") + what + " has " +
+                            std::to_string(data.size()) + " bytes, not a multiple of " +
+                            std::to_string(sizeof(T)));
+  std::vector<T> values(data.size() / sizeof(T));
+  std::memcpy(values.data(), data.data(), data.size());
+  return values;
+}
+
+py::tuple mesh_state(const PyMesh& self) {
+  const Mesh& mesh = *self.mesh;
+  return py::make_tuple(array_bytes(mesh.positions), array_bytes(mesh.polygon_offsets),
+                        array_bytes(mesh.polygon_vertices), array_bytes(mesh.triangles),
+                        array_bytes(mesh.face_of_triangle));
+}
+
+PyMesh mesh_from_state(const py::tuple& state) {
+  if (state.size() != 5) throw InvalidInputError("Mesh: not a pickled primseg.Mesh");
+  Mesh mesh;
+  mesh.positions = array_from_bytes<Vec3>(state[0], "positions");
+  mesh.polygon_offsets = array_from_bytes<std::uint32_t>(state[1], "polygon offsets");
+  mesh.polygon_vertices = array_from_bytes<std::uint32_t>(state[2], "polygon vertices");
+  mesh.triangles = array_from_bytes<Triangle>(state[3], "triangles");
+  mesh.face_of_triangle = array_from_bytes<std::uint32_t>(state[4], "face_of_triangle");
+  mesh.validate();
+  return PyMesh{std::make_shared<const Mesh>(std::move(mesh))};
+}
+
 std::vector<PrimitiveType> parse_primitives(const py::object& names) {
   std::vector<std::string> list;
   if (py::isinstance<py::str>(names))
@@ -855,11 +895,16 @@ or too spread out to fit reliably.)",
                      cpp_doc("describe_mesh", doc::mesh_info__file),
                      cpp_doc("check_geometric_range", doc::mesh__check_geometric_range)})
               .c_str())
-      .def("__repr__", [](const PyMesh& self) {
-        return "<primseg.Mesh: " + count_of(self.mesh->vertex_count(), "vertex", "vertices") +
-               ", " + count_of(self.mesh->face_count(), "face") + ", " +
-               count_of(self.mesh->triangle_count(), "triangle") + ">";
-      });
+      .def("__repr__",
+           [](const PyMesh& self) {
+             return "<primseg.Mesh: " + count_of(self.mesh->vertex_count(), "vertex", "vertices") +
+                    ", " + count_of(self.mesh->face_count(), "face") + ", " +
+                    count_of(self.mesh->triangle_count(), "triangle") + ">";
+           })
+      // Read-only: a copy is the object itself.
+      .def("__copy__", [](const py::object& self) { return self; })
+      .def("__deepcopy__", [](const py::object& self, const py::dict&) { return self; })
+      .def(py::pickle(&mesh_state, &mesh_from_state));
 
   m.def(
       "read_mesh",
@@ -1161,10 +1206,31 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
             return self.hierarchy->options().weights == VertexWeights::Uniform ? "uniform" : "area";
           },
           doc::hierarchy__HierarchyOptions__weights)
-      .def("__repr__", [](const PyHierarchy& self) {
-        return "<primseg.Hierarchy: " + count_of(self.hierarchy->face_count(), "face") + ", " +
-               count_of(self.hierarchy->component_count(), "component") + ">";
-      });
+      .def("__repr__",
+           [](const PyHierarchy& self) {
+             return "<primseg.Hierarchy: " + count_of(self.hierarchy->face_count(), "face") + ", " +
+                    count_of(self.hierarchy->component_count(), "component") + ">";
+           })
+      .def("__copy__", [](const py::object& self) { return self; })
+      .def("__deepcopy__", [](const py::object& self, const py::dict&) { return self; })
+      // Pickled as its tree file (Hierarchy.save's bytes): for multiprocessing and joblib.
+      .def(py::pickle(
+          [](const PyHierarchy& self) {
+            std::string bytes;
+            {
+              py::gil_scoped_release release;
+              bytes = serialize_tree(*self.hierarchy);
+            }
+            return py::make_tuple(py::bytes(bytes));
+          },
+          [](const py::tuple& state) {
+            if (state.size() != 1 || !py::isinstance<py::bytes>(state[0]))
+              throw InvalidInputError("Hierarchy: not a pickled primseg.Hierarchy");
+            const std::string bytes = state[0].cast<std::string>();
+            py::gil_scoped_release release;
+            return PyHierarchy{std::make_shared<const Hierarchy>(
+                deserialize_tree(bytes, "pickled primseg.Hierarchy"))};
+          }));
 
   // ------------------------------------------------------------------------------------------
   // denoise, skeleton, distance.

@@ -1,7 +1,10 @@
 """segment, cut, clusters, save/read_tree: the same results as the CLI, from any array layout."""
 
+import copy as copy_module
 import json
+import multiprocessing
 import os
+import pickle
 import signal
 import threading
 import time
@@ -62,6 +65,50 @@ def test_tree_file_round_trip_with_the_cli(cli, fandisk_tree, tmp_path):
     np.testing.assert_array_equal(reread.mesh.V, fandisk_tree.mesh.V)
     run_cli(cli, "cut", tmp_path / "f.tree", "--clusters", "12", "--labels", tmp_path / "l.txt", "--quiet")
     np.testing.assert_array_equal(reread.cut(12), np.loadtxt(tmp_path / "l.txt"))
+
+
+def _segment_in_a_worker(path):
+    return primseg.segment(primseg.read_mesh(path))
+
+
+def test_pickled_trees_and_meshes_come_back_the_same(fandisk, fandisk_tree):
+    # Across processes (multiprocessing, joblib pickle what they send): a tree built in a worker.
+    context = multiprocessing.get_context("spawn")
+    with context.Pool(1) as pool:
+        from_worker = pool.apply(_segment_in_a_worker, (str(fandisk),))
+    state = pickle.dumps(fandisk_tree)
+    for copy in (from_worker, pickle.loads(state)):
+        assert pickle.dumps(copy) == state  # the tree file's bytes: the same tree, bit for bit
+        np.testing.assert_array_equal(copy.linkage(), fandisk_tree.linkage())
+        np.testing.assert_array_equal(copy.cut(30, refine=2), fandisk_tree.cut(30, refine=2))
+    mesh = pickle.loads(pickle.dumps(fandisk_tree.mesh))
+    for name in ("V", "F", "face_of_triangle"):
+        np.testing.assert_array_equal(getattr(mesh, name), getattr(fandisk_tree.mesh, name))
+    assert mesh.face_count == fandisk_tree.mesh.face_count
+    # Read-only objects: a copy is the object itself.
+    assert copy_module.deepcopy(fandisk_tree) is fandisk_tree
+    original = fandisk_tree.mesh
+    assert copy_module.copy(original) is original
+
+
+def test_corrupt_pickles_are_refused(fandisk_tree):
+    tree_state = fandisk_tree.__getstate__()
+    bad_tree = tree_state[0][:100] + bytes([tree_state[0][100] ^ 1]) + tree_state[0][101:]
+    with pytest.raises(primseg.ParseError, match="pickled primseg.Hierarchy: checksum"):
+        primseg.Hierarchy.__new__(primseg.Hierarchy).__setstate__((bad_tree,))
+    with pytest.raises(primseg.InvalidInputError, match="not a pickled primseg.Hierarchy"):
+        primseg.Hierarchy.__new__(primseg.Hierarchy).__setstate__(("text",))
+    V, offsets, polygons, triangles, faces = fandisk_tree.mesh.__getstate__()
+    cases = [
+        ((V[:-1], offsets, polygons, triangles, faces), "positions has .* bytes"),
+        ((V, offsets, polygons, triangles[:-12], faces), "triangles but"),
+        ((V, offsets, polygons, triangles, faces[:-4] + b"\xff\xff\xff\x7f"), "face_of_triangle"),
+        ((V[: 24 * 10], offsets, polygons, triangles, faces), "vertex|vertices"),
+        ((V, offsets, polygons), "not a pickled primseg.Mesh"),
+    ]
+    for state, message in cases:
+        with pytest.raises(primseg.InvalidInputError, match=message):
+            primseg.Mesh.__new__(primseg.Mesh).__setstate__(state)
 
 
 @pytest.mark.parametrize("f_dtype", [np.int32, np.int64, np.uint32, np.uint64])
