@@ -284,12 +284,55 @@ Denoiser::Denoiser(Mesh mesh, DenoiseOptions options)
     local_edge_length_[v] = edge_count[v] ? edge_sum[v] / edge_count[v] : 0;
 }
 
+namespace {
+
+// The options estimate_noise() smooths with, and whether `options` smooth the same (threads
+// aside: the result does not depend on them).
+const BilateralSmoothingOptions kEstimateSmoothing{};
+
+bool smooths_as_the_estimate(const BilateralSmoothingOptions& options) {
+  const BilateralSmoothingOptions& e = kEstimateSmoothing;
+  return options.normal_iterations == e.normal_iterations &&
+         options.normal_sigma == e.normal_sigma && options.spatial_sigma == e.spatial_sigma &&
+         options.vertex_iterations == e.vertex_iterations;
+}
+
+// RMS distance between the used vertices of `mesh` and their smoothed positions.
+double noise_from(const Mesh& mesh, const Mesh& smoothed) {
+  // Over the vertices of triangles only: an unused vertex does not move and is no sample.
+  std::vector<char> used(mesh.vertex_count(), 0);
+  for (const Triangle& t : mesh.triangles)
+    for (const std::uint32_t v : t) used[v] = 1;
+  double sum = 0;
+  std::uint32_t count = 0;
+  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    if (!used[v]) continue;
+    sum += (to_eigen(mesh.positions[v]) - to_eigen(smoothed.positions[v])).squaredNorm();
+    ++count;
+  }
+  return count > 0 ? std::sqrt(sum / count) : 0.0;
+}
+
+}  // namespace
+
+std::shared_ptr<const Mesh> Denoiser::estimate_copy() const {
+  const std::lock_guard lock(estimate_copy_mutex_);
+  if (!estimate_copy_) {
+    BilateralSmoothingOptions options = kEstimateSmoothing;
+    if (options_.bilateral_smoothing) options.threads = options_.bilateral_smoothing->threads;
+    estimate_copy_ = std::make_shared<const Mesh>(bilateral_smooth(mesh_, options));
+  }
+  return estimate_copy_;
+}
+
 std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
   // Taubin's λ|μ smoothing with uniform weights over the edge neighbours: shrinks noise, not the
   // shape. Neighbours come from the triangles around each vertex (each edge seen twice: same
   // weights for all, so the average is unchanged).
-  if (options_.bilateral_smoothing)
+  if (options_.bilateral_smoothing) {
+    if (smooths_as_the_estimate(*options_.bilateral_smoothing)) return estimate_copy();
     return std::make_shared<Mesh>(bilateral_smooth(mesh_, *options_.bilateral_smoothing));
+  }
   constexpr double kLambda = 0.5, kMu = -0.53;
   auto segmented = std::make_shared<Mesh>(mesh_);
   std::vector<Vec3>& positions = segmented->positions;
@@ -314,19 +357,7 @@ std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
 }
 
 double estimate_noise(const Mesh& mesh, const BilateralSmoothingOptions& options) {
-  const Mesh smoothed = bilateral_smooth(mesh, options);
-  // Over the vertices of triangles only: an unused vertex does not move and is no sample.
-  std::vector<char> used(mesh.vertex_count(), 0);
-  for (const Triangle& t : mesh.triangles)
-    for (const std::uint32_t v : t) used[v] = 1;
-  double sum = 0;
-  std::uint32_t count = 0;
-  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-    if (!used[v]) continue;
-    sum += (to_eigen(mesh.positions[v]) - to_eigen(smoothed.positions[v])).squaredNorm();
-    ++count;
-  }
-  return count > 0 ? std::sqrt(sum / count) : 0.0;
+  return noise_from(mesh, bilateral_smooth(mesh, options));
 }
 
 double Denoiser::noise_tolerance_factor() const {
@@ -343,8 +374,8 @@ DenoiseLevel Denoiser::automatic_level(const Hierarchy& hierarchy) const {
   const bool stylize = options_.mode == SnapMode::NearestIncident;
   if (jump || stylize) level.segmentation = cut_by_count(hierarchy, level.automatic.clusters);
   if (stylize) return level;
-  // Only here: the estimate smooths the whole mesh once more.
-  level.noise = estimate_noise(mesh_);
+  // Only here: the estimate smooths the whole mesh, once more unless the segmented copy is its.
+  level.noise = noise_from(mesh_, *estimate_copy());
   level.tolerance = noise_tolerance_factor() * level.noise;
   level.by_noise = !jump || worst_cluster_rms(hierarchy, level.segmentation) >
                                 kMaxJumpClusterRmsInTolerances * level.tolerance;
@@ -506,6 +537,10 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   const bool bounded =
       options_.mode == SnapMode::AllIncident && std::isfinite(options_.max_move_edge_lengths);
   const std::vector<Vec3> start = mesh_.positions;
+  {
+    const std::lock_guard lock(estimate_copy_mutex_);
+    estimate_copy_.reset();  // of positions about to move
+  }
 
   // Candidate targets of a vertex, most preferred first: all incident primitives, then without
   // the farthest one, and so on down to the nearest alone.

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -202,8 +203,17 @@ class Denoiser {
   void relabel(const Mesh& judged, std::vector<Primitive>& primitives,
                Segmentation& segmentation) const;
 
+  // bilateral_smooth(mesh_) with the noise estimate's options: estimate_noise's copy, and the
+  // segmented copy too when DenoiseOptions::bilateral_smoothing has those options (up to
+  // threads), so that a round smooths the mesh once, not twice.
+  std::shared_ptr<const Mesh> estimate_copy() const;
+
   Mesh mesh_;
   DenoiseOptions options_;
+  // estimate_copy()'s result for the current positions (null until asked, reset by snap()).
+  // Guarded by the mutex, since the const methods that fill it may run concurrently.
+  mutable std::mutex estimate_copy_mutex_;
+  mutable std::shared_ptr<const Mesh> estimate_copy_;
   std::vector<Vec3> input_normals_;        // per triangle, unnormalised: orientation reference
   std::vector<double> local_edge_length_;  // per vertex, in the input mesh
   // Triangles around each vertex: those of vertex v are

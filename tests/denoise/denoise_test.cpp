@@ -520,6 +520,35 @@ TEST(Denoise, TaubinStepsOnTheSegmentedCopyDoNotShrinkTheShape) {
   EXPECT_LE(mean_radius, 1.01 * truth.radius);
 }
 
+// A round with the default bilateral copy smooths the mesh once: the segmented copy is the one
+// the automatic level's noise estimate measures (the same copy until the vertices move), and the
+// estimate is estimate_noise()'s, bit for bit, with that copy or another.
+TEST(Denoise, TheBilateralCopyIsTheNoiseEstimatesOwn) {
+  const NoisyShape box = noisy_shape("box", 0.004, 0.1);
+  for (const double normal_sigma : {0.35, 0.3}) {
+    SCOPED_TRACE(normal_sigma);
+    DenoiseOptions options;
+    options.bilateral_smoothing = BilateralSmoothingOptions{};
+    options.bilateral_smoothing->normal_sigma = normal_sigma;
+    options.bilateral_smoothing->threads = 1;
+    Denoiser denoiser(box.noisy.mesh, options);
+    const std::shared_ptr<const Mesh> copy = denoiser.segmented_mesh();
+    EXPECT_EQ(copy == denoiser.segmented_mesh(), normal_sigma == 0.35);
+    EXPECT_EQ(copy->positions,
+              bilateral_smooth(box.noisy.mesh, *options.bilateral_smoothing).positions);
+    for (int round = 0; round < 2; ++round) {
+      const Mesh before = denoiser.mesh();
+      const Hierarchy hierarchy = build_hierarchy(denoiser.segmented_mesh());
+      const DenoiseLevel level = denoiser.automatic_level(hierarchy);
+      EXPECT_EQ(level.noise, estimate_noise(before));
+      denoiser.snap(hierarchy, level.segmentation);
+      // The next round smooths the moved vertices.
+      EXPECT_EQ(denoiser.segmented_mesh()->positions,
+                bilateral_smooth(denoiser.mesh(), *options.bilateral_smoothing).positions);
+    }
+  }
+}
+
 TEST(Denoise, RejectsBadOptionsAndAMismatchedHierarchy) {
   const NoisyShape box = noisy_shape("box", 0.004, 0.1);
   EXPECT_THROW(denoise(box.noisy.mesh, level_by_count(6), {}, 0), InvalidInputError);
