@@ -5,6 +5,7 @@ set -euo pipefail
 packages=(build-essential cmake ninja-build clang clang-tidy libclang-rt-14-dev libeigen3-dev
           libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-demo
           python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest python3-scipy
+          python3-mypy
           chromium)
 missing=()
 for p in "${packages[@]}"; do
