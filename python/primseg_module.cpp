@@ -1172,6 +1172,70 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
                      cpp_doc("Merge::cost", doc::hierarchy__Merge__cost)})
               .c_str())
       .def(
+          "merges",
+          [](const PyHierarchy& self) {
+            const Hierarchy& tree = *self.hierarchy;
+            const std::span<const Merge> merges = tree.merges();
+            const std::size_t n = merges.size();
+            const auto rows = static_cast<py::ssize_t>(n);
+            std::vector<std::array<std::int32_t, 2>> children(n);
+            std::vector<std::int32_t> face_count(n);
+            std::vector<std::uint8_t> trailing(n);
+            std::vector<std::int8_t> type(n);
+            std::vector<Vec3> point(n), axis(n);
+            std::vector<double> rms(n), radius(n), minor_radius(n), half_angle(n);
+            for (std::size_t i = 0; i < n; ++i) {
+              const Merge& merge = merges[i];
+              children[i] = {static_cast<std::int32_t>(merge.first),
+                             static_cast<std::int32_t>(merge.second)};
+              face_count[i] = static_cast<std::int32_t>(merge.face_count);
+              trailing[i] = merge.trailing ? 1 : 0;
+              type[i] = merge.trailing ? -1 : static_cast<std::int8_t>(merge.primitive.type);
+              rms[i] = merge.trailing
+                           ? std::numeric_limits<double>::quiet_NaN()
+                           : tree.rms_estimate(tree.face_count() + static_cast<std::uint32_t>(i));
+              point[i] = merge.primitive.point;
+              axis[i] = merge.primitive.axis;
+              radius[i] = merge.primitive.radius;
+              minor_radius[i] = merge.primitive.minor_radius;
+              half_angle[i] = merge.primitive.half_angle;
+            }
+            // Type names by code, "" for the trailing merges (code -1, the last entry).
+            py::list names;
+            for (int t = 0; t < kPrimitiveTypeCount; ++t)
+              names.append(std::string(to_string(static_cast<PrimitiveType>(t))));
+            names.append("");
+            const py::module_ numpy = py::module_::import("numpy");
+            py::dict table;
+            table["children"] = adopt<std::int32_t>(std::move(children), {rows, 2});
+            table["face_count"] = adopt<std::int32_t>(std::move(face_count), {rows});
+            table["trailing"] = adopt<std::uint8_t>(std::move(trailing), {rows})
+                                    .attr("astype")(numpy.attr("bool_"));
+            table["type"] = numpy.attr("array")(names).attr("__getitem__")(
+                adopt<std::int8_t>(std::move(type), {rows}));
+            table["rms"] = adopt<double>(std::move(rms), {rows});
+            table["point"] = adopt<double>(std::move(point), {rows, 3});
+            table["axis"] = adopt<double>(std::move(axis), {rows, 3});
+            table["radius"] = adopt<double>(std::move(radius), {rows});
+            table["minor_radius"] = adopt<double>(std::move(minor_radius), {rows});
+            table["half_angle"] = adopt<double>(std::move(half_angle), {rows});
+            return table;
+          },
+          join_docs({R"(merges() -> dict
+
+Every merge of the tree, one row per node it makes (row i is node F + i; nodes 0..F-1 are the
+faces), as numpy arrays of length F - 1: children (F - 1, 2) int32 (node ids, as linkage()),
+face_count int32, trailing bool (merges joining connected components after all real ones: no
+fit), and the primitive the greedy fitted to the node from its moments: type str ("plane",
+"cylinder", "sphere", "cone", "torus"; "" when trailing), rms float64 (the node's RMS distance
+estimate, input units; NaN when trailing), point and axis (F - 1, 3) float64, radius,
+minor_radius and half_angle float64 (radians), in input units, zero where the type has none.
+Hierarchy.clusters() refits a level's clusters geometrically and measures their exact errors;
+these are the tree's own fits, for rules of one's own over all nodes.)",
+                     cpp_doc("Merge", doc::hierarchy__Merge),
+                     cpp_doc("Hierarchy::rms_estimate", doc::hierarchy__Hierarchy__rms_estimate)})
+              .c_str())
+      .def(
           "save",
           [](const PyHierarchy& self, const std::filesystem::path& path) {
             py::gil_scoped_release release;

@@ -172,6 +172,43 @@ def test_ground_truth_cylinder_and_planes():
     json.dumps(clusters)  # plain Python values
 
 
+def test_merges_hold_every_nodes_own_fit():
+    V, F, regions = capped_cylinder(radius=2.0, height=5.0, center=(1.0, -2.0, 0.5))
+    h = primseg.segment(V, F)
+    merges = h.merges()
+    F_count = h.face_count
+    assert all(len(column) == F_count - 1 for column in merges.values())
+    Z = h.linkage()
+    np.testing.assert_array_equal(merges["children"], Z[:, :2])
+    np.testing.assert_array_equal(merges["face_count"], Z[:, 3])
+    assert not merges["trailing"].any() and (merges["type"] != "").all()
+    # The node of each of the three clusters: a face's ancestor with the cluster's face count.
+    parent = np.full(2 * F_count - 1, -1)
+    parent[merges["children"].ravel()] = np.repeat(np.arange(F_count, 2 * F_count - 1), 2)
+    labels = h.cut(3)
+    for label in range(3):
+        faces = np.flatnonzero(labels == label)
+        node = faces[0]
+        while node < F_count or merges["face_count"][node - F_count] < len(faces):
+            node = parent[node]
+        row = node - F_count
+        assert merges["face_count"][row] == len(faces)
+        assert merges["rms"][row] < 1e-9
+        if regions[faces[0]] == 0:  # the tube
+            assert merges["type"][row] == "cylinder"
+            assert abs(merges["radius"][row] - 2.0) < 1e-6
+            assert np.allclose(np.abs(merges["axis"][row]), [0, 0, 1], atol=1e-9)
+        else:
+            assert merges["type"][row] == "plane"
+            assert np.allclose(np.abs(merges["axis"][row]), [0, 0, 1], atol=1e-9)
+            assert min(abs(merges["point"][row][2] - z) for z in (0.5, 5.5)) < 1e-9
+    # Components are joined by trailing merges, last, with no fit.
+    two = primseg.segment(np.vstack([V, V + [10, 0, 0]]), np.vstack([F, F + len(V)]))
+    last = two.merges()
+    assert last["trailing"].tolist() == [False] * (len(last["type"]) - 1) + [True]
+    assert last["type"][-1] == "" and np.isnan(last["rms"][-1])
+
+
 def test_sphere_radius_and_centre():
     phi, theta = np.meshgrid(np.linspace(0.2, np.pi - 0.2, 12), np.linspace(0, 2 * np.pi, 24, endpoint=False))
     points = np.stack([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi)], -1)
