@@ -69,12 +69,26 @@ Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes,
 
 Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* bytes,
                           std::optional<std::uint64_t> max_memory) {
-  const detail::ReadLimits limits = memory_limits(max_memory);
-  const detail::FileImage image = path.native() == kStandardInput
-                                      ? detail::read_standard_input(limits)
-                                      : detail::read_file(path, limits);
+  const bool standard_input = path.native() == kStandardInput;
+  const std::string name = input_name(path);
+  detail::ReadLimits limits = memory_limits(max_memory);
+  if (standard_input)
+    limits.check_prefix = [&](std::span<const char> prefix, std::uint64_t most_bytes) {
+      // Stop as soon as the data cannot be a tree that fits: a pipe may never end.
+      const TreeSizeBound size = tree_size_from_prefix(prefix, name);
+      if (size.bytes > most_bytes)
+        throw InvalidInputError(name + ": the tree's counts declare " + std::to_string(size.bytes) +
+                                " bytes, more than " +
+                                (max_memory ? "--max-memory " + std::to_string(*max_memory)
+                                            : std::string("this machine's memory")));
+      if (size.exact && prefix.size() > size.bytes)
+        throw ParseError(name + ": byte " + std::to_string(size.bytes) +
+                         ": unexpected data after the tree's checksum");
+    };
+  const detail::FileImage image =
+      standard_input ? detail::read_standard_input(limits) : detail::read_file(path, limits);
   if (bytes) *bytes = image.size;
-  return deserialize_tree({image.bytes.get(), image.size}, input_name(path));
+  return deserialize_tree({image.bytes.get(), image.size}, name);
 }
 
 std::vector<PrimitiveType> parse_primitives(const std::string& list) {

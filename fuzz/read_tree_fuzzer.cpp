@@ -5,7 +5,9 @@
 // - a tree it accepts is one the engine can use as it uses its own: the invariants of
 //   tree_invariants.hpp, every cut by count and a few by tolerance, the error curve, the automatic
 //   level and the cluster reports (finite);
-// - writing an accepted tree gives back the same bytes (the format has one spelling per tree).
+// - writing an accepted tree gives back the same bytes (the format has one spelling per tree);
+// - tree_size_from_prefix, on every prefix of the image, throws nothing but ParseError and never
+//   bounds the size above the image's when the image is a tree, and exactly once all has come.
 
 #include <cmath>
 #include <cstddef>
@@ -63,8 +65,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     hierarchy.emplace(deserialize_tree({image.data(), image.size()}, "fuzz"));
   } catch (const ParseError&) {
-    return 0;
   }
+  // What a pipe's reader sees first: a few prefixes, and the whole image.
+  for (const std::size_t length :
+       {std::size_t{0}, std::size_t{9}, std::size_t{15}, image.size() / 2, image.size()}) {
+    const std::string_view prefix = std::string_view(image).substr(0, length);
+    TreeSizeBound bound;
+    try {
+      bound = tree_size_from_prefix(prefix, "fuzz");
+    } catch (const ParseError&) {
+      if (hierarchy) fuzz::fail("a prefix of a valid tree refused", double(length));
+      continue;
+    }
+    if (hierarchy && (bound.bytes > image.size() ||
+                      (length == image.size() && !(bound.exact && bound.bytes == image.size()))))
+      fuzz::fail("size bound of a valid tree", double(bound.bytes), double(image.size()));
+  }
+  if (!hierarchy) return 0;
   use(*hierarchy);
   if (serialize_tree(*hierarchy) != image) fuzz::fail("written tree differs from the one read");
   return 0;

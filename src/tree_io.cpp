@@ -1,7 +1,10 @@
 #include "primseg/tree_io.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
+#include <iterator>
+#include <limits>
 
 #include "file_io.hpp"
 #include "primseg/error.hpp"
@@ -213,6 +216,44 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
   } catch (const InvalidInputError& e) {
     throw ParseError(name + ": invalid tree: " + e.what());
   }
+}
+
+TreeSizeBound tree_size_from_prefix(std::span<const char> prefix, const std::string& name) {
+  const std::size_t magic = std::min(prefix.size(), sizeof kMagic);
+  if (std::memcmp(prefix.data(), kMagic, magic) != 0)
+    throw ParseError(name + ": byte 0: not a primseg tree file (bad magic number)");
+  constexpr std::uint64_t kMost = std::numeric_limits<std::uint64_t>::max();
+  const auto plus = [](std::uint64_t a, std::uint64_t b) { return a > kMost - b ? kMost : a + b; };
+  const auto times = [](std::uint64_t count, std::uint64_t size) {
+    return count > kMost / size ? kMost : count * size;
+  };
+  // The layout of docs/tree-format.md: a fixed header, the primitive types, then four counted
+  // arrays and the merges, and the checksum. Fields not yet in the prefix end the walk.
+  constexpr std::uint64_t kChecksum = 8, kMergeBytes = 12 * 8 + 3 * 4 + 2;
+  Reader r(prefix, name);
+  std::uint64_t bytes = sizeof kMagic + 4 + 3 + 5 * 8 + 8 + 8 + kChecksum;  // no type, no array
+  if (prefix.size() < sizeof kMagic + 4 + 3) return {bytes, false};
+  for (std::size_t i = 0; i < sizeof kMagic; ++i) r.get<char>("the header");
+  const auto version = r.get<std::uint32_t>("the version");
+  if (version != kVersion)
+    r.fail("tree file version " + std::to_string(version) +
+           " is not supported (this primseg reads version " + std::to_string(kVersion) + ")");
+  r.get<std::uint8_t>("the options");
+  r.get<std::uint8_t>("the options");
+  const auto type_count = r.get<std::uint8_t>("the options");
+  bytes += type_count;
+  // Where each count lies, and the size of the items it counts.
+  std::uint64_t at = sizeof kMagic + 4 + 3 + type_count + 5 * 8 + 8;
+  const std::uint64_t item_sizes[] = {24, 4, 4, 16, kMergeBytes};
+  for (std::size_t k = 0; k < std::size(item_sizes); ++k) {
+    if (at > prefix.size() || prefix.size() - at < 8) return {bytes, false};
+    const std::uint64_t count = Reader(prefix.subspan(at, 8), name).get<std::uint64_t>("a count");
+    const std::uint64_t array = times(count, item_sizes[k]);
+    bytes = plus(bytes, array);
+    at = plus(at, plus(8, array));
+    if (k + 1 < std::size(item_sizes)) bytes = plus(bytes, 8);  // the next count
+  }
+  return {bytes, true};
 }
 
 void write_tree(const std::filesystem::path& path, const Hierarchy& hierarchy) {

@@ -11,7 +11,9 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -189,6 +191,41 @@ TEST(TreeIo, TheFuzzersAcceptedFindingsGiveFiniteReports) {
         EXPECT_TRUE(std::isfinite(report.max)) << k;
       }
   }
+}
+
+// What a pipe's first bytes tell: never more than the file has, the exact size once every count
+// has arrived, and a refusal as soon as the data is no tree file.
+TEST(TreeIo, ThePrefixOfATreeBoundsItsSize) {
+  const std::string bytes = serialize_tree(sample_hierarchy());
+  const std::uint64_t size = bytes.size();
+  std::uint64_t previous = 0;
+  bool exact = false;
+  for (std::size_t length = 0; length <= bytes.size(); length += length < 600 ? 1 : 997) {
+    SCOPED_TRACE(length);
+    const TreeSizeBound bound = tree_size_from_prefix(std::string_view(bytes).substr(0, length));
+    EXPECT_LE(bound.bytes, size);
+    EXPECT_GE(bound.bytes, previous);  // more bytes, more known
+    EXPECT_TRUE(bound.exact || !exact);
+    if (bound.exact) {
+      EXPECT_EQ(bound.bytes, size);
+    }
+    previous = bound.bytes;
+    exact = bound.exact;
+  }
+  EXPECT_TRUE(exact);
+
+  std::string foreign = bytes;
+  foreign[3] = 'x';
+  for (const std::size_t length : {4, 8, 100})
+    EXPECT_THROW(tree_size_from_prefix(std::string_view(foreign).substr(0, length)), ParseError);
+  EXPECT_NO_THROW(tree_size_from_prefix(std::string_view(foreign).substr(0, 3)));
+  std::string newer = bytes;
+  newer[8] = 2;
+  EXPECT_THROW(tree_size_from_prefix(std::string_view(newer).substr(0, 20)), ParseError);
+  // A vertex count of 2^63: the size saturates instead of wrapping around.
+  std::string huge = bytes.substr(0, 8 + 4 + 3 + static_cast<unsigned char>(bytes[14]) + 48);
+  huge += std::string(7, '\0') + '\x80';
+  EXPECT_EQ(tree_size_from_prefix(huge).bytes, std::numeric_limits<std::uint64_t>::max());
 }
 
 // The tree of an input is the same, bit for bit, on every build: the floating-point contract

@@ -969,6 +969,11 @@ TEST(Cli, BadTreeFilesAreRejectedWithAMessage) {
   write_file(dir / "extended.tree", tree + std::string(16, '\0'));
   std::string magic_only = tree.substr(0, 8);
   write_file(dir / "magic.tree", magic_only);
+  // The header up to the vertex count, then a count of 2^50 vertices (little-endian).
+  const std::size_t vertex_count_at = 8 + 4 + 3 + static_cast<unsigned char>(tree[14]) + 48;
+  std::string huge_count = tree.substr(0, vertex_count_at) + std::string(6, '\0');
+  huge_count += std::string{'\x04', '\0'} + std::string(64, '\0');
+  write_file(dir / "huge-count.tree", huge_count);
 
   const std::vector<BadCase> cases = {
       {"flipped byte", "cut " + dir.q("flipped.tree") + " --clusters 2", {"flipped.tree"}},
@@ -990,6 +995,10 @@ TEST(Cli, BadTreeFilesAreRejectedWithAMessage) {
       {"a tree on standard input beyond --max-memory",
        "cut - --clusters 2 --max-memory 1K < " + dir.q("t.tree"),
        {"standard input", "--max-memory"}},
+      {"endless zeros on standard input", "cut - --clusters 2 < /dev/zero", {"bad magic"}},
+      {"a tree whose counts declare more than can be read, on standard input",
+       "cut - --clusters 2 < " + dir.q("huge-count.tree"),
+       {"standard input", "declare", "more than this machine's memory"}},
       {"tree passed as a mesh", "segment " + dir.q("t.tree"), {"t.tree"}},
       {"cut --clusters 0", "cut " + dir.q("t.tree") + " --clusters 0", {"clusters"}},
       {"cut --clusters F+1",
@@ -1005,6 +1014,16 @@ TEST(Cli, BadTreeFilesAreRejectedWithAMessage) {
        {"o.stl"}},
   };
   for (const BadCase& c : cases) expect_rejected(c);
+
+  // A pipe that never ends stops as soon as it cannot be a tree: after the counts of a header
+  // followed by zeros, or a whole tree followed by more bytes.
+  for (const std::string& producer : {"(head -c 15 " + dir.q("t.tree") + "; cat /dev/zero)",
+                                      "(cat " + dir.q("t.tree") + "; cat /dev/zero)"}) {
+    const CliRun r = run("cut - --clusters 2", producer);
+    EXPECT_EQ(r.status, 1) << producer << ": " << r.output;
+    EXPECT_NE(r.output.find("unexpected data after the tree's checksum"), std::string::npos)
+        << r.output;
+  }
 
   // Every single-byte corruption at a few dozen positions across the file is caught (the
   // checksum covers everything), never crashes.
