@@ -3,12 +3,14 @@
 #include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -27,11 +29,18 @@ namespace primseg::detail {
                 "': " + std::strerror(error_number));
 }
 
-std::uint64_t physical_memory_bytes() {
+std::uint64_t usable_memory_bytes() {
   const long pages = ::sysconf(_SC_PHYS_PAGES);
   const long page_size = ::sysconf(_SC_PAGESIZE);
-  if (pages <= 0 || page_size <= 0) return 0;
-  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
+  std::uint64_t memory = pages > 0 && page_size > 0 ? static_cast<std::uint64_t>(pages) *
+                                                          static_cast<std::uint64_t>(page_size)
+                                                    : 0;
+  struct rlimit address_space {};
+  if (::getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur != RLIM_INFINITY) {
+    const auto limit = static_cast<std::uint64_t>(address_space.rlim_cur);
+    memory = memory == 0 ? limit : std::min(memory, limit);
+  }
+  return memory;
 }
 
 namespace {
@@ -44,20 +53,34 @@ std::string limit_phrase(const ReadLimits& limits) {
 
 // Reads what is left of `fd` until end of file into a buffer of at least `expected` + 1 bytes
 // (the size from fstat may be stale: a growing file, or a pipe, whose size is 0).
-FileImage read_to_end(int fd, const std::filesystem::path& name, std::uint64_t expected,
+// `sized`: the source has a size (a regular file), `expected`; else it is read up to the
+// limits' fraction of the usable memory when no max_bytes bounds it.
+FileImage read_to_end(int fd, const std::filesystem::path& name, bool sized, std::uint64_t expected,
                       const ReadLimits& limits) {
-  const std::uint64_t memory = physical_memory_bytes();
+  const std::uint64_t memory = usable_memory_bytes();
+  const std::uint64_t unsized_most =
+      !sized && limits.max_bytes == UINT64_MAX && memory != 0
+          ? static_cast<std::uint64_t>(static_cast<double>(memory) * limits.unsized_memory_fraction)
+          : UINT64_MAX;
   // The buffer never holds more than one byte past a limit: that byte is what tells.
-  const std::uint64_t most = std::min(limits.max_bytes, memory == 0 ? UINT64_MAX : memory);
+  const std::uint64_t most =
+      std::min({limits.max_bytes, memory == 0 ? UINT64_MAX : memory, unsized_most});
   const std::uint64_t largest_buffer = most == UINT64_MAX ? most : most + 1;
   std::size_t capacity = static_cast<std::size_t>(std::min(expected + 1, largest_buffer));
   FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
   while (true) {
     if (image.size > limits.max_bytes)
       throw InvalidInputError(name.string() + ": more than " + limit_phrase(limits));
+    if (image.size > unsized_most)
+      throw InvalidInputError(name.string() + ": more than " + std::to_string(unsized_most) +
+                              " bytes, the most read without a size (1/" +
+                              std::to_string(std::lround(1 / limits.unsized_memory_fraction)) +
+                              " of the " + std::to_string(memory) +
+                              " bytes of memory this process may use; --max-memory sets "
+                              "another limit)");
     if (image.size > most)
-      throw IoError("cannot read '" + name.string() + "': more than this machine's memory (" +
-                    std::to_string(memory) + " bytes)");
+      throw IoError("cannot read '" + name.string() + "': more than the memory this process " +
+                    "may use (" + std::to_string(memory) + " bytes)");
     if (image.size == capacity) {
       const std::size_t grown = static_cast<std::size_t>(
           std::min<std::uint64_t>(capacity + capacity / 2 + 4096, largest_buffer));
@@ -91,18 +114,19 @@ FileImage read_file(const std::filesystem::path& path, const ReadLimits& limits)
   if (::fstat(fd, &status) != 0) io_failure(path, "stat", errno);
   if (S_ISDIR(status.st_mode)) io_failure(path, "read", EISDIR);
 
-  // Refused before any allocation: a file over the limit, or larger than the machine's memory
-  // (which could not be parsed). A pipe or a device has no size here: read_to_end() bounds it.
+  // Refused before any allocation: a file over the limit, or larger than the memory this process
+  // may use (it could not be parsed). A pipe or a device has no size here: read_to_end() bounds
+  // it.
   const auto size = static_cast<std::uint64_t>(status.st_size);
   if (size > limits.max_bytes)
     throw InvalidInputError("'" + path.string() + "': the file has " + std::to_string(size) +
                             " bytes, more than " + limit_phrase(limits));
-  const std::uint64_t memory = physical_memory_bytes();
+  const std::uint64_t memory = usable_memory_bytes();
   if (memory != 0 && size > memory)
-    throw IoError("cannot read '" + path.string() + "': the file has " +
-                  std::to_string(status.st_size) + " bytes, more than this machine's memory (" +
-                  std::to_string(memory) + " bytes)");
-  return read_to_end(fd, path, size, limits);
+    throw IoError(
+        "cannot read '" + path.string() + "': the file has " + std::to_string(status.st_size) +
+        " bytes, more than the memory this process may use (" + std::to_string(memory) + " bytes)");
+  return read_to_end(fd, path, S_ISREG(status.st_mode), size, limits);
 }
 
 FileImage read_standard_input(const ReadLimits& limits) {
@@ -111,7 +135,7 @@ FileImage read_standard_input(const ReadLimits& limits) {
   if (S_ISDIR(status.st_mode)) io_failure("standard input", "read", EISDIR);
   // A pipe has no size: start with a block, the buffer grows by half as it fills.
   const bool sized = S_ISREG(status.st_mode);
-  return read_to_end(STDIN_FILENO, "standard input",
+  return read_to_end(STDIN_FILENO, "standard input", sized,
                      sized ? static_cast<std::uint64_t>(status.st_size) : std::uint64_t{65536},
                      limits);
 }

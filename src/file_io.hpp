@@ -22,8 +22,9 @@ struct FileImage {
   std::string_view view() const { return {bytes.get(), size}; }
 };
 
-/// Physical memory of the machine in bytes (0 if unknown).
-std::uint64_t physical_memory_bytes();
+/// The memory this process may use, in bytes: the machine's physical memory, or the process's
+/// address-space limit (ulimit -v) when lower; 0 if unknown.
+std::uint64_t usable_memory_bytes();
 
 /// Bounds on a read whose size is known only at its end (standard input, a pipe, a device).
 struct ReadLimits {
@@ -31,8 +32,13 @@ struct ReadLimits {
   /// <limit_name> <max_bytes> bytes" (limit_name: the option that set it, if any).
   std::uint64_t max_bytes = UINT64_MAX;
   std::string_view limit_name;
+  /// Without max_bytes, data that has no size (a pipe, a device) is read up to this fraction of
+  /// usable_memory_bytes(), so that an endless pipe stops there instead of filling the memory.
+  /// The default suits meshes: processing one takes about ten times its file's bytes (512 per
+  /// triangle against 50 in a binary STL), so no larger one could be processed anyway.
+  double unsized_memory_fraction = 1.0 / 8;
   /// Called after each read with the bytes read so far and the most the read accepts (max_bytes,
-  /// or the machine's memory if lower); throws to stop reading (data that already cannot be what
+  /// or the memory bound if lower); throws to stop reading (data that already cannot be what
   /// the caller expects).
   std::function<void(std::span<const char> prefix, std::uint64_t most_bytes)> check_prefix;
 };

@@ -443,6 +443,30 @@ TEST(Limits, ImpossibleDeclaredCountsAreRefusedWithoutAllocating) {
   fs::remove_all(dir);
 }
 
+// Standard input has no size: without --max-memory it is read up to an eighth of the memory the
+// process may use (no larger mesh could be processed), so an endless pipe of a valid-looking
+// mesh stops there instead of filling the memory.
+TEST(Limits, AnEndlessPipeStopsAtAnEighthOfTheUsableMemory) {
+  if (under_address_sanitizer())
+    GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v, and without it the read is 3 GB";
+  std::string output;
+  EXPECT_EQ(testing::run_command("ulimit -v 1000000; (printf 'OFF\\n3 1 0\\n'; yes '0 0 0') | '" +
+                                     testing::cli_path().string() + "' info - 2>&1",
+                                 &output),
+            1);
+  EXPECT_NE(output.find("standard input: more than 128000000 bytes, the most read without a "
+                        "size (1/8 of the 1024000000 bytes of memory this process may use"),
+            std::string::npos)
+      << output;
+  // --max-memory sets the limit instead.
+  EXPECT_EQ(testing::run_command("(printf 'OFF\\n3 1 0\\n'; yes '0 0 0') | '" +
+                                     testing::cli_path().string() + "' info - --max-memory 1M 2>&1",
+                                 &output),
+            1);
+  EXPECT_NE(output.find("standard input: more than --max-memory 1048576 bytes"), std::string::npos)
+      << output;
+}
+
 TEST(Interrupt, CtrlCLeavesCompleteOutputsOrNone) {
   const fs::path dir = testing::temp_directory("interrupt");
   const fs::path mesh = testing::cgal_mesh("fandisk.off");
