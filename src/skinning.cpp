@@ -222,9 +222,19 @@ std::uint32_t child_of_joint(const Skeleton& skeleton, const BoneTree& tree, std
     throw InvalidInputError("joint " + std::to_string(joint) + " does not exist (" +
                             std::to_string(skeleton.joints.size()) + " joints)");
   const Joint& j = skeleton.joints[joint];
-  if (j.kind != JointKind::Sensitive)
+  if (j.kind != JointKind::Sensitive) {
+    // Name the ones that do, so that the message says what to write instead.
+    std::string sensitive;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < skeleton.joints.size(); ++i)
+      if (skeleton.joints[i].kind == JointKind::Sensitive && count++ < 12)
+        sensitive += (sensitive.empty() ? "" : ", ") + std::to_string(i);
+    if (count > 12) sensitive += ", ... (" + std::to_string(count) + " in all)";
     throw InvalidInputError("joint " + std::to_string(joint) + " is " +
-                            std::string(to_string(j.kind)) + ": only sensitive joints rotate");
+                            std::string(to_string(j.kind)) + ": only sensitive joints rotate (" +
+                            (count ? "this skeleton's: " + sensitive : "this skeleton has none") +
+                            ")");
+  }
   for (const std::uint32_t b : j.bones)
     if (tree.parent_joint[b] == joint) return b;
   throw InvalidInputError("joint " + std::to_string(joint) +
