@@ -74,14 +74,18 @@ std::string key_for(const fs::path& relative) {
 std::vector<Item> collect_inputs(const fs::path& input) {
   std::vector<Item> items;
   std::error_code error;
-  if (fs::is_directory(input, error)) {
+  const bool standard_input = input.native() == kStandardInput;
+  if (!standard_input && fs::is_directory(input, error)) {
     for (auto it = fs::recursive_directory_iterator(input, error); !error && it != fs::end(it);
          it.increment(error))
       if (it->is_regular_file() && is_mesh_path(it->path()))
         items.push_back({it->path(), key_for(it->path().lexically_relative(input))});
     if (error) detail::io_failure(input, "list", error.value());
   } else {
-    const detail::FileImage list = detail::read_file(input);
+    // A list of paths on standard input (`find ... | primseg batch -`), relative to the working
+    // directory as a list file's are.
+    const detail::FileImage list =
+        standard_input ? detail::read_standard_input() : detail::read_file(input);
     const std::string_view text = list.view();
     std::size_t begin = 0;
     while (begin < text.size()) {
@@ -102,7 +106,9 @@ std::vector<Item> collect_inputs(const fs::path& input) {
     if (items[i].key == items[i - 1].key)
       throw InvalidInputError("'" + items[i - 1].input.string() + "' and '" +
                               items[i].input.string() + "' would write the same outputs");
-  if (items.empty()) throw InvalidInputError("'" + input.string() + "': no mesh files to process");
+  if (items.empty())
+    throw InvalidInputError((standard_input ? input_name(input) : "'" + input.string() + "'") +
+                            ": no mesh files to process");
   return items;
 }
 
@@ -295,7 +301,8 @@ Command add_batch_command(CLI::App& app) {
       "batch", "Segment every mesh of a directory (recursively) or a list file, in parallel");
   batch
       ->add_option("INPUT_DIR_OR_LIST", o->input,
-                   "Directory of .off .obj .ply .stl files, or a text file with one path per line")
+                   "Directory of .off .obj .ply .stl files, or a text file with one path per line "
+                   "(- for standard input)")
       ->required();
   batch
       ->add_option("--out", o->out,

@@ -192,6 +192,11 @@ TEST(Batch, UnionOfShardsEqualsOneRunAndAListEqualsItsDirectory) {
     expected["in/" + name] = content;
   }
   EXPECT_EQ(listed, expected);
+  // The same list on standard input (`find ... | primseg batch -`).
+  EXPECT_EQ(testing::run_command("cd '" + dir.string() + "' && '" + testing::cli_path().string() +
+                                 "' batch - --out piped" + options + " < list.txt"),
+            1);
+  EXPECT_EQ(outputs(dir / "piped"), listed);
   fs::remove_all(dir);
 }
 
@@ -213,6 +218,8 @@ TEST(Batch, BadArgumentsAreRejectedWithAMessage) {
            {"batch '" + in.string() + "' --out '" + (in / "box.off" / "out").string() + "'",
             "cannot create the directory '" + (in / "box.off" / "out").string() +
                 "': Not a directory"},
+           {"batch - --out '" + (dir / "out").string() + "' < /dev/null",
+            "standard input: no mesh files to process"},
        }) {
     std::string output;
     EXPECT_EQ(primseg(c.args + " 2>&1", &output), 1) << c.args << "\n" << output;
