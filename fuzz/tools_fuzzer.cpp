@@ -202,11 +202,16 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
   for (const Triangle& t : input.triangles)
     for (const std::uint32_t v : t)
       if (!used[v]) used[v] = 1, --isolated;
-  if (report.moved + report.blocked + isolated != input.vertex_count())
-    fail("snap report: moved + blocked", report.moved, report.blocked);
+  if (report.snapped + report.blocked + isolated != input.vertex_count())
+    fail("snap report: snapped + blocked", report.snapped, report.blocked);
+  std::uint32_t changed = 0;
+  for (std::uint32_t v = 0; v < input.vertex_count(); ++v)
+    changed += denoised.positions[v] != input.positions[v] ? 1 : 0;
+  if (report.moved != changed) fail("snap report: moved", report.moved, changed);
   if (report.interior_vertices + report.boundary_vertices + isolated != input.vertex_count())
     fail("snap report: interior + boundary", report.interior_vertices, report.boundary_vertices);
-  if (!stylize && report.fallbacks > report.moved) fail("snap report: fallbacks", report.fallbacks);
+  if (!stylize && report.fallbacks > report.snapped)
+    fail("snap report: fallbacks", report.fallbacks);
 }
 
 Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
