@@ -14,6 +14,8 @@ namespace {
 
 constexpr char kMagic[8] = {'P', 'R', 'I', 'M', 'S', 'E', 'G', 'T'};
 constexpr std::uint32_t kVersion = 1;
+// A merge's bytes: 12 doubles, 3 uint32 and 2 bytes (docs/tree-format.md).
+constexpr std::size_t kMergeBytes = 110;
 
 std::uint64_t fnv1a(std::string_view bytes) {
   std::uint64_t hash = 0xcbf29ce484222325ull;
@@ -192,7 +194,7 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
     r.fail(std::string("invalid mesh: ") + e.what());
   }
 
-  std::vector<Merge> merges(r.get_count(12 * 8 + 3 * 4 + 2, "merge"));
+  std::vector<Merge> merges(r.get_count(kMergeBytes, "merge"));
   for (Merge& m : merges) {
     m.first = r.get<std::uint32_t>("the merges");
     m.second = r.get<std::uint32_t>("the merges");
@@ -229,10 +231,13 @@ TreeSizeBound tree_size_from_prefix(std::span<const char> prefix, const std::str
   };
   // The layout of docs/tree-format.md: a fixed header, the primitive types, then four counted
   // arrays and the merges, and the checksum. Fields not yet in the prefix end the walk.
-  constexpr std::uint64_t kChecksum = 8, kMergeBytes = 12 * 8 + 3 * 4 + 2;
+  constexpr std::uint64_t kHeader = sizeof kMagic + 4 + 3;  // magic, version, 3 option bytes
+  constexpr std::uint64_t kPenalties = std::uint64_t{5} * 8, kTolerance = 8, kCount = 8;
+  constexpr std::uint64_t kChecksum = 8;
   Reader r(prefix, name);
-  std::uint64_t bytes = sizeof kMagic + 4 + 3 + 5 * 8 + 8 + 8 + kChecksum;  // no type, no array
-  if (prefix.size() < sizeof kMagic + 4 + 3) return {bytes, false};
+  // So far: no primitive type, and only the first count of empty arrays.
+  std::uint64_t bytes = kHeader + kPenalties + kTolerance + kCount + kChecksum;
+  if (prefix.size() < kHeader) return {bytes, false};
   for (std::size_t i = 0; i < sizeof kMagic; ++i) r.get<char>("the header");
   const auto version = r.get<std::uint32_t>("the version");
   if (version != kVersion)
@@ -243,15 +248,16 @@ TreeSizeBound tree_size_from_prefix(std::span<const char> prefix, const std::str
   const auto type_count = r.get<std::uint8_t>("the options");
   bytes += type_count;
   // Where each count lies, and the size of the items it counts.
-  std::uint64_t at = sizeof kMagic + 4 + 3 + type_count + 5 * 8 + 8;
+  std::uint64_t at = kHeader + type_count + kPenalties + kTolerance;
   const std::uint64_t item_sizes[] = {24, 4, 4, 16, kMergeBytes};
   for (std::size_t k = 0; k < std::size(item_sizes); ++k) {
-    if (at > prefix.size() || prefix.size() - at < 8) return {bytes, false};
-    const std::uint64_t count = Reader(prefix.subspan(at, 8), name).get<std::uint64_t>("a count");
+    if (at > prefix.size() || prefix.size() - at < kCount) return {bytes, false};
+    const std::uint64_t count =
+        Reader(prefix.subspan(at, kCount), name).get<std::uint64_t>("a count");
     const std::uint64_t array = times(count, item_sizes[k]);
     bytes = plus(bytes, array);
-    at = plus(at, plus(8, array));
-    if (k + 1 < std::size(item_sizes)) bytes = plus(bytes, 8);  // the next count
+    at = plus(at, plus(kCount, array));
+    if (k + 1 < std::size(item_sizes)) bytes = plus(bytes, kCount);  // the next count
   }
   return {bytes, true};
 }
