@@ -795,12 +795,13 @@ PYBIND11_MODULE(primseg, m) {
   // Registered before the functions that return it, so that their signatures name it.
   py::class_<PyHierarchy> hierarchy_class(
       m, "Hierarchy",
-      join_docs({"The whole merge tree of a mesh (from segment or read_tree).",
+      join_docs({"The whole merge tree of a mesh (from segment or read_tree). Read-only; pickles "
+                 "as its tree file's bytes (Hierarchy.save).",
                  cpp_doc("Hierarchy", doc::hierarchy__Hierarchy)})
           .c_str());
 
   py::class_<PyMesh>(m, "Mesh",
-                     join_docs({"A polygon mesh and its triangulation (read-only).",
+                     join_docs({"A polygon mesh and its triangulation (read-only; pickles).",
                                 cpp_doc("Mesh", doc::mesh__Mesh)})
                          .c_str())
       .def(py::init([](const py::object& V, const py::object& F) {
