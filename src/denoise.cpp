@@ -316,13 +316,13 @@ double noise_from(const Mesh& mesh, const Mesh& smoothed) {
 }  // namespace
 
 std::shared_ptr<const Mesh> Denoiser::estimate_copy() const {
-  const std::lock_guard lock(estimate_copy_mutex_);
-  if (!estimate_copy_) {
+  const std::lock_guard lock(estimate_copy_.mutex);
+  if (!estimate_copy_.copy) {
     BilateralSmoothingOptions options = kEstimateSmoothing;
     if (options_.bilateral_smoothing) options.threads = options_.bilateral_smoothing->threads;
-    estimate_copy_ = std::make_shared<const Mesh>(bilateral_smooth(mesh_, options));
+    estimate_copy_.copy = std::make_shared<const Mesh>(bilateral_smooth(mesh_, options));
   }
-  return estimate_copy_;
+  return estimate_copy_.copy;
 }
 
 std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
@@ -537,10 +537,7 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   const bool bounded =
       options_.mode == SnapMode::AllIncident && std::isfinite(options_.max_move_edge_lengths);
   const std::vector<Vec3> start = mesh_.positions;
-  {
-    const std::lock_guard lock(estimate_copy_mutex_);
-    estimate_copy_.reset();  // of positions about to move
-  }
+  estimate_copy_.set(nullptr);  // of positions about to move
 
   // Candidate targets of a vertex, most preferred first: all incident primitives, then without
   // the farthest one, and so on down to the nearest alone.

@@ -208,12 +208,31 @@ class Denoiser {
   // threads), so that a round smooths the mesh once, not twice.
   std::shared_ptr<const Mesh> estimate_copy() const;
 
+  // estimate_copy()'s result for the current positions (null until asked, reset by snap()),
+  // guarded by its mutex since the const methods that fill it may run concurrently. Copied and
+  // moved with the Denoiser (the copy is immutable and shared), each with its own mutex.
+  struct EstimateCopyCache {
+    EstimateCopyCache() = default;
+    EstimateCopyCache(const EstimateCopyCache& other) : copy(other.get()) {}
+    EstimateCopyCache& operator=(const EstimateCopyCache& other) {
+      set(other.get());
+      return *this;
+    }
+    std::shared_ptr<const Mesh> get() const {
+      const std::lock_guard lock(mutex);
+      return copy;
+    }
+    void set(std::shared_ptr<const Mesh> mesh) {
+      const std::lock_guard lock(mutex);
+      copy = std::move(mesh);
+    }
+    mutable std::mutex mutex;
+    std::shared_ptr<const Mesh> copy;
+  };
+
   Mesh mesh_;
   DenoiseOptions options_;
-  // estimate_copy()'s result for the current positions (null until asked, reset by snap()).
-  // Guarded by the mutex, since the const methods that fill it may run concurrently.
-  mutable std::mutex estimate_copy_mutex_;
-  mutable std::shared_ptr<const Mesh> estimate_copy_;
+  mutable EstimateCopyCache estimate_copy_;
   std::vector<Vec3> input_normals_;        // per triangle, unnormalised: orientation reference
   std::vector<double> local_edge_length_;  // per vertex, in the input mesh
   // Triangles around each vertex: those of vertex v are

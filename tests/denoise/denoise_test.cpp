@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -534,6 +535,13 @@ TEST(Denoise, TheBilateralCopyIsTheNoiseEstimatesOwn) {
     Denoiser denoiser(box.noisy.mesh, options);
     const std::shared_ptr<const Mesh> copy = denoiser.segmented_mesh();
     EXPECT_EQ(copy == denoiser.segmented_mesh(), normal_sigma == 0.35);
+    // A Denoiser copies with its copy; snapping the other one leaves this one's alone.
+    static_assert(std::is_copy_constructible_v<Denoiser> && std::is_move_assignable_v<Denoiser>);
+    Denoiser other = denoiser;
+    EXPECT_EQ(other.segmented_mesh() == copy, normal_sigma == 0.35);
+    other.iterate(level_by_count(6));
+    EXPECT_EQ(denoiser.segmented_mesh() == copy, normal_sigma == 0.35);
+    EXPECT_NE(other.segmented_mesh()->positions, copy->positions);
     EXPECT_EQ(copy->positions,
               bilateral_smooth(box.noisy.mesh, *options.bilateral_smoothing).positions);
     for (int round = 0; round < 2; ++round) {
