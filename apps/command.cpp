@@ -83,7 +83,7 @@ Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* byte
             name + ": the tree's counts declare " + std::to_string(size.bytes) +
             " bytes, more than " +
             (max_memory ? "--max-memory " + std::to_string(*max_memory)
-                        : std::to_string(most_bytes) + ", the most read without a size"));
+                        : std::to_string(most_bytes) + " bytes, the most this read accepts"));
       if (size.exact && prefix.size() > size.bytes)
         throw ParseError(name + ": byte " + std::to_string(size.bytes) +
                          ": unexpected data after the tree's checksum");

@@ -76,8 +76,8 @@ FileImage read_to_end(int fd, const std::filesystem::path& name, bool sized, std
                               " bytes, the most read without a size (1/" +
                               std::to_string(std::lround(1 / limits.unsized_memory_fraction)) +
                               " of the " + std::to_string(memory) +
-                              " bytes of memory this process may use; --max-memory sets "
-                              "another limit)");
+                              " bytes of memory this process may use; a command's "
+                              "--max-memory sets another limit)");
     if (image.size > most)
       throw IoError("cannot read '" + name.string() + "': more than the memory this process " +
                     "may use (" + std::to_string(memory) + " bytes)");

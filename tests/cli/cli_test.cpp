@@ -998,7 +998,7 @@ TEST(Cli, BadTreeFilesAreRejectedWithAMessage) {
       {"endless zeros on standard input", "cut - --clusters 2 < /dev/zero", {"bad magic"}},
       {"a tree whose counts declare more than can be read, on standard input",
        "cut - --clusters 2 < " + dir.q("huge-count.tree"),
-       {"standard input", "declare", "the most read without a size"}},
+       {"standard input", "declare", "the most this read accepts"}},
       {"tree passed as a mesh", "segment " + dir.q("t.tree"), {"t.tree"}},
       {"cut --clusters 0", "cut " + dir.q("t.tree") + " --clusters 0", {"clusters"}},
       {"cut --clusters F+1",
