@@ -215,7 +215,7 @@ class Denoiser {
     EstimateCopyCache() = default;
     EstimateCopyCache(const EstimateCopyCache& other) : copy(other.get()) {}
     EstimateCopyCache& operator=(const EstimateCopyCache& other) {
-      set(other.get());
+      if (this != &other) set(other.get());
       return *this;
     }
     std::shared_ptr<const Mesh> get() const {
