@@ -74,7 +74,7 @@ std::string key_for(const fs::path& relative) {
 std::vector<Item> collect_inputs(const fs::path& input) {
   std::vector<Item> items;
   std::error_code error;
-  const bool standard_input = input.native() == kStandardInput;
+  const bool standard_input = is_standard_input(input);
   if (!standard_input && fs::is_directory(input, error)) {
     for (auto it = fs::recursive_directory_iterator(input, error); !error && it != fs::end(it);
          it.increment(error))

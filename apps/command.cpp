@@ -19,7 +19,7 @@ double seconds_since(Clock::time_point start) {
 }
 
 std::string input_name(const std::filesystem::path& path) {
-  return path.native() == kStandardInput ? std::string("standard input") : path.string();
+  return is_standard_input(path) ? std::string("standard input") : path.string();
 }
 
 namespace {
@@ -37,7 +37,7 @@ detail::ReadLimits memory_limits(std::optional<std::uint64_t> max_memory) {
 
 Mesh read_input_mesh(const std::filesystem::path& path, std::uint64_t* bytes,
                      std::optional<std::uint64_t> max_memory) {
-  const bool standard_input = path.native() == kStandardInput;
+  const bool standard_input = is_standard_input(path);
   // As read_mesh(path): an unknown extension fails before the file is read.
   const std::optional<MeshFormat> format =
       standard_input ? std::nullopt : std::optional(mesh_format_from_path(path));
@@ -69,7 +69,7 @@ Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes,
 
 Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* bytes,
                           std::optional<std::uint64_t> max_memory) {
-  const bool standard_input = path.native() == kStandardInput;
+  const bool standard_input = is_standard_input(path);
   const std::string name = input_name(path);
   detail::ReadLimits limits = memory_limits(max_memory);
   // Cutting a tree takes about 3.3 times its file's bytes (512 per face against 154).

@@ -41,6 +41,11 @@ double seconds_since(Clock::time_point start);
 /// The input path that stands for standard input.
 inline constexpr std::string_view kStandardInput = "-";
 
+/// True for the path "-".
+inline bool is_standard_input(const std::filesystem::path& path) {
+  return path.native() == kStandardInput;
+}
+
 /// How messages name an input: its path, or "standard input" for "-".
 std::string input_name(const std::filesystem::path& path);
 

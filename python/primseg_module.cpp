@@ -1210,8 +1210,7 @@ same clusters as cut(k). The same matrix as the CLI's --linkage.)",
             py::dict table;
             table["children"] = adopt<std::int32_t>(std::move(children), {rows, 2});
             table["face_count"] = adopt<std::int32_t>(std::move(face_count), {rows});
-            table["trailing"] = adopt<std::uint8_t>(std::move(trailing), {rows})
-                                    .attr("astype")(numpy.attr("bool_"));
+            table["trailing"] = adopt<bool>(std::move(trailing), {rows});  // bytes 0 and 1
             table["type"] = numpy.attr("array")(names).attr("__getitem__")(
                 adopt<std::int8_t>(std::move(type), {rows}));
             table["rms"] = adopt<double>(std::move(rms), {rows});
@@ -1291,7 +1290,8 @@ these are the tree's own fits, for rules of one's own over all nodes.)",
           [](const py::tuple& state) {
             if (state.size() != 1 || !py::isinstance<py::bytes>(state[0]))
               throw InvalidInputError("Hierarchy: not a pickled primseg.Hierarchy");
-            const std::string bytes = state[0].cast<std::string>();
+            // The bytes object outlives the read (the caller holds the state): no copy.
+            const auto bytes = state[0].cast<std::string_view>();
             py::gil_scoped_release release;
             return PyHierarchy{std::make_shared<const Hierarchy>(
                 deserialize_tree(bytes, "pickled primseg.Hierarchy"))};

@@ -290,11 +290,9 @@ namespace {
 // aside: the result does not depend on them).
 const BilateralSmoothingOptions kEstimateSmoothing{};
 
-bool smooths_as_the_estimate(const BilateralSmoothingOptions& options) {
-  const BilateralSmoothingOptions& e = kEstimateSmoothing;
-  return options.normal_iterations == e.normal_iterations &&
-         options.normal_sigma == e.normal_sigma && options.spatial_sigma == e.spatial_sigma &&
-         options.vertex_iterations == e.vertex_iterations;
+bool smooths_as_the_estimate(BilateralSmoothingOptions options) {
+  options.threads = kEstimateSmoothing.threads;
+  return options == kEstimateSmoothing;
 }
 
 // RMS distance between the used vertices of `mesh` and their smoothed positions.

@@ -88,6 +88,22 @@ class Reader {
   std::size_t offset_ = 0;
 };
 
+// The first checks of every reader: the magic number, as far as `bytes` holds it (`r` at their
+// start), then, from `r`, the magic number and a version this primseg reads.
+void check_magic(std::span<const char> bytes, const Reader& r) {
+  const std::size_t length = std::min(bytes.size(), sizeof kMagic);
+  if (length > 0 && std::memcmp(bytes.data(), kMagic, length) != 0)
+    r.fail("not a primseg tree file (bad magic number)");
+}
+
+void read_magic_and_version(Reader& r) {
+  for (std::size_t i = 0; i < sizeof kMagic; ++i) r.get<char>("the header");
+  const auto version = r.get<std::uint32_t>("the version");
+  if (version != kVersion)
+    r.fail("tree file version " + std::to_string(version) +
+           " is not supported (this primseg reads version " + std::to_string(kVersion) + ")");
+}
+
 }  // namespace
 
 std::string serialize_tree(const Hierarchy& hierarchy) {
@@ -139,8 +155,7 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
   if (bytes.empty()) throw ParseError(name + ": empty file");
   Reader r(bytes, name);
   r.need(sizeof kMagic, "the header");
-  if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
-    r.fail("not a primseg tree file (bad magic number)");
+  check_magic(bytes, r);
   if (bytes.size() < sizeof kMagic + 4 + 8) r.fail("truncated file while reading the header");
   {
     Reader checksum_reader(bytes.subspan(bytes.size() - 8), name);
@@ -150,13 +165,7 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
   }
   bytes = bytes.first(bytes.size() - 8);
   r = Reader(bytes, name);
-  for (std::size_t i = 0; i < sizeof kMagic; ++i) r.get<char>("the header");
-  const auto version = r.get<std::uint32_t>("the version");
-  if (version != kVersion)
-    r.fail("tree file version " + std::to_string(version) +
-           " is not supported (this primseg reads "
-           "version " +
-           std::to_string(kVersion) + ")");
+  read_magic_and_version(r);
 
   HierarchyOptions options;
   const auto weights = r.get<std::uint8_t>("the options");
@@ -221,9 +230,8 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
 }
 
 TreeSizeBound tree_size_from_prefix(std::span<const char> prefix, const std::string& name) {
-  const std::size_t magic = std::min(prefix.size(), sizeof kMagic);
-  if (std::memcmp(prefix.data(), kMagic, magic) != 0)
-    throw ParseError(name + ": byte 0: not a primseg tree file (bad magic number)");
+  Reader r(prefix, name);
+  check_magic(prefix, r);
   constexpr std::uint64_t kMost = std::numeric_limits<std::uint64_t>::max();
   const auto plus = [](std::uint64_t a, std::uint64_t b) { return a > kMost - b ? kMost : a + b; };
   const auto times = [](std::uint64_t count, std::uint64_t size) {
@@ -234,15 +242,10 @@ TreeSizeBound tree_size_from_prefix(std::span<const char> prefix, const std::str
   constexpr std::uint64_t kHeader = sizeof kMagic + 4 + 3;  // magic, version, 3 option bytes
   constexpr std::uint64_t kPenalties = std::uint64_t{5} * 8, kTolerance = 8, kCount = 8;
   constexpr std::uint64_t kChecksum = 8;
-  Reader r(prefix, name);
   // So far: no primitive type, and only the first count of empty arrays.
   std::uint64_t bytes = kHeader + kPenalties + kTolerance + kCount + kChecksum;
   if (prefix.size() < kHeader) return {bytes, false};
-  for (std::size_t i = 0; i < sizeof kMagic; ++i) r.get<char>("the header");
-  const auto version = r.get<std::uint32_t>("the version");
-  if (version != kVersion)
-    r.fail("tree file version " + std::to_string(version) +
-           " is not supported (this primseg reads version " + std::to_string(kVersion) + ")");
+  read_magic_and_version(r);
   r.get<std::uint8_t>("the options");
   r.get<std::uint8_t>("the options");
   const auto type_count = r.get<std::uint8_t>("the options");

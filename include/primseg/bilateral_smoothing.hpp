@@ -33,6 +33,8 @@ struct BilateralSmoothingOptions {
   /// Threads over the faces and vertices of each pass (0: all hardware threads); the result is
   /// the same, bit for bit, for any number.
   unsigned threads = 0;
+
+  bool operator==(const BilateralSmoothingOptions&) const = default;
 };
 
 /// Throws InvalidInputError for options out of range.
