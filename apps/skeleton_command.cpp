@@ -8,6 +8,7 @@
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/skeleton.hpp"
+#include "primseg/skeleton_gltf.hpp"
 #include "primseg/skinning.hpp"
 #include "skeleton_io.hpp"
 
@@ -16,7 +17,8 @@ namespace primseg::cli {
 Command add_skeleton_command(CLI::App& app) {
   struct Options {
     std::string mesh_path, output, primitives = "cylinder";
-    std::optional<std::string> skin_weights;
+    std::optional<std::string> skin_weights, gltf;
+    std::uint32_t max_influences = GltfOptions{}.max_influences;
     SkeletonPicture picture;
     LevelChoice level;
     double band = SkinningOptions{}.band;
@@ -40,6 +42,16 @@ Command add_skeleton_command(CLI::App& app) {
   command->add_option("-o,--output", o->output, "Skeleton file (JSON)")->required();
   command->add_option("--skin-weights", o->skin_weights,
                       "Write skinning weights: one line per vertex, 'bone weight' pairs");
+  auto* gltf_option =
+      command->add_option("--gltf", o->gltf,
+                          "Write the mesh skinned to the skeleton as binary glTF 2.0 (.glb), for "
+                          "Blender, three.js or a game engine");
+  command
+      ->add_option("--max-influences", o->max_influences,
+                   "--gltf: most bones per vertex, the largest weights kept and rescaled (0: all; "
+                   "4 for engines that take four)")
+      ->capture_default_str()
+      ->needs(gltf_option);
   command
       ->add_option("--band", o->band,
                    "Skinning blend half-width on each side of a boundary, in bone radii")
@@ -49,56 +61,62 @@ Command add_skeleton_command(CLI::App& app) {
   command->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
   add_limit_options(*command, o->limits, kHierarchyBytesPerFace);
 
-  return {command, [o] {
-            HierarchyOptions options;
-            options.primitives = parse_primitives(o->primitives);
-            options.threads = o->threads;
-            validate(options);
-            if (!(std::isfinite(o->band) && o->band >= 0))
-              throw InvalidInputError("--band: must be a finite number >= 0");
-            auto mesh = std::make_shared<const Mesh>(
-                read_geometry_within(o->mesh_path, o->limits, o->picture.png ? kPictureBytes : 0));
-            validate_level(o->level, mesh->face_count());
-            const auto build_start = Clock::now();
-            HierarchyBuilder builder(mesh, options);
-            const Hierarchy hierarchy = builder.finish(Progress("hierarchy", o->quiet));
-            const double build_seconds = seconds_since(build_start);
-            const auto skeleton_start = Clock::now();
-            const Skeleton skeleton =
-                extract_skeleton(hierarchy, cut(hierarchy, o->level).segmentation);
-            const double skeleton_seconds = seconds_since(skeleton_start);
+  return {
+      command, [o] {
+        HierarchyOptions options;
+        options.primitives = parse_primitives(o->primitives);
+        options.threads = o->threads;
+        validate(options);
+        if (!(std::isfinite(o->band) && o->band >= 0))
+          throw InvalidInputError("--band: must be a finite number >= 0");
+        auto mesh = std::make_shared<const Mesh>(
+            read_geometry_within(o->mesh_path, o->limits, o->picture.png ? kPictureBytes : 0));
+        validate_level(o->level, mesh->face_count());
+        const auto build_start = Clock::now();
+        HierarchyBuilder builder(mesh, options);
+        const Hierarchy hierarchy = builder.finish(Progress("hierarchy", o->quiet));
+        const double build_seconds = seconds_since(build_start);
+        const auto skeleton_start = Clock::now();
+        const Skeleton skeleton =
+            extract_skeleton(hierarchy, cut(hierarchy, o->level).segmentation);
+        const double skeleton_seconds = seconds_since(skeleton_start);
 
-            nlohmann::json json;
-            json["mesh"] = mesh_summary(o->mesh_path, hierarchy);
-            json["primitives"] = o->primitives;
-            const std::optional<std::uint32_t> requested = parse_cluster_count(*o->level.clusters);
-            if (requested)
-              json["requested_clusters"] = *requested;
-            else
-              json["requested_clusters"] = "auto";
-            json["timing"] = {{"hierarchy_seconds", build_seconds},
-                              {"skeleton_seconds", skeleton_seconds}};
-            if (o->skin_weights) {
-              const auto skin_start = Clock::now();
-              SkinningOptions skinning;
-              skinning.band = o->band;
-              const SkinWeights weights = compute_skin_weights(*mesh, skeleton, skinning);
-              json["timing"]["skin_weights_seconds"] = seconds_since(skin_start);
-              detail::write_file_atomically(*o->skin_weights, skin_weights_text(weights));
-            }
-            detail::write_file_atomically(o->output, skeleton_file_text(skeleton, std::move(json)));
-            o->picture.write(*mesh, skeleton);
-            if (!o->quiet) {
-              std::size_t counts[3] = {0, 0, 0};
-              for (const Joint& joint : skeleton.joints) ++counts[static_cast<int>(joint.kind)];
-              std::printf(
-                  "%s: %s, hierarchy in %.3f s; %s, %s (%zu sensitive, %zu locked, %zu virtual)\n",
-                  input_name(o->mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
-                  build_seconds, count_of(skeleton.cluster_count(), "bone").c_str(),
-                  count_of(skeleton.joints.size(), "joint").c_str(), counts[0], counts[1],
-                  counts[2]);
-            }
-          }};
+        nlohmann::json json;
+        json["mesh"] = mesh_summary(o->mesh_path, hierarchy);
+        json["primitives"] = o->primitives;
+        const std::optional<std::uint32_t> requested = parse_cluster_count(*o->level.clusters);
+        if (requested)
+          json["requested_clusters"] = *requested;
+        else
+          json["requested_clusters"] = "auto";
+        json["timing"] = {{"hierarchy_seconds", build_seconds},
+                          {"skeleton_seconds", skeleton_seconds}};
+        if (o->skin_weights || o->gltf) {
+          const auto skin_start = Clock::now();
+          SkinningOptions skinning;
+          skinning.band = o->band;
+          const SkinWeights weights = compute_skin_weights(*mesh, skeleton, skinning);
+          json["timing"]["skin_weights_seconds"] = seconds_since(skin_start);
+          if (o->skin_weights)
+            detail::write_file_atomically(*o->skin_weights, skin_weights_text(weights));
+          if (o->gltf) {
+            GltfOptions gltf;
+            gltf.max_influences = o->max_influences;
+            detail::write_file_atomically(*o->gltf, skinned_glb(*mesh, skeleton, weights, gltf));
+          }
+        }
+        detail::write_file_atomically(o->output, skeleton_file_text(skeleton, std::move(json)));
+        o->picture.write(*mesh, skeleton);
+        if (!o->quiet) {
+          std::size_t counts[3] = {0, 0, 0};
+          for (const Joint& joint : skeleton.joints) ++counts[static_cast<int>(joint.kind)];
+          std::printf(
+              "%s: %s, hierarchy in %.3f s; %s, %s (%zu sensitive, %zu locked, %zu virtual)\n",
+              input_name(o->mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
+              build_seconds, count_of(skeleton.cluster_count(), "bone").c_str(),
+              count_of(skeleton.joints.size(), "joint").c_str(), counts[0], counts[1], counts[2]);
+        }
+      }};
 }
 
 }  // namespace primseg::cli

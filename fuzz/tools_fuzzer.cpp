@@ -8,8 +8,9 @@
 // - every result is finite, and holds what its header promises: a report's `max` is the largest
 //   distance of its cluster's vertices of positive weight and bounds its `rms`; refinement keeps
 //   the number of clusters and each one connected; a skeleton has a bone per cluster and valid
-//   joint ids; every skinning row sums to 1; denoising keeps the connectivity and inverts no
-//   triangle; a distance's mean <= RMS <= Hausdorff;
+//   joint ids; every skinning row sums to 1; its glTF file is well formed (chunk sizes, every
+//   accessor inside the buffer, finite bounds, float32 weight rows summing to 1); denoising keeps
+//   the connectivity and inverts no triangle; a distance's mean <= RMS <= Hausdorff;
 // - units do not matter (mesh.hpp, kMaxCoordinateMagnitude): the scaled run gives the same tree,
 //   costs, labels, weights and picture, and every length scaled by exactly the same power of two
 //   (but for round-off zeros that underflowed below the normal doubles, see ScaleCheck);
@@ -23,8 +24,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <vector>
@@ -38,6 +41,7 @@
 #include "primseg/refine.hpp"
 #include "primseg/render.hpp"
 #include "primseg/skeleton.hpp"
+#include "primseg/skeleton_gltf.hpp"
 #include "primseg/skinning.hpp"
 #include "tree_invariants.hpp"
 
@@ -184,6 +188,50 @@ void check_skeleton(const Mesh& mesh, const Segmentation& level, const Skeleton&
   }
 }
 
+std::uint32_t u32_at(const std::string& bytes, std::size_t offset) {
+  std::uint32_t value = 0;
+  if (offset + 4 <= bytes.size()) std::memcpy(&value, bytes.data() + offset, 4);
+  return value;
+}
+
+// The GLB container and the promises of skeleton_gltf.hpp, as a glTF reader relies on them.
+void check_glb(const std::string& glb, std::uint32_t vertex_count) {
+  if (u32_at(glb, 0) != 0x46546C67 || u32_at(glb, 8) != glb.size()) fail("glb header");
+  const std::uint32_t json_length = u32_at(glb, 12);
+  const std::size_t bin_at = 20 + std::size_t{json_length};
+  if (json_length % 4 != 0 || bin_at + 8 > glb.size()) fail("glb json chunk", json_length);
+  const std::string bin = glb.substr(bin_at + 8);
+  if (u32_at(glb, bin_at) != bin.size() || bin.size() % 4 != 0) fail("glb bin chunk");
+  const nlohmann::json gltf = nlohmann::json::parse(glb.substr(20, json_length));
+  if (gltf["buffers"][0]["byteLength"] != bin.size()) fail("glb buffer length");
+  for (const auto& accessor : gltf["accessors"]) {
+    const auto& view = gltf["bufferViews"][accessor["bufferView"].get<std::size_t>()];
+    if (view["byteOffset"].get<std::size_t>() + view["byteLength"].get<std::size_t>() > bin.size())
+      fail("glb view outside the buffer");
+    for (const char* bound : {"min", "max"})
+      if (accessor.contains(bound))
+        for (const auto& x : accessor[bound])
+          if (!x.is_number()) fail("glb accessor bound");
+  }
+  const auto& attributes = gltf["meshes"][0]["primitives"][0]["attributes"];
+  std::vector<double> sums(vertex_count, 0.0);
+  for (int set = 0; attributes.contains("WEIGHTS_" + std::to_string(set)); ++set) {
+    const auto& accessor =
+        gltf["accessors"][attributes["WEIGHTS_" + std::to_string(set)].get<std::size_t>()];
+    if (accessor["count"] != vertex_count) fail("glb weight count");
+    const std::size_t at =
+        gltf["bufferViews"][accessor["bufferView"].get<std::size_t>()]["byteOffset"];
+    for (std::size_t i = 0; i < 4 * std::size_t{vertex_count}; ++i) {
+      float w = 0;
+      std::memcpy(&w, bin.data() + at + 4 * i, 4);
+      if (!(w >= 0 && w <= 1)) fail("glb weight", w);
+      sums[i / 4] += w;
+    }
+  }
+  for (std::uint32_t v = 0; v < vertex_count; ++v)
+    if (std::abs(sums[v] - 1) > 1e-6) fail("glb weight row sum", v, sums[v]);
+}
+
 void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& report,
                     bool stylize) {
   if (denoised.vertex_count() != input.vertex_count() || denoised.triangles != input.triangles ||
@@ -238,6 +286,7 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
   results.skeleton = extract_skeleton(hierarchy, results.level);
   results.skin = compute_skin_weights(*mesh, results.skeleton);
   check_skeleton(*mesh, results.level, results.skeleton, results.skin);
+  check_glb(skinned_glb(*mesh, results.skeleton, results.skin), mesh->vertex_count());
 
   Denoiser denoiser(*mesh, settings.denoise);
   const SnapReport report = settings.automatic_level ? denoiser.iterate([&](const Hierarchy& h) {

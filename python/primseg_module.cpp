@@ -32,6 +32,7 @@
 #include "primseg/refine.hpp"
 #include "primseg/render.hpp"
 #include "primseg/skeleton.hpp"
+#include "primseg/skeleton_gltf.hpp"
 #include "primseg/skinning.hpp"
 #include "primseg/tree_io.hpp"
 
@@ -1551,6 +1552,34 @@ repeated joint, or a zero axis.)",
                      cpp_doc("JointRotation", doc::skinning__JointRotation),
                      cpp_doc("pose_bones", doc::skinning__pose_bones),
                      cpp_doc("skin_positions", doc::skinning__skin_positions)})
+              .c_str())
+      .def(
+          "gltf",
+          [](PySkeleton& self, double band, std::int64_t max_influences) {
+            if (max_influences < 0 || max_influences > std::numeric_limits<std::uint32_t>::max())
+              throw InvalidInputError("max_influences must be >= 0 (0: all), not " +
+                                      std::to_string(max_influences));
+            const std::shared_ptr<const SkinWeights> weights = self.skin_weights(band);
+            std::string bytes;
+            {
+              py::gil_scoped_release release;
+              GltfOptions options;
+              options.max_influences = static_cast<std::uint32_t>(max_influences);
+              bytes = skinned_glb(*self.mesh, *self.skeleton, *weights, options);
+            }
+            return py::bytes(bytes);
+          },
+          py::arg("band") = SkinningOptions{}.band,
+          py::arg("max_influences") = GltfOptions{}.max_influences,
+          join_docs({R"(gltf(band=0.5, max_influences=0) -> bytes
+
+`primseg skeleton --gltf`: the mesh skinned to this skeleton as a binary glTF 2.0 file (GLB), the
+CLI's file byte for byte; write it with open(path, "wb").write(...) and open it in Blender,
+three.js or a game engine. Rotating bone b's node (named "bone_b"; its extras name the joint it
+turns about) poses the mesh as deform() does. band: as in skin_weights(); max_influences: as
+the CLI's --max-influences (0 keeps every weight).)",
+                     cpp_doc("skeleton_gltf.hpp", doc::skeleton_gltf__file),
+                     cpp_doc("skinned_glb", doc::skeleton_gltf__skinned_glb)})
               .c_str())
       .def(
           "posed_joint_positions",

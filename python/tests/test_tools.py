@@ -2,6 +2,7 @@
 promise on shapes with known answers."""
 
 import json
+import struct
 
 import numpy as np
 import pytest
@@ -199,6 +200,29 @@ def test_deform_matches_the_cli(cli, man, man_skeleton, tmp_path):
     # The same pose as a list of dicts or of tuples.
     np.testing.assert_array_equal(man_skeleton.deform(pose["rotations"], band=0.8), expected)
     np.testing.assert_array_equal(man_skeleton.deform([(joint, (1, 0, 0), 40.0)], band=0.8), expected)
+
+
+def gltf_json(glb):
+    """The JSON chunk of a GLB file, after checking its header."""
+    magic, version, length, json_length, chunk = struct.unpack_from("<4sIIII", glb)
+    assert (magic, version, length, chunk) == (b"glTF", 2, len(glb), 0x4E4F534A)
+    return json.loads(glb[20:20 + json_length])
+
+
+def test_gltf_matches_the_cli(cli, man, man_skeleton, tmp_path):
+    run_cli(cli, "skeleton", man, "--clusters", "20", "-o", tmp_path / "s.json", "--gltf",
+            tmp_path / "man.glb", "--quiet")
+    glb = man_skeleton.gltf()
+    assert glb == (tmp_path / "man.glb").read_bytes()
+    # Some of man's vertices have five bones: every weight is kept in a second set unless capped.
+    attributes = gltf_json(glb)["meshes"][0]["primitives"][0]["attributes"]
+    assert "WEIGHTS_1" in attributes
+    capped = gltf_json(man_skeleton.gltf(max_influences=4))["meshes"][0]["primitives"][0]["attributes"]
+    assert "WEIGHTS_0" in capped and "WEIGHTS_1" not in capped
+    bones = [n for n in gltf_json(glb)["nodes"] if "bone" in n.get("extras", {})]
+    assert [n["name"] for n in bones] == [f"bone_{b}" for b in range(man_skeleton.cluster_count)]
+    with pytest.raises(ValueError, match="max_influences must be >= 0"):
+        man_skeleton.gltf(max_influences=-1)
 
 
 def test_skin_weights_and_poses(man_skeleton):

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -100,6 +101,32 @@ TEST_F(SkeletonCli, WritesTheSkeletonAndSkinWeights) {
     ++rows;
   }
   EXPECT_EQ(rows, figure_.mesh.vertex_count());
+}
+
+// The rigged mesh as GLB (read in depth by skeleton_gltf_test.cpp and web/test/gltf.test.mjs).
+TEST_F(SkeletonCli, WritesTheRiggedMeshAsGltf) {
+  const json s = skeleton("-q --gltf " + path("figure.glb") + " --max-influences 1");
+  const std::string glb = testing::file_contents(path("figure.glb"));
+  ASSERT_GE(glb.size(), 20u);
+  EXPECT_EQ(glb.substr(0, 4), "glTF");
+  std::uint32_t json_length = 0;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  const json gltf = json::parse(glb.substr(20, json_length));
+  std::size_t bones = 0;
+  for (const json& node : gltf["nodes"])
+    bones += node.contains("extras") && node["extras"].contains("bone");
+  EXPECT_EQ(bones, s["bones"].size());
+  // One bone per vertex: a single set of joints.
+  const json& attributes = gltf["meshes"][0]["primitives"][0]["attributes"];
+  EXPECT_TRUE(attributes.contains("WEIGHTS_0"));
+  EXPECT_FALSE(attributes.contains("WEIGHTS_1"));
+
+  std::string output;
+  EXPECT_NE(run("skeleton " + path("figure.off") + " --clusters 8 -o " + path("s.json") +
+                    " --max-influences 4",
+                &output),
+            0);
+  EXPECT_NE(output.find("--max-influences requires --gltf"), std::string::npos) << output;
 }
 
 TEST_F(SkeletonCli, DefaultPrimitivesAreCylindersOnly) {

@@ -1,5 +1,6 @@
 // Test meshes written as OFF files: generated here, so that the tests need no data download.
-import { writeFileSync } from 'node:fs';
+import assert from 'node:assert/strict';
+import { readFileSync, writeFileSync } from 'node:fs';
 
 function writeOff(path, vertices, triangles) {
   const lines = ['OFF', `${vertices.length} ${triangles.length} 0`];
@@ -58,4 +59,21 @@ export function writeWavyTorus(path, rows, columns) {
       triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
   writeOff(path, vertices, triangles);
   return triangles.length;
+}
+
+/** Vertex positions of an OFF file, flat. */
+export function readOffPositions(path) {
+  const words = readFileSync(path, 'utf8').split('\n').filter((line) => !line.startsWith('#'))
+    .join(' ').trim().split(/\s+/);
+  assert.equal(words[0], 'OFF');
+  const vertices = Number(words[1]);
+  return words.slice(4, 4 + 3 * vertices).map(Number);
+}
+
+/** Largest difference between two flat position arrays. */
+export function largestDifference(a, b) {
+  assert.equal(a.length, b.length);
+  let largest = 0;
+  for (let i = 0; i < a.length; ++i) largest = Math.max(largest, Math.abs(a[i] - b[i]));
+  return largest;
 }

@@ -12,6 +12,7 @@ import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { launchBrowser, openViewer } from './browser.mjs';
+import { largestDifference, readOffPositions } from './meshes.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const cli = resolve(process.env.PRIMSEG ?? join(here, '../../build/primseg'));
@@ -24,23 +25,6 @@ const primseg = (...args) => execFileSync(cli, args, { encoding: 'utf8', stdio: 
 const file = (name) => join(work, name);
 const SENSITIVE = 0, LOCKED = 1, VIRTUAL = 2;
 const KINDS = ['sensitive', 'locked', 'virtual'];
-
-/** Vertex positions of an OFF file, flat. */
-function readOffPositions(path) {
-  const words = readFileSync(path, 'utf8').split('\n').filter((line) => !line.startsWith('#'))
-    .join(' ').trim().split(/\s+/);
-  assert.equal(words[0], 'OFF');
-  const vertices = Number(words[1]);
-  return words.slice(4, 4 + 3 * vertices).map(Number);
-}
-
-// Largest difference between two flat position arrays.
-function largestDifference(a, b) {
-  assert.equal(a.length, b.length);
-  let largest = 0;
-  for (let i = 0; i < a.length; ++i) largest = Math.max(largest, Math.abs(a[i] - b[i]));
-  return largest;
-}
 
 // The figure's skeleton at K = 8 (torso, head, two upper arms, two forearms, two legs), from
 // primseg skeleton and in the page, with cylinders and spheres as in the C++ skeleton tests.

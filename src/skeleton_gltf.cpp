@@ -1,0 +1,351 @@
+#include "primseg/skeleton_gltf.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "no_index.hpp"
+#include "primseg/error.hpp"
+
+namespace primseg {
+namespace {
+
+using nlohmann::json;
+
+static_assert(std::endian::native == std::endian::little, "GLB is little-endian");
+
+using detail::kNone;
+constexpr std::size_t kInfluencesPerSet = 4;
+constexpr std::size_t kMaxSkinJoints = std::size_t{std::numeric_limits<std::uint16_t>::max()} + 1;
+// glTF's enumerations.
+constexpr int kFloat = 5126, kUnsignedShort = 5123, kUnsignedInt = 5125;
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963, kTriangles = 4;
+constexpr std::uint32_t kGlbMagic = 0x46546C67, kGlbVersion = 2;          // "glTF"
+constexpr std::uint32_t kJsonChunk = 0x4E4F534A, kBinChunk = 0x004E4942;  // "JSON", "BIN\0"
+
+// Checks what skinned_glb() relies on, for weights that did not come from compute_skin_weights.
+void check_inputs(const Mesh& mesh, const Skeleton& skeleton, const SkinWeights& weights) {
+  const std::size_t k = skeleton.bones.size();
+  if (k == 0) throw InvalidInputError("glTF skin: the skeleton has no bone");
+  if (skeleton.face_labels.size() != mesh.face_count())
+    throw InvalidInputError("glTF skin: the skeleton has " +
+                            std::to_string(skeleton.face_labels.size()) + " face labels for " +
+                            std::to_string(mesh.face_count()) + " faces");
+  if (weights.offsets.size() != std::size_t{mesh.vertex_count()} + 1 ||
+      weights.offsets.front() != 0 || weights.offsets.back() != weights.bones.size() ||
+      weights.bones.size() != weights.weights.size())
+    throw InvalidInputError("glTF skin: the skin weights do not have one row per vertex (" +
+                            std::to_string(mesh.vertex_count()) + ")");
+  for (std::uint32_t v = 0; v < weights.vertex_count(); ++v)
+    if (weights.offsets[v] > weights.offsets[v + 1])
+      throw InvalidInputError("glTF skin: the skin weights' row offsets decrease at vertex " +
+                              std::to_string(v));
+  for (std::size_t i = 0; i < weights.bones.size(); ++i) {
+    if (weights.bones[i] >= k)
+      throw InvalidInputError("glTF skin: a skin weight names bone " +
+                              std::to_string(weights.bones[i]) + " of " + std::to_string(k));
+    if (!(std::isfinite(weights.weights[i]) && weights.weights[i] >= 0))
+      throw InvalidInputError("glTF skin: skin weights must be finite and >= 0");
+  }
+  for (const Joint& joint : skeleton.joints)
+    for (const std::uint32_t b : joint.bones)
+      if (b >= k) throw InvalidInputError("glTF skin: a joint names a bone that does not exist");
+  for (const Bone& bone : skeleton.bones)
+    for (const std::uint32_t j : bone.joints)
+      if (j >= skeleton.joints.size())
+        throw InvalidInputError("glTF skin: a bone names a joint that does not exist");
+}
+
+// Each vertex's influences, largest weight first, in float32 rows summing to 1.
+struct Influences {
+  std::size_t per_vertex = 0;  // a multiple of kInfluencesPerSet
+  std::vector<std::uint16_t> joints;
+  std::vector<float> weights;
+};
+
+Influences vertex_influences(const SkinWeights& skin, std::uint32_t root_bone,
+                             std::uint32_t max_influences) {
+  const std::uint32_t n = skin.vertex_count();
+  std::size_t widest = 1;  // an empty row follows the root bone
+  for (std::uint32_t v = 0; v < n; ++v)
+    widest = std::max<std::size_t>(widest, skin.offsets[v + 1] - skin.offsets[v]);
+  if (max_influences > 0) widest = std::min<std::size_t>(widest, max_influences);
+  Influences out;
+  out.per_vertex = (widest + kInfluencesPerSet - 1) / kInfluencesPerSet * kInfluencesPerSet;
+  out.joints.assign(n * out.per_vertex, 0);
+  out.weights.assign(n * out.per_vertex, 0.0f);
+  std::vector<std::pair<double, std::uint32_t>> row;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    row.clear();
+    const auto bones = skin.bones_of(v);
+    const auto weights = skin.weights_of(v);
+    for (std::size_t i = 0; i < bones.size(); ++i)
+      if (weights[i] > 0) row.emplace_back(weights[i], bones[i]);
+    // Largest first, ties by bone id: set 0 holds what matters most, deterministically.
+    std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) {
+      return a.first > b.first || (a.first == b.first && a.second < b.second);
+    });
+    if (row.size() > widest) row.resize(widest);
+    double total = 0;
+    for (const auto& [weight, bone] : row) total += weight;
+    if (row.empty() || !(total > 0)) {
+      row.assign(1, {1.0, root_bone});
+      total = 1;
+    }
+    // float32 rows that sum to 1 as closely as float32 allows: the largest takes the rest.
+    float* w = &out.weights[v * out.per_vertex];
+    std::uint16_t* j = &out.joints[v * out.per_vertex];
+    double rest = 1;
+    for (std::size_t i = row.size(); i-- > 1;) {
+      w[i] = static_cast<float>(row[i].first / total);
+      rest -= w[i];
+    }
+    w[0] = static_cast<float>(rest);
+    for (std::size_t i = 0; i < row.size(); ++i) j[i] = static_cast<std::uint16_t>(row[i].second);
+  }
+  return out;
+}
+
+// Area-weighted vertex normals (unit); (0, 0, 1) where the triangles around a vertex have no area.
+std::vector<std::array<float, 3>> vertex_normals(const Mesh& mesh) {
+  std::vector<Vec3> sums(mesh.vertex_count(), Vec3{0, 0, 0});
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
+    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const Vec3 cross{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                     u[0] * w[1] - u[1] * w[0]};
+    for (const std::uint32_t v : t)
+      for (int i = 0; i < 3; ++i) sums[v][i] += cross[i];
+  }
+  std::vector<std::array<float, 3>> normals(sums.size(), {0.0f, 0.0f, 1.0f});
+  for (std::size_t v = 0; v < sums.size(); ++v) {
+    const double length = std::hypot(sums[v][0], sums[v][1], sums[v][2]);
+    if (length > 0 && std::isfinite(length))
+      for (int i = 0; i < 3; ++i) normals[v][i] = static_cast<float>(sums[v][i] / length);
+  }
+  return normals;
+}
+
+// The binary chunk, its views and accessors, built side by side.
+class BufferBuilder {
+ public:
+  // Appends `count` elements of `bytes_per_element` bytes; returns the accessor's index.
+  template <class T>
+  std::size_t add(const std::vector<T>& data, std::size_t count, const char* type,
+                  int component_type, std::optional<int> target,
+                  const json& extra = json::object()) {
+    const std::size_t offset = bin_.size();
+    const std::size_t bytes = data.size() * sizeof(T);
+    bin_.resize(offset + (bytes + 3) / 4 * 4, '\0');
+    if (bytes > 0) std::memcpy(bin_.data() + offset, data.data(), bytes);
+    json view{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}};
+    if (target) view["target"] = *target;
+    views_.push_back(std::move(view));
+    json accessor{{"bufferView", views_.size() - 1},
+                  {"componentType", component_type},
+                  {"count", count},
+                  {"type", type}};
+    accessor.update(extra);
+    accessors_.push_back(std::move(accessor));
+    return accessors_.size() - 1;
+  }
+
+  void finish(json& gltf, std::string& bin) {
+    gltf["buffers"] = json::array({{{"byteLength", bin_.size()}}});
+    gltf["bufferViews"] = std::move(views_);
+    gltf["accessors"] = std::move(accessors_);
+    bin = std::move(bin_);
+  }
+
+ private:
+  std::string bin_;
+  json views_ = json::array(), accessors_ = json::array();
+};
+
+void append_u32(std::string& out, std::uint32_t value) {
+  char bytes[4];
+  std::memcpy(bytes, &value, 4);
+  out.append(bytes, 4);
+}
+
+std::string glb(const json& gltf, const std::string& bin) {
+  std::string text = gltf.dump();
+  text.resize((text.size() + 3) / 4 * 4, ' ');  // the JSON chunk is padded with spaces
+  const std::size_t total = 12 + 8 + text.size() + 8 + bin.size();
+  if (total > std::numeric_limits<std::uint32_t>::max())
+    throw InvalidInputError("glTF skin: the mesh is too large for a GLB file (4 GB)");
+  std::string out;
+  out.reserve(total);
+  append_u32(out, kGlbMagic);
+  append_u32(out, kGlbVersion);
+  append_u32(out, static_cast<std::uint32_t>(total));
+  append_u32(out, static_cast<std::uint32_t>(text.size()));
+  append_u32(out, kJsonChunk);
+  out += text;
+  append_u32(out, static_cast<std::uint32_t>(bin.size()));
+  append_u32(out, kBinChunk);
+  out += bin;
+  return out;
+}
+
+json vec3_json(const Vec3& v) {
+  return json::array({v[0], v[1], v[2]});
+}
+
+}  // namespace
+
+std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWeights& weights,
+                        const GltfOptions& options) {
+  check_inputs(mesh, skeleton, weights);
+  const std::uint32_t k = skeleton.cluster_count();
+  std::vector<std::uint32_t> ends;  // virtual joints, in id order
+  for (const Joint& joint : skeleton.joints)
+    if (joint.kind == JointKind::Virtual && joint.bones.size() == 1) ends.push_back(joint.id);
+  const std::size_t skin_joints = std::size_t{k} + ends.size();
+  if (skin_joints > kMaxSkinJoints)
+    throw InvalidInputError("glTF skin: " + std::to_string(k) + " bones and " +
+                            std::to_string(ends.size()) +
+                            " end joints are more than a glTF skin's 16-bit joint indices hold");
+
+  const BoneTree tree = bone_tree(skeleton);
+  // Each bone turns about its pivot: the joint it hangs from, or its own axis point at a root.
+  std::vector<Vec3> pivots(k);
+  for (std::uint32_t b = 0; b < k; ++b)
+    pivots[b] = tree.parent_joint[b] == kNone ? skeleton.bones[b].point
+                                              : skeleton.joints[tree.parent_joint[b]].position;
+  const auto offset_from = [](const Vec3& p, const Vec3& origin) {
+    return Vec3{p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]};
+  };
+
+  BufferBuilder buffer;
+  const std::uint32_t n = mesh.vertex_count();
+  std::vector<float> positions(3 * std::size_t{n});
+  std::array<float, 3> low{}, high{};
+  for (std::size_t v = 0; v < n; ++v)
+    for (std::size_t i = 0; i < 3; ++i) {
+      const float x = static_cast<float>(mesh.positions[v][i]);
+      positions[3 * v + i] = x;
+      low[i] = v == 0 ? x : std::min(low[i], x);
+      high[i] = v == 0 ? x : std::max(high[i], x);
+    }
+  json primitive_attributes;
+  primitive_attributes["POSITION"] =
+      buffer.add(positions, n, "VEC3", kFloat, kArrayBuffer,
+                 {{"min", json::array({low[0], low[1], low[2]})},
+                  {"max", json::array({high[0], high[1], high[2]})}});
+  const auto normals = vertex_normals(mesh);
+  primitive_attributes["NORMAL"] = buffer.add(normals, n, "VEC3", kFloat, kArrayBuffer);
+
+  const Influences influences =
+      vertex_influences(weights, skeleton.root_bone(), options.max_influences);
+  for (std::size_t set = 0; set * kInfluencesPerSet < influences.per_vertex; ++set) {
+    std::vector<std::uint16_t> joints(4 * std::size_t{n});
+    std::vector<float> values(4 * std::size_t{n});
+    for (std::size_t v = 0; v < n; ++v)
+      for (std::size_t i = 0; i < kInfluencesPerSet; ++i) {
+        const std::size_t from = v * influences.per_vertex + set * kInfluencesPerSet + i;
+        joints[kInfluencesPerSet * v + i] = influences.joints[from];
+        values[kInfluencesPerSet * v + i] = influences.weights[from];
+      }
+    // (Appended, not "_" + to_string(): g++ 12 warns falsely on that, -Wrestrict.)
+    std::string joints_name = "JOINTS_", weights_name = "WEIGHTS_";
+    joints_name += std::to_string(set);
+    weights_name += std::to_string(set);
+    primitive_attributes[joints_name] = buffer.add(joints, n, "VEC4", kUnsignedShort, kArrayBuffer);
+    primitive_attributes[weights_name] = buffer.add(values, n, "VEC4", kFloat, kArrayBuffer);
+  }
+
+  std::vector<std::uint32_t> indices;
+  indices.reserve(3 * mesh.triangles.size());
+  for (const Triangle& t : mesh.triangles) indices.insert(indices.end(), t.begin(), t.end());
+  const std::size_t index_accessor =
+      buffer.add(indices, indices.size(), "SCALAR", kUnsignedInt, kElementArrayBuffer);
+
+  // Inverse bind matrices (column-major): the rest pose has every node unrotated, so each one
+  // only moves its joint's rest position to the origin.
+  std::vector<float> inverse_binds;
+  inverse_binds.reserve(16 * skin_joints);
+  const auto add_inverse_bind = [&inverse_binds](const Vec3& at) {
+    const float matrix[16] = {1,
+                              0,
+                              0,
+                              0,
+                              0,
+                              1,
+                              0,
+                              0,
+                              0,
+                              0,
+                              1,
+                              0,
+                              static_cast<float>(-at[0]),
+                              static_cast<float>(-at[1]),
+                              static_cast<float>(-at[2]),
+                              1};
+    inverse_binds.insert(inverse_binds.end(), matrix, matrix + 16);
+  };
+  for (std::uint32_t b = 0; b < k; ++b) add_inverse_bind(pivots[b]);
+  for (const std::uint32_t j : ends) add_inverse_bind(skeleton.joints[j].position);
+  const std::size_t inverse_bind_accessor =
+      buffer.add(inverse_binds, skin_joints, "MAT4", kFloat, std::nullopt);
+
+  constexpr std::size_t kFirstBoneNode = 2;
+  json nodes = json::array();
+  nodes.push_back({{"name", "mesh"}, {"mesh", 0}, {"skin", 0}});
+  nodes.push_back({{"name", "skeleton"}, {"children", json::array()}});
+  for (std::uint32_t b = 0; b < k; ++b) {
+    const std::uint32_t parent = tree.parent_bone[b], joint = tree.parent_joint[b];
+    json extras{{"bone", b}};
+    extras["joint"] = joint == kNone ? json(nullptr) : json(joint);
+    extras["joint_kind"] =
+        joint == kNone ? json(nullptr) : json(to_string(skeleton.joints[joint].kind));
+    nodes.push_back(
+        {{"name", "bone_" + std::to_string(b)},
+         {"translation",
+          vec3_json(parent == kNone ? pivots[b] : offset_from(pivots[b], pivots[parent]))},
+         {"extras", std::move(extras)}});
+    if (parent == kNone) nodes[1]["children"].push_back(kFirstBoneNode + b);
+  }
+  for (std::size_t e = 0; e < ends.size(); ++e) {
+    const Joint& joint = skeleton.joints[ends[e]];
+    const std::uint32_t bone = joint.bones[0];
+    nodes.push_back({{"name", "end_" + std::to_string(joint.id)},
+                     {"translation", vec3_json(offset_from(joint.position, pivots[bone]))},
+                     {"extras", {{"joint", joint.id}, {"joint_kind", to_string(joint.kind)}}}});
+  }
+  // Children in node order, so that the file does not depend on the order they were found in.
+  for (std::uint32_t b = 0; b < k; ++b)
+    if (tree.parent_bone[b] != kNone)
+      nodes[kFirstBoneNode + tree.parent_bone[b]]["children"].push_back(kFirstBoneNode + b);
+  for (std::size_t e = 0; e < ends.size(); ++e)
+    nodes[kFirstBoneNode + skeleton.joints[ends[e]].bones[0]]["children"].push_back(kFirstBoneNode +
+                                                                                    k + e);
+
+  json skin_joint_nodes = json::array();
+  for (std::size_t i = 0; i < skin_joints; ++i) skin_joint_nodes.push_back(kFirstBoneNode + i);
+
+  json gltf;
+  gltf["asset"] = {{"version", "2.0"}, {"generator", "primseg"}};
+  gltf["scene"] = 0;
+  gltf["scenes"] = json::array({{{"nodes", json::array({0, 1})}}});
+  gltf["nodes"] = std::move(nodes);
+  gltf["meshes"] = json::array({{{"name", "mesh"},
+                                 {"primitives", json::array({{{"attributes", primitive_attributes},
+                                                              {"indices", index_accessor},
+                                                              {"mode", kTriangles}}})}}});
+  gltf["skins"] = json::array({{{"joints", std::move(skin_joint_nodes)},
+                                {"inverseBindMatrices", inverse_bind_accessor},
+                                {"skeleton", 1}}});
+  std::string bin;
+  buffer.finish(gltf, bin);
+  return glb(gltf, bin);
+}
+
+}  // namespace primseg
