@@ -1,5 +1,7 @@
 #include "outputs.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -22,9 +24,9 @@ nlohmann::json vec3_json(const Vec3& v) {
 
 namespace {
 
-// The outputs that may go to standard output.
-std::array<const std::optional<std::string>*, 4> text_outputs(const OutputFiles& files) {
-  return {&files.labels, &files.json, &files.linkage, &files.curve};
+// The outputs that may go to standard output: text, and the tree file for a pipe into `cut -`.
+std::array<const std::optional<std::string>*, 5> standard_outputs(const OutputFiles& files) {
+  return {&files.labels, &files.json, &files.linkage, &files.curve, &files.tree};
 }
 
 bool to_standard_output(const std::optional<std::string>* path) {
@@ -35,16 +37,23 @@ bool to_standard_output(const std::optional<std::string>* path) {
 
 void validate_output_files(const OutputFiles& files) {
   const std::pair<const char*, const std::optional<std::string>*> binary[] = {
-      {"--colored", &files.colored}, {"--png", &files.png}, {"--tree", &files.tree}};
+      {"--colored", &files.colored}, {"--png", &files.png}};
   for (const auto& [option, path] : binary)
     if (*path == kStandardOutput)
       throw InvalidInputError(std::string(option) +
                               ": cannot write to standard output ('-'); only --labels, --json, "
-                              "--curve and --linkage can (to write a file named '-', give ./-)");
-  const auto text = text_outputs(files);
-  if (std::count_if(text.begin(), text.end(), to_standard_output) > 1)
+                              "--curve, --linkage and --tree can (to write a file named '-', give "
+                              "./-)");
+  const auto outputs = standard_outputs(files);
+  if (std::count_if(outputs.begin(), outputs.end(), to_standard_output) > 1)
     throw InvalidInputError(
-        "only one of --labels, --json, --curve and --linkage can write to standard output ('-')");
+        "only one of --labels, --json, --curve, --linkage and --tree can write to standard output "
+        "('-')");
+  // As gzip does: binary data on a terminal is garbage on the screen, and usually a mistake.
+  if (files.tree == kStandardOutput && ::isatty(STDOUT_FILENO))
+    throw InvalidInputError(
+        "--tree -: standard output is a terminal, and a tree file is binary; redirect it "
+        "(> part.tree) or pipe it (| primseg cut - --clusters 20)");
   if (files.colored) {
     bool supported = false;
     try {
@@ -66,8 +75,8 @@ std::string count_of(std::uint64_t count, std::string_view noun, std::string_vie
 }
 
 bool writes_to_standard_output(const OutputFiles& files) {
-  const auto text = text_outputs(files);
-  return std::any_of(text.begin(), text.end(), to_standard_output);
+  const auto outputs = standard_outputs(files);
+  return std::any_of(outputs.begin(), outputs.end(), to_standard_output);
 }
 
 void write_text_output(const std::string& path, std::string_view text) {

@@ -35,12 +35,12 @@ std::string count_of(std::uint64_t count, std::string_view noun, std::string_vie
 /// a coloured mesh that is neither .ply nor .obj, '-' for a binary output, or '-' twice.
 void validate_output_files(const OutputFiles& files);
 
-/// True when a text output goes to standard output: the command must then print nothing else
-/// there (its summary is suppressed as by --quiet).
+/// True when an output (a text one, or the tree) goes to standard output: the command must then
+/// print nothing else there (its summary is suppressed as by --quiet).
 bool writes_to_standard_output(const OutputFiles& files);
 
-/// Writes `text` to the file `path` atomically, or to standard output when `path` is "-".
-/// Throws IoError.
+/// Writes `text` (any bytes) to the file `path` atomically, or to standard output when `path` is
+/// "-". Throws IoError.
 void write_text_output(const std::string& path, std::string_view text);
 
 /// A member of a JSON document that is a large array: dump_document prints its elements, made

@@ -475,6 +475,13 @@ TEST(Cli, CutFromTreeReproducesSegmentAtEveryLevel) {
   const double diagonal = bounding_box_diagonal(mesh);
 
   ASSERT_EXIT_OK(run("segment " + dir.q("in.ply") + " --quiet --tree " + dir.q("t.tree")));
+  // --tree - writes the same bytes to standard output, alone (no summary), for a pipe into cut.
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.ply") + " --tree - > " + dir.q("piped.tree")));
+  EXPECT_EQ(testing::file_contents(dir / "piped.tree"), testing::file_contents(dir / "t.tree"));
+  const CliRun pipeline = run("cut - --clusters 7 --labels -",
+                              quote(cli_path()) + " segment " + dir.q("in.ply") + " --tree -");
+  ASSERT_EXIT_OK(pipeline);
+  EXPECT_EQ(pipeline.output, run("cut " + dir.q("t.tree") + " --clusters 7 --labels -").output);
   // Moving the mesh away proves `cut` does not need it.
   fs::rename(dir / "in.ply", dir / "moved.ply");
 
@@ -791,6 +798,21 @@ TEST(Cli, BadMeshFilesAreRejectedWithAMessage) {
   for (const BadCase& c : cases) expect_rejected(c);
 }
 
+TEST(Cli, TheTreeIsNotWrittenToATerminal) {
+  TempDir dir("tree-terminal");
+  write_mesh(dir / "box.off", make_shape("box").mesh);
+  // script(1) (Debian's essential bsdutils) runs the command with a terminal as its output.
+  CliRun r;
+  r.status = run_command(
+      "script -qec " + quote(quote(cli_path()) + " segment " + dir.q("box.off") + " --tree -") +
+          " /dev/null",
+      &r.output);
+  EXPECT_NE(r.status, 0);
+  for (const char* part :
+       {"primseg: error: --tree -: standard output is a terminal", "| primseg cut - --clusters 20"})
+    EXPECT_NE(r.output.find(part), std::string::npos) << r.output;
+}
+
 TEST(Cli, ClustersAutoFindsTheRegionsAndReportsCandidatesAndTheCurve) {
   TempDir dir("auto");
   ShapeOptions options;
@@ -936,7 +958,9 @@ TEST(Cli, BadOptionsAreRejectedWithAMessage) {
       {"--colored -",
        "segment " + mesh + " --clusters 2 --colored -",
        {"--colored", "standard output"}},
-      {"--tree -", "segment " + mesh + " --tree -", {"--tree", "standard output"}},
+      {"--tree - and --json -",
+       "segment " + mesh + " --tree - --json -",
+       {"only one", "--tree", "standard output"}},
       {"unknown option", "segment " + mesh + " --frobnicate", {"frobnicate"}, false},
       {"missing mesh argument", "segment --clusters 3", {"MESH"}, false},
       {"unknown subcommand", "frobnicate " + mesh, {"frobnicate"}, false},
