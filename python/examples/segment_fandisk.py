@@ -7,6 +7,7 @@
 # at the end of each cell make it a test too (CTest runs it).
 
 # %%
+import json
 import pathlib
 import sys
 import tarfile
@@ -173,3 +174,13 @@ print(f"rotating joint {joint} by 45 degrees moves {moved.sum()} of {len(man.V)}
       f" (bones {skeleton.bones_beyond(joint)})")
 assert np.allclose(weights[np.unique(man.F)].sum(axis=1), 1.0)
 assert 0 < moved.sum() < len(man.V)
+
+# The rig for other tools: the mesh skinned to this skeleton as binary glTF (Blender, three.js,
+# game engines). Rotating the node of the bone that hangs from `joint` by the same 45 degrees
+# poses the mesh as `deform` did.
+rig = skeleton.gltf()
+(folder / "man-rig.glb").write_bytes(rig)
+hanging = [n["name"] for n in json.loads(rig[20:20 + int.from_bytes(rig[12:16], "little")])["nodes"]
+           if n.get("extras", {}).get("joint") == joint and "bone" in n["extras"]]
+print(f"wrote man-rig.glb ({len(rig) / 1e6:.1f} MB); joint {joint} turns node {hanging[0]}")
+assert rig[:4] == b"glTF" and len(hanging) == 1
