@@ -293,10 +293,26 @@ class SkeletonOverlay {
       this.resetPose();
       this.say('rest pose');
     });
+    document.getElementById('save-pose').addEventListener('click', () => this.savePose());
     const kinds = [0, 0, 0];
     for (let j = 0; j < this.skeleton.jointCount; ++j) ++kinds[this.skeleton.kind(j)];
     document.getElementById('skeleton-summary').textContent =
       `${this.skeleton.boneCount} bones, joints: ${kinds[SENSITIVE]} sensitive, ${kinds[VIRTUAL]} virtual, ${kinds[LOCKED]} locked`;
+  }
+
+  /** Downloads the current pose as pose.json: `primseg deform MESH SKEL.json pose.json -o OUT`
+   *  then poses the mesh as the page shows it. */
+  savePose() {
+    const pose = this.pose();
+    const url = URL.createObjectURL(new Blob([JSON.stringify(pose, null, 1) + '\n'], { type: 'application/json' }));
+    const link = document.createElement('a');
+    link.href = url;
+    link.download = 'pose.json';
+    link.click();
+    // After the click has started the download (revoking at once may cancel it in some browsers).
+    setTimeout(() => URL.revokeObjectURL(url), 0);
+    const turned = pose.rotations.length;
+    this.say(`pose.json saved: ${turned} joint${turned === 1 ? '' : 's'} turned`);
   }
 
   say(text) {

@@ -183,8 +183,13 @@ test('dragging joints poses the mesh live, as primseg deform poses it', async ()
   await page.screenshot({ path: join(artifacts, 'figure-dragged.png') });
   pose = await page.evaluate(() => window.primseg.pose());
   assert.equal(pose.rotations.length, 1, 'the elbow turned further');
-  // The dragged pose, run through primseg deform, gives the page's vertices.
-  writeFileSync(file('dragged.json'), JSON.stringify(pose));
+  // The dragged pose, saved by the page's button and run through primseg deform, gives the page's
+  // vertices.
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#save-pose')]);
+  assert.equal(download.suggestedFilename(), 'pose.json');
+  await download.saveAs(file('dragged.json'));
+  assert.deepEqual(JSON.parse(readFileSync(file('dragged.json'), 'utf8')), pose);
+  assert.match(await page.textContent('#status'), /^pose\.json saved: 1 joint turned/);
   primseg('deform', file('figure.off'), file('skeleton.json'), file('dragged.json'), '-o', file('dragged.off'), '--quiet');
   const page_positions = await page.evaluate(() => window.primseg.deformedPositions());
   // The pose file goes through JSON (17 significant digits): the angle is read back rounded.
