@@ -14,19 +14,77 @@
 
 namespace primseg::cli {
 
+namespace {
+
+struct SkeletonCommandOptions {
+  std::string mesh_path, output, primitives = "cylinder";
+  std::optional<std::string> skin_weights, gltf;
+  std::uint32_t max_influences = GltfOptions{}.max_influences;
+  SkeletonPicture picture;
+  LevelChoice level;
+  double band = SkinningOptions{}.band;
+  unsigned threads = 0;
+  bool quiet = false;
+  ResourceLimits limits;
+};
+
+// Runs `primseg skeleton` with its parsed options.
+void run_skeleton(const SkeletonCommandOptions& o) {
+  HierarchyOptions options;
+  options.primitives = parse_primitives(o.primitives);
+  options.threads = o.threads;
+  validate(options);
+  if (!(std::isfinite(o.band) && o.band >= 0))
+    throw InvalidInputError("--band: must be a finite number >= 0");
+  auto mesh = std::make_shared<const Mesh>(
+      read_geometry_within(o.mesh_path, o.limits, o.picture.png ? kPictureBytes : 0));
+  validate_level(o.level, mesh->face_count());
+  const auto build_start = Clock::now();
+  HierarchyBuilder builder(mesh, options);
+  const Hierarchy hierarchy = builder.finish(Progress("hierarchy", o.quiet));
+  const double build_seconds = seconds_since(build_start);
+  const auto skeleton_start = Clock::now();
+  const Skeleton skeleton = extract_skeleton(hierarchy, cut(hierarchy, o.level).segmentation);
+  const double skeleton_seconds = seconds_since(skeleton_start);
+
+  nlohmann::json json;
+  json["mesh"] = mesh_summary(o.mesh_path, hierarchy);
+  json["primitives"] = o.primitives;
+  const std::optional<std::uint32_t> requested = parse_cluster_count(*o.level.clusters);
+  if (requested)
+    json["requested_clusters"] = *requested;
+  else
+    json["requested_clusters"] = "auto";
+  json["timing"] = {{"hierarchy_seconds", build_seconds}, {"skeleton_seconds", skeleton_seconds}};
+  if (o.skin_weights || o.gltf) {
+    const auto skin_start = Clock::now();
+    SkinningOptions skinning;
+    skinning.band = o.band;
+    const SkinWeights weights = compute_skin_weights(*mesh, skeleton, skinning);
+    json["timing"]["skin_weights_seconds"] = seconds_since(skin_start);
+    if (o.skin_weights) detail::write_file_atomically(*o.skin_weights, skin_weights_text(weights));
+    if (o.gltf) {
+      GltfOptions gltf;
+      gltf.max_influences = o.max_influences;
+      detail::write_file_atomically(*o.gltf, skinned_glb(*mesh, skeleton, weights, gltf));
+    }
+  }
+  detail::write_file_atomically(o.output, skeleton_file_text(skeleton, std::move(json)));
+  o.picture.write(*mesh, skeleton);
+  if (!o.quiet) {
+    std::size_t counts[3] = {0, 0, 0};
+    for (const Joint& joint : skeleton.joints) ++counts[static_cast<int>(joint.kind)];
+    std::printf("%s: %s, hierarchy in %.3f s; %s, %s (%zu sensitive, %zu locked, %zu virtual)\n",
+                input_name(o.mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
+                build_seconds, count_of(skeleton.cluster_count(), "bone").c_str(),
+                count_of(skeleton.joints.size(), "joint").c_str(), counts[0], counts[1], counts[2]);
+  }
+}
+
+}  // namespace
+
 Command add_skeleton_command(CLI::App& app) {
-  struct Options {
-    std::string mesh_path, output, primitives = "cylinder";
-    std::optional<std::string> skin_weights, gltf;
-    std::uint32_t max_influences = GltfOptions{}.max_influences;
-    SkeletonPicture picture;
-    LevelChoice level;
-    double band = SkinningOptions{}.band;
-    unsigned threads = 0;
-    bool quiet = false;
-    ResourceLimits limits;
-  };
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<SkeletonCommandOptions>();
   auto* command = app.add_subcommand(
       "skeleton", "Extract a deformation skeleton (one bone per cluster) from a level");
   command
@@ -61,62 +119,7 @@ Command add_skeleton_command(CLI::App& app) {
   command->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
   add_limit_options(*command, o->limits, kHierarchyBytesPerFace);
 
-  return {
-      command, [o] {
-        HierarchyOptions options;
-        options.primitives = parse_primitives(o->primitives);
-        options.threads = o->threads;
-        validate(options);
-        if (!(std::isfinite(o->band) && o->band >= 0))
-          throw InvalidInputError("--band: must be a finite number >= 0");
-        auto mesh = std::make_shared<const Mesh>(
-            read_geometry_within(o->mesh_path, o->limits, o->picture.png ? kPictureBytes : 0));
-        validate_level(o->level, mesh->face_count());
-        const auto build_start = Clock::now();
-        HierarchyBuilder builder(mesh, options);
-        const Hierarchy hierarchy = builder.finish(Progress("hierarchy", o->quiet));
-        const double build_seconds = seconds_since(build_start);
-        const auto skeleton_start = Clock::now();
-        const Skeleton skeleton =
-            extract_skeleton(hierarchy, cut(hierarchy, o->level).segmentation);
-        const double skeleton_seconds = seconds_since(skeleton_start);
-
-        nlohmann::json json;
-        json["mesh"] = mesh_summary(o->mesh_path, hierarchy);
-        json["primitives"] = o->primitives;
-        const std::optional<std::uint32_t> requested = parse_cluster_count(*o->level.clusters);
-        if (requested)
-          json["requested_clusters"] = *requested;
-        else
-          json["requested_clusters"] = "auto";
-        json["timing"] = {{"hierarchy_seconds", build_seconds},
-                          {"skeleton_seconds", skeleton_seconds}};
-        if (o->skin_weights || o->gltf) {
-          const auto skin_start = Clock::now();
-          SkinningOptions skinning;
-          skinning.band = o->band;
-          const SkinWeights weights = compute_skin_weights(*mesh, skeleton, skinning);
-          json["timing"]["skin_weights_seconds"] = seconds_since(skin_start);
-          if (o->skin_weights)
-            detail::write_file_atomically(*o->skin_weights, skin_weights_text(weights));
-          if (o->gltf) {
-            GltfOptions gltf;
-            gltf.max_influences = o->max_influences;
-            detail::write_file_atomically(*o->gltf, skinned_glb(*mesh, skeleton, weights, gltf));
-          }
-        }
-        detail::write_file_atomically(o->output, skeleton_file_text(skeleton, std::move(json)));
-        o->picture.write(*mesh, skeleton);
-        if (!o->quiet) {
-          std::size_t counts[3] = {0, 0, 0};
-          for (const Joint& joint : skeleton.joints) ++counts[static_cast<int>(joint.kind)];
-          std::printf(
-              "%s: %s, hierarchy in %.3f s; %s, %s (%zu sensitive, %zu locked, %zu virtual)\n",
-              input_name(o->mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
-              build_seconds, count_of(skeleton.cluster_count(), "bone").c_str(),
-              count_of(skeleton.joints.size(), "joint").c_str(), counts[0], counts[1], counts[2]);
-        }
-      }};
+  return {command, [o] { run_skeleton(*o); }};
 }
 
 }  // namespace primseg::cli

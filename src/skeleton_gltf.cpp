@@ -136,7 +136,8 @@ std::vector<std::array<float, 3>> vertex_normals(const Mesh& mesh) {
 // The binary chunk, its views and accessors, built side by side.
 class BufferBuilder {
  public:
-  // Appends `count` elements of `bytes_per_element` bytes; returns the accessor's index.
+  // Appends `data` (`count` elements of the accessor's `type`) as a view and its accessor; returns
+  // the accessor's index.
   template <class T>
   std::size_t add(const std::vector<T>& data, std::size_t count, const char* type,
                   int component_type, std::optional<int> target,
