@@ -32,7 +32,7 @@ namespace {
 
 // Normals spanning less than this (smallest eigenvalue of Σ A n nᵀ over the area) leave the
 // apex undetermined: flat or cylindrical data.
-constexpr double kMinNormalSpread = 1e-9;
+constexpr double kConeMinNormalSpread = 1e-9;
 // Largest distance from the centroid to the apex, relative to the RMS spread of the points:
 // beyond it the fit loses precision (moments of degree 4 about the apex) and the cluster is a
 // cylinder or a plane for any practical purpose.
@@ -41,7 +41,7 @@ constexpr double kMaxRelativeApexDistance = 100;
 // narrow band; near 0 for points on both nappes, which the reported (one-sided) cone misses.
 constexpr double kMinOneSidedness = 0.85;
 // Levenberg–Marquardt steps of the joint refinement (each about a microsecond).
-constexpr int kRefinementSteps = 6;
+constexpr int kConeRefinementSteps = 6;
 
 // The 6 coefficients m of a symmetric M in the order (xx, yy, zz, xy, xz, yz); yᵀMy = Σ m_k φ_k
 // with φ = (x², y², z², 2xy, 2xz, 2yz).
@@ -262,7 +262,7 @@ void refine_cone(const Moments& moments, double scale, ConeParameters& cone, dou
   using Matrix6 = Eigen::Matrix<double, 6, 6>;
   Gram g = gram_of(about_apex, scale);
   double lambda = 1e-3;
-  for (int iteration = 0; iteration < kRefinementSteps; ++iteration) {
+  for (int iteration = 0; iteration < kConeRefinementSteps; ++iteration) {
     const Eigen::Vector3d u = cone.axis;
     Eigen::Index least;
     u.cwiseAbs().minCoeff(&least);
@@ -379,7 +379,7 @@ PrimitiveFit ConeFitter::fit(const ClusterView& cluster, double /*error_to_beat*
   // 1. The apex.
   const Eigen::Matrix3d normals = centred.face_planes.normal_normal_matrix();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> normal_eigen(normals);
-  if (!(normal_eigen.eigenvalues()(0) > kMinNormalSpread * centred.area)) return result;
+  if (!(normal_eigen.eigenvalues()(0) > kConeMinNormalSpread * centred.area)) return result;
   const Eigen::Vector3d apex_offset =
       normal_eigen.eigenvectors() *
       ((normal_eigen.eigenvectors().transpose() * centred.face_planes.normal_offset)

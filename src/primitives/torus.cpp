@@ -33,7 +33,7 @@ namespace {
 
 constexpr int kParameters = 7;
 // The smallest eigenvalue of Σ ŵ n nᵀ over Σ ŵ below this: normals (nearly) coplanar, no torus.
-constexpr double kMinNormalSpread = 1e-9;
+constexpr double kTorusMinNormalSpread = 1e-9;
 // A torus whose major radius is below this fraction of its minor radius is the sphere it nearly
 // is (a sphere is a torus of major radius 0 about any axis through its centre).
 constexpr double kMinRelativeMajorRadius = 0.05;
@@ -42,7 +42,7 @@ constexpr double kMinRelativeMajorRadius = 0.05;
 // cylinder or a plane (a cone's band is fitted by tori of growing tube as closely as wanted).
 constexpr double kMaxRelativeMinorRadius = 20;
 // Levenberg–Marquardt steps on the sample (each O(32)).
-constexpr int kRefinementSteps = 8;
+constexpr int kTorusRefinementSteps = 8;
 
 }  // namespace
 
@@ -89,7 +89,7 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   }
   const Eigen::Matrix3d nn = lines.bottomRightCorner<3, 3>();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> normal_eigen(nn);
-  if (!(normal_eigen.eigenvalues()(0) > kMinNormalSpread * sample_weight)) return result;
+  if (!(normal_eigen.eigenvalues()(0) > kTorusMinNormalSpread * sample_weight)) return result;
   const Eigen::Matrix3d nn_inverse = normal_eigen.eigenvectors() *
                                      normal_eigen.eigenvalues().cwiseInverse().asDiagonal() *
                                      normal_eigen.eigenvectors().transpose();
@@ -136,7 +136,7 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   start.radius = tube_centre.x();
   start.minor_radius = circle.radius;
   GeometricFitOptions options;
-  options.max_iterations = kRefinementSteps;
+  options.max_iterations = kTorusRefinementSteps;
   const GeometricFit refined = fit_geometric(start, std::span<const Vec3>(points.data(), n),
                                              std::span<const double>(weights.data(), n), options);
   const Primitive& torus = refined.primitive;
