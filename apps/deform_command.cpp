@@ -5,6 +5,7 @@
 #include "limits.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/skeleton_io.hpp"
 #include "primseg/skinning.hpp"
 #include "skeleton_io.hpp"
 
@@ -48,8 +49,8 @@ Command add_deform_command(CLI::App& app) {
             mesh_format_from_path(o->output);  // an unknown extension fails before any work
             const Mesh mesh =
                 read_geometry_within(o->mesh_path, o->limits, o->picture.png ? kPictureBytes : 0);
-            const Skeleton skeleton = read_skeleton_file(o->skeleton_path);
-            const std::vector<JointRotation> pose = read_pose_file(o->pose_path);
+            const Skeleton skeleton = read_skeleton(o->skeleton_path);
+            const std::vector<JointRotation> pose = read_pose(o->pose_path);
             if (skeleton.face_labels.size() != mesh.face_count())
               throw InvalidInputError("'" + o->skeleton_path + "' was made from a mesh of " +
                                       std::to_string(skeleton.face_labels.size()) + " faces, " +

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "../src/json_document.hpp"
 #include "primseg/cut.hpp"
 
 namespace primseg::cli {
@@ -43,20 +44,10 @@ bool writes_to_standard_output(const OutputFiles& files);
 /// "-". Throws IoError.
 void write_text_output(const std::string& path, std::string_view text);
 
-/// A member of a JSON document that is a large array: dump_document prints its elements, made
-/// one at a time, instead of holding them all as a document (about 4 times their text).
-struct StreamedArray {
-  std::string_view name;                               ///< a top-level member of the document
-  std::size_t size = 0;                                ///< elements
-  std::function<nlohmann::json(std::size_t)> element;  ///< element i
-};
-
-/// `document` as document.dump(2) prints it (invalid UTF-8 replaced), and a newline, with each of
-/// `arrays`, an empty array in `document`, holding its elements.
-std::string dump_document(const nlohmann::json& document, std::span<const StreamedArray> arrays);
-
-/// A point or direction as the JSON array [x, y, z].
-nlohmann::json vec3_json(const Vec3& v);
+// JSON documents with large arrays, and points as JSON (src/json_document.hpp).
+using detail::dump_document;
+using detail::StreamedArray;
+using detail::vec3_json;
 
 /// JSON parameters of a primitive, input units.
 nlohmann::json primitive_params(const Primitive& primitive);

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "../src/file_io.hpp"
+#include "../src/skeleton_file.hpp"
 #include "command.hpp"
 #include "limits.hpp"
 #include "primseg/error.hpp"
@@ -69,7 +70,7 @@ void run_skeleton(const SkeletonCommandOptions& o) {
       detail::write_file_atomically(*o.gltf, skinned_glb(*mesh, skeleton, weights, gltf));
     }
   }
-  detail::write_file_atomically(o.output, skeleton_file_text(skeleton, std::move(json)));
+  detail::write_file_atomically(o.output, detail::skeleton_file_text(skeleton, std::move(json)));
   o.picture.write(*mesh, skeleton);
   if (!o.quiet) {
     std::size_t counts[3] = {0, 0, 0};

@@ -1,10 +1,9 @@
 #pragma once
-// What `primseg skeleton` and `primseg deform` share: the skeleton file (written by one, read by
-// the other), the pose file, the skin weights file and the picture options.
+// What `primseg skeleton` and `primseg deform` share besides the skeleton and pose files
+// (primseg/skeleton_io.hpp): the skin weights file and the picture options.
 
 #include <CLI/CLI.hpp>
 #include <array>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,19 +13,6 @@
 #include "primseg/skinning.hpp"
 
 namespace primseg::cli {
-
-/// The skeleton file: `summary` (the caller's "mesh", "timing"...) with {"joints": [{"id",
-/// "position", "kind", "visible", "bones"}], "bones": [{"id", "cluster", "joints", "visible",
-/// "axis", "point", "radius", "area"}], "cluster_count", "root_bone", "face_labels"}, input
-/// units, as JSON text.
-std::string skeleton_file_text(const Skeleton& skeleton, nlohmann::json summary);
-
-/// Reads a skeleton file. Throws ParseError naming the file and what is wrong.
-Skeleton read_skeleton_file(const std::string& path);
-
-/// Reads a pose file: {"rotations": [{"joint": J, "axis": [x, y, z], "degrees": A}]}.
-/// Throws ParseError naming the file and what is wrong.
-std::vector<JointRotation> read_pose_file(const std::string& path);
 
 /// Text, one line per vertex: "bone weight bone weight ..." (bones increasing, weights summing
 /// to 1, 17 significant digits); an unused vertex has an empty line.

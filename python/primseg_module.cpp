@@ -33,6 +33,7 @@
 #include "primseg/render.hpp"
 #include "primseg/skeleton.hpp"
 #include "primseg/skeleton_gltf.hpp"
+#include "primseg/skeleton_io.hpp"
 #include "primseg/skinning.hpp"
 #include "primseg/tree_io.hpp"
 
@@ -627,6 +628,19 @@ struct PySkeleton {
   }
 };
 
+// A skeleton read from a file or a pickle, for `mesh`: one label per face, or InvalidInputError.
+PySkeleton skeleton_of_mesh(std::shared_ptr<const Mesh> mesh, Skeleton skeleton,
+                            const std::string& name) {
+  if (skeleton.face_labels.size() != mesh->face_count())
+    throw InvalidInputError("'" + name + "' was made from a mesh of " +
+                            std::to_string(skeleton.face_labels.size()) + " faces, this one has " +
+                            std::to_string(mesh->face_count()));
+  PySkeleton out;
+  out.mesh = std::move(mesh);
+  out.skeleton = std::make_shared<const Skeleton>(std::move(skeleton));
+  return out;
+}
+
 // The joints and bones as the CLI's skeleton file lists them.
 py::dict joint_dict(const Joint& joint) {
   py::dict dict;
@@ -1038,6 +1052,29 @@ coordinates, index out of range, no faces) or bad options.)";
            cpp_doc("HierarchyOptions::threads", doc::hierarchy__HierarchyOptions__threads),
            cpp_doc("HierarchyOptions::evaluation", doc::hierarchy__HierarchyOptions__evaluation),
            cpp_doc("HierarchyOptions::exact_costs", doc::hierarchy__HierarchyOptions__exact_costs)})
+          .c_str());
+
+  m.def(
+      "read_skeleton",
+      [](const std::filesystem::path& path, const py::object& first, const py::object& faces) {
+        const std::shared_ptr<const Mesh> mesh =
+            mesh_or_tree_argument("read_skeleton", first, faces);
+        Skeleton skeleton;
+        {
+          py::gil_scoped_release release;
+          skeleton = read_skeleton(path);
+        }
+        return skeleton_of_mesh(mesh, std::move(skeleton), path.string());
+      },
+      py::arg("path"), py::arg("mesh_or_V"), py::arg("F") = py::none(),
+      join_docs({R"(read_skeleton(path, mesh) -> Skeleton
+read_skeleton(path, V, F) -> Skeleton
+
+A skeleton file (`primseg skeleton -o`, Skeleton.save) with the mesh it was made from (a Mesh, a
+Hierarchy's or arrays V and F): the Skeleton primseg.skeleton() gave, for deform(), gltf() and
+skin_weights() without building the hierarchy again. Raises ParseError for a malformed file,
+InvalidInputError when its face labels do not fit the mesh.)",
+                 cpp_doc("parse_skeleton_json", doc::skeleton_io__parse_skeleton_json)})
           .c_str());
 
   m.def(
@@ -1477,6 +1514,34 @@ radius, area (input units).)")
       .def_property_readonly(
           "mesh", [](const PySkeleton& self) { return PyMesh{self.mesh}; },
           "The mesh the skeleton was made from (shared, no copy).")
+      .def(
+          "save",
+          [](const PySkeleton& self, const std::filesystem::path& path) {
+            py::gil_scoped_release release;
+            write_skeleton(path, *self.skeleton);
+          },
+          py::arg("path"),
+          join_docs({"save(path): writes the skeleton file (JSON), as `primseg skeleton -o` does "
+                     "without its summary; read_skeleton() and `primseg deform` read it.",
+                     cpp_doc("write_skeleton", doc::skeleton_io__write_skeleton)})
+              .c_str())
+      // Read-only (the weights it caches are a function of the band): a copy is the object itself.
+      .def("__copy__", [](const py::object& self) { return self; })
+      .def("__deepcopy__", [](const py::object& self, const py::dict&) { return self; })
+      .def(py::pickle(
+          [](const PySkeleton& self) {
+            return py::make_tuple(mesh_state(PyMesh{self.mesh}),
+                                  py::bytes(skeleton_json(*self.skeleton)));
+          },
+          [](const py::tuple& state) {
+            if (state.size() != 2 || !py::isinstance<py::tuple>(state[0]) ||
+                !py::isinstance<py::bytes>(state[1]))
+              throw InvalidInputError("Skeleton: not a pickled primseg.Skeleton");
+            const std::string_view text = state[1].cast<std::string_view>();
+            return skeleton_of_mesh(mesh_from_state(state[0].cast<py::tuple>()).mesh,
+                                    parse_skeleton_json(text, "pickled primseg.Skeleton"),
+                                    "pickled primseg.Skeleton");
+          }))
       .def(
           "to_dict",
           [](const PySkeleton& self) {

@@ -3,7 +3,7 @@
 # its committed seed corpus and dictionary. Fails on the first finding, leaving the reproducer in
 # $build/artifacts/ (make it a regression test: fuzz/regressions/ and tests/mesh_io/).
 #
-#   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 45: 8 targets, about 6 minutes)
+#   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 45: 9 targets, about 7 minutes)
 #   PRIMSEG_FUZZ_BUILD_DIR=build-fuzz        build directory
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,11 +14,11 @@ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_CO
   -DPRIMSEG_FUZZ=ON -DPRIMSEG_WERROR=ON -DPRIMSEG_BUILD_TESTS=OFF -DPRIMSEG_BUILD_CLI=OFF \
   -DPRIMSEG_BUILD_BENCH=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build "$build" --target fuzz_read_off fuzz_read_obj fuzz_read_ply fuzz_read_stl \
-  fuzz_read_detect fuzz_read_tree fuzz_segment fuzz_tools
+  fuzz_read_detect fuzz_read_tree fuzz_read_skeleton fuzz_segment fuzz_tools
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 mkdir -p "$build/artifacts"
-for target in off obj ply stl detect tree segment tools; do
+for target in off obj ply stl detect tree skeleton segment tools; do
   dict=fuzz/dict/$target.dict
   case $target in
     detect) cat fuzz/dict/{off,obj,ply,stl}.dict >"$build/detect.dict"; dict=$build/detect.dict ;;

@@ -11,12 +11,14 @@
 #include <utility>
 #include <vector>
 
+#include "json_document.hpp"
 #include "no_index.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg {
 namespace {
 
+using detail::vec3_json;
 using nlohmann::json;
 
 static_assert(std::endian::native == std::endian::little, "GLB is little-endian");
@@ -194,10 +196,6 @@ std::string glb(const json& gltf, const std::string& bin) {
   append_u32(out, kBinChunk);
   out += bin;
   return out;
-}
-
-json vec3_json(const Vec3& v) {
-  return json::array({v[0], v[1], v[2]});
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 """denoise, skeleton and distance: the CLI commands of those names, bit for bit, and what they
 promise on shapes with known answers."""
 
+import copy as copy_module
 import json
+import pickle
 import struct
 
 import numpy as np
@@ -223,6 +225,36 @@ def test_gltf_matches_the_cli(cli, man, man_skeleton, tmp_path):
     assert [n["name"] for n in bones] == [f"bone_{b}" for b in range(man_skeleton.cluster_count)]
     with pytest.raises(ValueError, match="max_influences must be >= 0"):
         man_skeleton.gltf(max_influences=-1)
+
+
+def test_skeleton_files_and_pickles_give_the_same_skeleton(cli, man, man_skeleton, fandisk, tmp_path):
+    run_cli(cli, "skeleton", man, "--clusters", "20", "-o", tmp_path / "cli.json", "--quiet")
+    mesh = man_skeleton.mesh
+    pose = [(sensitive_joint(man_skeleton)[0], (1, 0, 0), 40.0)]
+    copies = {
+        "read_skeleton of the CLI's file": primseg.read_skeleton(tmp_path / "cli.json", mesh),
+        "read_skeleton with V, F": primseg.read_skeleton(tmp_path / "cli.json", mesh.V, mesh.F),
+        "pickled": pickle.loads(pickle.dumps(man_skeleton)),
+    }
+    man_skeleton.save(tmp_path / "saved.json")
+    copies["saved and read"] = primseg.read_skeleton(tmp_path / "saved.json", mesh)
+    assert json.loads((tmp_path / "saved.json").read_text()) == man_skeleton.to_dict()
+    for name, copy in copies.items():
+        assert copy.to_dict() == man_skeleton.to_dict(), name  # every double bit for bit
+        np.testing.assert_array_equal(copy.deform(pose), man_skeleton.deform(pose), err_msg=name)
+        assert copy.gltf() == man_skeleton.gltf(), name
+    assert copy_module.copy(man_skeleton) is man_skeleton
+    assert copy_module.deepcopy(man_skeleton) is man_skeleton
+    # A skeleton of another mesh, a file that is no skeleton, a corrupt pickle.
+    with pytest.raises(primseg.InvalidInputError, match="was made from a mesh of 34986 faces"):
+        primseg.read_skeleton(tmp_path / "cli.json", primseg.read_mesh(fandisk))
+    (tmp_path / "bad.json").write_text('{"bones": []}')
+    with pytest.raises(primseg.ParseError, match="bad.json.*not a skeleton file"):
+        primseg.read_skeleton(tmp_path / "bad.json", mesh)
+    state = man_skeleton.__getstate__()
+    broken = primseg.Skeleton.__new__(primseg.Skeleton)
+    with pytest.raises(primseg.ParseError, match="pickled primseg.Skeleton"):
+        broken.__setstate__((state[0], state[1][:100]))
 
 
 def test_skin_weights_and_poses(man_skeleton):
