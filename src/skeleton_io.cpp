@@ -15,8 +15,6 @@ namespace {
 
 using nlohmann::json;
 
-using nlohmann::json;
-
 // Parses JSON text; ParseError with the name on malformed text.
 json parse_text(std::string_view text, const std::string& name) {
   try {
@@ -112,6 +110,8 @@ Skeleton parse_skeleton_json(std::string_view text, const std::string& name) {
       if (!(std::isfinite(bone.radius) && bone.radius >= 0))
         throw InvalidInputError(where + ": radius must be finite and >= 0");
       bone.area = member(bones[i], "area", where).get<double>();
+      if (!(std::isfinite(bone.area) && bone.area >= 0))
+        throw InvalidInputError(where + ": area must be finite and >= 0");
       skeleton.bones.push_back(std::move(bone));
     }
     for (std::size_t i = 0; i < joint_count; ++i) {

@@ -26,9 +26,9 @@ namespace primseg {
 std::string skeleton_json(const Skeleton& skeleton);
 
 /// Parses a skeleton file's text. Checks the ids (0..K-1 and 0..J-1 in order), that joints and
-/// bones list each other, the kinds, finite positions and directions, radii >= 0, labels < K
-/// and root_bone 0; members it does not use are ignored. Throws ParseError naming `name` and
-/// what is wrong. (It cannot check that the labels fit a mesh: compare face_labels.size() with
+/// bones list each other, the kinds, finite positions and directions, finite radii and areas >= 0,
+/// labels < K and root_bone 0; members it does not use are ignored. Throws ParseError naming `name`
+/// and what is wrong. (It cannot check that the labels fit a mesh: compare face_labels.size() with
 /// the mesh's face count.)
 Skeleton parse_skeleton_json(std::string_view text, const std::string& name = "<memory>");
 

@@ -106,6 +106,11 @@ TEST(SkeletonIo, MalformedFilesAreRefusedWithTheReason) {
   refused(edited([](json& s) { s["joints"][0]["position"] = {0, 1}; }), "array of 3 numbers");
   refused(edited([](json& s) { s["bones"][0]["axis"][2] = "x"; }), "array of 3 numbers");
   refused(edited([](json& s) { s["bones"][0]["radius"] = -1; }), "radius must be finite");
+  refused(edited([](json& s) { s["bones"][0]["area"] = -0.5; }), "area must be finite");
+  // A number beyond the doubles is no JSON number nlohmann reads (never an infinite area).
+  std::string huge_area = good.dump();
+  huge_area.replace(huge_area.find("\"area\":") + 7, 1, "1e999,\"was\":");
+  refused(huge_area, "number overflow");
   refused(edited([](json& s) { s["face_labels"][0] = 8; }), "face label must be an integer in");
   refused(edited([](json& s) { s["root_bone"] = 1; }), "root_bone must be 0");
   // A joint listing a bone that does not list it back.
