@@ -24,7 +24,7 @@ namespace {
 using nlohmann::json;
 
 // The stick figure's skeleton at its 8 parts (cylinders and spheres).
-const Skeleton& figure_skeleton() {
+const Skeleton& stick_figure_skeleton() {
   static const Skeleton skeleton = [] {
     HierarchyOptions options;
     options.primitives = {PrimitiveType::Cylinder, PrimitiveType::Sphere};
@@ -57,7 +57,7 @@ void expect_same(const Skeleton& a, const Skeleton& b) {
 }
 
 TEST(SkeletonIo, ASkeletonReadsBackBitForBit) {
-  const Skeleton& skeleton = figure_skeleton();
+  const Skeleton& skeleton = stick_figure_skeleton();
   const std::string text = skeleton_json(skeleton);
   expect_same(parse_skeleton_json(text), skeleton);
   const json document = json::parse(text);
@@ -72,16 +72,16 @@ TEST(SkeletonIo, ASkeletonReadsBackBitForBit) {
 }
 
 TEST(SkeletonIo, MembersItDoesNotUseAreIgnored) {
-  json document = json::parse(skeleton_json(figure_skeleton()));
+  json document = json::parse(skeleton_json(stick_figure_skeleton()));
   document["mesh"] = {{"faces", 1234}};
   document["timing"] = {{"hierarchy_seconds", 0.5}};
   document["bones"][0]["note"] = "ignored";
-  expect_same(parse_skeleton_json(document.dump()), figure_skeleton());
+  expect_same(parse_skeleton_json(document.dump()), stick_figure_skeleton());
 }
 
 // Each edit of a good file, and the words the refusal must contain.
 TEST(SkeletonIo, MalformedFilesAreRefusedWithTheReason) {
-  const json good = json::parse(skeleton_json(figure_skeleton()));
+  const json good = json::parse(skeleton_json(stick_figure_skeleton()));
   const auto refused = [](const std::string& text, const std::string& reason) {
     try {
       (void)parse_skeleton_json(text, "s.json");
