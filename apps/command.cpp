@@ -216,7 +216,7 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, Chose
   else
     summary["level"]["tolerance"] = options.level.tolerance.value_or(kDefaultTolerance);
   write_level_outputs(hierarchy, segmentation, reports, options.files, summary);
-  if (options.files.tree) write_text_output(*options.files.tree, serialize_tree(hierarchy));
+  if (options.files.tree) write_output(*options.files.tree, serialize_tree(hierarchy));
   if (!options.quiet) print_summary(reports);
 }
 

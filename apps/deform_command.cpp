@@ -7,7 +7,7 @@
 #include "primseg/mesh_io.hpp"
 #include "primseg/skeleton_io.hpp"
 #include "primseg/skinning.hpp"
-#include "skeleton_io.hpp"
+#include "skeleton_outputs.hpp"
 
 namespace primseg::cli {
 

@@ -78,7 +78,7 @@ Command add_distance_command(CLI::App& app) {
                           d.diagonal)},
                 {"seed", o->seed},
                 {"timing", {{"seconds", seconds}}}};
-            if (o->json) write_text_output(*o->json, json.dump(2) + "\n");
+            if (o->json) write_output(*o->json, json.dump(2) + "\n");
             if (o->quiet || o->json == kStandardOutput) return;
             const double percent = d.diagonal > 0 ? 100 / d.diagonal : 0;
             std::printf("bounding-box diagonal %.6g; %llu + %llu samples\n", d.diagonal,

@@ -54,7 +54,7 @@ Command add_info_command(CLI::App& app) {
                   {"bbox_max", i.bbox_max},
                   {"bbox_diagonal", i.bbox_diagonal},
                   {"out_of_range", out_of_range ? nlohmann::json(*out_of_range) : nullptr}};
-              write_text_output(*o->json, json.dump(2) + "\n");
+              write_output(*o->json, json.dump(2) + "\n");
               if (*o->json == kStandardOutput) return;
             }
             std::printf("%s\n", input_name(o->path).c_str());

@@ -76,11 +76,11 @@ bool writes_to_standard_output(const OutputFiles& files) {
   return std::any_of(outputs.begin(), outputs.end(), to_standard_output);
 }
 
-void write_text_output(const std::string& path, std::string_view text) {
+void write_output(const std::string& path, std::string_view bytes) {
   if (path == kStandardOutput)
-    detail::write_standard_output(text);
+    detail::write_standard_output(bytes);
   else
-    detail::write_file_atomically(path, text);
+    detail::write_file_atomically(path, bytes);
 }
 
 nlohmann::json primitive_params(const Primitive& primitive) {
@@ -100,7 +100,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
       text += std::to_string(label);
       text += '\n';
     }
-    write_text_output(*files.labels, text);
+    write_output(*files.labels, text);
   }
   if (files.json) {
     // A level of a cluster per face (a triangle soup at --clusters auto) held about 1.6 KB per
@@ -118,7 +118,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
                                        {"max", r.max},
                                        {"params", primitive_params(r.primitive)}};
                                  }};
-    write_text_output(*files.json, dump_document(json, {&clusters, 1}));
+    write_output(*files.json, dump_document(json, {&clusters, 1}));
   }
   if (files.colored) {
     const std::filesystem::path path(*files.colored);
@@ -135,7 +135,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
                                   row[2], row[3]);
       text.append(line, static_cast<std::size_t>(n));
     }
-    write_text_output(*files.linkage, text);
+    write_output(*files.linkage, text);
   }
   if (files.curve) {
     std::string text = "k,rms\n";
@@ -144,7 +144,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
       const int n = std::snprintf(line, sizeof line, "%u,%.17g\n", point.clusters, point.rms);
       text.append(line, static_cast<std::size_t>(n));
     }
-    write_text_output(*files.curve, text);
+    write_output(*files.curve, text);
   }
   if (files.png) {
     write_png(*files.png, hierarchy.mesh(), group_face_colors(segmentation.labels));

@@ -40,9 +40,9 @@ void validate_output_files(const OutputFiles& files);
 /// print nothing else there (its summary is suppressed as by --quiet).
 bool writes_to_standard_output(const OutputFiles& files);
 
-/// Writes `text` (any bytes) to the file `path` atomically, or to standard output when `path` is
-/// "-". Throws IoError.
-void write_text_output(const std::string& path, std::string_view text);
+/// Writes `bytes` (text, or the tree file) to the file `path` atomically, or to standard output
+/// when `path` is "-". Throws IoError.
+void write_output(const std::string& path, std::string_view bytes);
 
 // JSON documents with large arrays, and points as JSON (src/json_document.hpp).
 using detail::dump_document;

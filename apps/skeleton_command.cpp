@@ -11,7 +11,7 @@
 #include "primseg/skeleton.hpp"
 #include "primseg/skeleton_gltf.hpp"
 #include "primseg/skinning.hpp"
-#include "skeleton_io.hpp"
+#include "skeleton_outputs.hpp"
 
 namespace primseg::cli {
 

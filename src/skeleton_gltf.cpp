@@ -14,11 +14,13 @@
 #include "json_document.hpp"
 #include "no_index.hpp"
 #include "primseg/error.hpp"
+#include "shape_generator/vector_math.hpp"
 
 namespace primseg {
 namespace {
 
 using detail::vec3_json;
+using namespace shape_detail;  // Vec3 -, cross, norm
 using nlohmann::json;
 
 static_assert(std::endian::native == std::endian::little, "GLB is little-endian");
@@ -65,29 +67,31 @@ void check_inputs(const Mesh& mesh, const Skeleton& skeleton, const SkinWeights&
         throw InvalidInputError("glTF skin: a bone names a joint that does not exist");
 }
 
-// Each vertex's influences, largest weight first, in float32 rows summing to 1.
-struct Influences {
-  std::size_t per_vertex = 0;  // a multiple of kInfluencesPerSet
+// One JOINTS_n / WEIGHTS_n pair: four influences per vertex, shape (4n) each.
+struct InfluenceSet {
   std::vector<std::uint16_t> joints;
   std::vector<float> weights;
 };
 
-Influences vertex_influences(const SkinWeights& skin, std::uint32_t root_bone,
-                             std::uint32_t max_influences) {
+// Each vertex's influences, largest weight first, in float32 rows summing to 1, spread over as
+// many sets of four as the widest row needs.
+std::vector<InfluenceSet> influence_sets(const SkinWeights& skin, std::uint32_t root_bone,
+                                         std::uint32_t max_influences) {
   const std::uint32_t n = skin.vertex_count();
   std::size_t widest = 1;  // an empty row follows the root bone
   for (std::uint32_t v = 0; v < n; ++v)
     widest = std::max<std::size_t>(widest, skin.offsets[v + 1] - skin.offsets[v]);
   if (max_influences > 0) widest = std::min<std::size_t>(widest, max_influences);
-  Influences out;
-  out.per_vertex = (widest + kInfluencesPerSet - 1) / kInfluencesPerSet * kInfluencesPerSet;
-  out.joints.assign(n * out.per_vertex, 0);
-  out.weights.assign(n * out.per_vertex, 0.0f);
+  std::vector<InfluenceSet> sets((widest + kInfluencesPerSet - 1) / kInfluencesPerSet);
+  for (InfluenceSet& set : sets) {
+    set.joints.assign(kInfluencesPerSet * n, 0);
+    set.weights.assign(kInfluencesPerSet * n, 0.0f);
+  }
   std::vector<std::pair<double, std::uint32_t>> row;
-  for (std::uint32_t v = 0; v < n; ++v) {
+  for (std::size_t v = 0; v < n; ++v) {
     row.clear();
-    const auto bones = skin.bones_of(v);
-    const auto weights = skin.weights_of(v);
+    const auto bones = skin.bones_of(static_cast<std::uint32_t>(v));
+    const auto weights = skin.weights_of(static_cast<std::uint32_t>(v));
     for (std::size_t i = 0; i < bones.size(); ++i)
       if (weights[i] > 0) row.emplace_back(weights[i], bones[i]);
     // Largest first, ties by bone id: set 0 holds what matters most, deterministically.
@@ -102,33 +106,28 @@ Influences vertex_influences(const SkinWeights& skin, std::uint32_t root_bone,
       total = 1;
     }
     // float32 rows that sum to 1 as closely as float32 allows: the largest takes the rest.
-    float* w = &out.weights[v * out.per_vertex];
-    std::uint16_t* j = &out.joints[v * out.per_vertex];
+    const auto slot = [&sets, v](std::size_t i) -> std::pair<std::uint16_t&, float&> {
+      InfluenceSet& set = sets[i / kInfluencesPerSet];
+      const std::size_t at = kInfluencesPerSet * v + i % kInfluencesPerSet;
+      return {set.joints[at], set.weights[at]};
+    };
     double rest = 1;
-    for (std::size_t i = row.size(); i-- > 1;) {
-      w[i] = static_cast<float>(row[i].first / total);
-      rest -= w[i];
+    for (std::size_t i = row.size(); i-- > 0;) {
+      auto [joint, weight] = slot(i);
+      joint = static_cast<std::uint16_t>(row[i].second);
+      weight = static_cast<float>(i == 0 ? rest : row[i].first / total);
+      rest -= weight;
     }
-    w[0] = static_cast<float>(rest);
-    for (std::size_t i = 0; i < row.size(); ++i) j[i] = static_cast<std::uint16_t>(row[i].second);
   }
-  return out;
+  return sets;
 }
 
 // Area-weighted vertex normals (unit); (0, 0, 1) where the triangles around a vertex have no area.
 std::vector<std::array<float, 3>> vertex_normals(const Mesh& mesh) {
-  std::vector<Vec3> sums(mesh.vertex_count(), Vec3{0, 0, 0});
-  for (const Triangle& t : mesh.triangles) {
-    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
-    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const Vec3 cross{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                     u[0] * w[1] - u[1] * w[0]};
-    for (const std::uint32_t v : t)
-      for (int i = 0; i < 3; ++i) sums[v][i] += cross[i];
-  }
+  const std::vector<Vec3> sums = area_weighted_normal_sums(mesh.positions, mesh.triangles);
   std::vector<std::array<float, 3>> normals(sums.size(), {0.0f, 0.0f, 1.0f});
   for (std::size_t v = 0; v < sums.size(); ++v) {
-    const double length = std::hypot(sums[v][0], sums[v][1], sums[v][2]);
+    const double length = norm(sums[v]);
     if (length > 0 && std::isfinite(length))
       for (int i = 0; i < 3; ++i) normals[v][i] = static_cast<float>(sums[v][i] / length);
   }
@@ -219,9 +218,6 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
   for (std::uint32_t b = 0; b < k; ++b)
     pivots[b] = tree.parent_joint[b] == kNone ? skeleton.bones[b].point
                                               : skeleton.joints[tree.parent_joint[b]].position;
-  const auto offset_from = [](const Vec3& p, const Vec3& origin) {
-    return Vec3{p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]};
-  };
 
   BufferBuilder buffer;
   const std::uint32_t n = mesh.vertex_count();
@@ -242,23 +238,17 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
   const auto normals = vertex_normals(mesh);
   primitive_attributes["NORMAL"] = buffer.add(normals, n, "VEC3", kFloat, kArrayBuffer);
 
-  const Influences influences =
-      vertex_influences(weights, skeleton.root_bone(), options.max_influences);
-  for (std::size_t set = 0; set * kInfluencesPerSet < influences.per_vertex; ++set) {
-    std::vector<std::uint16_t> joints(4 * std::size_t{n});
-    std::vector<float> values(4 * std::size_t{n});
-    for (std::size_t v = 0; v < n; ++v)
-      for (std::size_t i = 0; i < kInfluencesPerSet; ++i) {
-        const std::size_t from = v * influences.per_vertex + set * kInfluencesPerSet + i;
-        joints[kInfluencesPerSet * v + i] = influences.joints[from];
-        values[kInfluencesPerSet * v + i] = influences.weights[from];
-      }
+  const std::vector<InfluenceSet> sets =
+      influence_sets(weights, skeleton.root_bone(), options.max_influences);
+  for (std::size_t set = 0; set < sets.size(); ++set) {
     // (Appended, not "_" + to_string(): g++ 12 warns falsely on that, -Wrestrict.)
     std::string joints_name = "JOINTS_", weights_name = "WEIGHTS_";
     joints_name += std::to_string(set);
     weights_name += std::to_string(set);
-    primitive_attributes[joints_name] = buffer.add(joints, n, "VEC4", kUnsignedShort, kArrayBuffer);
-    primitive_attributes[weights_name] = buffer.add(values, n, "VEC4", kFloat, kArrayBuffer);
+    primitive_attributes[joints_name] =
+        buffer.add(sets[set].joints, n, "VEC4", kUnsignedShort, kArrayBuffer);
+    primitive_attributes[weights_name] =
+        buffer.add(sets[set].weights, n, "VEC4", kFloat, kArrayBuffer);
   }
 
   std::vector<std::uint32_t> indices;
@@ -307,8 +297,7 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
         joint == kNone ? json(nullptr) : json(to_string(skeleton.joints[joint].kind));
     nodes.push_back(
         {{"name", "bone_" + std::to_string(b)},
-         {"translation",
-          vec3_json(parent == kNone ? pivots[b] : offset_from(pivots[b], pivots[parent]))},
+         {"translation", vec3_json(parent == kNone ? pivots[b] : pivots[b] - pivots[parent])},
          {"extras", std::move(extras)}});
     if (parent == kNone) nodes[1]["children"].push_back(kFirstBoneNode + b);
   }
@@ -316,7 +305,7 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
     const Joint& joint = skeleton.joints[ends[e]];
     const std::uint32_t bone = joint.bones[0];
     nodes.push_back({{"name", "end_" + std::to_string(joint.id)},
-                     {"translation", vec3_json(offset_from(joint.position, pivots[bone]))},
+                     {"translation", vec3_json(joint.position - pivots[bone])},
                      {"extras", {{"joint", joint.id}, {"joint_kind", to_string(joint.kind)}}}});
   }
   // Children in node order, so that the file does not depend on the order they were found in.

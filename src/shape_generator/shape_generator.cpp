@@ -131,12 +131,7 @@ std::vector<Primitive> canonical_regions(const PatchBuilder& builder, const Moti
 /// Moves each vertex along its area-weighted normal by N(0, sigma).
 void add_normal_noise(std::vector<Vec3>& positions, const std::vector<Triangle>& triangles,
                       double sigma, std::uint64_t seed) {
-  std::vector<Vec3> normals(positions.size(), Vec3{0, 0, 0});
-  for (const Triangle& tri : triangles) {
-    const Vec3 &a = positions[tri[0]], &b = positions[tri[1]], &c = positions[tri[2]];
-    const Vec3 area_normal = shape_detail::cross(b - a, c - a);  // length = twice the area
-    for (std::uint32_t v : tri) normals[v] = normals[v] + area_normal;
-  }
+  const std::vector<Vec3> normals = shape_detail::area_weighted_normal_sums(positions, triangles);
   SplitMix64 random(seed ^ kNoiseStream);
   for (std::size_t v = 0; v < positions.size(); ++v) {
     const double offset = sigma * random.normal();  // drawn for every vertex: stable stream

@@ -84,6 +84,23 @@ Eigen::Affine3d local_transform(const json& node) {
   return local;
 }
 
+// One JOINTS_n / WEIGHTS_n pair of the file: four joints and weights per vertex.
+struct InfluenceSet {
+  std::vector<std::uint16_t> joints;
+  std::vector<float> weights;
+};
+
+// Every set of the file, read once.
+std::vector<InfluenceSet> influence_sets(const Glb& file) {
+  const json& attributes = file.gltf["meshes"][0]["primitives"][0]["attributes"];
+  std::vector<InfluenceSet> sets;
+  for (int set = 0; attributes.contains("JOINTS_" + std::to_string(set)); ++set)
+    sets.push_back(
+        {file.read<std::uint16_t>(attributes["JOINTS_" + std::to_string(set)], 5123, "VEC4", 4),
+         file.read<float>(attributes["WEIGHTS_" + std::to_string(set)], 5126, "VEC4", 4)});
+  return sets;
+}
+
 // Every vertex skinned as a glTF reader does: world(joint) · inverseBind(joint) blended by the
 // weights of every JOINTS_n / WEIGHTS_n set.
 std::vector<Eigen::Vector3d> skin_as_gltf(const Glb& file) {
@@ -111,17 +128,12 @@ std::vector<Eigen::Vector3d> skin_as_gltf(const Glb& file) {
   const json& attributes = gltf["meshes"][0]["primitives"][0]["attributes"];
   const auto positions = file.read<float>(attributes["POSITION"], 5126, "VEC3", 3);
   std::vector<Eigen::Vector3d> out(positions.size() / 3, Eigen::Vector3d::Zero());
-  for (int set = 0; attributes.contains("JOINTS_" + std::to_string(set)); ++set) {
-    const auto joints =
-        file.read<std::uint16_t>(attributes["JOINTS_" + std::to_string(set)], 5123, "VEC4", 4);
-    const auto weights =
-        file.read<float>(attributes["WEIGHTS_" + std::to_string(set)], 5126, "VEC4", 4);
+  for (const InfluenceSet& set : influence_sets(file))
     for (std::size_t v = 0; v < out.size(); ++v) {
       const Eigen::Vector3d rest(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
-      for (int i = 0; i < 4; ++i)
-        out[v] += double{weights[4 * v + i]} * (joint_matrices.at(joints[4 * v + i]) * rest);
+      for (std::size_t i = 4 * v; i < 4 * v + 4; ++i)
+        out[v] += double{set.weights[i]} * (joint_matrices.at(set.joints[i]) * rest);
     }
-  }
   return out;
 }
 
@@ -149,17 +161,12 @@ const Rig& rig() {
 }
 
 // The weights of vertex v in every set, as (bone, weight) pairs with a weight above zero.
-std::vector<std::pair<std::uint32_t, double>> weights_of(const Glb& file, std::uint32_t v) {
-  const json& attributes = file.gltf["meshes"][0]["primitives"][0]["attributes"];
+std::vector<std::pair<std::uint32_t, double>> weights_of(const std::vector<InfluenceSet>& sets,
+                                                         std::uint32_t v) {
   std::vector<std::pair<std::uint32_t, double>> row;
-  for (int set = 0; attributes.contains("JOINTS_" + std::to_string(set)); ++set) {
-    const auto joints =
-        file.read<std::uint16_t>(attributes["JOINTS_" + std::to_string(set)], 5123, "VEC4", 4);
-    const auto weights =
-        file.read<float>(attributes["WEIGHTS_" + std::to_string(set)], 5126, "VEC4", 4);
-    for (int i = 0; i < 4; ++i)
-      if (weights[4 * v + i] > 0) row.emplace_back(joints[4 * v + i], weights[4 * v + i]);
-  }
+  for (const InfluenceSet& set : sets)
+    for (std::size_t i = 4 * std::size_t{v}; i < 4 * std::size_t{v} + 4; ++i)
+      if (set.weights[i] > 0) row.emplace_back(set.joints[i], set.weights[i]);
   std::sort(row.begin(), row.end());
   return row;
 }
@@ -184,9 +191,10 @@ TEST(SkeletonGltf, TheFileHoldsTheMeshAndEveryWeightAsWritten) {
     ASSERT_NEAR(std::hypot(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]), 1.0, 1e-6);
 
   // Every row as compute_skin_weights gave it, to float32 round-off, summing to 1.
+  const auto sets = influence_sets(file);
   std::size_t widest = 0;
   for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-    const auto row = weights_of(file, v);
+    const auto row = weights_of(sets, v);
     const auto bones = r.weights.bones_of(v);
     const auto weights = r.weights.weights_of(v);
     widest = std::max(widest, bones.size());
@@ -320,7 +328,7 @@ TEST(SkeletonGltf, WideRowsTakeMoreSetsOrKeepTheLargestWeights) {
   const json& attributes = all.gltf["meshes"][0]["primitives"][0]["attributes"];
   EXPECT_TRUE(attributes.contains("JOINTS_1"));
   EXPECT_FALSE(attributes.contains("JOINTS_2"));
-  auto row = weights_of(all, v);
+  auto row = weights_of(influence_sets(all), v);
   ASSERT_EQ(row.size(), 6u);
   for (std::uint32_t b = 0; b < 6; ++b) EXPECT_NEAR(row[b].second, spread[b], 1e-7);
   // The largest four are in the first set, largest first.
@@ -332,7 +340,8 @@ TEST(SkeletonGltf, WideRowsTakeMoreSetsOrKeepTheLargestWeights) {
   four.max_influences = 4;
   const Glb capped(skinned_glb(r.figure.mesh, r.skeleton, wide, four));
   EXPECT_FALSE(capped.gltf["meshes"][0]["primitives"][0]["attributes"].contains("JOINTS_1"));
-  row = weights_of(capped, v);
+  const auto capped_sets = influence_sets(capped);
+  row = weights_of(capped_sets, v);
   ASSERT_EQ(row.size(), 4u);
   const double kept = 0.3 + 0.25 + 0.2 + 0.1;
   EXPECT_EQ(row[0].first, 1u);
@@ -340,7 +349,7 @@ TEST(SkeletonGltf, WideRowsTakeMoreSetsOrKeepTheLargestWeights) {
   EXPECT_EQ(row[2].first, 3u);
   EXPECT_NEAR(row[2].second, 0.25 / kept, 1e-7);
   // Rows of two bones are unchanged by the cap.
-  EXPECT_EQ(weights_of(capped, 0), weights_of(all, 0));
+  EXPECT_EQ(weights_of(capped_sets, 0), weights_of(influence_sets(all), 0));
 }
 
 TEST(SkeletonGltf, AVertexOfNoTriangleFollowsTheRootBone) {
@@ -350,7 +359,7 @@ TEST(SkeletonGltf, AVertexOfNoTriangleFollowsTheRootBone) {
   const SkinWeights weights = compute_skin_weights(mesh, r.skeleton);
   ASSERT_EQ(weights.bones_of(mesh.vertex_count() - 1).size(), 0u);
   const Glb file(skinned_glb(mesh, r.skeleton, weights));
-  const auto row = weights_of(file, mesh.vertex_count() - 1);
+  const auto row = weights_of(influence_sets(file), mesh.vertex_count() - 1);
   ASSERT_EQ(row.size(), 1u);
   EXPECT_EQ(row[0].first, r.skeleton.root_bone());
   EXPECT_EQ(row[0].second, 1.0);

@@ -13,7 +13,7 @@ import { fileURLToPath } from 'node:url';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import validator from 'gltf-validator';
-import { largestDifference, readOffPositions } from './meshes.mjs';
+import { figurePose, largestDifference, readOffPositions } from './meshes.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const cli = resolve(process.env.PRIMSEG ?? join(here, '../../build/primseg'));
@@ -87,17 +87,8 @@ test('three.js reads one bone per cluster, an end per virtual joint, and the res
 });
 
 test('posing the bones in three.js moves every vertex where primseg deform does', async () => {
-  const nearestJoint = (point) => skeleton.joints.reduce((best, joint) => {
-    const d = Math.hypot(...joint.position.map((x, a) => x - point[a]));
-    return !best || d < best.d ? { id: joint.id, d } : best;
-  }, null).id;
   // Nested along the left arm (shoulder then elbow), oblique axes, and a hip.
-  const rotations = [
-    { joint: nearestJoint([-1, 0, 3.2]), axis: [0.2, 1, 0.3], degrees: 35 },
-    { joint: nearestJoint([-2.4, 0, 3.2]), axis: [0, 1, 0], degrees: -50 },
-    { joint: nearestJoint([2.4, 0, 3.2]), axis: [0.5, -1, 2], degrees: 70.5 },
-    { joint: nearestJoint([1, 0, 1.2]), axis: [1, 1, 0], degrees: 20 },
-  ];
+  const rotations = figurePose(skeleton);
   writeFileSync(file('pose.json'), JSON.stringify({ rotations }));
   primseg('deform', file('figure.off'), file('skeleton.json'), file('pose.json'), '-o', file('posed.off'), '--quiet');
   const expected = readOffPositions(file('posed.off'));

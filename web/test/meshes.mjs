@@ -77,3 +77,25 @@ export function largestDifference(a, b) {
   for (let i = 0; i < a.length; ++i) largest = Math.max(largest, Math.abs(a[i] - b[i]));
   return largest;
 }
+
+/** The id of the joint of a skeleton file (primseg skeleton -o, parsed) nearest a point. */
+export function nearestJoint(skeleton, point) {
+  let best = null;
+  for (const joint of skeleton.joints) {
+    const d = Math.hypot(...joint.position.map((x, a) => x - point[a]));
+    if (!best || d < best.d) best = { id: joint.id, d };
+  }
+  return best.id;
+}
+
+/** The stick figure's test pose (tests/support/stick_figure.hpp at K = 8): the left shoulder and
+ *  elbow nested along the arm, the right elbow and the right hip, about oblique axes. */
+export function figurePose(skeleton) {
+  const at = (point) => nearestJoint(skeleton, point);
+  return [
+    { joint: at([-1, 0, 3.2]), axis: [0.2, 1, 0.3], degrees: 35 },
+    { joint: at([-2.4, 0, 3.2]), axis: [0, 1, 0], degrees: -50 },
+    { joint: at([2.4, 0, 3.2]), axis: [0.5, -1, 2], degrees: 70.5 },
+    { joint: at([1, 0, 1.2]), axis: [1, 1, 0], degrees: 20 },
+  ];
+}

@@ -12,7 +12,7 @@ import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { launchBrowser, openViewer } from './browser.mjs';
-import { largestDifference, readOffPositions } from './meshes.mjs';
+import { figurePose, largestDifference, nearestJoint, readOffPositions } from './meshes.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const cli = resolve(process.env.PRIMSEG ?? join(here, '../../build/primseg'));
@@ -57,16 +57,6 @@ async function openFigure({ file: html = file('figure.html') } = {}) {
   return opened;
 }
 
-// The joint of the skeleton file nearest a point.
-function nearestJoint(point) {
-  let best = null;
-  for (const joint of skeleton.joints) {
-    const d = Math.hypot(...joint.position.map((x, a) => x - point[a]));
-    if (!best || d < best.d) best = { id: joint.id, d };
-  }
-  return best.id;
-}
-
 test('the page carries the skeleton primseg skeleton extracts, and draws its visible parts', async () => {
   const { page, errors } = await openFigure();
   const shown = await page.evaluate(async () => {
@@ -99,14 +89,7 @@ test('the page carries the skeleton primseg skeleton extracts, and draws its vis
 
 test('a pose applied in the page moves every vertex where primseg deform moves it, to 1e-9', async () => {
   // Elbows, a shoulder and a hip, about oblique axes: rotations nested along the arm.
-  const elbowLeft = nearestJoint([-2.4, 0, 3.2]), elbowRight = nearestJoint([2.4, 0, 3.2]);
-  const shoulderLeft = nearestJoint([-1, 0, 3.2]), hipRight = nearestJoint([1, 0, 1.2]);
-  const rotations = [
-    { joint: shoulderLeft, axis: [0.2, 1, 0.3], degrees: 35 },
-    { joint: elbowLeft, axis: [0, 1, 0], degrees: -50 },
-    { joint: elbowRight, axis: [0.5, -1, 2], degrees: 70.5 },
-    { joint: hipRight, axis: [1, 1, 0], degrees: 20 },
-  ];
+  const rotations = figurePose(skeleton);
   for (const { joint } of rotations) assert.equal(skeleton.joints[joint].kind, 'sensitive');
   const pose = { rotations };
   writeFileSync(file('pose.json'), JSON.stringify(pose));
@@ -162,7 +145,7 @@ async function dragJoint(page, joint, dx, dy) {
 
 test('dragging joints poses the mesh live, as primseg deform poses it', async () => {
   const { page, errors } = await openFigure();
-  const elbow = nearestJoint([2.4, 0, 3.2]);
+  const elbow = nearestJoint(skeleton, [2.4, 0, 3.2]);
   const hand = skeleton.joints.find((j) => j.kind === 'virtual' && j.position[0] > 2 && j.position[2] > 1.5).id;
   // The right forearm: dragging its free end (the hand) turns it about the elbow, so that the hand
   // follows the pointer; then dragging the elbow turns the whole forearm again.

@@ -1,4 +1,4 @@
-#include "skeleton_io.hpp"
+#include "skeleton_outputs.hpp"
 
 #include <cstdio>
 
