@@ -148,7 +148,11 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
   command.add_option("--labels", options.files.labels,
                      "Write one cluster label per input face (- for standard output)");
   command.add_option("--json", options.files.json,
-                     "Write clusters and primitives as JSON (- for standard output)");
+                     "Write clusters and primitives, and the borders where clusters meet, as JSON "
+                     "(- for standard output)");
+  command.add_option("--borders", options.files.borders,
+                     "Write the borders where clusters meet as OBJ polylines (.obj; one object "
+                     "border_A_B per pair of clusters)");
   command.add_option("--colored", options.files.colored,
                      "Write the mesh coloured by cluster (.ply colours or .obj groups)");
   command.add_option("--curve", options.files.curve,

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -34,7 +35,7 @@ bool to_standard_output(const std::optional<std::string>* path) {
 
 void validate_output_files(const OutputFiles& files) {
   const std::pair<const char*, const std::optional<std::string>*> binary[] = {
-      {"--colored", &files.colored}, {"--png", &files.png}};
+      {"--colored", &files.colored}, {"--png", &files.png}, {"--borders", &files.borders}};
   for (const auto& [option, path] : binary)
     if (*path == kStandardOutput)
       throw InvalidInputError(std::string(option) +
@@ -51,6 +52,8 @@ void validate_output_files(const OutputFiles& files) {
     throw InvalidInputError(
         "--tree -: standard output is a terminal, and a tree file is binary; redirect it "
         "(> part.tree) or pipe it (| primseg cut - --clusters 20)");
+  if (files.borders && std::filesystem::path(*files.borders).extension() != ".obj")
+    throw InvalidInputError("--borders: '" + *files.borders + "' must end in .obj");
   if (files.colored) {
     bool supported = false;
     try {
@@ -90,6 +93,60 @@ nlohmann::json primitive_params(const Primitive& primitive) {
   return params;
 }
 
+namespace {
+
+nlohmann::json border_json(const ClusterBorder& border) {
+  nlohmann::json curves = nlohmann::json::array();
+  for (const BorderCurve& curve : border.curves)
+    curves.push_back({{"closed", curve.closed}, {"vertices", curve.vertices}});
+  return {
+      {"clusters",
+       {border.first,
+        border.second == kMeshBoundary ? nlohmann::json(nullptr) : nlohmann::json(border.second)}},
+      {"edges", border.edge_count},
+      {"length", border.length},
+      {"angle", std::isnan(border.angle) ? nlohmann::json(nullptr) : nlohmann::json(border.angle)},
+      {"curves", std::move(curves)}};
+}
+
+}  // namespace
+
+std::string borders_obj(const Mesh& mesh, std::span<const ClusterBorder> borders) {
+  std::vector<std::uint32_t> obj_index(mesh.vertex_count(), 0);  // 1-based, 0: not written
+  for (const ClusterBorder& border : borders)
+    for (const BorderCurve& curve : border.curves)
+      for (const std::uint32_t v : curve.vertices) obj_index[v] = 1;
+  std::string text = "# primseg cluster borders: one object per pair of clusters that meet\n";
+  char line[128];
+  std::uint32_t written = 0;
+  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    if (obj_index[v] == 0) continue;
+    obj_index[v] = ++written;
+    const Vec3& p = mesh.positions[v];
+    const int n = std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+    text.append(line, static_cast<std::size_t>(n));
+  }
+  // (snprintf, not string concatenation: g++ 12 warns falsely on that, -Wstringop-overflow.)
+  for (const ClusterBorder& border : borders) {
+    const int n =
+        border.second == kMeshBoundary
+            ? std::snprintf(line, sizeof line, "o border_%u_boundary\n", border.first)
+            : std::snprintf(line, sizeof line, "o border_%u_%u\n", border.first, border.second);
+    text.append(line, static_cast<std::size_t>(n));
+    for (const BorderCurve& curve : border.curves) {
+      text += 'l';
+      const auto append_index = [&](std::uint32_t v) {
+        const int m = std::snprintf(line, sizeof line, " %u", obj_index[v]);
+        text.append(line, static_cast<std::size_t>(m));
+      };
+      for (const std::uint32_t v : curve.vertices) append_index(v);
+      if (curve.closed) append_index(curve.vertices.front());
+      text += '\n';
+    }
+  }
+  return text;
+}
+
 void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
                          const std::vector<ClusterReport>& reports, const OutputFiles& files,
                          const nlohmann::json& summary) {
@@ -102,11 +159,19 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     }
     write_output(*files.labels, text);
   }
+  std::vector<ClusterBorder> borders;
+  if (files.json || files.borders) {
+    std::vector<Primitive> primitives;
+    primitives.reserve(reports.size());
+    for (const ClusterReport& report : reports) primitives.push_back(report.primitive);
+    borders = cluster_borders(hierarchy.mesh(), segmentation.labels, primitives);
+  }
   if (files.json) {
     // A level of a cluster per face (a triangle soup at --clusters auto) held about 1.6 KB per
     // cluster as a document, 0.4 KB as text.
     nlohmann::json json = summary;
     json["clusters"] = nlohmann::json::array();
+    json["borders"] = nlohmann::json::array();
     const StreamedArray clusters{"clusters", reports.size(), [&reports](std::size_t i) {
                                    const ClusterReport& r = reports[i];
                                    return nlohmann::json{
@@ -118,8 +183,12 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
                                        {"max", r.max},
                                        {"params", primitive_params(r.primitive)}};
                                  }};
-    write_output(*files.json, dump_document(json, {&clusters, 1}));
+    const StreamedArray border_array{"borders", borders.size(),
+                                     [&borders](std::size_t i) { return border_json(borders[i]); }};
+    const StreamedArray arrays[] = {clusters, border_array};
+    write_output(*files.json, dump_document(json, arrays));
   }
+  if (files.borders) write_output(*files.borders, borders_obj(hierarchy.mesh(), borders));
   if (files.colored) {
     const std::filesystem::path path(*files.colored);
     MeshWriteOptions options;

@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "../src/json_document.hpp"
+#include "primseg/borders.hpp"
 #include "primseg/cut.hpp"
 
 namespace primseg::cli {
@@ -20,7 +21,8 @@ inline constexpr std::string_view kStandardOutput = "-";
 
 struct OutputFiles {
   std::optional<std::string> labels;   // one label per line, per input face
-  std::optional<std::string> json;     // clusters with primitives
+  std::optional<std::string> json;     // clusters with primitives, and their borders
+  std::optional<std::string> borders;  // border curves as OBJ polylines
   std::optional<std::string> colored;  // .ply (face colours) or .obj (groups)
   std::optional<std::string> tree;     // whole hierarchy (segment only)
   std::optional<std::string> png;      // picture of the clusters
@@ -33,7 +35,8 @@ struct OutputFiles {
 std::string count_of(std::uint64_t count, std::string_view noun, std::string_view plural = {});
 
 /// Throws InvalidInputError for output names that cannot be written (checked before any work):
-/// a coloured mesh that is neither .ply nor .obj, '-' for a binary output, or '-' twice.
+/// a coloured mesh that is neither .ply nor .obj, borders not in .obj, '-' for a binary output,
+/// or '-' twice.
 void validate_output_files(const OutputFiles& files);
 
 /// True when an output (a text one, or the tree) goes to standard output: the command must then
@@ -51,6 +54,11 @@ using detail::vec3_json;
 
 /// JSON parameters of a primitive, input units.
 nlohmann::json primitive_params(const Primitive& primitive);
+
+/// The border curves as an OBJ file of polylines: the vertices they use, in index order, and one
+/// object `border_A_B` (`border_A_boundary` along the mesh's open boundary) of `l` lines per
+/// border, a closed curve ending at its first vertex.
+std::string borders_obj(const Mesh& mesh, std::span<const ClusterBorder> borders);
 
 /// Writes the requested per-level files. `summary` holds mesh and timing entries for the JSON.
 void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,

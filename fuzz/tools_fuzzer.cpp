@@ -7,13 +7,15 @@
 // Checked:
 // - every result is finite, and holds what its header promises: a report's `max` is the largest
 //   distance of its cluster's vertices of positive weight and bounds its `rms`; refinement keeps
-//   the number of clusters and each one connected; a skeleton has a bone per cluster and valid
+//   the number of clusters and each one connected; border curves walk their border's edges,
+//   angles within [0, 180]; a skeleton has a bone per cluster and valid
 //   joint ids; every skinning row sums to 1; its glTF file is well formed (chunk sizes, every
 //   accessor inside the buffer, finite bounds, float32 weight rows summing to 1); denoising keeps
 //   the connectivity and inverts no triangle; a distance's mean <= RMS <= Hausdorff;
 // - units do not matter (mesh.hpp, kMaxCoordinateMagnitude): the scaled run gives the same tree,
-//   costs, labels, weights and picture, and every length scaled by exactly the same power of two
-//   (but for round-off zeros that underflowed below the normal doubles, see ScaleCheck);
+//   costs, labels, weights, border curves and angles and picture, and every length scaled by
+//   exactly the same power of two (but for round-off zeros that underflowed below the normal
+//   doubles, see ScaleCheck);
 // - nothing throws but primseg::InvalidInputError where a function documents it.
 //
 // Input layout: byte 0 = options (bit 0: all five primitive types, bit 1: uniform weights,
@@ -33,6 +35,7 @@
 #include <vector>
 
 #include "grid_mesh.hpp"
+#include "primseg/borders.hpp"
 #include "primseg/cut.hpp"
 #include "primseg/denoise.hpp"
 #include "primseg/error.hpp"
@@ -104,6 +107,7 @@ struct Results {
   Segmentation level;
   std::vector<ClusterReport> reports;
   RefinedLevel refined;
+  std::vector<ClusterBorder> borders;
   Skeleton skeleton;
   SkinWeights skin;
   Mesh denoised;
@@ -151,6 +155,25 @@ void check_reports(const Hierarchy& hierarchy, const Segmentation& level,
     if (std::abs(report.max - largest[c]) > 1e-9 * largest[c] + 1e-12 * diagonal)
       fail("report max is not the largest distance", report.max, largest[c]);
     if (report.rms > report.max * (1 + 1e-12)) fail("report rms above max", report.rms, report.max);
+  }
+}
+
+// Each curve walks edges of the mesh, its border's edge count in all, with lengths and angles in
+// range.
+void check_borders(const Mesh& mesh, const std::vector<ClusterBorder>& borders) {
+  for (const ClusterBorder& border : borders) {
+    if (!(border.first < border.second)) fail("border clusters", border.first, border.second);
+    check_length(border.length, "border length");
+    if (!(std::isnan(border.angle) || (border.angle >= 0 && border.angle <= 180)))
+      fail("border angle", border.angle);
+    std::uint32_t edges = 0;
+    for (const BorderCurve& curve : border.curves) {
+      if (curve.vertices.size() < 2) fail("border curve size", double(curve.vertices.size()));
+      for (const std::uint32_t v : curve.vertices)
+        if (v >= mesh.vertex_count()) fail("border curve vertex", v);
+      edges += static_cast<std::uint32_t>(curve.vertices.size()) - (curve.closed ? 0 : 1);
+    }
+    if (edges != border.edge_count) fail("border curves' edges", edges, border.edge_count);
   }
 }
 
@@ -282,6 +305,11 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
     fail("refinement changed the cluster count");
   fuzz::check_cut(hierarchy, results.refined.segmentation);
   check_reports(hierarchy, results.refined.segmentation, results.refined.reports);
+  std::vector<Primitive> primitives;
+  for (const ClusterReport& report : results.refined.reports)
+    primitives.push_back(report.primitive);
+  results.borders = cluster_borders(*mesh, results.refined.segmentation.labels, primitives);
+  check_borders(*mesh, results.borders);
 
   results.skeleton = extract_skeleton(hierarchy, results.level);
   results.skin = compute_skin_weights(*mesh, results.skeleton);
@@ -384,6 +412,18 @@ void check_scaled(const Results& a, const Results& b, int exponent) {
   scaled.reports(a.reports, b.reports);
   if (a.refined.segmentation.labels != b.refined.segmentation.labels) fail("scaled refined labels");
   scaled.reports(a.refined.reports, b.refined.reports);
+  if (a.borders.size() != b.borders.size()) fail("scaled border count");
+  for (std::size_t i = 0; i < a.borders.size(); ++i) {
+    const ClusterBorder &x = a.borders[i], &y = b.borders[i];
+    if (x.first != y.first || x.second != y.second || x.edge_count != y.edge_count)
+      fail("scaled border", double(i));
+    scaled.length(x.length, y.length, "scaled border length");
+    scaled.same(x.angle, y.angle, "scaled border angle");
+    if (x.curves.size() != y.curves.size()) fail("scaled border curves", double(i));
+    for (std::size_t c = 0; c < x.curves.size(); ++c)
+      if (x.curves[c].vertices != y.curves[c].vertices || x.curves[c].closed != y.curves[c].closed)
+        fail("scaled border curve", double(i));
+  }
   if (a.skeleton.joints.size() != b.skeleton.joints.size()) fail("scaled joint count");
   for (std::size_t j = 0; j < a.skeleton.joints.size(); ++j)
     scaled.point(a.skeleton.joints[j].position, b.skeleton.joints[j].position,

@@ -33,6 +33,9 @@ def declared_name(line):
     code = line.split("//")[0]
     while re.search(r"<[^<>]*>", code):  # template arguments name types, not the declaration
         code = re.sub(r"<[^<>]*>", "", code)
+    initialised = re.match(r"[^(]*?(" + IDENTIFIER + r")\s*=[^=]", code)
+    if initialised and initialised.group(1) != "operator":  # a member whose initialiser calls
+        return initialised.group(1)
     if "(" in code:  # a function: the identifier just before the first parenthesis
         match = re.search(r"(~?" + IDENTIFIER + r"|operator\S*)\s*\($", code[: code.index("(") + 1])
         if match and match.group(1).startswith("operator"):  # operator* -> operator_mul: a C++ name

@@ -21,6 +21,7 @@
 
 #include "doxygen_docstrings.hpp"
 #include "primseg/auto_level.hpp"
+#include "primseg/borders.hpp"
 #include "primseg/cut.hpp"
 #include "primseg/denoise.hpp"
 #include "primseg/error.hpp"
@@ -470,6 +471,27 @@ py::dict cluster_dict(const ClusterReport& report) {
   cluster["max"] = report.max;
   cluster["params"] = params;
   return cluster;
+}
+
+// A border as the CLI's --json "borders" writes it.
+py::dict border_dict(const ClusterBorder& border) {
+  py::list curves;
+  for (const BorderCurve& curve : border.curves) {
+    py::dict c;
+    c["closed"] = curve.closed;
+    c["vertices"] = py::cast(curve.vertices);
+    curves.append(c);
+  }
+  py::dict d;
+  d["clusters"] = py::make_tuple(border.first, border.second == kMeshBoundary
+                                                   ? py::object(py::none())
+                                                   : py::object(py::int_(border.second)));
+  d["edges"] = border.edge_count;
+  d["length"] = border.length;
+  d["angle"] =
+      std::isnan(border.angle) ? py::object(py::none()) : py::object(py::float_(border.angle));
+  d["curves"] = curves;
+  return d;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1141,6 +1163,40 @@ as lists). json.dumps() takes it as it is.)",
                cpp_doc("ClusterReport::rms", doc::cut__ClusterReport__rms),
                cpp_doc("ClusterReport::max", doc::cut__ClusterReport__max),
                cpp_doc("named_parameters", doc::primitive__named_parameters)})
+              .c_str())
+      .def(
+          "borders",
+          [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
+             std::optional<double> relative_tolerance, std::int64_t refine) {
+            const LevelArguments level{std::move(k), tolerance, relative_tolerance};
+            std::vector<ClusterBorder> borders;
+            {
+              py::gil_scoped_release release;
+              std::vector<ClusterReport> reports;
+              const Segmentation segmentation =
+                  refined_level(*self.hierarchy, level, refine, &reports);
+              std::vector<Primitive> primitives;
+              for (const ClusterReport& report : reports) primitives.push_back(report.primitive);
+              borders = cluster_borders(self.hierarchy->mesh(), segmentation.labels, primitives);
+            }
+            py::list list;
+            for (const ClusterBorder& border : borders) list.append(border_dict(border));
+            return list;
+          },
+          py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
+          py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
+          join_docs(
+              {R"(borders(k=None, *, tolerance=None, relative_tolerance=None, refine=0) -> list of dict
+
+Where the clusters of the level meet, as the CLI's --json "borders": one dict per border with
+clusters (a, b), b None along the mesh's open boundary; edges (count); length (input units);
+angle (degrees between the two fitted surfaces across it: 0 tangent, 90 a box's edge; None on
+the open boundary); and curves, a list of dicts {closed, vertices} with the vertex indices in
+order along each curve. json.dumps() takes it as it is.)",
+               kLevelArguments, kRefineArgument,
+               cpp_doc("cluster_borders", doc::borders__cluster_borders),
+               cpp_doc("ClusterBorder::angle", doc::borders__ClusterBorder__angle),
+               cpp_doc("ClusterBorder::curves", doc::borders__ClusterBorder__curves)})
               .c_str())
       .def(
           "auto_level",

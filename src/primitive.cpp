@@ -108,4 +108,30 @@ Vec3 Primitive::closest_point(const Vec3& x) const {
   return x;
 }
 
+Vec3 Primitive::normal(const Vec3& x) const {
+  const Eigen::Vector3d p = to_eigen(x);
+  const Eigen::Vector3d origin = to_eigen(point);
+  const Eigen::Vector3d a = to_eigen(axis);
+  switch (type) {
+    case PrimitiveType::Plane:
+      return axis;
+    case PrimitiveType::Sphere: {
+      const Eigen::Vector3d d = p - origin;
+      return d.squaredNorm() > 0 ? to_vec3(d.normalized()) : Vec3{1, 0, 0};
+    }
+    case PrimitiveType::Cylinder:
+      return to_vec3(radial_direction(p - origin, a));
+    case PrimitiveType::Cone:
+      // Orthogonal to the generator a cos + u sin in the half-plane of p, away from the axis.
+      return to_vec3(radial_direction(p - origin, a) * std::cos(half_angle) -
+                     a * std::sin(half_angle));
+    case PrimitiveType::Torus: {
+      const Eigen::Vector3d ring = origin + radial_direction(p - origin, a) * radius;
+      const Eigen::Vector3d to_p = p - ring;
+      return to_p.squaredNorm() > 0 ? to_vec3(to_p.normalized()) : axis;
+    }
+  }
+  return axis;
+}
+
 }  // namespace primseg

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 
+#include "edge_sides.hpp"
 #include "eigen_conversions.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
 
@@ -27,31 +28,17 @@ std::vector<std::uint32_t> triangle_labels(const Mesh& mesh,
 
 std::vector<ClusterPairBoundary> cluster_pair_boundaries(
     const Mesh& mesh, std::span<const std::uint32_t> triangle_labels) {
-  // Every edge with the cluster of each of its triangles: sorted, an edge's entries are
-  // consecutive.
-  struct EdgeEntry {
-    std::uint32_t low, high, label;
-    // NOLINTNEXTLINE(modernize-use-nullptr): clang-tidy 14 misreads the defaulted <=>.
-    auto operator<=>(const EdgeEntry&) const = default;
-  };
-  std::vector<EdgeEntry> entries;
-  entries.reserve(3 * mesh.triangles.size());
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const Triangle& tri = mesh.triangles[t];
-    for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = tri[e], b = tri[(e + 1) % 3];
-      if (a != b) entries.push_back({std::min(a, b), std::max(a, b), triangle_labels[t]});
-    }
-  }
-  std::sort(entries.begin(), entries.end());
-  entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+  // Every edge with the clusters of its triangles, each cluster once.
+  std::vector<detail::EdgeSide> entries = detail::edge_sides(mesh, triangle_labels);
+  entries.erase(std::unique(entries.begin(), entries.end(),
+                            [](const detail::EdgeSide& a, const detail::EdgeSide& b) {
+                              return a.low == b.low && a.high == b.high && a.label == b.label;
+                            }),
+                entries.end());
 
   std::map<std::pair<std::uint32_t, std::uint32_t>, ClusterPairBoundary> pairs;
   for (std::size_t begin = 0; begin < entries.size();) {
-    std::size_t end = begin + 1;
-    while (end < entries.size() && entries[end].low == entries[begin].low &&
-           entries[end].high == entries[begin].high)
-      ++end;
+    const std::size_t end = detail::edge_end(entries, begin);
     const std::uint32_t a = entries[begin].low, b = entries[begin].high;
     const double length = norm(mesh.positions[b] - mesh.positions[a]);
     const Vec3 midpoint = 0.5 * (mesh.positions[a] + mesh.positions[b]);

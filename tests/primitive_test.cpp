@@ -1,6 +1,6 @@
-// Primitive::closest_point and distance against a dense sampling of each surface at random poses,
-// the query points where the nearest point is not unique (a centre, an axis, a tube's core, behind
-// an apex), and the names users see for types and parameters.
+// Primitive::closest_point, distance and normal against a dense sampling of each surface at random
+// poses, the query points where the nearest point is not unique (a centre, an axis, a tube's core,
+// behind an apex), and the names users see for types and parameters.
 
 #include "primseg/primitive.hpp"
 
@@ -178,6 +178,61 @@ TEST(Primitive, QueriesWithoutAUniqueNearestPoint) {
   // On the torus's axis, and on the circle at the core of its tube.
   expect_nearest(PrimitiveType::Torus, {0, 0, 0.25}, std::hypot(kRadius, 0.25) - kMinorRadius);
   expect_nearest(PrimitiveType::Torus, {0, kRadius, 0}, kMinorRadius);
+}
+
+// The normal is the gradient of the distance (central differences of the independent local
+// distance) wherever the query is off the surface and has one nearest point, and points away
+// from the centre, axis or core circle.
+TEST(Primitive, NormalIsTheDistanceGradientAndPointsAway) {
+  std::mt19937_64 rng(20261127);
+  std::uniform_real_distribution<double> coordinate(-1, 1);
+  constexpr double kStep = 1e-6;
+  for (int pose = 0; pose < 3; ++pose)
+    for (const PlacedPrimitive& placed : placed_primitives(rng)) {
+      const PrimitiveType type = placed.primitive.type;
+      SCOPED_TRACE(std::string(to_string(type)) + ", pose " + std::to_string(pose));
+      for (int query = 0; query < 200; ++query) {
+        const Eigen::Vector3d local(coordinate(rng), coordinate(rng), coordinate(rng));
+        const Eigen::Vector2d radial_plane(planar_radius(local), local.z());
+        // Behind a cone's apex the apex is nearest and the distance's gradient is not a normal.
+        if (type == PrimitiveType::Cone &&
+            radial_plane.dot(Eigen::Vector2d(std::sin(kHalfAngle), std::cos(kHalfAngle))) <= 0)
+          continue;
+        const Vec3 x = placed.to_world(local);
+        const Vec3 n = placed.primitive.normal(x);
+        const Eigen::Vector3d world_normal(n[0], n[1], n[2]);
+        EXPECT_NEAR(world_normal.norm(), 1, 1e-15);
+        Eigen::Vector3d gradient;
+        for (int i = 0; i < 3; ++i) {
+          Eigen::Vector3d step = Eigen::Vector3d::Zero();
+          step[i] = kStep;
+          gradient[i] =
+              (placed.local_distance(local + step) - placed.local_distance(local - step)) /
+              (2 * kStep);
+        }
+        const Eigen::Vector3d local_normal = placed.rotation.transpose() * world_normal;
+        EXPECT_NEAR(std::abs(gradient.dot(local_normal)), 1, 1e-6);
+        const Eigen::Vector3d radial(local.x(), local.y(), 0);
+        switch (type) {
+          case PrimitiveType::Plane:
+            EXPECT_EQ(n, placed.primitive.axis);
+            break;
+          case PrimitiveType::Sphere:
+            EXPECT_GT(local_normal.dot(local), 0);
+            break;
+          case PrimitiveType::Cylinder:
+            EXPECT_GT(local_normal.dot(radial), 0);
+            break;
+          case PrimitiveType::Cone:
+            EXPECT_GT(local_normal.dot(radial), 0);
+            EXPECT_LT(local_normal.z(), 0);  // the cone opens along +z
+            break;
+          case PrimitiveType::Torus:
+            EXPECT_GT(local_normal.dot(local - kRadius * radial.normalized()), 0);
+            break;
+        }
+      }
+    }
 }
 
 TEST(Primitive, ParametersAndTypesByName) {

@@ -246,13 +246,14 @@ TEST(RefineBoundaries, OnlyTheMovesThatWouldSplitAClusterAreUndone) {
 // in the plane, so over their flat triangles its faces look closer to the plane than to their
 // own cylinder, which their corners fit exactly.
 Mesh plane_into_coarse_cylinder() {
-  constexpr double kRadius = 5, kStep = 0.05, kTilt = 0.4 * kStep;  // angles in radians
+  constexpr double kArcRadius = 5, kStep = 0.05, kTilt = 0.4 * kStep;  // angles in radians
   constexpr int kPlaneSegments = 10, kArcSegments = 12, kRows = 2;
   std::vector<Vec3> section;  // the cross-section in the xz plane, the plane's part first
   for (int i = kPlaneSegments; i > 0; --i)
     section.push_back({-0.2 * i * std::cos(kTilt), 0, -0.2 * i * std::sin(kTilt)});
   for (int i = 0; i <= kArcSegments; ++i)
-    section.push_back({kRadius * std::sin(i * kStep), 0, kRadius * (1 - std::cos(i * kStep))});
+    section.push_back(
+        {kArcRadius * std::sin(i * kStep), 0, kArcRadius * (1 - std::cos(i * kStep))});
   std::vector<Vec3> positions;
   for (int row = 0; row <= kRows; ++row)
     for (const Vec3& p : section) positions.push_back({p[0], 2.0 * row, p[2]});

@@ -52,6 +52,11 @@ struct Primitive {
   /// The point of the primitive's surface closest to x. Where several are (x at a sphere's
   /// centre, on the axis of a cylinder, cone or torus, on a torus's core circle), one of them.
   Vec3 closest_point(const Vec3& x) const;
+  /// Unit normal of the surface at closest_point(x): a plane's `axis`; for the other types the
+  /// direction away from the centre, axis or core circle (outward on a sphere, a cylinder, a cone
+  /// and a torus seen from outside). Where the closest point is one of several, the normal at
+  /// the one closest_point() picks; at a cone's apex, that of the generator through it.
+  Vec3 normal(const Vec3& x) const;
 };
 
 /// One parameter of a primitive as users see it: a named 3-vector or scalar, input units.

@@ -41,6 +41,28 @@ def test_labels_and_clusters_match_the_cli(cli, fandisk, fandisk_tree, tmp_path,
     assert fandisk_tree.clusters(**python_level) == json.loads((tmp_path / "c.json").read_text())["clusters"]
 
 
+@pytest.mark.parametrize("cli_level, python_level",
+                         [(("--clusters", "30"), {"k": 30}),
+                          (("--clusters", "20", "--refine", "3"), {"k": 20, "refine": 3})])
+def test_borders_match_the_cli(cli, fandisk, fandisk_tree, tmp_path, cli_level, python_level):
+    run_cli(cli, "segment", fandisk, *cli_level, "--json", tmp_path / "c.json", "--quiet")
+    borders = fandisk_tree.borders(**python_level)
+    assert json.loads(json.dumps(borders)) == json.loads((tmp_path / "c.json").read_text())["borders"]
+
+
+def test_borders_of_a_capped_cylinder_are_two_circles_at_right_angles():
+    V, F, regions = capped_cylinder()
+    tree = primseg.segment(V, F)
+    assert same_partition(tree.cut(3), regions)
+    borders = tree.borders(3)
+    assert [b["clusters"][1] is None for b in borders] == [False, False]
+    for border in borders:
+        assert border["angle"] == pytest.approx(90, abs=1e-6)
+        [curve] = border["curves"]
+        assert curve["closed"] and len(curve["vertices"]) == 48
+        assert border["edges"] == 48
+
+
 def test_refinement_moves_border_faces_and_checks_its_pass_count(fandisk_tree):
     cut = fandisk_tree.cut(30)
     refined = fandisk_tree.cut(30, refine=5)

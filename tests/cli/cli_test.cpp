@@ -406,6 +406,83 @@ TEST(Cli, SegmentBoxWithHoleWritesEveryOutputAndRecoversGroundTruth) {
   EXPECT_EQ(read_mesh(dir / "c.obj").face_count(), f);
 }
 
+// The borders of a level: in the JSON, and as OBJ polylines through the same vertices.
+TEST(Cli, SegmentWritesTheBordersInTheJsonAndAsObjPolylines) {
+  TempDir dir("borders");
+  ShapeOptions options;
+  options.random_motion = true;
+  const GroundTruthShape shape = make_shape("box_with_hole", options);
+  write_mesh(dir / "in.off", shape.mesh);
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --clusters 7 --quiet --json " +
+                     dir.q("c.json") + " --borders " + dir.q("b.obj")));
+  const json borders = read_json(dir / "c.json").at("borders");
+  // The box's 12 edges and the hole's two circles, all at right angles.
+  ASSERT_EQ(borders.size(), 14u);
+  std::vector<std::vector<std::uint32_t>> curves;  // every curve, closed ones ending at their start
+  int closed = 0;
+  for (const json& border : borders) {
+    SCOPED_TRACE(border.dump().substr(0, 200));
+    EXPECT_FALSE(border.at("clusters").at(1).is_null());
+    EXPECT_NEAR(border.at("angle").get<double>(), 90, 1e-6);
+    for (const json& curve : border.at("curves")) {
+      curves.push_back(curve.at("vertices").get<std::vector<std::uint32_t>>());
+      if (curve.at("closed").get<bool>()) {
+        ++closed;
+        curves.back().push_back(curves.back().front());
+      }
+    }
+  }
+  EXPECT_EQ(closed, 2);
+
+  // OBJ: one object per border, one `l` per curve, through the same points.
+  std::istringstream lines(testing::file_contents(dir / "b.obj"));
+  std::string line;
+  std::vector<Vec3> points;
+  std::vector<std::string> objects;
+  std::size_t curve = 0;
+  while (std::getline(lines, line)) {
+    std::istringstream fields(line);
+    std::string kind;
+    fields >> kind;
+    if (kind == "v") {
+      Vec3 p;
+      fields >> p[0] >> p[1] >> p[2];
+      points.push_back(p);
+    } else if (kind == "o") {
+      objects.push_back(line);
+    } else if (kind == "l") {
+      ASSERT_LT(curve, curves.size());
+      std::vector<std::uint32_t> indices;
+      for (std::uint32_t i; fields >> i;) indices.push_back(i);
+      ASSERT_EQ(indices.size(), curves[curve].size());
+      for (std::size_t i = 0; i < indices.size(); ++i) {
+        ASSERT_GE(indices[i], 1u);
+        ASSERT_LE(indices[i], points.size());
+        EXPECT_EQ(points[indices[i] - 1], shape.mesh.positions[curves[curve][i]]);
+      }
+      ++curve;
+    }
+  }
+  EXPECT_EQ(curve, curves.size());
+  ASSERT_EQ(objects.size(), 14u);
+  const json& first = borders[0].at("clusters");
+  EXPECT_EQ(objects[0], "o border_" + first[0].dump() + "_" + first[1].dump());
+
+  // `cut` writes the same borders from the tree.
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --tree " + dir.q("t.tree")));
+  ASSERT_EXIT_OK(
+      run("cut " + dir.q("t.tree") + " --clusters 7 --quiet --borders " + dir.q("c.obj")));
+  EXPECT_EQ(testing::file_contents(dir / "c.obj"), testing::file_contents(dir / "b.obj"));
+
+  // Polylines go to an .obj file only.
+  for (const char* target : {"b.ply", "-"}) {
+    const CliRun refused = run("segment " + dir.q("in.off") + " --clusters 7 --borders " +
+                               (std::string(target) == "-" ? std::string("-") : dir.q(target)));
+    EXPECT_NE(refused.status, 0);
+    EXPECT_NE(refused.output.find("--borders"), std::string::npos) << refused.output;
+  }
+}
+
 TEST(Cli, QuietPrintsNothingAndDefaultPrintsASummary) {
   TempDir dir("quiet");
   write_mesh(dir / "in.off", make_shape("box").mesh);

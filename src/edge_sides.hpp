@@ -1,0 +1,32 @@
+#pragma once
+/// @file edge_sides.hpp
+/// The mesh's edges with the clusters on each side: what cluster borders (borders.hpp) and
+/// skeleton joints (skeleton.hpp) are made of.
+
+#include <compare>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "primseg/mesh.hpp"
+
+namespace primseg::detail {
+
+/// One triangle on one mesh edge.
+struct EdgeSide {
+  std::uint32_t low = 0, high = 0;  ///< the edge's vertices, low < high
+  std::uint32_t label = 0;          ///< the triangle's cluster
+  std::uint32_t triangle = 0;
+  // NOLINTNEXTLINE(modernize-use-nullptr): clang-tidy 14 misreads the defaulted <=>.
+  auto operator<=>(const EdgeSide&) const = default;
+};
+
+/// Every side of every edge of the triangles (edges between equal vertex indices left out), sorted
+/// by (low, high, label, triangle): the sides of one edge are consecutive. `triangle_labels` has
+/// shape (T).
+std::vector<EdgeSide> edge_sides(const Mesh& mesh, std::span<const std::uint32_t> triangle_labels);
+
+/// The end of the run of sides of the edge at `begin` (sides sorted as edge_sides() returns them).
+std::size_t edge_end(std::span<const EdgeSide> sides, std::size_t begin);
+
+}  // namespace primseg::detail
