@@ -12,6 +12,7 @@ import { readPageData } from './data.js';
 import { Tree, TYPE_NAMES } from './hierarchy.js';
 import { clusterErrors, facePlane, primitiveSurface } from './primitives.js';
 import { ErrorPlot } from './plot.js';
+import { BorderLines } from './borders.js';
 import { createOverlays } from './hooks.js';
 import './skeleton.js';
 
@@ -115,6 +116,9 @@ class Viewer {
       new THREE.MeshBasicMaterial({ color: 0x000000, wireframe: true, transparent: true, opacity: 0.35 }));
     this.wireframe.visible = false;
     this.scene.add(this.wireframe);
+    // White in test mode: no cluster's code up to 2^24 - 1 clusters.
+    this.borderLines = new BorderLines(this.data, this.geometry, this.drawOrder, testMode ? 0xffffff : 0x15171c);
+    this.scene.add(this.borderLines.lines);
 
     const sphere = this.geometry.boundingSphere;
     this.radius = sphere.radius > 0 ? sphere.radius : 1;
@@ -152,7 +156,9 @@ class Viewer {
   }
 
   render() {
-    if (this.renderer && !this.deferRender) this.renderer.render(this.scene, this.camera);
+    if (!this.renderer || this.deferRender) return;
+    this.borderLines?.refresh();
+    this.renderer.render(this.scene, this.camera);
   }
 
   setUpControls() {
@@ -190,6 +196,10 @@ class Viewer {
       this.recolor();
     });
     $('show-primitives').addEventListener('change', () => this.updatePrimitives());
+    $('show-borders').addEventListener('change', (event) => {
+      this.borderLines.setVisible(event.target.checked, this.cut);
+      this.render();
+    });
     $('show-wireframe').addEventListener('change', (event) => {
       this.wireframe.visible = event.target.checked;
       this.render();
@@ -254,6 +264,7 @@ class Viewer {
     $('info').style.display = 'none';
     this.recolor();
     this.updatePrimitives();
+    this.borderLines.update(cut);
     for (const overlay of this.overlays) overlay.update(cut);
     const K = cut.size;
     $('clusters-slider').value = String(this.sliderOf(K));

@@ -117,6 +117,17 @@ test('a pose applied in the page moves every vertex where primseg deform moves i
     return Array.from(positions);
   });
   assert.ok(largestDifference(drawn, expected) < 1e-5);
+  // The border lines follow the posed mesh: each end at its vertex's posed position.
+  await page.check('#show-borders');
+  const lineEnds = await page.evaluate(async () => {
+    const viewer = await window.primseg.ready, c = viewer.header.center;
+    const ends = viewer.borderLines.lines.geometry.getAttribute('position').array;
+    return viewer.borderLines.borderEdges().flatMap((edge, i) =>
+      edge.map((v, end) => ({ v, p: [0, 1, 2].map((a) => ends[6 * i + 3 * end + a] + c[a]) })));
+  });
+  assert.ok(lineEnds.length > 0);
+  for (const { v, p } of lineEnds)
+    assert.ok(largestDifference(p, expected.slice(3 * v, 3 * v + 3)) < 1e-5, `border line end at vertex ${v}`);
   await page.screenshot({ path: join(artifacts, 'figure-posed.png') });
   // A pose primseg refuses is refused in the page too, and changes nothing.
   const locked = skeleton.joints.find((j) => j.kind !== 'sensitive');

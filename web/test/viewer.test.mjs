@@ -307,6 +307,65 @@ test('fandisk: screenshot with the fitted primitives drawn', async () => {
   await page.close();
 });
 
+/** The edges of primseg's border curves (its JSON), as "lower,higher" vertex pairs. */
+function borderEdgesOf(json) {
+  const edges = new Set();
+  for (const border of json.borders)
+    for (const { vertices, closed } of border.curves) {
+      const ring = closed ? [...vertices, vertices[0]] : vertices;
+      for (let i = 0; i + 1 < ring.length; ++i)
+        edges.add([Math.min(ring[i], ring[i + 1]), Math.max(ring[i], ring[i + 1])].join());
+    }
+  return edges;
+}
+
+/** Pixels of exactly this colour drawn from six axis views (test mode). */
+async function pixelsOfColor(page, rgb) {
+  let count = 0;
+  for (const direction of [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]) {
+    const { rgba } = await page.evaluate(async (d) => {
+      const viewer = await window.primseg.ready;
+      viewer.setView(d);
+      return viewer.readPixels();
+    }, direction);
+    const pixels = Buffer.from(rgba, 'base64');
+    for (let i = 0; i < pixels.length; i += 4)
+      count += pixels[i] === rgb[0] && pixels[i + 1] === rgb[1] && pixels[i + 2] === rgb[2] ? 1 : 0;
+  }
+  return count;
+}
+
+test('fandisk: the borders drawn are the edges of primseg\'s border curves, at every level', async () => {
+  const { page, errors } = await openViewer(browser, join(work, 'fandisk.html'), { test: true, width: 640, height: 480 });
+  assert.equal(await pixelsOfColor(page, [255, 255, 255]), 0, 'no border line before the box is ticked');
+  await page.check('#show-borders');
+  for (const K of [27, 5, 300, 12946]) {
+    const jsonFile = join(work, 'borders.json');
+    primseg('cut', join(work, 'fandisk.tree'), '--clusters', String(K), '--json', jsonFile, '--quiet');
+    const expected = borderEdgesOf(JSON.parse(readFileSync(jsonFile, 'utf8')));
+    const drawn = await page.evaluate(async (k) => {
+      const viewer = await window.primseg.ready;
+      viewer.setClusters(k);
+      return viewer.borderLines.borderEdges().map((e) => e.join());
+    }, K);
+    assert.equal(drawn.length, expected.size, `K = ${K}`);
+    assert.deepEqual(new Set(drawn), expected, `K = ${K}`);
+  }
+  await page.evaluate(async () => (await window.primseg.ready).setClusters(27));
+  assert.ok(await pixelsOfColor(page, [255, 255, 255]) > 100, 'border lines are drawn');
+  await page.uncheck('#show-borders');
+  assert.equal(await pixelsOfColor(page, [255, 255, 255]), 0, 'no border line once unticked');
+  assert.deepEqual(errors, []);
+  await page.close();
+
+  // A picture for the eye.
+  const shown = await openViewer(browser, join(work, 'fandisk.html'), { width: 1100, height: 700 });
+  await shown.page.check('#show-borders');
+  await shown.page.screenshot({ path: join(artifacts, 'fandisk-borders.png') });
+  assert.deepEqual(shown.errors, []);
+  await shown.page.close();
+});
+
 test('the page is the same bytes from the mesh alone or with its tree', () => {
   const html = join(work, 'again.html');
   primseg('view', fandisk, '--clusters', '27', '-o', html, '--quiet');
