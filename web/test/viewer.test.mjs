@@ -77,21 +77,26 @@ function assertSameReport(info, expected, diagonal, what) {
   }
 }
 
-/** Distinct non-background colours drawn from six axis views, as cluster indices (code - 1). */
-async function drawnClusters(page) {
-  const codes = new Set();
+/** The canvas's RGBA pixels seen from each of the six axis directions, in turn. */
+async function* axisViewPixels(page) {
   for (const direction of [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]) {
     const { rgba } = await page.evaluate(async (d) => {
       const viewer = await window.primseg.ready;
       viewer.setView(d);
       return viewer.readPixels();
     }, direction);
-    const pixels = Buffer.from(rgba, 'base64');
+    yield Buffer.from(rgba, 'base64');
+  }
+}
+
+/** Distinct non-background colours drawn from six axis views, as cluster indices (code - 1). */
+async function drawnClusters(page) {
+  const codes = new Set();
+  for await (const pixels of axisViewPixels(page))
     for (let i = 0; i < pixels.length; i += 4) {
       const code = pixels[i] | (pixels[i + 1] << 8) | (pixels[i + 2] << 16);
       if (code) codes.add(code - 1);
     }
-  }
   return codes;
 }
 
@@ -322,16 +327,9 @@ function borderEdgesOf(json) {
 /** Pixels of exactly this colour drawn from six axis views (test mode). */
 async function pixelsOfColor(page, rgb) {
   let count = 0;
-  for (const direction of [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]) {
-    const { rgba } = await page.evaluate(async (d) => {
-      const viewer = await window.primseg.ready;
-      viewer.setView(d);
-      return viewer.readPixels();
-    }, direction);
-    const pixels = Buffer.from(rgba, 'base64');
+  for await (const pixels of axisViewPixels(page))
     for (let i = 0; i < pixels.length; i += 4)
       count += pixels[i] === rgb[0] && pixels[i + 1] === rgb[1] && pixels[i + 2] === rgb[2] ? 1 : 0;
-  }
   return count;
 }
 
