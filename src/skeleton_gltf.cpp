@@ -8,11 +8,13 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
 #include "json_document.hpp"
 #include "no_index.hpp"
+#include "primseg/dual_graph.hpp"
 #include "primseg/error.hpp"
 #include "shape_generator/vector_math.hpp"
 
@@ -122,9 +124,20 @@ std::vector<InfluenceSet> influence_sets(const SkinWeights& skin, std::uint32_t 
   return sets;
 }
 
+// The triangles consistently oriented (outward on a closed part), as the dual graph orients them,
+// whatever way the file lists them: glTF readers cull back faces and shade with the normals.
+std::vector<Triangle> oriented_triangles(const Mesh& mesh) {
+  std::vector<Triangle> triangles = mesh.triangles;
+  const DualGraph graph(mesh, VertexWeights::Area);
+  for (std::uint32_t t = 0; t < triangles.size(); ++t)
+    if (graph.flipped(t)) std::swap(triangles[t][1], triangles[t][2]);
+  return triangles;
+}
+
 // Area-weighted vertex normals (unit); (0, 0, 1) where the triangles around a vertex have no area.
-std::vector<std::array<float, 3>> vertex_normals(const Mesh& mesh) {
-  const std::vector<Vec3> sums = area_weighted_normal_sums(mesh.positions, mesh.triangles);
+std::vector<std::array<float, 3>> vertex_normals(const Mesh& mesh,
+                                                 std::span<const Triangle> triangles) {
+  const std::vector<Vec3> sums = area_weighted_normal_sums(mesh.positions, triangles);
   std::vector<std::array<float, 3>> normals(sums.size(), {0.0f, 0.0f, 1.0f});
   for (std::size_t v = 0; v < sums.size(); ++v) {
     const double length = norm(sums[v]);
@@ -235,7 +248,8 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
       buffer.add(positions, n, "VEC3", kFloat, kArrayBuffer,
                  {{"min", json::array({low[0], low[1], low[2]})},
                   {"max", json::array({high[0], high[1], high[2]})}});
-  const auto normals = vertex_normals(mesh);
+  const std::vector<Triangle> triangles = oriented_triangles(mesh);
+  const auto normals = vertex_normals(mesh, triangles);
   primitive_attributes["NORMAL"] = buffer.add(normals, n, "VEC3", kFloat, kArrayBuffer);
 
   const std::vector<InfluenceSet> sets =
@@ -253,7 +267,7 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
 
   std::vector<std::uint32_t> indices;
   indices.reserve(3 * mesh.triangles.size());
-  for (const Triangle& t : mesh.triangles) indices.insert(indices.end(), t.begin(), t.end());
+  for (const Triangle& t : triangles) indices.insert(indices.end(), t.begin(), t.end());
   const std::size_t index_accessor =
       buffer.add(indices, indices.size(), "SCALAR", kUnsignedInt, kElementArrayBuffer);
 

@@ -7,7 +7,9 @@
 ///
 /// Layout of the file:
 /// - node 0, "mesh": the triangles (input units, float32 positions; area-weighted vertex normals),
-///   with attributes JOINTS_n / WEIGHTS_n;
+///   with attributes JOINTS_n / WEIGHTS_n. Triangles are consistently oriented (outward on a
+///   closed part) whatever way the input lists them, since readers cull back faces: a triangle the
+///   dual graph flips (DualGraph::flipped) is written with its last two corners swapped;
 /// - node 1, "skeleton": the common root of the joints, at the origin, without a transform;
 /// - nodes 2 .. 2+K-1, "bone_b": one per bone in bone id order, arranged as bone_tree() arranges
 ///   them. Bone b's node sits at its pivot: the joint it hangs from (BoneTree::parent_joint), or

@@ -371,6 +371,29 @@ TEST(SkeletonGltf, TheSameRigGivesTheSameBytes) {
             skinned_glb(r.figure.mesh, r.skeleton, r.weights));
 }
 
+// The file's triangles face one way whatever way the input lists them (readers cull back faces
+// and shade with the normals): flipping every other triangle of the input changes no byte.
+TEST(SkeletonGltf, TrianglesAreWrittenConsistentlyOriented) {
+  const Rig& r = rig();
+  Mesh mixed = r.figure.mesh;
+  for (std::size_t t = 1; t < mixed.triangles.size(); t += 2)
+    std::swap(mixed.triangles[t][1], mixed.triangles[t][2]);
+  const std::string expected = skinned_glb(r.figure.mesh, r.skeleton, r.weights);
+  EXPECT_EQ(skinned_glb(mixed, r.skeleton, r.weights), expected);
+  // And they face outwards: the signed volume they enclose is positive.
+  const Glb file(expected);
+  const json& primitive = file.gltf["meshes"][0]["primitives"][0];
+  const auto indices = file.read<std::uint32_t>(primitive["indices"], 5125, "SCALAR", 1);
+  const Mesh& mesh = r.figure.mesh;
+  double volume = 0;
+  for (std::size_t i = 0; i < indices.size(); i += 3) {
+    const Eigen::Vector3d a(mesh.positions[indices[i]].data()),
+        b(mesh.positions[indices[i + 1]].data()), c(mesh.positions[indices[i + 2]].data());
+    volume += a.dot(b.cross(c)) / 6;
+  }
+  EXPECT_GT(volume, 0);
+}
+
 TEST(SkeletonGltf, InconsistentInputIsRefused) {
   const Rig& r = rig();
   const auto refused = [&](const Mesh& mesh, const Skeleton& skeleton, const SkinWeights& weights,
