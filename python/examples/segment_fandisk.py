@@ -78,6 +78,25 @@ assert clusters[0]["type"] == "plane" and cylinders  # fandisk: flat faces and f
 assert all(c["rms"] <= c["max"] for c in clusters)
 
 # %% [markdown]
+# ## Where the clusters meet
+# The borders, as in the CLI's JSON: each pair of clusters that share edges, the curves of
+# vertices along which they meet, and the angle between their fitted surfaces there. A fillet
+# meets its faces tangentially (near 0 degrees); a sharp edge shows its dihedral turn (90 on a box).
+
+# %%
+borders = tree.borders(30)
+angles = np.array([b["angle"] for b in borders])
+print(f"{len(borders)} borders: {np.sum(angles < 7)} tangent (< 7 degrees),"
+      f" {np.sum(angles > 80)} sharp (> 80 degrees)")
+sharpest = max(borders, key=lambda b: b["length"] if b["angle"] > 80 else 0)
+first, second = sharpest["clusters"]
+print(f"the longest sharp edge: clusters {first} ({clusters[first]['type']}) and {second}"
+      f" ({clusters[second]['type']}),"
+      f" {sharpest['length']:.3f} long, {sharpest['angle']:.1f} degrees")
+assert all(border["clusters"][1] is not None for border in borders)  # fandisk is closed
+assert np.sum(angles < 7) >= 5 and np.sum(angles > 80) >= 5
+
+# %% [markdown]
 # ## Per-face quantities with numpy
 # Labels index the cluster list, so per-face arrays are one fancy-indexing away: here the RMS
 # distance of each face's cluster, ready to colour a mesh viewer with.
