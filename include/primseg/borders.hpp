@@ -20,8 +20,7 @@ inline constexpr std::uint32_t kMeshBoundary = std::numeric_limits<std::uint32_t
 
 /// A chain of mesh vertices along a border, consecutive ones joined by one of its edges.
 struct BorderCurve {
-  /// Vertex indices in order along the curve, shape (n), n >= 2 (n >= 3 when closed, but for a
-  /// loop of two edges between the same two vertices).
+  /// Vertex indices in order along the curve, shape (n), n >= 2 (n >= 3 when closed).
   std::vector<std::uint32_t> vertices;
   /// The last vertex joins the first by an edge of the border (the first is not repeated).
   bool closed = false;
@@ -42,10 +41,11 @@ struct ClusterBorder {
   /// 90 at a box's edge. NaN along the mesh boundary, without primitives, and when the triangles
   /// of every edge have zero area.
   double angle = std::numeric_limits<double>::quiet_NaN();
-  /// Its edges as curves, each edge in exactly one. A curve ends at a vertex where another border
-  /// meets this one (a corner: a third cluster or the mesh boundary) or where the border does not
-  /// go on through exactly two of its edges; a loop with no such vertex is closed. Open curves come
-  /// first, each starting at the lower-numbered of its ends, then loops from their lowest edge.
+  /// Its edges as curves, each edge in exactly one. A curve stops at an end of the border: a
+  /// vertex where another border meets it (a corner: a third cluster or the mesh boundary), or
+  /// where it does not go on through exactly two of its edges. A loop without an end is closed.
+  /// Curves from ends come first, each starting at its lower-numbered end (closed when it comes
+  /// back to the end it left), then the loops, each from its lowest edge.
   std::vector<BorderCurve> curves;
 };
 
