@@ -216,7 +216,9 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     write_output(*files.curve, text);
   }
   if (files.png) {
-    write_png(*files.png, hierarchy.mesh(), group_face_colors(segmentation.labels));
+    RenderOptions picture;
+    picture.borders = true;
+    write_png(*files.png, hierarchy.mesh(), group_face_colors(segmentation.labels), picture);
   }
 }
 

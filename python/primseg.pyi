@@ -163,6 +163,7 @@ def render(
     view: Sequence[float] = (-1.0, -0.8, -1.3),
     up: Sequence[float] = (0.0, 1.0, 0.0),
     edges: bool = False,
+    borders: bool = False,
     path: _Path | None = None,
 ) -> NDArray[np.uint8]: ...
 @overload

@@ -1000,7 +1000,7 @@ OSError) when the file cannot be written.)",
       "render",
       [](const py::object& first, const py::object& faces, const py::object& labels, int width,
          int height, const std::array<double, 3>& view, const std::array<double, 3>& up, bool edges,
-         const std::optional<std::filesystem::path>& path) {
+         bool borders, const std::optional<std::filesystem::path>& path) {
         const std::shared_ptr<const Mesh> mesh = mesh_or_tree_argument("render", first, faces);
         const std::vector<std::uint32_t> groups =
             labels.is_none() ? std::vector<std::uint32_t>{} : face_labels(labels, *mesh);
@@ -1010,6 +1010,7 @@ OSError) when the file cannot be written.)",
         options.view_direction = view;
         options.up = up;
         options.edges = edges;
+        options.borders = borders;
         std::vector<std::uint8_t> rgb;
         {
           py::gil_scoped_release release;
@@ -1022,16 +1023,17 @@ OSError) when the file cannot be written.)",
       py::arg("labels") = py::none(), py::arg("width") = 800, py::arg("height") = 600,
       py::arg("view") = std::array<double, 3>{-1.0, -0.8, -1.3},
       py::arg("up") = std::array<double, 3>{0.0, 1.0, 0.0}, py::arg("edges") = false,
-      py::arg("path") = py::none(),
+      py::arg("borders") = false, py::arg("path") = py::none(),
       join_docs(
-          {R"(render(mesh, *, labels=None, width=800, height=600, view=(-1, -0.8, -1.3), up=(0, 1, 0), edges=False, path=None) -> numpy.ndarray
+          {R"(render(mesh, *, labels=None, width=800, height=600, view=(-1, -0.8, -1.3), up=(0, 1, 0), edges=False, borders=False, path=None) -> numpy.ndarray
 render(V, F, *, ...) -> numpy.ndarray
 
 A picture of a Mesh, a Hierarchy's mesh or arrays V, F: uint8 (height, width, 3), top row first
 (matplotlib: plt.imshow(picture)). labels: one integer per face (cut()'s), each cluster in the
 colour of the CLI's --png and --colored; None: light grey. view: direction from the eye to the
-model; up: direction that points up in the picture; edges: draw the triangle edges. path: also
-write the picture there as PNG (the CLI's --png, byte for byte, with cut()'s labels).
+model; up: direction that points up in the picture; edges: draw the triangle edges; borders:
+draw only the lines between clusters and along the open boundary. path: also write the picture
+there as PNG (the CLI's --png, byte for byte, with cut()'s labels and borders=True).
 Raises InvalidInputError (a ValueError) for sizes outside 1..16384 or bad arrays, IoError (an
 OSError) when the PNG cannot be written.)",
            cpp_doc("render_mesh", doc::render__render_mesh),

@@ -6,6 +6,7 @@
 #include <string_view>
 #include <utility>
 
+#include "edge_sides.hpp"
 #include "file_io.hpp"
 #include "primseg/error.hpp"
 #include "shape_generator/vector_math.hpp"
@@ -256,12 +257,20 @@ struct SampleBuffer {
         owner(depth.size(), kNoTriangle) {}
 };
 
+// Lines drawn along a triangle's edges: bit k for its edge from corner k to corner k + 1 (mod 3).
+using EdgeMask = std::uint8_t;
+constexpr EdgeMask kAllEdges = 7;
+
 void rasterise_triangle(std::uint32_t triangle_index, ProjectedVertex a, ProjectedVertex b,
-                        ProjectedVertex c, double edge_half_width_subpixels, SampleBuffer& buffer) {
+                        ProjectedVertex c, EdgeMask lines, double edge_half_width_subpixels,
+                        SampleBuffer& buffer) {
   std::int64_t twice_area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
   if (twice_area == 0) return;  // degenerate, or seen edge-on
-  if (twice_area < 0) {         // back-facing in the picture: draw both sides alike
+  // The edges opposite a (b to c), b (c to a) and c (a to b).
+  bool line_opposite_a = lines & 2, line_opposite_b = lines & 4, line_opposite_c = lines & 1;
+  if (twice_area < 0) {  // back-facing in the picture: draw both sides alike
     std::swap(b, c);
+    std::swap(line_opposite_b, line_opposite_c);
     twice_area = -twice_area;
   }
 
@@ -283,10 +292,13 @@ void rasterise_triangle(std::uint32_t triangle_index, ProjectedVertex a, Project
   const double depth_gradient_b = (double{b.depth} - double{a.depth}) / double(twice_area);
   const double depth_gradient_c = (double{c.depth} - double{a.depth}) / double(twice_area);
 
-  const bool draw_edges = edge_half_width_subpixels > 0.0;
-  const double line_a = draw_edges ? opposite_a.line_threshold(edge_half_width_subpixels) : 0.0;
-  const double line_b = draw_edges ? opposite_b.line_threshold(edge_half_width_subpixels) : 0.0;
-  const double line_c = draw_edges ? opposite_c.line_threshold(edge_half_width_subpixels) : 0.0;
+  const bool draw_edges = edge_half_width_subpixels > 0.0 && lines != 0;
+  const auto threshold = [&](const EdgeFunction& edge, bool drawn) {
+    return draw_edges && drawn ? edge.line_threshold(edge_half_width_subpixels) : 0.0;
+  };
+  const double line_a = threshold(opposite_a, line_opposite_a);
+  const double line_b = threshold(opposite_b, line_opposite_b);
+  const double line_c = threshold(opposite_c, line_opposite_c);
 
   const std::int64_t first_x = x_begin * kSubpixel + kHalfSubpixel;
   for (std::int64_t y = y_begin; y <= y_end; ++y) {
@@ -316,6 +328,34 @@ void rasterise_triangle(std::uint32_t triangle_index, ProjectedVertex a, Project
       weight_c += opposite_c.step_x;
     }
   }
+}
+
+// For each triangle, its edges that are borders: on the mesh's open boundary (one triangle), or
+// between faces of different colours. (No colours: the open boundary alone.)
+std::vector<EdgeMask> border_edges(const Mesh& mesh,
+                                   std::span<const std::array<std::uint8_t, 3>> face_colors) {
+  std::vector<std::uint32_t> colour_of_triangle(mesh.triangles.size(), 0);
+  if (!face_colors.empty())
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const auto& rgb = face_colors[mesh.face_of_triangle[t]];
+      colour_of_triangle[t] = rgb[0] | (std::uint32_t{rgb[1]} << 8) | (std::uint32_t{rgb[2]} << 16);
+    }
+  const std::vector<detail::EdgeSide> sides = detail::edge_sides(mesh, colour_of_triangle);
+  std::vector<EdgeMask> lines(mesh.triangles.size(), 0);
+  for (std::size_t begin = 0; begin < sides.size();) {
+    const std::size_t end = detail::edge_end(sides, begin);
+    // Sides are sorted by colour: the colours differ when the first and last do.
+    if (end - begin == 1 || sides[begin].label != sides[end - 1].label)
+      for (std::size_t i = begin; i < end; ++i) {
+        const Triangle& triangle = mesh.triangles[sides[i].triangle];
+        for (int k = 0; k < 3; ++k)
+          if (std::minmax(triangle[k], triangle[(k + 1) % 3]) ==
+              std::minmax(sides[i].low, sides[i].high))
+            lines[sides[i].triangle] |= static_cast<EdgeMask>(1 << k);
+      }
+    begin = end;
+  }
+  return lines;
 }
 
 std::uint8_t to_channel(double value) {
@@ -707,12 +747,16 @@ std::vector<std::uint8_t> render_mesh(const Mesh& mesh,
   if (picture_camera(mesh, options, camera)) {
     const std::vector<ProjectedVertex> projected = project_vertices(mesh, camera);
     const double edge_half_width_subpixels =
-        options.edges ? kEdgeHalfWidthPixels * options.supersample * kSubpixel : 0.0;
+        options.edges || options.borders ? kEdgeHalfWidthPixels * options.supersample * kSubpixel
+                                         : 0.0;
+    const std::vector<EdgeMask> lines = options.edges     ? std::vector<EdgeMask>()
+                                        : options.borders ? border_edges(mesh, face_colors)
+                                                          : std::vector<EdgeMask>();
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       const Triangle& triangle = mesh.triangles[t];
       rasterise_triangle(static_cast<std::uint32_t>(t), projected[triangle[0]],
-                         projected[triangle[1]], projected[triangle[2]], edge_half_width_subpixels,
-                         buffer);
+                         projected[triangle[1]], projected[triangle[2]],
+                         lines.empty() ? kAllEdges : lines[t], edge_half_width_subpixels, buffer);
     }
   }
   return resolve(buffer, mesh, face_colors, camera, options);

@@ -39,6 +39,9 @@ struct RenderOptions {
   std::optional<std::array<Vec3, 2>> frame_box;
   /// Draws the visible triangle edges as thin dark lines (shows the tessellation).
   bool edges = false;
+  /// Draws, as the same lines, only the edges between faces of different colours and the edges of
+  /// the mesh's open boundary: the borders of a segmentation (borders.hpp), not its tessellation.
+  bool borders = false;
   /// Colour of pixels that no triangle covers.
   std::array<std::uint8_t, 3> background{255, 255, 255};
   /// Shading is flat per triangle: colour * (ambient + (1 - ambient) * |n·v|), where n is the

@@ -369,8 +369,15 @@ def test_auto_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path):
 
 def test_render_gives_the_cli_picture(cli, fandisk, fandisk_tree, tmp_path):
     run_cli(cli, "segment", fandisk, "--clusters", "30", "--png", tmp_path / "cli.png", "--quiet")
-    picture = primseg.render(fandisk_tree, labels=fandisk_tree.cut(30), path=tmp_path / "py.png")
+    picture = primseg.render(fandisk_tree, labels=fandisk_tree.cut(30), borders=True,
+                             path=tmp_path / "py.png")
     assert (tmp_path / "py.png").read_bytes() == (tmp_path / "cli.png").read_bytes()
+    # The lines between clusters darken a few percent of the part's pixels.
+    plain = primseg.render(fandisk_tree, labels=fandisk_tree.cut(30))
+    part = np.any(plain != 255, axis=2)
+    lined = np.any(plain != picture, axis=2)
+    assert 0.01 * part.sum() < lined.sum() < 0.2 * part.sum()
+    assert np.all(picture[lined].sum(axis=1) < plain[lined].sum(axis=1))
     assert picture.dtype == np.uint8 and picture.shape == (600, 800, 3)
     assert len(np.unique(picture.reshape(-1, 3), axis=0)) > 30  # clusters, shading, background
     assert np.array_equal(picture[0, 0], [255, 255, 255])  # the corner is background

@@ -430,6 +430,60 @@ TEST(RenderMesh, EdgesDarkenPixelsAlongTheTriangleEdgesOnly) {
   EXPECT_LT(darkened, covered / 4);
 }
 
+// Borders are the edges between colours: the cube's outline and the edges between its sides, not
+// the diagonals inside each side; a cube of one colour, closed, has none.
+TEST(RenderMesh, BordersDarkenOnlyTheEdgesBetweenColours) {
+  RenderOptions options;
+  options.width = 240;
+  options.height = 180;
+  options.supersample = 1;
+  const std::vector<std::uint8_t> plain = render_mesh(unit_cube(), kCubeSideColors, options);
+  options.edges = true;
+  const std::vector<std::uint8_t> all_edges = render_mesh(unit_cube(), kCubeSideColors, options);
+  options.edges = false;
+  options.borders = true;
+  const std::vector<std::uint8_t> borders = render_mesh(unit_cube(), kCubeSideColors, options);
+  int by_borders = 0, by_edges = 0;
+  for (std::size_t at = 0; at < plain.size(); at += 3) {
+    const Color before{plain[at], plain[at + 1], plain[at + 2]};
+    const Color edge{all_edges[at], all_edges[at + 1], all_edges[at + 2]};
+    const Color border{borders[at], borders[at + 1], borders[at + 2]};
+    by_edges += edge != before;
+    if (border == before) continue;
+    ++by_borders;
+    EXPECT_EQ(border, edge) << "a border is drawn as the same line as the edge";
+  }
+  EXPECT_GT(by_borders, 150);
+  EXPECT_LT(by_borders, by_edges - 100) << "the diagonals inside the sides are not borders";
+
+  const std::vector<Color> one_colour(6, kGreen);
+  EXPECT_EQ(render_mesh(unit_cube(), one_colour, options), [&] {
+    RenderOptions without = options;
+    without.borders = false;
+    return render_mesh(unit_cube(), one_colour, without);
+  }());
+
+  // An open rectangle in two colours: its outline and the line between the colours.
+  options.width = 200;
+  options.height = 100;
+  options.view_direction = {0, 0, -1};
+  options.supersample = 2;  // one sample per pixel can straddle a half-pixel line at the outline
+  const std::vector<Color> two{kRed, kBlue};
+  const std::vector<std::uint8_t> split = render_mesh(split_rectangle(), two, options);
+  options.borders = false;
+  const std::vector<std::uint8_t> unlined = render_mesh(split_rectangle(), two, options);
+  const auto lined = [&](int x, int y) {
+    return pixel(split, options, x, y) != pixel(unlined, options, x, y);
+  };
+  EXPECT_FALSE(lined(50, 50));
+  int middle = 0;
+  for (int x = 90; x <= 110; ++x) middle += lined(x, 50);
+  EXPECT_GE(middle, 1) << "the line between the two colours";
+  int outline = 0;
+  for (int y = 0; y < 100; ++y) outline += lined(50, y);
+  EXPECT_GE(outline, 2) << "the top and bottom of the open rectangle";
+}
+
 TEST(RenderMesh, TwoColourSplitRendersBothHues) {
   RenderOptions options;
   options.width = 200;
