@@ -399,11 +399,17 @@ TEST(RenderMesh, FullAmbientLightGivesTheFaceColoursExactly) {
   EXPECT_EQ(seen, (std::set<Color>{kWhite, kRed, kGreen, kBlue}));
 }
 
-TEST(RenderMesh, EdgesDarkenPixelsAlongTheTriangleEdgesOnly) {
+// A small picture of the cube, one sample per pixel: lines cover whole pixels.
+RenderOptions small_unsampled_picture() {
   RenderOptions options;
   options.width = 240;
   options.height = 180;
   options.supersample = 1;
+  return options;
+}
+
+TEST(RenderMesh, EdgesDarkenPixelsAlongTheTriangleEdgesOnly) {
+  RenderOptions options = small_unsampled_picture();
   const std::vector<std::uint8_t> plain = render_mesh(unit_cube(), kCubeSideColors, options);
   options.edges = true;
   const std::vector<std::uint8_t> outlined = render_mesh(unit_cube(), kCubeSideColors, options);
@@ -433,10 +439,7 @@ TEST(RenderMesh, EdgesDarkenPixelsAlongTheTriangleEdgesOnly) {
 // Borders are the edges between colours: the cube's outline and the edges between its sides, not
 // the diagonals inside each side; a cube of one colour, closed, has none.
 TEST(RenderMesh, BordersDarkenOnlyTheEdgesBetweenColours) {
-  RenderOptions options;
-  options.width = 240;
-  options.height = 180;
-  options.supersample = 1;
+  RenderOptions options = small_unsampled_picture();
   const std::vector<std::uint8_t> plain = render_mesh(unit_cube(), kCubeSideColors, options);
   options.edges = true;
   const std::vector<std::uint8_t> all_edges = render_mesh(unit_cube(), kCubeSideColors, options);
