@@ -47,10 +47,8 @@ void check_inputs(const Mesh& mesh, std::span<const std::uint32_t> face_labels,
 
 // Every edge of every border, sorted by border, then edge.
 std::vector<BorderEdge> border_edges(const Mesh& mesh, std::span<const std::uint32_t> face_labels) {
-  std::vector<std::uint32_t> triangle_labels(mesh.triangle_count());
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-    triangle_labels[t] = face_labels[mesh.face_of_triangle[t]];
-  const std::vector<EdgeSide> sides = detail::edge_sides(mesh, triangle_labels);
+  const std::vector<EdgeSide> sides =
+      detail::edge_sides(mesh, detail::triangle_labels(mesh, face_labels));
   std::vector<BorderEdge> edges;
   for (std::size_t begin = 0; begin < sides.size();) {
     const std::size_t end = detail::edge_end(sides, begin);

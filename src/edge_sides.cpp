@@ -4,6 +4,14 @@
 
 namespace primseg::detail {
 
+std::vector<std::uint32_t> triangle_labels(const Mesh& mesh,
+                                           std::span<const std::uint32_t> face_labels) {
+  std::vector<std::uint32_t> labels(mesh.triangles.size());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    labels[t] = face_labels[mesh.face_of_triangle[t]];
+  return labels;
+}
+
 std::vector<EdgeSide> edge_sides(const Mesh& mesh, std::span<const std::uint32_t> triangle_labels) {
   std::vector<EdgeSide> sides;
   sides.reserve(3 * mesh.triangles.size());

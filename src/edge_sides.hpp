@@ -1,7 +1,7 @@
 #pragma once
 /// @file edge_sides.hpp
-/// The mesh's edges with the clusters on each side: what cluster borders (borders.hpp) and
-/// skeleton joints (skeleton.hpp) are made of.
+/// The mesh's edges with the clusters on each side: what cluster borders (borders.hpp), skeleton
+/// joints (skeleton.hpp) and the border lines of pictures (render.hpp) are made of.
 
 #include <compare>
 #include <cstdint>
@@ -11,6 +11,10 @@
 #include "primseg/mesh.hpp"
 
 namespace primseg::detail {
+
+/// Cluster of each triangle, shape (T), from the cluster of each input face (shape (F)).
+std::vector<std::uint32_t> triangle_labels(const Mesh& mesh,
+                                           std::span<const std::uint32_t> face_labels);
 
 /// One triangle on one mesh edge.
 struct EdgeSide {

@@ -18,14 +18,6 @@ double distance_to_line(const Vec3& x, const Vec3& point, const Vec3& axis) {
   return norm(d - dot(d, axis) * axis);
 }
 
-std::vector<std::uint32_t> triangle_labels(const Mesh& mesh,
-                                           std::span<const std::uint32_t> face_labels) {
-  std::vector<std::uint32_t> labels(mesh.triangles.size());
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    labels[t] = face_labels[mesh.face_of_triangle[t]];
-  return labels;
-}
-
 std::vector<ClusterPairBoundary> cluster_pair_boundaries(
     const Mesh& mesh, std::span<const std::uint32_t> triangle_labels) {
   // Every edge with the clusters of its triangles, each cluster once.

@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "edge_sides.hpp"
 #include "primseg/mesh.hpp"
 #include "shape_generator/vector_math.hpp"
 
@@ -29,9 +30,7 @@ struct ClusterPairBoundary {
   std::vector<std::uint32_t> vertices;  ///< vertices of those edges, increasing
 };
 
-/// Cluster of each triangle, shape (T), from the cluster of each input face.
-std::vector<std::uint32_t> triangle_labels(const Mesh& mesh,
-                                           std::span<const std::uint32_t> face_labels);
+using detail::triangle_labels;
 
 /// Every pair of clusters that share a mesh edge (an edge of triangles of both), sorted by
 /// (first, second). On a non-manifold edge every pair of distinct clusters around it counts.
