@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -14,6 +15,7 @@
 
 #include "../src/file_io.hpp"
 #include "primseg/auto_level.hpp"
+#include "primseg/borders.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/render.hpp"
@@ -29,6 +31,15 @@ std::array<const std::optional<std::string>*, 5> standard_outputs(const OutputFi
 
 bool to_standard_output(const std::optional<std::string>* path) {
   return *path == kStandardOutput;
+}
+
+// Whether the file's extension names one of these mesh formats (as the mesh writers read it).
+bool has_format(const std::string& path, std::initializer_list<MeshFormat> formats) {
+  try {
+    return std::ranges::find(formats, mesh_format_from_path(path)) != formats.end();
+  } catch (const InvalidInputError&) {
+    return false;  // an unknown extension, reported in the option's own terms
+  }
 }
 
 }  // namespace
@@ -52,19 +63,10 @@ void validate_output_files(const OutputFiles& files) {
     throw InvalidInputError(
         "--tree -: standard output is a terminal, and a tree file is binary; redirect it "
         "(> part.tree) or pipe it (| primseg cut - --clusters 20)");
-  if (files.borders && std::filesystem::path(*files.borders).extension() != ".obj")
+  if (files.borders && !has_format(*files.borders, {MeshFormat::Obj}))
     throw InvalidInputError("--borders: '" + *files.borders + "' must end in .obj");
-  if (files.colored) {
-    bool supported = false;
-    try {
-      const MeshFormat format = mesh_format_from_path(*files.colored);
-      supported = format == MeshFormat::Ply || format == MeshFormat::Obj;
-    } catch (const InvalidInputError&) {
-      // An unknown extension: reported below in the option's own terms.
-    }
-    if (!supported)
-      throw InvalidInputError("--colored: '" + *files.colored + "' must end in .ply or .obj");
-  }
+  if (files.colored && !has_format(*files.colored, {MeshFormat::Ply, MeshFormat::Obj}))
+    throw InvalidInputError("--colored: '" + *files.colored + "' must end in .ply or .obj");
 }
 
 std::string count_of(std::uint64_t count, std::string_view noun, std::string_view plural) {
@@ -109,14 +111,17 @@ nlohmann::json border_json(const ClusterBorder& border) {
       {"curves", std::move(curves)}};
 }
 
-}  // namespace
-
+// The border curves as an OBJ file of polylines: the vertices they use, in index order, and one
+// object `border_A_B` (`border_A_boundary` along the mesh's open boundary) of `l` lines per
+// border, a closed curve ending at its first vertex.
 std::string borders_obj(const Mesh& mesh, std::span<const ClusterBorder> borders) {
   std::vector<std::uint32_t> obj_index(mesh.vertex_count(), 0);  // 1-based, 0: not written
   for (const ClusterBorder& border : borders)
     for (const BorderCurve& curve : border.curves)
       for (const std::uint32_t v : curve.vertices) obj_index[v] = 1;
-  std::string text = "# primseg cluster borders: one object per pair of clusters that meet\n";
+  std::string text =
+      "# primseg cluster borders: one object per pair of clusters that meet, or per cluster along "
+      "the open boundary\n";
   char line[128];
   std::uint32_t written = 0;
   for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
@@ -146,6 +151,8 @@ std::string borders_obj(const Mesh& mesh, std::span<const ClusterBorder> borders
   }
   return text;
 }
+
+}  // namespace
 
 void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
                          const std::vector<ClusterReport>& reports, const OutputFiles& files,

@@ -10,7 +10,6 @@
 #include <string_view>
 
 #include "../src/json_document.hpp"
-#include "primseg/borders.hpp"
 #include "primseg/cut.hpp"
 
 namespace primseg::cli {
@@ -54,11 +53,6 @@ using detail::vec3_json;
 
 /// JSON parameters of a primitive, input units.
 nlohmann::json primitive_params(const Primitive& primitive);
-
-/// The border curves as an OBJ file of polylines: the vertices they use, in index order, and one
-/// object `border_A_B` (`border_A_boundary` along the mesh's open boundary) of `l` lines per
-/// border, a closed curve ending at its first vertex.
-std::string borders_obj(const Mesh& mesh, std::span<const ClusterBorder> borders);
 
 /// Writes the requested per-level files. `summary` holds mesh and timing entries for the JSON.
 void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
