@@ -3,6 +3,11 @@
 // The lines take their ends from the drawn mesh, so they follow a posed skeleton.
 
 import * as THREE from 'three';
+import { normal } from './primitives.js';
+
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const norm = (a) => Math.sqrt(dot(a, a));
 
 /**
  * Every mesh edge once: its two vertices, the triangles on it and, for drawing, the corners of
@@ -132,6 +137,79 @@ export class BorderLines {
     const geometry = this.lines.geometry;
     geometry.setAttribute('position', new THREE.BufferAttribute(ends, 3));
     geometry.computeBoundingSphere();
+  }
+
+  /**
+   * Where cluster c of `cut` meets the others, as primseg's borders (borders.hpp) have it: one
+   * entry per neighbouring cluster (-1: the mesh's open boundary) with its edge count, length and
+   * mean angle in degrees between the two primitives across the border (null without both
+   * primitives or along the open boundary), longest first.
+   * @param primitiveOf (cluster) => primitive in the page's centred coordinates, or null
+   */
+  clusterBorders(cut, c, primitiveOf) {
+    const { count, ends, sideStart, side } = this.edges;
+    const labels = cut.faceCluster, faceOfTriangle = this.data.faceOfTriangle;
+    const positions = this.data.positions, triangles = this.data.triangles;
+    const triangleOf = (s) => Math.floor(side[s] / 3);
+    const clusterOf = (t) => labels[faceOfTriangle ? faceOfTriangle[t] : t];
+    const point = (v) => [positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]];
+    const listedNormal = (t) => {
+      const [a, b, d] = [0, 1, 2].map((k) => point(triangles[3 * t + k]));
+      return cross([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [d[0] - a[0], d[1] - a[1], d[2] - a[2]]);
+    };
+    // +1 when triangle t runs from `low` to `high` along the edge, -1 the other way.
+    const direction = (t, low, high) => {
+      for (let k = 0; k < 3; ++k)
+        if (triangles[3 * t + k] === low && triangles[3 * t + ((k + 1) % 3)] === high) return 1;
+      return -1;
+    };
+    const neighbours = new Map(); // cluster -> {edges, length, angleSum, angleWeight}
+    const add = (other, length, angle) => {
+      const entry = neighbours.get(other) ?? { edges: 0, length: 0, angleSum: 0, angleWeight: 0 };
+      entry.edges += 1;
+      entry.length += length;
+      if (angle !== null) {
+        entry.angleSum += length * angle;
+        entry.angleWeight += length;
+      }
+      neighbours.set(other, entry);
+    };
+    for (let e = 0; e < count; ++e) {
+      const from = sideStart[e], to = sideStart[e + 1];
+      // The lowest triangle of each cluster on the edge (sides are sorted by triangle).
+      const first = new Map();
+      for (let s = from; s < to; ++s) if (!first.has(clusterOf(triangleOf(s)))) first.set(clusterOf(triangleOf(s)), triangleOf(s));
+      if (!first.has(c) || (first.size === 1 && to - from > 1)) continue;
+      const low = ends[2 * e], high = ends[2 * e + 1];
+      const a = point(low), b = point(high);
+      const length = norm([b[0] - a[0], b[1] - a[1], b[2] - a[2]]);
+      if (to - from === 1) {
+        add(-1, length, null);
+        continue;
+      }
+      const own = first.get(c), mine = primitiveOf(c);
+      for (const [other, theirs] of first) {
+        if (other === c) continue;
+        const primitive = primitiveOf(other);
+        let angle = null;
+        const n1 = listedNormal(own);
+        let n2 = listedNormal(theirs);
+        if (mine && primitive && norm(n1) > 0 && norm(n2) > 0) {
+          if (direction(own, low, high) === direction(theirs, low, high)) n2 = n2.map((x) => -x);
+          const middle = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2];
+          const oriented = (p, like) => {
+            const n = normal(p, middle);
+            return dot(n, like) < 0 ? n.map((x) => -x) : n;
+          };
+          const u = oriented(mine, n1), v = oriented(primitive, n2);
+          angle = Math.min(180, (Math.atan2(norm(cross(u, v)), dot(u, v)) * 180) / Math.PI);
+        }
+        add(other, length, angle);
+      }
+    }
+    return [...neighbours].map(([cluster, { edges, length, angleSum, angleWeight }]) => ({
+      cluster, edges, length, angle: angleWeight > 0 ? angleSum / angleWeight : null,
+    })).sort((x, y) => y.length - x.length || x.cluster - y.cluster);
   }
 
   /** The current border edges as [lower vertex, higher vertex] pairs. */

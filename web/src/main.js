@@ -504,6 +504,12 @@ class Viewer {
         torus: { center: point, axis: primitive.axis, major_radius: primitive.radius, minor_radius: primitive.minorRadius } };
       info.params = p[TYPE_NAMES[primitive.type]];
     }
+    // Its borders: the neighbouring clusters (ids as primseg numbers them, null for the open
+    // boundary), with the angle between the fitted surfaces across each.
+    const clusterIds = tree.clusterIds(this.cut);
+    info.borders = this.borderLines.clusterBorders(this.cut, c, (k) => tree.primitive(this.cut.nodes[k]))
+      .map((b) => ({ ...b, cluster: b.cluster < 0 ? null : clusterIds[b.cluster],
+        type: b.cluster < 0 ? null : TYPE_NAMES[tree.type(this.cut.nodes[b.cluster])] }));
     return info;
   }
 
@@ -523,6 +529,12 @@ class Viewer {
     else rows.push(['parameters', 'not in the page at this level (too fine)']);
     if (info.rms !== undefined) rows.push(['RMS', format(info.rms)], ['max error', format(info.max)]);
     rows.push(['RMS estimate', format(info.rmsEstimate)]);
+    // The longest borders: whom it meets, and how (0 degrees tangent, 90 a square edge).
+    const shown = info.borders.slice(0, 6).map((b) => (b.cluster === null ? 'open boundary'
+      : `${b.cluster} (${b.type})${b.angle === null ? '' : ` at ${b.angle.toFixed(1)}&deg;`}`) +
+      `, ${b.length.toPrecision(3)} long`);
+    if (info.borders.length > shown.length) shown.push(`... ${info.borders.length - shown.length} more`);
+    if (shown.length) rows.push(['meets', shown.join('<br>')]);
     const panel = $('info');
     panel.innerHTML = `<h2>cluster ${info.id} of ${info.clusters}</h2><table>${rows.map(([k, v]) => `<tr><td>${k}</td><td>${v}</td></tr>`).join('')}</table>`;
     panel.style.display = 'block';

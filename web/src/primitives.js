@@ -52,6 +52,31 @@ export function distance(p, x) {
   return NaN;
 }
 
+/** Unit normal of the surface at its point nearest x, as primseg's Primitive::normal: a plane's
+ *  axis; away from the centre, axis or core circle for the other types. */
+export function normal(p, x) {
+  const d = sub(x, p.point), a = p.axis;
+  const radialDirection = () => {
+    const radial = sub(d, scale(a, dot(a, d)));
+    return norm(radial) > 0 ? normalized(radial) : basis(a)[0];
+  };
+  switch (p.type) {
+    case 0:
+      return a;
+    case 1:
+      return radialDirection();
+    case 2:
+      return normalized(d);
+    case 3:
+      return sub(scale(radialDirection(), Math.cos(p.halfAngle)), scale(a, Math.sin(p.halfAngle)));
+    case 4: {
+      const toX = sub(d, scale(radialDirection(), p.radius));
+      return norm(toX) > 0 ? normalized(toX) : a;
+    }
+  }
+  return [NaN, NaN, NaN];
+}
+
 /**
  * Exact RMS and maximum distance of a cluster's vertices to a primitive, weighted as primseg
  * weighs them: area/3 per triangle corner, or 1/valence per corner for uniform weights.

@@ -364,6 +364,52 @@ test('fandisk: the borders drawn are the edges of primseg\'s border curves, at e
   await shown.page.close();
 });
 
+test('fandisk: a cluster\'s panel lists its borders as primseg cut reports them', async () => {
+  const { page, errors } = await openViewer(browser, join(work, 'fandisk.html'));
+  primseg('cut', join(work, 'fandisk.tree'), '--clusters', '27', '--labels', join(work, 'm.labels'),
+    '--json', join(work, 'm.json'), '--quiet');
+  const cliLabels = readLabels(join(work, 'm.labels'));
+  const borders = JSON.parse(readFileSync(join(work, 'm.json'), 'utf8')).borders;
+  const { pageLabels, panels } = await page.evaluate(async () => {
+    const viewer = await window.primseg.ready;
+    viewer.setClusters(27);
+    const faceCluster = viewer.cut.faceCluster;
+    const panels = [];
+    for (let c = 0; c < viewer.cut.size; ++c) panels.push(viewer.describe(c, faceCluster.indexOf(c)));
+    return { pageLabels: viewer.labels(), panels };
+  });
+  // Page ids to primseg's (the same clusters; ids of near-equal areas may differ).
+  const cliOf = new Map();
+  pageLabels.forEach((p, f) => cliOf.set(p, cliLabels[f]));
+  let compared = 0;
+  for (const panel of panels) {
+    const id = cliOf.get(panel.id);
+    const expected = borders.filter((b) => b.clusters.includes(id))
+      .map((b) => ({ other: b.clusters[0] === id ? b.clusters[1] : b.clusters[0], ...b }))
+      .sort((x, y) => x.other - y.other);
+    const shown = panel.borders.map((b) => ({ ...b, other: b.cluster === null ? null : cliOf.get(b.cluster) }))
+      .sort((x, y) => x.other - y.other);
+    assert.deepEqual(shown.map((b) => b.other), expected.map((b) => b.other), `cluster ${id}: neighbours`);
+    shown.forEach((b, i) => {
+      const e = expected[i], what = `cluster ${id} meets ${e.other}`;
+      assert.equal(b.edges, e.edges, what);
+      assert.ok(Math.abs(b.length - e.length) <= 1e-5 * e.length, `${what}: length ${b.length} vs ${e.length}`);
+      assert.ok(Math.abs(b.angle - e.angle) <= 1e-3, `${what}: angle ${b.angle} vs ${e.angle}`);
+      ++compared;
+    });
+  }
+  assert.equal(compared, 2 * borders.length);
+  // The panel shows them.
+  const text = await page.evaluate(async () => {
+    const viewer = await window.primseg.ready;
+    viewer.showInfo(viewer.describe(0, viewer.cut.faceCluster.indexOf(0)));
+    return document.getElementById('info').textContent;
+  });
+  assert.match(text, /meets.*\d+ \((plane|cylinder|sphere)\) at \d+\.\d°/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('the page is the same bytes from the mesh alone or with its tree', () => {
   const html = join(work, 'again.html');
   primseg('view', fandisk, '--clusters', '27', '-o', html, '--quiet');
