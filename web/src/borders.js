@@ -176,10 +176,16 @@ export class BorderLines {
     };
     for (let e = 0; e < count; ++e) {
       const from = sideStart[e], to = sideStart[e + 1];
+      // Only edges of c on a border: one triangle, or a triangle of another cluster.
+      let mine = false, others = false;
+      for (let s = from; s < to; ++s) {
+        if (clusterOf(triangleOf(s)) === c) mine = true;
+        else others = true;
+      }
+      if (!mine || (!others && to - from > 1)) continue;
       // The lowest triangle of each cluster on the edge (sides are sorted by triangle).
       const first = new Map();
       for (let s = from; s < to; ++s) if (!first.has(clusterOf(triangleOf(s)))) first.set(clusterOf(triangleOf(s)), triangleOf(s));
-      if (!first.has(c) || (first.size === 1 && to - from > 1)) continue;
       const low = ends[2 * e], high = ends[2 * e + 1];
       const a = point(low), b = point(high);
       const length = norm([b[0] - a[0], b[1] - a[1], b[2] - a[2]]);
@@ -187,21 +193,21 @@ export class BorderLines {
         add(-1, length, null);
         continue;
       }
-      const own = first.get(c), mine = primitiveOf(c);
+      const own = first.get(c), ownPrimitive = primitiveOf(c);
       for (const [other, theirs] of first) {
         if (other === c) continue;
         const primitive = primitiveOf(other);
         let angle = null;
         const n1 = listedNormal(own);
         let n2 = listedNormal(theirs);
-        if (mine && primitive && norm(n1) > 0 && norm(n2) > 0) {
+        if (ownPrimitive && primitive && norm(n1) > 0 && norm(n2) > 0) {
           if (direction(own, low, high) === direction(theirs, low, high)) n2 = n2.map((x) => -x);
           const middle = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2];
           const oriented = (p, like) => {
             const n = normal(p, middle);
             return dot(n, like) < 0 ? n.map((x) => -x) : n;
           };
-          const u = oriented(mine, n1), v = oriented(primitive, n2);
+          const u = oriented(ownPrimitive, n1), v = oriented(primitive, n2);
           angle = Math.min(180, (Math.atan2(norm(cross(u, v)), dot(u, v)) * 180) / Math.PI);
         }
         add(other, length, angle);
