@@ -332,8 +332,8 @@ void rasterise_triangle(std::uint32_t triangle_index, ProjectedVertex a, Project
 
 // For each triangle, its edges that are borders: on the mesh's open boundary (one triangle), or
 // between faces of different colours. (No colours: the open boundary alone.)
-std::vector<EdgeMask> border_edges(const Mesh& mesh,
-                                   std::span<const std::array<std::uint8_t, 3>> face_colors) {
+std::vector<EdgeMask> border_line_masks(const Mesh& mesh,
+                                        std::span<const std::array<std::uint8_t, 3>> face_colors) {
   std::vector<std::uint32_t> colour_of_triangle(mesh.triangles.size(), 0);
   if (!face_colors.empty())
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -750,7 +750,7 @@ std::vector<std::uint8_t> render_mesh(const Mesh& mesh,
         options.edges || options.borders ? kEdgeHalfWidthPixels * options.supersample * kSubpixel
                                          : 0.0;
     const std::vector<EdgeMask> lines = options.edges     ? std::vector<EdgeMask>()
-                                        : options.borders ? border_edges(mesh, face_colors)
+                                        : options.borders ? border_line_masks(mesh, face_colors)
                                                           : std::vector<EdgeMask>();
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       const Triangle& triangle = mesh.triangles[t];

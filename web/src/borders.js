@@ -3,11 +3,7 @@
 // The lines take their ends from the drawn mesh, so they follow a posed skeleton.
 
 import * as THREE from 'three';
-import { normal } from './primitives.js';
-
-const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-const norm = (a) => Math.sqrt(dot(a, a));
+import { cross, dot, norm, normal, sub } from './primitives.js';
 
 /**
  * Every mesh edge once: its two vertices, the triangles on it and, for drawing, the corners of
@@ -155,7 +151,7 @@ export class BorderLines {
     const point = (v) => [positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]];
     const listedNormal = (t) => {
       const [a, b, d] = [0, 1, 2].map((k) => point(triangles[3 * t + k]));
-      return cross([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [d[0] - a[0], d[1] - a[1], d[2] - a[2]]);
+      return cross(sub(b, a), sub(d, a));
     };
     // +1 when triangle t runs from `low` to `high` along the edge, -1 the other way.
     const direction = (t, low, high) => {
@@ -188,7 +184,7 @@ export class BorderLines {
       for (let s = from; s < to; ++s) if (!first.has(clusterOf(triangleOf(s)))) first.set(clusterOf(triangleOf(s)), triangleOf(s));
       const low = ends[2 * e], high = ends[2 * e + 1];
       const a = point(low), b = point(high);
-      const length = norm([b[0] - a[0], b[1] - a[1], b[2] - a[2]]);
+      const length = norm(sub(b, a));
       if (to - from === 1) {
         add(-1, length, null);
         continue;

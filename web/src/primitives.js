@@ -3,12 +3,12 @@
 // A primitive: {type, point[3], axis[3], radius, minorRadius, halfAngle}; types as
 // include/primseg/primitive.hpp: 0 plane, 1 cylinder, 2 sphere, 3 cone, 4 torus.
 
-const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+export const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+export const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const scale = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
 const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
-const norm = (a) => Math.sqrt(dot(a, a));
-const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+export const norm = (a) => Math.sqrt(dot(a, a));
+export const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const normalized = (a) => {
   const n = norm(a);
   return n > 0 ? scale(a, 1 / n) : [1, 0, 0];
