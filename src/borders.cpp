@@ -28,6 +28,10 @@ struct BorderEdge {
   }
 };
 
+bool same_border(const BorderEdge& a, const BorderEdge& b) {
+  return a.first == b.first && a.second == b.second;
+}
+
 void check_inputs(const Mesh& mesh, std::span<const std::uint32_t> face_labels,
                   std::span<const Primitive> primitives) {
   mesh.validate();
@@ -176,8 +180,7 @@ std::vector<ClusterBorder> cluster_borders(const Mesh& mesh,
     std::vector<std::size_t> border_at(mesh.vertex_count(), edges.size());  // first edge's border
     std::size_t border = 0;
     for (std::size_t i = 0; i < edges.size(); ++i) {
-      if (i > 0 && (edges[i].first != edges[i - 1].first || edges[i].second != edges[i - 1].second))
-        ++border;
+      if (i > 0 && !same_border(edges[i], edges[i - 1])) ++border;
       for (const std::uint32_t v : {edges[i].low, edges[i].high}) {
         if (border_at[v] == edges.size())
           border_at[v] = border;
@@ -190,9 +193,7 @@ std::vector<ClusterBorder> cluster_borders(const Mesh& mesh,
   std::vector<ClusterBorder> borders;
   for (std::size_t begin = 0; begin < edges.size();) {
     std::size_t end = begin + 1;
-    while (end < edges.size() && edges[end].first == edges[begin].first &&
-           edges[end].second == edges[begin].second)
-      ++end;
+    while (end < edges.size() && same_border(edges[end], edges[begin])) ++end;
     const std::span<const BorderEdge> own(edges.data() + begin, end - begin);
     ClusterBorder border;
     border.first = own.front().first;

@@ -219,15 +219,6 @@ export class Tree {
     return ids;
   }
 
-  /** The id of one cluster, O(F) without sorting. */
-  clusterId(cut, c) {
-    const lowest = this.lowestFaces(cut);
-    let rank = 0;
-    for (let other = 0; other < cut.size; ++other)
-      if (other !== c && this.compareClusters(cut, lowest, other, c) < 0) ++rank;
-    return rank;
-  }
-
   /** The largest clusters of a cut (at most `count`), largest first. O(K · count). */
   largestClusters(cut, count) {
     const best = [];

@@ -485,8 +485,9 @@ class Viewer {
     const { offsets, triangles } = this.trianglesByCluster();
     const ids = triangles.subarray(offsets[c], offsets[c + 1]);
     const primitive = tree.primitive(node) ?? (tree.isLeaf(node) ? facePlane(this.data.positions, this.data.triangles, ids) : null);
+    const clusterIds = tree.clusterIds(this.cut);
     const info = {
-      id: tree.clusterId(this.cut, c), clusters: this.cut.size, node, face,
+      id: clusterIds[c], clusters: this.cut.size, node, face,
       type: TYPE_NAMES[tree.type(node)], faces: tree.faces[node], area: tree.area[node],
       rmsEstimate: tree.rms(node),
     };
@@ -506,7 +507,6 @@ class Viewer {
     }
     // Its borders: the neighbouring clusters (ids as primseg numbers them, null for the open
     // boundary), with the angle between the fitted surfaces across each.
-    const clusterIds = tree.clusterIds(this.cut);
     info.borders = this.borderLines.clusterBorders(this.cut, c, (k) => tree.primitive(this.cut.nodes[k]))
       .map((b) => ({ ...b, cluster: b.cluster < 0 ? null : clusterIds[b.cluster],
         type: b.cluster < 0 ? null : TYPE_NAMES[tree.type(this.cut.nodes[b.cluster])] }));
