@@ -133,12 +133,11 @@ nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy)
           {"bbox_diagonal", bounding_box_diagonal(mesh)}};
 }
 
-void add_level_options(CLI::App& command, LevelOptions& options) {
+void add_level_options(CLI::App& command, LevelOptions& options, std::string_view auto_level) {
   auto* clusters =
       command.add_option("--clusters", options.level.clusters,
-                         "Number of clusters K (1..F), or 'auto': the finest level after which "
-                         "the error curve jumps (x2), else its knee (rule, candidates and scores "
-                         "in the JSON)");
+                         "Number of clusters K (1..F), or 'auto': " + std::string(auto_level) +
+                             " (rule, candidates and scores in the JSON)");
   auto* tolerance = command.add_option(
       "--tolerance", options.level.tolerance,
       std::string("Largest RMS distance of a cluster to its primitive, in input units or T% of "
@@ -163,13 +162,16 @@ void add_level_options(CLI::App& command, LevelOptions& options) {
   command.add_option("--linkage", options.files.linkage,
                      "Write the whole tree as a SciPy linkage matrix (text: a b cost size per "
                      "merge, numpy.loadtxt; - for standard output)");
+  command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
+}
+
+void add_refine_option(CLI::App& command, LevelOptions& options) {
   command
       .add_option("--refine", options.refine,
                   "Boundary refinement passes after the cut: border faces move to the adjacent "
                   "cluster whose primitive fits them better (0: none)")
       ->check(CLI::Range(0u, 1000u))
       ->capture_default_str();
-  command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
 }
 
 void validate_level_outputs(LevelOptions& options) {
@@ -202,26 +204,34 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, Chose
     reports = describe_clusters(hierarchy, segmentation);
   }
   summary["timing"]["cut_seconds"] = seconds_since(cut_start);
-  summary["level"] = {{"clusters", segmentation.cluster_count()}};
+  summary["level"] = level_summary(options, level, segmentation.cluster_count());
   if (!refinement.is_null()) summary["level"]["refinement"] = std::move(refinement);
+  write_level_outputs(hierarchy, hierarchy.mesh(), segmentation.labels, reports, options.files,
+                      summary);
+  if (options.files.tree) write_output(*options.files.tree, serialize_tree(hierarchy));
+  if (!options.quiet) print_summary(reports);
+}
+
+nlohmann::json level_summary(const LevelOptions& options, const ChosenLevel& level,
+                             std::uint32_t clusters) {
+  nlohmann::json summary = {{"clusters", clusters}};
   if (level.automatic) {
-    summary["level"]["requested_clusters"] = "auto";
-    summary["level"]["rule"] = level.by_noise ? "noise" : to_string(level.automatic->rule);
+    summary["requested_clusters"] = "auto";
+    summary["rule"] = level.by_noise ? "noise" : to_string(level.automatic->rule);
     nlohmann::json candidates = nlohmann::json::array();
     for (const LevelCandidate& c : level.automatic->candidates)
       candidates.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
-    summary["level"]["candidates"] = std::move(candidates);
+    summary["candidates"] = std::move(candidates);
     if (level.by_noise) {
-      summary["level"]["noise_estimate"] = level.by_noise->noise;
-      summary["level"]["noise_tolerance"] = level.by_noise->tolerance;
+      summary["noise_estimate"] = level.by_noise->noise;
+      summary["noise_tolerance"] = level.by_noise->tolerance;
     }
-  } else if (options.level.clusters)
-    summary["level"]["requested_clusters"] = *parse_cluster_count(*options.level.clusters);
-  else
-    summary["level"]["tolerance"] = options.level.tolerance.value_or(kDefaultTolerance);
-  write_level_outputs(hierarchy, segmentation, reports, options.files, summary);
-  if (options.files.tree) write_output(*options.files.tree, serialize_tree(hierarchy));
-  if (!options.quiet) print_summary(reports);
+  } else if (options.level.clusters) {
+    summary["requested_clusters"] = *parse_cluster_count(*options.level.clusters);
+  } else {
+    summary["tolerance"] = options.level.tolerance.value_or(kDefaultTolerance);
+  }
+  return summary;
 }
 
 }  // namespace primseg::cli

@@ -8,6 +8,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "level.hpp"
@@ -97,8 +98,16 @@ struct LevelOptions {
   bool quiet = false;
 };
 
-/// Adds --clusters, --tolerance, the per-level output files and --quiet to a command.
-void add_level_options(CLI::App& command, LevelOptions& options);
+/// What `--clusters auto` means for segment and cut (choose_level).
+inline constexpr std::string_view kChosenLevelRule =
+    "the finest level after which the error curve jumps (x2), else its knee";
+
+/// Adds --clusters (whose help says `auto_level` of 'auto'), --tolerance, the per-level output
+/// files and --quiet to a command.
+void add_level_options(CLI::App& command, LevelOptions& options,
+                       std::string_view auto_level = kChosenLevelRule);
+/// Adds --refine (LevelOptions::refine) to a command that reports a hierarchy's level.
+void add_refine_option(CLI::App& command, LevelOptions& options);
 
 /// Checks the output names before any work (validate_output_files) and turns `quiet` on when an
 /// output goes to standard output ('-'), which must then carry that output alone.
@@ -110,5 +119,9 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohm
 /// The same for a level the command has already cut.
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, ChosenLevel level,
                   nlohmann::json summary, Clock::time_point cut_start);
+
+/// The JSON's "level" entry: `clusters`, and how the level was asked for and chosen.
+nlohmann::json level_summary(const LevelOptions& options, const ChosenLevel& level,
+                             std::uint32_t clusters);
 
 }  // namespace primseg::cli

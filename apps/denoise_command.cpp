@@ -35,7 +35,9 @@ Command add_denoise_command(CLI::App& app) {
       ->required();
   denoise->add_option("-o,--output", o->output_path, "Output mesh (same vertex and face order)")
       ->required();
-  add_level_options(*denoise, o->level);
+  add_level_options(*denoise, o->level,
+                    "a jump of the error curve whose clusters fit the noise, else the clusters "
+                    "within a multiple of the estimated noise (--noise-factor)");
   denoise
       ->add_option("--iterations", o->iterations,
                    "Segment-and-snap rounds, each on the previous round's result")
@@ -155,8 +157,17 @@ Command add_denoise_command(CLI::App& app) {
                                                                               : "input"},
                                   {"rounds", rounds}};
             summary["timing"] = {{"denoise_seconds", seconds_since(start)}};
-            // The per-level outputs describe the segmentation the last round snapped onto.
-            report_level(*hierarchy, o->level, std::move(level), summary, Clock::now());
+            // The level outputs show the last round's snap: its clusters after relabelling, with
+            // the primitives the vertices went onto, on the denoised mesh (whose borders are the
+            // recovered feature lines). The error curve and the linkage are the last round's
+            // hierarchy's, built on the segmented copy.
+            const SnappedLevel& snapped = denoiser.snapped_level();
+            summary["level"] =
+                level_summary(o->level, level, static_cast<std::uint32_t>(snapped.clusters.size()));
+            summary["level"]["hierarchy_clusters"] = level.segmentation.cluster_count();
+            write_level_outputs(*hierarchy, denoiser.mesh(), snapped.labels, snapped.clusters,
+                                o->level.files, summary);
+            if (!o->level.quiet) print_summary(snapped.clusters);
           }};
 }
 

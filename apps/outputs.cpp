@@ -154,13 +154,14 @@ std::string borders_obj(const Mesh& mesh, std::span<const ClusterBorder> borders
 
 }  // namespace
 
-void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
+void write_level_outputs(const Hierarchy& hierarchy, const Mesh& mesh,
+                         std::span<const std::uint32_t> labels,
                          const std::vector<ClusterReport>& reports, const OutputFiles& files,
                          const nlohmann::json& summary) {
   if (files.labels) {
     std::string text;
-    text.reserve(segmentation.labels.size() * 4);
-    for (std::uint32_t label : segmentation.labels) {
+    text.reserve(labels.size() * 4);
+    for (std::uint32_t label : labels) {
       text += std::to_string(label);
       text += '\n';
     }
@@ -171,7 +172,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     std::vector<Primitive> primitives;
     primitives.reserve(reports.size());
     for (const ClusterReport& report : reports) primitives.push_back(report.primitive);
-    borders = cluster_borders(hierarchy.mesh(), segmentation.labels, primitives);
+    borders = cluster_borders(mesh, labels, primitives);
   }
   if (files.json) {
     // A level of a cluster per face (a triangle soup at --clusters auto) held about 1.6 KB per
@@ -195,12 +196,12 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
     const StreamedArray arrays[] = {clusters, border_array};
     write_output(*files.json, dump_document(json, arrays));
   }
-  if (files.borders) write_output(*files.borders, borders_obj(hierarchy.mesh(), borders));
+  if (files.borders) write_output(*files.borders, borders_obj(mesh, borders));
   if (files.colored) {
     const std::filesystem::path path(*files.colored);
     MeshWriteOptions options;
-    options.face_groups = segmentation.labels;
-    write_mesh(path, hierarchy.mesh(), options);
+    options.face_groups = labels;
+    write_mesh(path, mesh, options);
   }
   if (files.linkage) {
     // numpy.loadtxt gives SciPy's (F − 1, 4) linkage matrix: children, height, size.
@@ -225,7 +226,7 @@ void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segment
   if (files.png) {
     RenderOptions picture;
     picture.borders = true;
-    write_png(*files.png, hierarchy.mesh(), group_face_colors(segmentation.labels), picture);
+    write_png(*files.png, mesh, group_face_colors(labels), picture);
   }
 }
 

@@ -54,8 +54,12 @@ using detail::vec3_json;
 /// JSON parameters of a primitive, input units.
 nlohmann::json primitive_params(const Primitive& primitive);
 
-/// Writes the requested per-level files. `summary` holds mesh and timing entries for the JSON.
-void write_level_outputs(const Hierarchy& hierarchy, const Segmentation& segmentation,
+/// Writes the requested per-level files: those of a level (`labels`, shape (F), and its
+/// clusters' `reports`) on `mesh`, which the coloured mesh, the picture and the border curves
+/// show (the hierarchy's mesh, or a mesh with its connectivity), and those of the whole
+/// `hierarchy` (the linkage and the error curve). `summary` holds the JSON's other entries.
+void write_level_outputs(const Hierarchy& hierarchy, const Mesh& mesh,
+                         std::span<const std::uint32_t> labels,
                          const std::vector<ClusterReport>& reports, const OutputFiles& files,
                          const nlohmann::json& summary);
 

@@ -1397,7 +1397,7 @@ these are the tree's own fits, for rules of one's own over all nodes.)",
   // denoise, skeleton, distance.
 
   const char* denoise_doc =
-      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, primitives=None, weights=None, threads=0, return_rounds=False, progress=None) -> numpy.ndarray
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, primitives=None, weights=None, threads=0, return_rounds=False, return_level=False, progress=None) -> numpy.ndarray
 denoise(V, F, *, ...) -> numpy.ndarray
 denoise(hierarchy, *, ...) -> numpy.ndarray
 
@@ -1406,7 +1406,10 @@ round segments the previous round's result), and returns the new positions, floa
 the input's vertex order (the faces do not change): the CLI's output mesh, bit for bit. With
 return_rounds=True it returns (V, rounds), rounds a list of dicts like the CLI's --json
 "denoise" "rounds" (clusters, boundary_vertices, snapped, moved, fallbacks, blocked, mean_move,
-max_move).
+max_move). With return_level=True it returns (V, level), or (V, rounds, level) with both: the
+last round's snap (Denoiser::snapped_level) as a dict of "labels" (int32 (F,), the CLI's
+--labels), "clusters" and "borders" (the CLI's --json entries: the clusters after relabelling with
+the primitives the vertices went onto, their borders on the denoised mesh).
 The input is a Mesh, arrays V and F (as segment takes them), or a Hierarchy: its first round
 then snaps onto that tree's level without building it again (smoothing_steps must be 0, and the
 later rounds use its primitives and weights).
@@ -1432,7 +1435,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
          int smoothing_steps, bool bilateral, bool stylize, double max_move,
          double min_crease_angle, int relabel_passes, double relation_significance,
          std::optional<double> noise_tolerance_factor, const py::object& primitives,
-         const py::object& weights, unsigned threads, bool return_rounds,
+         const py::object& weights, unsigned threads, bool return_rounds, bool return_level,
          const py::object& progress) -> py::object {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
@@ -1472,6 +1475,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         const std::function<void(double)> progress_of_all = python_progress(progress);
         std::vector<SnapReport> reports;
         std::vector<Vec3> positions;
+        SnappedLevel snapped;
+        std::vector<ClusterBorder> borders;
         without_gil([&] {
           Denoiser denoiser(*mesh, options);
           // k="auto": denoising's own automatic level, as `primseg denoise --clusters auto`.
@@ -1491,13 +1496,37 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
                 *hierarchy, automatic ? denoiser.automatic_level(*hierarchy).segmentation
                                       : cut_level(*hierarchy, level)));
           }
+          if (return_level) {
+            snapped = denoiser.snapped_level();
+            std::vector<Primitive> snapped_primitives;
+            for (const ClusterReport& report : snapped.clusters)
+              snapped_primitives.push_back(report.primitive);
+            borders = cluster_borders(denoiser.mesh(), snapped.labels, snapped_primitives);
+          }
           positions = denoiser.mesh().positions;
         });
         py::array V = positions_array(std::move(positions));
-        if (!return_rounds) return V;
-        py::list rounds;
-        for (const SnapReport& report : reports) rounds.append(snap_report_dict(report));
-        return py::make_tuple(V, rounds);
+        if (!return_rounds && !return_level) return V;
+        py::list result;
+        result.append(V);
+        if (return_rounds) {
+          py::list rounds;
+          for (const SnapReport& report : reports) rounds.append(snap_report_dict(report));
+          result.append(rounds);
+        }
+        if (return_level) {
+          py::dict snapped_dict;
+          py::list clusters, border_list;
+          for (const ClusterReport& report : snapped.clusters)
+            clusters.append(cluster_dict(report));
+          for (const ClusterBorder& border : borders) border_list.append(border_dict(border));
+          const auto face_count = static_cast<py::ssize_t>(snapped.labels.size());
+          snapped_dict["labels"] = adopt<std::int32_t>(std::move(snapped.labels), {face_count});
+          snapped_dict["clusters"] = clusters;
+          snapped_dict["borders"] = border_list;
+          result.append(snapped_dict);
+        }
+        return py::tuple(result);
       },
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(), py::arg("k") = py::none(),
       py::arg("tolerance") = py::none(), py::arg("relative_tolerance") = py::none(),
@@ -1509,7 +1538,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       py::arg("relation_significance") = DenoiseOptions{}.relation_significance,
       py::arg("noise_tolerance_factor") = py::none(), py::arg("primitives") = py::none(),
       py::arg("weights") = py::none(), py::arg("threads") = 0u, py::arg("return_rounds") = false,
-      py::arg("progress") = py::none(),
+      py::arg("return_level") = false, py::arg("progress") = py::none(),
       join_docs(
           {denoise_doc, cpp_doc("denoise.hpp", doc::denoise__file),
            cpp_doc("DenoiseOptions::max_move_edge_lengths",
@@ -1526,7 +1555,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
            cpp_doc("DenoiseOptions::bilateral_smoothing",
                    doc::denoise__DenoiseOptions__bilateral_smoothing),
            cpp_doc("SnapMode", doc::denoise__SnapMode),
-           cpp_doc("SnapReport", doc::denoise__SnapReport)})
+           cpp_doc("SnapReport", doc::denoise__SnapReport),
+           cpp_doc("SnappedLevel", doc::denoise__SnappedLevel)})
           .c_str());
 
   py::class_<PySkeleton>(

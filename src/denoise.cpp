@@ -11,6 +11,7 @@
 #include <string>
 
 #include "eigen_conversions.hpp"
+#include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "primseg/geometric_fit.hpp"
@@ -469,7 +470,7 @@ void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
   std::vector<std::uint32_t> face_offsets(mesh_.face_count() + 1, 0);
   for (const std::uint32_t f : mesh_.face_of_triangle) ++face_offsets[f + 1];
   for (std::uint32_t f = 0; f < mesh_.face_count(); ++f) face_offsets[f + 1] += face_offsets[f];
-  const std::vector<Primitive> hierarchy_fits = primitives;
+  const std::vector<Primitive> refit_starts = primitives;  // each pass refits from these
   std::vector<std::uint32_t> near, next;
   for (int pass = 0; pass < options_.relabel_passes; ++pass) {
     next = labels;
@@ -505,9 +506,67 @@ void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
     }
     labels.swap(next);
     if (!changed) break;
-    primitives = hierarchy_fits;
+    primitives = refit_starts;
     if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
   }
+}
+
+SnappedLevel Denoiser::describe_snap(const Segmentation& hierarchy_level,
+                                     const Segmentation& relabelled,
+                                     const std::vector<Primitive>& hierarchy_fits,
+                                     const std::vector<Primitive>& primitives) const {
+  const std::size_t k = primitives.size();
+  std::vector<ClusterReport> reports(k);
+  std::vector<std::uint32_t> lowest_face(k, detail::kNone);
+  for (std::uint32_t f = 0; f < mesh_.face_count(); ++f) {
+    const std::uint32_t c = relabelled.labels[f];
+    ++reports[c].face_count;
+    lowest_face[c] = std::min(lowest_face[c], f);
+  }
+  for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t) {
+    const Triangle& corners = mesh_.triangles[t];
+    reports[relabelled.labels[mesh_.face_of_triangle[t]]].area +=
+        triangle_normal(to_eigen(mesh_.positions[corners[0]]),
+                        to_eigen(mesh_.positions[corners[1]]),
+                        to_eigen(mesh_.positions[corners[2]]))
+            .norm() /
+        2;
+  }
+  std::vector<std::vector<Vec3>> points;
+  std::vector<std::vector<double>> weights;
+  cluster_vertices(relabelled, k, points, weights);
+  for (std::size_t c = 0; c < k; ++c) {
+    ClusterReport& r = reports[c];
+    r.node = hierarchy_level.nodes[c];
+    r.primitive = primitives[c];
+    r.algebraic = hierarchy_fits[c];
+    double weighted_squares = 0, weight_sum = 0;
+    for (std::size_t i = 0; i < points[c].size(); ++i) {
+      const double d = primitives[c].distance(points[c][i]);
+      weighted_squares += weights[c][i] * d * d;
+      weight_sum += weights[c][i];
+      if (weights[c][i] > 0) r.max = std::max(r.max, d);
+    }
+    r.rms = weight_sum > 0 ? std::sqrt(weighted_squares / weight_sum) : 0;
+  }
+  // Numbered as a Segmentation is, without the clusters relabelling emptied.
+  std::vector<std::uint32_t> order;
+  for (std::uint32_t c = 0; c < k; ++c)
+    if (reports[c].face_count > 0) order.push_back(c);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    if (reports[a].area != reports[b].area) return reports[a].area > reports[b].area;
+    return lowest_face[a] < lowest_face[b];
+  });
+  SnappedLevel level;
+  std::vector<std::uint32_t> rank(k, detail::kNone);
+  for (std::uint32_t r = 0; r < order.size(); ++r) {
+    rank[order[r]] = r;
+    level.clusters.push_back(reports[order[r]]);
+    level.clusters.back().id = r;
+  }
+  level.labels.reserve(relabelled.labels.size());
+  for (const std::uint32_t c : relabelled.labels) level.labels.push_back(rank[c]);
+  return level;
 }
 
 SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmentation) {
@@ -519,17 +578,19 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
     throw InvalidInputError("denoise: the segmentation has " +
                             std::to_string(segmentation.labels.size()) + " labels for " +
                             std::to_string(mesh_.face_count()) + " faces");
-  std::vector<Primitive> primitives;
+  std::vector<Primitive> hierarchy_fits;
   for (const ClusterReport& cluster : describe_clusters(hierarchy, segmentation))
-    primitives.push_back(cluster.primitive);
+    hierarchy_fits.push_back(cluster.primitive);
+  std::vector<Primitive> primitives = hierarchy_fits;
   if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
   Segmentation labelled = segmentation;
   relabel(segmented, primitives, labelled);
   if (options_.relation_significance > 0 && options_.refit_outlier_threshold > 0)
     regularize(labelled, primitives);
+  snapped_level_ = describe_snap(segmentation, labelled, hierarchy_fits, primitives);
 
   SnapReport report;
-  report.clusters = segmentation.cluster_count();
+  report.clusters = static_cast<std::uint32_t>(snapped_level_.clusters.size());
   const double eigenvalue_ratio =
       std::pow(std::tan(options_.min_crease_angle_degrees * std::numbers::pi / 360), 2);
   const bool bounded =

@@ -135,6 +135,7 @@ struct DenoiseLevel {
 
 /// What one snapping pass did.
 struct SnapReport {
+  /// Clusters the vertices were snapped onto: the level's, less any that relabelling emptied.
   std::uint32_t clusters = 0;
   std::uint32_t interior_vertices = 0;  ///< vertices of one cluster only
   std::uint32_t boundary_vertices = 0;  ///< vertices shared by two or more clusters
@@ -149,6 +150,23 @@ struct SnapReport {
   std::uint32_t blocked = 0;
   double mean_move = 0;  ///< over moved vertices, input units (0 when none moved)
   double max_move = 0;   ///< input units
+};
+
+/// The clusters a snap moved the vertices onto (Denoiser::snapped_level): the level it was given,
+/// after relabelling (DenoiseOptions::relabel_passes), with each cluster's primitive after the
+/// robust refit and the relations. Their borders on the denoised mesh,
+/// `cluster_borders(denoiser.mesh(), level.labels, primitives)`, are its recovered feature lines.
+struct SnappedLevel {
+  /// Cluster of each input face, shape (F), 0..K−1, numbered like Segmentation's by decreasing
+  /// area (before the snap), ties by lowest face. A cluster relabelling emptied is gone.
+  std::vector<std::uint32_t> labels;
+  /// One per cluster, in label order, shape (K). `primitive`: what the cluster's vertices were
+  /// snapped onto, input units; `algebraic`: the hierarchy's fit of the level's cluster it came
+  /// from, and `node` that cluster's tree node. `area` (input units²), `face_count`, and `rms`
+  /// and `max`: distances to `primitive` of the cluster's vertices before the snap, each weighted
+  /// by the area of its triangles in the cluster (as the hierarchy's area weights do; `max` leaves
+  /// out vertices of zero weight), input units: what the snap took out.
+  std::vector<ClusterReport> clusters;
 };
 
 /// Step-by-step denoising of one mesh. The vertex and face order never change; only positions do.
@@ -191,8 +209,15 @@ class Denoiser {
   /// The current mesh (the input after the iterations so far).
   const Mesh& mesh() const { return mesh_; }
 
+  /// The clusters the last snap() (or iterate()) moved the vertices onto; empty before the first.
+  const SnappedLevel& snapped_level() const { return snapped_level_; }
+
  private:
   void refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const;
+  // The snap's clusters (snapped_level) on the current positions, before they move.
+  SnappedLevel describe_snap(const Segmentation& hierarchy_level, const Segmentation& relabelled,
+                             const std::vector<Primitive>& hierarchy_fits,
+                             const std::vector<Primitive>& primitives) const;
   void cluster_vertices(const Segmentation& segmentation, std::size_t cluster_count,
                         std::vector<std::vector<Vec3>>& points,
                         std::vector<std::vector<double>>& weights) const;
@@ -233,6 +258,7 @@ class Denoiser {
   Mesh mesh_;
   DenoiseOptions options_;
   mutable EstimateCopyCache estimate_copy_;
+  SnappedLevel snapped_level_;
   std::vector<Vec3> input_normals_;        // per triangle, unnormalised: orientation reference
   std::vector<double> local_edge_length_;  // per vertex, in the input mesh
   // Triangles around each vertex: those of vertex v are

@@ -149,8 +149,15 @@ print(f"saved and reloaded {tree_path.name}: {tree_path.stat().st_size / 1e6:.1f
 rng = np.random.default_rng(1)
 noisy_V = mesh.V + rng.normal(scale=1e-3 * mesh.bounding_box_diagonal, size=mesh.V.shape)
 start = time.perf_counter()
-clean_V, rounds = primseg.denoise(noisy_V, mesh.F, k=30, return_rounds=True)
+clean_V, rounds, level = primseg.denoise(noisy_V, mesh.F, k=30, return_rounds=True,
+                                         return_level=True)
 print(f"denoised in {time.perf_counter() - start:.2f} s:", rounds[0])
+# The clusters the vertices went onto meet along the denoised mesh's feature lines: the sharp
+# ones are fandisk's recovered edges.
+sharp = [b for b in level["borders"] if b["angle"] is not None and b["angle"] > 60]
+print(f"{len(level['clusters'])} clusters; {len(sharp)} sharp borders, "
+      f"{sum(b['length'] for b in sharp):.3f} long in all")
+assert len(level["clusters"]) == rounds[0]["clusters"] and len(sharp) > 20
 before = primseg.distance(mesh, (noisy_V, mesh.F), samples=50000)
 after = primseg.distance(mesh, (clean_V, mesh.F), samples=50000)
 for name, d in [("noisy", before), ("denoised", after)]:

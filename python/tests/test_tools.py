@@ -57,15 +57,23 @@ def man_skeleton(man):
      (("--clusters", "auto", "--noise-factor", "2"), {"k": "auto", "noise_tolerance_factor": 2.0})])
 def test_denoise_matches_the_cli(cli, noisy_fandisk, tmp_path, cli_options, python_options):
     run_cli(cli, "denoise", noisy_fandisk, *cli_options, "-o", tmp_path / "out.off",
-            "--json", tmp_path / "summary.json", "--quiet")
+            "--json", tmp_path / "summary.json", "--labels", tmp_path / "labels.txt", "--quiet")
     expected = primseg.read_mesh(tmp_path / "out.off").V  # written in shortest round-trip form
     summary = json.loads((tmp_path / "summary.json").read_text())
     mesh = primseg.read_mesh(noisy_fandisk)
-    V, rounds = primseg.denoise(mesh, **python_options, return_rounds=True)
+    V, rounds, level = primseg.denoise(mesh, **python_options, return_rounds=True,
+                                       return_level=True)
     assert V.dtype == np.float64 and V.shape == mesh.V.shape and V.flags.writeable
     np.testing.assert_array_equal(V, expected)  # bit for bit
     assert rounds == summary["denoise"]["rounds"]
     assert not np.array_equal(V, mesh.V)
+    # The snap's clusters and their borders on the denoised mesh, as the CLI writes them.
+    assert level["labels"].dtype == np.int32 and level["labels"].shape == (mesh.face_count,)
+    np.testing.assert_array_equal(level["labels"], np.loadtxt(tmp_path / "labels.txt"))
+    assert level["clusters"] == summary["clusters"]
+    assert json.loads(json.dumps(level["borders"])) == summary["borders"]
+    assert len(level["clusters"]) == summary["level"]["clusters"] == rounds[-1]["clusters"]
+    np.testing.assert_array_equal(primseg.denoise(mesh, **python_options, return_level=True)[0], V)
 
 
 def test_denoise_auto_level_is_a_multiple_of_the_estimated_noise(cli, noisy_fandisk, tmp_path):

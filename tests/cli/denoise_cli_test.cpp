@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -183,6 +185,81 @@ TEST(CliDenoise, SnappingOptionsAreTheLibrarys) {
     EXPECT_EQ(read_mesh(out).positions, expected);
     EXPECT_NE(expected, defaults);  // the option changes something on this mesh
   }
+}
+
+// The level outputs show the snap: the clusters after relabelling, the primitives the vertices
+// went onto, all on the denoised mesh, whose borders are the box's recovered edges. They are the
+// library's snapped level (Denoiser::snapped_level), here with the bilateral copy segmented.
+TEST(CliDenoise, LevelOutputsShowTheSnapOnTheDenoisedMesh) {
+  const Files f = noisy_box();
+  const fs::path out = f.dir / "level.ply", colored = f.dir / "colored.ply",
+                 borders = f.dir / "borders.obj", labels = f.dir / "labels.txt",
+                 json_path = f.dir / "level.json";
+  std::string output;
+  ASSERT_EQ(
+      primseg({"denoise", q(f.noisy), "--clusters 6 --bilateral -o", q(out), "--colored",
+               q(colored), "--borders", q(borders), "--labels", q(labels), "--json", q(json_path)},
+              &output),
+      0)
+      << output;
+  DenoiseOptions options;
+  options.bilateral_smoothing = BilateralSmoothingOptions{};
+  Denoiser denoiser(read_mesh(f.noisy), options);
+  denoiser.iterate(level_by_count(6));
+  const SnappedLevel& level = denoiser.snapped_level();
+  const Mesh denoised = read_mesh(out);
+  ASSERT_EQ(denoised.positions, denoiser.mesh().positions);
+  EXPECT_EQ(read_mesh(colored).positions, denoised.positions);
+
+  std::ifstream label_file(labels);
+  std::vector<std::uint32_t> written_labels;
+  for (std::uint32_t label = 0; label_file >> label;) written_labels.push_back(label);
+  EXPECT_EQ(written_labels, level.labels);
+
+  std::ifstream json_file(json_path);
+  const nlohmann::json json = nlohmann::json::parse(json_file);
+  EXPECT_EQ(json["level"]["clusters"], 6);
+  EXPECT_EQ(json["level"]["hierarchy_clusters"], 6);
+  ASSERT_EQ(json["clusters"].size(), level.clusters.size());
+  for (std::size_t c = 0; c < level.clusters.size(); ++c) {
+    const ClusterReport& r = level.clusters[c];
+    const nlohmann::json& cluster = json["clusters"][c];
+    EXPECT_EQ(cluster["faces"], r.face_count);
+    EXPECT_EQ(cluster["rms"].get<double>(), r.rms);
+    EXPECT_EQ(cluster["type"], std::string(to_string(r.primitive.type)));
+    for (const NamedParameter& p : named_parameters(r.primitive)) {
+      const nlohmann::json& value = cluster["params"][std::string(p.name)];
+      if (p.is_vector)
+        EXPECT_EQ(value.get<std::vector<double>>(),
+                  std::vector<double>(p.value.begin(), p.value.end()))
+            << p.name;
+      else
+        EXPECT_EQ(value.get<double>(), p.value[0]) << p.name;
+    }
+  }
+  // The box's edges (a face may be fitted by a cylinder of radius 45 times its width, whose
+  // normal turns by a degree across it).
+  ASSERT_EQ(json["borders"].size(), 12u);
+  for (const nlohmann::json& border : json["borders"])
+    EXPECT_NEAR(border["angle"].get<double>(), 90, 2) << border["clusters"];
+
+  // The polylines run through the denoised positions.
+  std::ifstream obj(borders);
+  std::size_t points = 0;
+  for (std::string line; std::getline(obj, line);) {
+    if (line.rfind("v ", 0) != 0) continue;
+    Vec3 p;
+    ASSERT_EQ(std::sscanf(line.c_str(), "v %lf %lf %lf", &p[0], &p[1], &p[2]), 3) << line;
+    EXPECT_NE(std::find(denoised.positions.begin(), denoised.positions.end(), p),
+              denoised.positions.end())
+        << line;
+    ++points;
+  }
+  EXPECT_GT(points, 12u);
+
+  // Boundary refinement is a hierarchy level's (segment, cut); denoise relabels on its own.
+  EXPECT_NE(primseg({"denoise", q(f.noisy), "--clusters 6 --refine 2 -o", q(out)}, &output), 0);
+  EXPECT_NE(output.find("--refine"), std::string::npos) << output;
 }
 
 TEST(CliDenoise, BadUsageFailsWithAMessage) {

@@ -10,7 +10,9 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -18,6 +20,7 @@
 
 #include "denoise_test_support.hpp"
 #include "marching_tetrahedra.hpp"
+#include "primseg/borders.hpp"
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
 #include "primseg/hierarchy.hpp"
@@ -481,6 +484,136 @@ TEST(Denoise, AutomaticLevelKeepsTheJumpOfAChamferedBox) {
     const MeshDistance after = mesh_distance(denoiser.mesh(), sharp, measure_options());
     EXPECT_LE(after.hausdorff * 5, before.hausdorff) << bilateral;
   }
+}
+
+// What a user reads after denoising: the clusters the vertices went onto, their primitives and
+// their borders. On the noisy box at 6 clusters: the box's six faces, numbered by decreasing
+// area, each plane within a degree of the true one and spread as the noise was; every vertex
+// inside a face on its plane; and the denoised mesh's borders the box's twelve edges at 90°,
+// through the true edges and corners.
+TEST(Denoise, SnappedLevelIsTheBoxsFacesAndItsEdges) {
+  const NoisyShape box = noisy_shape("box", 0.004, 0.04);
+  Denoiser denoiser(box.noisy.mesh);
+  EXPECT_TRUE(denoiser.snapped_level().labels.empty());
+  EXPECT_TRUE(denoiser.snapped_level().clusters.empty());
+  const Hierarchy hierarchy = build_hierarchy(denoiser.segmented_mesh());
+  const Segmentation cut = cut_by_count(hierarchy, 6);
+  const std::vector<ClusterReport> cut_reports = describe_clusters(hierarchy, cut);
+  const SnapReport report = denoiser.snap(hierarchy, cut);
+  const SnappedLevel& level = denoiser.snapped_level();
+  ASSERT_EQ(level.clusters.size(), 6u);
+  ASSERT_EQ(level.labels.size(), box.noisy.mesh.face_count());
+  EXPECT_EQ(report.clusters, 6u);
+  EXPECT_EQ(report.blocked, 0u);
+
+  // One true region per cluster, one-to-one, and the faces counted.
+  constexpr std::uint32_t kUnset = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> region_of_cluster(6, kUnset), faces(6, 0);
+  for (std::uint32_t f = 0; f < level.labels.size(); ++f) {
+    const std::uint32_t c = level.labels[f];
+    ASSERT_LT(c, 6u);
+    ++faces[c];
+    if (region_of_cluster[c] == kUnset) region_of_cluster[c] = box.noisy.region_of_face[f];
+    EXPECT_EQ(box.noisy.region_of_face[f], region_of_cluster[c]) << "face " << f;
+  }
+  std::vector<std::uint32_t> regions = region_of_cluster;
+  std::sort(regions.begin(), regions.end());
+  EXPECT_EQ(std::unique(regions.begin(), regions.end()), regions.end());
+
+  for (std::uint32_t c = 0; c < 6; ++c) {
+    SCOPED_TRACE(c);
+    const ClusterReport& r = level.clusters[c];
+    EXPECT_EQ(r.id, c);
+    EXPECT_EQ(r.face_count, faces[c]);
+    if (c > 0) {
+      EXPECT_GE(level.clusters[c - 1].area, r.area);
+    }
+    ASSERT_EQ(r.primitive.type, PrimitiveType::Plane);
+    const Primitive& truth = box.clean.regions[region_of_cluster[c]];
+    const double cosine = r.primitive.axis[0] * truth.axis[0] +
+                          r.primitive.axis[1] * truth.axis[1] + r.primitive.axis[2] * truth.axis[2];
+    EXPECT_GE(std::abs(cosine), std::cos(std::numbers::pi / 180));
+    EXPECT_NEAR(r.rms, box.sigma, 0.25 * box.sigma);
+    EXPECT_GT(r.max, 2 * r.rms);
+    // The fit it started from is the hierarchy's cluster's, whose tree node it keeps.
+    const auto from = std::find(cut.nodes.begin(), cut.nodes.end(), r.node);
+    ASSERT_NE(from, cut.nodes.end());
+    const Primitive& start =
+        cut_reports[static_cast<std::size_t>(from - cut.nodes.begin())].primitive;
+    EXPECT_EQ(r.algebraic.point, start.point);
+    EXPECT_EQ(r.algebraic.axis, start.axis);
+  }
+
+  // Vertices of one cluster only lie on its primitive.
+  const Mesh& denoised = denoiser.mesh();
+  std::vector<std::vector<std::uint32_t>> clusters_of_vertex(denoised.vertex_count());
+  for (std::uint32_t t = 0; t < denoised.triangle_count(); ++t)
+    for (const std::uint32_t v : denoised.triangles[t])
+      clusters_of_vertex[v].push_back(level.labels[denoised.face_of_triangle[t]]);
+  const double diagonal = bounding_box_diagonal(denoised);
+  for (std::uint32_t v = 0; v < denoised.vertex_count(); ++v) {
+    const auto& near = clusters_of_vertex[v];
+    if (std::all_of(near.begin(), near.end(), [&](std::uint32_t c) { return c == near[0]; })) {
+      EXPECT_LE(level.clusters[near[0]].primitive.distance(denoised.positions[v]), 1e-9 * diagonal);
+    }
+  }
+
+  std::vector<Primitive> primitives;
+  for (const ClusterReport& r : level.clusters) primitives.push_back(r.primitive);
+  const std::vector<ClusterBorder> borders = cluster_borders(denoised, level.labels, primitives);
+  ASSERT_EQ(borders.size(), 12u);
+  double worst = 0;
+  for (const ClusterBorder& border : borders) {
+    ASSERT_NE(border.second, kMeshBoundary);
+    EXPECT_NEAR(border.angle, 90, 1);
+    const std::vector<Primitive> planes = {box.clean.regions[region_of_cluster[border.first]],
+                                           box.clean.regions[region_of_cluster[border.second]]};
+    for (const BorderCurve& curve : border.curves)
+      for (const std::uint32_t v : curve.vertices)
+        worst = std::max(worst, distance_to_feature(denoised.positions[v], planes));
+  }
+  std::printf("box: border vertices at most %.4g from the true edges (sigma %.4g)\n", worst,
+              box.sigma);
+  EXPECT_LE(worst, box.sigma / 2);
+}
+
+// A cluster that relabelling empties is gone from the snapped level, whose labels stay 0..K−1:
+// two triangles across an edge of a clean box given as a seventh cluster go back to their faces.
+TEST(Denoise, SnappedLevelDropsAClusterRelabellingEmptied) {
+  ShapeOptions shape;
+  shape.tessellation = Tessellation::Uniform;
+  shape.edge_length = 0.1;
+  const GroundTruthShape box = make_shape("box", shape);
+  const Hierarchy hierarchy = build_hierarchy(std::make_shared<const Mesh>(box.mesh));
+  const Segmentation faces = cut_by_count(hierarchy, 6);
+  // Two triangles that share an edge of the box.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> triangle_of_edge;
+  std::pair<std::uint32_t, std::uint32_t> across{0, 0};
+  for (std::uint32_t t = 0; t < box.mesh.triangle_count() && across.first == across.second; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const auto [a, b] = std::minmax(box.mesh.triangles[t][k], box.mesh.triangles[t][(k + 1) % 3]);
+      const auto [found, inserted] = triangle_of_edge.try_emplace({a, b}, t);
+      if (!inserted && faces.labels[found->second] != faces.labels[t]) across = {found->second, t};
+    }
+  ASSERT_NE(across.first, across.second);
+  Segmentation seven = faces;
+  seven.labels[across.first] = seven.labels[across.second] = 6;
+  seven.nodes.push_back(across.first);  // a leaf: the fit starts from that triangle's plane
+
+  DenoiseOptions options;
+  options.refit_outlier_threshold = 0;  // the fold's fit, not one of its triangles', judges
+  Denoiser denoiser(box.mesh, options);
+  EXPECT_EQ(denoiser.snap(hierarchy, seven).clusters, 6u);
+  const SnappedLevel& level = denoiser.snapped_level();
+  ASSERT_EQ(level.clusters.size(), 6u);
+  // The box's faces again, numbered by area as a cut numbers them (up to ties between equal
+  // faces): the same partition.
+  std::map<std::uint32_t, std::uint32_t> cut_label_of;
+  for (std::uint32_t f = 0; f < level.labels.size(); ++f) {
+    const auto [found, inserted] = cut_label_of.try_emplace(level.labels[f], faces.labels[f]);
+    EXPECT_EQ(found->second, faces.labels[f]) << "face " << f;
+  }
+  EXPECT_EQ(cut_label_of.size(), 6u);
 }
 
 TEST(Denoise, IsDeterministic) {
