@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
 
 #include "edge_sides.hpp"
 #include "eigen_conversions.hpp"
+#include "primseg/error.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
 
 namespace primseg::skeleton_detail {
@@ -55,6 +57,18 @@ std::vector<ClusterPairBoundary> cluster_pair_boundaries(
     result.push_back(std::move(boundary));
   }
   return result;
+}
+
+void check_face_labels(const Mesh& mesh, const Skeleton& skeleton, std::string_view caller) {
+  if (skeleton.face_labels.size() != mesh.face_count())
+    throw InvalidInputError(std::string(caller) + ": the skeleton has " +
+                            std::to_string(skeleton.face_labels.size()) + " face labels for " +
+                            std::to_string(mesh.face_count()) + " faces");
+  for (std::size_t f = 0; f < skeleton.face_labels.size(); ++f)
+    if (skeleton.face_labels[f] >= skeleton.bones.size())
+      throw InvalidInputError(std::string(caller) + ": face " + std::to_string(f) + " has label " +
+                              std::to_string(skeleton.face_labels[f]) + ", not one of the " +
+                              std::to_string(skeleton.bones.size()) + " bones");
 }
 
 }  // namespace primseg::skeleton_detail

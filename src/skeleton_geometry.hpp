@@ -6,10 +6,12 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "edge_sides.hpp"
 #include "primseg/mesh.hpp"
+#include "primseg/skeleton.hpp"
 #include "shape_generator/vector_math.hpp"
 
 namespace primseg::skeleton_detail {
@@ -31,6 +33,10 @@ struct ClusterPairBoundary {
 };
 
 using detail::triangle_labels;
+
+/// Throws InvalidInputError, its message starting with `caller`, unless `skeleton` was made for
+/// `mesh`: one face label per face, each naming one of its bones.
+void check_face_labels(const Mesh& mesh, const Skeleton& skeleton, std::string_view caller);
 
 /// Every pair of clusters that share a mesh edge (an edge of triangles of both), sorted by
 /// (first, second). On a non-manifold edge every pair of distinct clusters around it counts.

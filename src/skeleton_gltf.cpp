@@ -17,6 +17,7 @@
 #include "primseg/dual_graph.hpp"
 #include "primseg/error.hpp"
 #include "shape_generator/vector_math.hpp"
+#include "skeleton_geometry.hpp"
 
 namespace primseg {
 namespace {
@@ -40,10 +41,7 @@ constexpr std::uint32_t kJsonChunk = 0x4E4F534A, kBinChunk = 0x004E4942;  // "JS
 void check_inputs(const Mesh& mesh, const Skeleton& skeleton, const SkinWeights& weights) {
   const std::size_t k = skeleton.bones.size();
   if (k == 0) throw InvalidInputError("glTF skin: the skeleton has no bone");
-  if (skeleton.face_labels.size() != mesh.face_count())
-    throw InvalidInputError("glTF skin: the skeleton has " +
-                            std::to_string(skeleton.face_labels.size()) + " face labels for " +
-                            std::to_string(mesh.face_count()) + " faces");
+  skeleton_detail::check_face_labels(mesh, skeleton, "glTF skin");
   if (weights.offsets.size() != std::size_t{mesh.vertex_count()} + 1 ||
       weights.offsets.front() != 0 || weights.offsets.back() != weights.bones.size() ||
       weights.bones.size() != weights.weights.size())

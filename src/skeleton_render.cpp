@@ -7,6 +7,7 @@
 
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
+#include "skeleton_geometry.hpp"
 
 namespace primseg {
 namespace {
@@ -81,15 +82,11 @@ class Canvas {
 
 std::vector<std::uint8_t> render_skeleton(const Mesh& mesh, const Skeleton& skeleton,
                                           const RenderOptions& options) {
-  if (skeleton.face_labels.size() != mesh.face_count())
-    throw InvalidInputError("render_skeleton: " + std::to_string(skeleton.face_labels.size()) +
-                            " face labels for " + std::to_string(mesh.face_count()) + " faces");
+  skeleton_detail::check_face_labels(mesh, skeleton, "render_skeleton");
   const auto palette = distinct_colors(skeleton.bones.size());
   std::vector<Rgb> face_colors(mesh.face_count());
   for (std::size_t f = 0; f < face_colors.size(); ++f) {
     const std::uint32_t label = skeleton.face_labels[f];
-    if (label >= palette.size())
-      throw InvalidInputError("render_skeleton: face label out of range");
     for (int c = 0; c < 3; ++c)  // pale, so that the skeleton stands out
       face_colors[f][c] = static_cast<std::uint8_t>((palette[label][c] + 2 * 255) / 3);
   }

@@ -51,13 +51,7 @@ SkinWeights compute_skin_weights(const Mesh& mesh, const Skeleton& skeleton,
                                  const SkinningOptions& options) {
   if (!(std::isfinite(options.band) && options.band >= 0))
     throw InvalidInputError("compute_skin_weights: band must be finite and >= 0");
-  if (skeleton.face_labels.size() != mesh.face_count())
-    throw InvalidInputError(
-        "compute_skin_weights: the skeleton has " + std::to_string(skeleton.face_labels.size()) +
-        " face labels, the mesh " + std::to_string(mesh.face_count()) + " faces");
-  for (const std::uint32_t label : skeleton.face_labels)
-    if (label >= skeleton.bones.size())
-      throw InvalidInputError("compute_skin_weights: face label out of range");
+  skeleton_detail::check_face_labels(mesh, skeleton, "compute_skin_weights");
   for (const Triangle& tri : mesh.triangles)
     for (const std::uint32_t v : tri)
       if (v >= mesh.vertex_count())

@@ -7,14 +7,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <numbers>
 #include <set>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
 #include "primseg/hierarchy.hpp"
+#include "primseg/skeleton_gltf.hpp"
 #include "primseg/skeleton_render.hpp"
 #include "primseg/skinning.hpp"
 #include "support/stick_figure.hpp"
@@ -478,6 +483,35 @@ TEST(Skeleton, BadInputIsRejected) {
   EXPECT_THROW(extract_skeleton(mesh, std::vector<std::uint32_t>(8, 0), two), InvalidInputError)
       << "cluster 1 has no face";
   EXPECT_THROW(extract_skeleton(mesh, std::vector<std::uint32_t>(8, 2), two), InvalidInputError);
+}
+
+// A skeleton of another mesh (or edited) is refused by what uses its face labels, naming the
+// function and what is wrong.
+TEST(Skeleton, UsesRefuseASkeletonOfAnotherMesh) {
+  const FigureSkeleton& s = figure_skeleton();
+  Skeleton fewer = s.skeleton, beyond = s.skeleton;
+  fewer.face_labels.pop_back();
+  beyond.face_labels[7] = static_cast<std::uint32_t>(beyond.bones.size());
+  const SkinWeights weights = compute_skin_weights(s.figure.mesh, s.skeleton);
+  const std::vector<std::pair<std::string, std::function<void(const Skeleton&)>>> uses = {
+      {"compute_skin_weights", [&](const Skeleton& k) { compute_skin_weights(s.figure.mesh, k); }},
+      {"render_skeleton", [&](const Skeleton& k) { render_skeleton(s.figure.mesh, k); }},
+      {"glTF skin", [&](const Skeleton& k) { skinned_glb(s.figure.mesh, k, weights); }}};
+  for (const auto& [name, use] : uses)
+    for (const auto& [skeleton, message] :
+         {std::pair{&fewer, "the skeleton has " + std::to_string(fewer.face_labels.size()) +
+                                " face labels for " + std::to_string(s.figure.mesh.face_count()) +
+                                " faces"},
+          std::pair{&beyond, "face 7 has label " + std::to_string(beyond.bones.size()) +
+                                 ", not one of the " + std::to_string(beyond.bones.size()) +
+                                 " bones"}}) {
+      try {
+        use(*skeleton);
+        ADD_FAILURE() << name << " accepted: " << message;
+      } catch (const InvalidInputError& e) {
+        EXPECT_EQ(std::string(e.what()), name + ": " + message);
+      }
+    }
 }
 
 TEST(Skeleton, IsDeterministic) {
