@@ -73,8 +73,8 @@ struct InfluenceSet {
   std::vector<float> weights;
 };
 
-// Each vertex's influences, largest weight first, in float32 rows summing to 1, spread over as
-// many sets of four as the widest row needs.
+// Each vertex's influences, largest weight first, in float32 rows summing to exactly 1, spread
+// over as many sets of four as the widest row needs.
 std::vector<InfluenceSet> influence_sets(const SkinWeights& skin, std::uint32_t root_bone,
                                          std::uint32_t max_influences) {
   const std::uint32_t n = skin.vertex_count();
@@ -105,18 +105,23 @@ std::vector<InfluenceSet> influence_sets(const SkinWeights& skin, std::uint32_t 
       row.assign(1, {1.0, root_bone});
       total = 1;
     }
-    // float32 rows that sum to 1 as closely as float32 allows: the largest takes the rest.
-    const auto slot = [&sets, v](std::size_t i) -> std::pair<std::uint16_t&, float&> {
+    // Rows that sum to exactly 1: the weights after the largest are rounded to multiples of
+    // 2^-24 (dropped if that makes them 0), which float32 holds exactly below 1, and so does the
+    // rest, which the largest takes. A reader blends the joints' translations with weights
+    // summing to 1 then, not to 1 ± 6e-8, which would move a vertex by that fraction of its
+    // joints' distance from the origin.
+    double rest = 1;
+    for (std::size_t i = 1; i < row.size(); ++i) {
+      row[i].first = std::ldexp(std::round(std::ldexp(row[i].first / total, 24)), -24);
+      rest -= row[i].first;
+    }
+    row[0].first = rest;
+    std::erase_if(row, [](const auto& influence) { return influence.first == 0; });
+    for (std::size_t i = 0; i < row.size(); ++i) {
       InfluenceSet& set = sets[i / kInfluencesPerSet];
       const std::size_t at = kInfluencesPerSet * v + i % kInfluencesPerSet;
-      return {set.joints[at], set.weights[at]};
-    };
-    double rest = 1;
-    for (std::size_t i = row.size(); i-- > 0;) {
-      auto [joint, weight] = slot(i);
-      joint = static_cast<std::uint16_t>(row[i].second);
-      weight = static_cast<float>(i == 0 ? rest : row[i].first / total);
-      rest -= weight;
+      set.joints[at] = static_cast<std::uint16_t>(row[i].second);
+      set.weights[at] = static_cast<float>(row[i].first);
     }
   }
   return sets;
@@ -230,13 +235,27 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
     pivots[b] = tree.parent_joint[b] == kNone ? skeleton.bones[b].point
                                               : skeleton.joints[tree.parent_joint[b]].position;
 
-  BufferBuilder buffer;
+  // Positions and pivots are written relative to the centre of the bounding box, where the
+  // skeleton node stands: float32 then holds a part far from the origin (a scan in survey
+  // coordinates) as finely as one at it.
   const std::uint32_t n = mesh.vertex_count();
+  Vec3 origin{0, 0, 0};
+  if (n > 0) {
+    Vec3 low = mesh.positions[0], high = mesh.positions[0];
+    for (const Vec3& p : mesh.positions)
+      for (std::size_t i = 0; i < 3; ++i) {
+        low[i] = std::min(low[i], p[i]);
+        high[i] = std::max(high[i], p[i]);
+      }
+    for (std::size_t i = 0; i < 3; ++i) origin[i] = low[i] + (high[i] - low[i]) / 2;
+  }
+
+  BufferBuilder buffer;
   std::vector<float> positions(3 * std::size_t{n});
   std::array<float, 3> low{}, high{};
   for (std::size_t v = 0; v < n; ++v)
     for (std::size_t i = 0; i < 3; ++i) {
-      const float x = static_cast<float>(mesh.positions[v][i]);
+      const float x = static_cast<float>(mesh.positions[v][i] - origin[i]);
       positions[3 * v + i] = x;
       low[i] = v == 0 ? x : std::min(low[i], x);
       high[i] = v == 0 ? x : std::max(high[i], x);
@@ -270,7 +289,8 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
       buffer.add(indices, indices.size(), "SCALAR", kUnsignedInt, kElementArrayBuffer);
 
   // Inverse bind matrices (column-major): the rest pose has every node unrotated, so each one
-  // only moves its joint's rest position to the origin.
+  // only moves its joint's rest position (relative to the centre, as the positions are) to the
+  // origin.
   std::vector<float> inverse_binds;
   inverse_binds.reserve(16 * skin_joints);
   const auto add_inverse_bind = [&inverse_binds](const Vec3& at) {
@@ -292,25 +312,26 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
                               1};
     inverse_binds.insert(inverse_binds.end(), matrix, matrix + 16);
   };
-  for (std::uint32_t b = 0; b < k; ++b) add_inverse_bind(pivots[b]);
-  for (const std::uint32_t j : ends) add_inverse_bind(skeleton.joints[j].position);
+  for (std::uint32_t b = 0; b < k; ++b) add_inverse_bind(pivots[b] - origin);
+  for (const std::uint32_t j : ends) add_inverse_bind(skeleton.joints[j].position - origin);
   const std::size_t inverse_bind_accessor =
       buffer.add(inverse_binds, skin_joints, "MAT4", kFloat, std::nullopt);
 
   constexpr std::size_t kFirstBoneNode = 2;
   json nodes = json::array();
   nodes.push_back({{"name", "mesh"}, {"mesh", 0}, {"skin", 0}});
-  nodes.push_back({{"name", "skeleton"}, {"children", json::array()}});
+  nodes.push_back(
+      {{"name", "skeleton"}, {"translation", vec3_json(origin)}, {"children", json::array()}});
   for (std::uint32_t b = 0; b < k; ++b) {
     const std::uint32_t parent = tree.parent_bone[b], joint = tree.parent_joint[b];
     json extras{{"bone", b}};
     extras["joint"] = joint == kNone ? json(nullptr) : json(joint);
     extras["joint_kind"] =
         joint == kNone ? json(nullptr) : json(to_string(skeleton.joints[joint].kind));
-    nodes.push_back(
-        {{"name", "bone_" + std::to_string(b)},
-         {"translation", vec3_json(parent == kNone ? pivots[b] : pivots[b] - pivots[parent])},
-         {"extras", std::move(extras)}});
+    nodes.push_back({{"name", "bone_" + std::to_string(b)},
+                     {"translation",
+                      vec3_json(parent == kNone ? pivots[b] - origin : pivots[b] - pivots[parent])},
+                     {"extras", std::move(extras)}});
     if (parent == kNone) nodes[1]["children"].push_back(kFirstBoneNode + b);
   }
   for (std::size_t e = 0; e < ends.size(); ++e) {

@@ -6,11 +6,14 @@
 /// `primseg deform` does (skinning.hpp's pose semantics map onto glTF's node rotations exactly).
 ///
 /// Layout of the file:
-/// - node 0, "mesh": the triangles (input units, float32 positions; area-weighted vertex normals),
-///   with attributes JOINTS_n / WEIGHTS_n. Triangles are consistently oriented (outward on a
-///   closed part) whatever way the input lists them, since readers cull back faces: a triangle the
-///   dual graph flips (DualGraph::flipped) is written with its last two corners swapped;
-/// - node 1, "skeleton": the common root of the joints, at the origin, without a transform;
+/// - node 0, "mesh": the triangles (input units, float32 positions relative to the centre of the
+///   mesh's bounding box; area-weighted vertex normals), with attributes JOINTS_n / WEIGHTS_n.
+///   Triangles are consistently oriented (outward on a closed part) whatever way the input lists
+///   them, since readers cull back faces: a triangle the dual graph flips (DualGraph::flipped) is
+///   written with its last two corners swapped;
+/// - node 1, "skeleton": the common root of the joints, translated to that centre (so skinning
+///   puts every vertex back where the input has it, and float32 holds a part far from the origin,
+///   such as a scan in survey coordinates, as finely as one at it);
 /// - nodes 2 .. 2+K-1, "bone_b": one per bone in bone id order, arranged as bone_tree() arranges
 ///   them. Bone b's node sits at its pivot: the joint it hangs from (BoneTree::parent_joint), or
 ///   its axis point (Bone::point) for a root bone. The node's `extras` give {"bone": b, "joint":
@@ -18,9 +21,10 @@
 ///   Rotating bone b's node by a quaternion is JointRotation{joint, axis, angle} on that joint,
 ///   with the axis in the parent bone's frame, as skinning.hpp defines it.
 /// - then one "end_j" node per virtual joint j (the free end of a limb), a child of its bone's
-/// node,
-///   with no weights: importers such as Blender's use it for the bone's length and direction.
-/// Skin joint i is node 2 + i; inverse bind matrices translate each pivot to the origin.
+///   node, with no weights: importers such as Blender's use it for the bone's length and
+///   direction.
+/// Skin joint i is node 2 + i; inverse bind matrices translate each pivot (relative to the centre)
+/// to the origin.
 
 #include <cstdint>
 #include <string>
@@ -39,8 +43,10 @@ struct GltfOptions {
   std::uint32_t max_influences = 0;
 };
 
-/// The GLB file's bytes. Weights are written in float32 rows summing to 1 within float32
-/// round-off, joint indices as unsigned 16-bit integers (so at most 65,536 bones and end joints).
+/// The GLB file's bytes. Weights are written in float32 rows summing to exactly 1 (each row's
+/// weights after its largest rounded to multiples of 2^-24, below which they are left out; the
+/// largest takes the rest), joint indices as unsigned 16-bit integers (so at most 65,536 bones
+/// and end joints).
 /// A vertex used by no triangle (an empty weight row) follows the root bone.
 ///
 /// `skeleton` must have been made from `mesh` and `weights` from both (compute_skin_weights).

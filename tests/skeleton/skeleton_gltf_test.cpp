@@ -160,6 +160,17 @@ const Rig& rig() {
   return shared;
 }
 
+Vec3 bounding_box_centre(const Mesh& mesh) {
+  Vec3 low = mesh.positions[0], high = mesh.positions[0];
+  for (const Vec3& p : mesh.positions)
+    for (int i = 0; i < 3; ++i) {
+      low[i] = std::min(low[i], p[i]);
+      high[i] = std::max(high[i], p[i]);
+    }
+  return {low[0] + (high[0] - low[0]) / 2, low[1] + (high[1] - low[1]) / 2,
+          low[2] + (high[2] - low[2]) / 2};
+}
+
 // The weights of vertex v in every set, as (bone, weight) pairs with a weight above zero.
 std::vector<std::pair<std::uint32_t, double>> weights_of(const std::vector<InfluenceSet>& sets,
                                                          std::uint32_t v) {
@@ -179,9 +190,13 @@ TEST(SkeletonGltf, TheFileHoldsTheMeshAndEveryWeightAsWritten) {
   const json& primitive = file.gltf["meshes"][0]["primitives"][0];
   const auto positions = file.read<float>(primitive["attributes"]["POSITION"], 5126, "VEC3", 3);
   ASSERT_EQ(positions.size(), 3 * std::size_t{mesh.vertex_count()});
+  // Relative to the centre of the bounding box, where the skeleton node stands.
+  const Vec3 centre = bounding_box_centre(mesh);
+  EXPECT_EQ(file.gltf["nodes"][1]["translation"].get<std::vector<double>>(),
+            std::vector<double>(centre.begin(), centre.end()));
   for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v)
     for (int i = 0; i < 3; ++i)
-      ASSERT_EQ(positions[3 * v + i], static_cast<float>(mesh.positions[v][i]));
+      ASSERT_EQ(positions[3 * v + i], static_cast<float>(mesh.positions[v][i] - centre[i]));
   const auto indices = file.read<std::uint32_t>(primitive["indices"], 5125, "SCALAR", 1);
   ASSERT_EQ(indices.size(), 3 * mesh.triangles.size());
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
@@ -205,7 +220,7 @@ TEST(SkeletonGltf, TheFileHoldsTheMeshAndEveryWeightAsWritten) {
       EXPECT_NEAR(row[i].second, weights[i], 2e-7);
       sum += row[i].second;
     }
-    ASSERT_NEAR(sum, 1.0, 2e-7);
+    ASSERT_EQ(sum, 1.0);  // exactly: a far part's joints blend without drift
   }
   EXPECT_GE(widest, 2u);
   EXPECT_TRUE(primitive["attributes"].contains("JOINTS_0"));
@@ -232,6 +247,7 @@ TEST(SkeletonGltf, NodesFollowTheBoneTreeAndSitAtTheirPivots) {
       place(c);
     }
   };
+  at[1] = local_transform(nodes[1]).translation();
   place(1);
   for (std::uint32_t b = 0; b < k; ++b) {
     const json& node = nodes[2 + b];
@@ -350,6 +366,51 @@ TEST(SkeletonGltf, WideRowsTakeMoreSetsOrKeepTheLargestWeights) {
   EXPECT_NEAR(row[2].second, 0.25 / kept, 1e-7);
   // Rows of two bones are unchanged by the cap.
   EXPECT_EQ(weights_of(capped_sets, 0), weights_of(influence_sets(all), 0));
+}
+
+// A part far from the origin, as scans in survey coordinates are (millions of units away, a
+// thousand times its size): float32 positions relative to its centre keep the rest pose and
+// the poses to float32 round-off of its size, not of its distance (0.25 units there).
+TEST(SkeletonGltf, APartFarFromTheOriginKeepsItsPrecision) {
+  const Rig& near = rig();
+  const Vec3 far{3.0e6, -2.0e6, 5.0e6};
+  Mesh mesh = near.figure.mesh;
+  for (Vec3& p : mesh.positions)
+    for (int i = 0; i < 3; ++i) p[i] += far[i];
+  HierarchyOptions options;
+  options.primitives = {PrimitiveType::Cylinder, PrimitiveType::Sphere};
+  const Hierarchy hierarchy = build_hierarchy(mesh, options);
+  const Skeleton skeleton = extract_skeleton(hierarchy, cut_by_count(hierarchy, 8));
+  const SkinWeights weights = compute_skin_weights(mesh, skeleton);
+  Glb file(skinned_glb(mesh, skeleton, weights));
+
+  const auto rest = skin_as_gltf(file);
+  double worst = 0;
+  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v)
+    worst = std::max(worst, (rest[v] - Eigen::Vector3d(mesh.positions[v].data())).norm());
+  EXPECT_LE(worst, 1e-6 * near.size);
+
+  JointRotation elbow{kNone, {0.2, 1.0, -0.4}, 0.8};
+  for (const Joint& joint : skeleton.joints)
+    if (joint.kind == JointKind::Sensitive) elbow.joint = joint.id;
+  ASSERT_NE(elbow.joint, kNone);
+  for (json& node : file.gltf["nodes"])
+    if (node.contains("extras") && node["extras"].contains("bone") &&
+        node["extras"]["joint"] == elbow.joint) {
+      const Eigen::Quaterniond q(
+          Eigen::AngleAxisd(elbow.angle, Eigen::Vector3d(elbow.axis.data()).normalized()));
+      node["rotation"] = {q.x(), q.y(), q.z(), q.w()};
+    }
+  const auto posed = skin_as_gltf(file);
+  const std::vector<Vec3> expected =
+      skin_positions(mesh.positions, weights, pose_bones(skeleton, {&elbow, 1}));
+  double largest = 0, moved = 0;
+  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    largest = std::max(largest, (posed[v] - Eigen::Vector3d(expected[v].data())).norm());
+    moved = std::max(moved, (posed[v] - rest[v]).norm());
+  }
+  EXPECT_GT(moved, 0.1 * near.size);
+  EXPECT_LE(largest, 1e-5 * near.size);
 }
 
 TEST(SkeletonGltf, AVertexOfNoTriangleFollowsTheRootBone) {
