@@ -252,7 +252,7 @@ void check_glb(const std::string& glb, std::uint32_t vertex_count) {
     }
   }
   for (std::uint32_t v = 0; v < vertex_count; ++v)
-    if (std::abs(sums[v] - 1) > 1e-6) fail("glb weight row sum", v, sums[v]);
+    if (sums[v] != 1) fail("glb weight row sum", v, sums[v]);  // exactly, as promised
 }
 
 void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& report,
@@ -283,6 +283,34 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
     fail("snap report: interior + boundary", report.interior_vertices, report.boundary_vertices);
   if (!stylize && report.fallbacks > report.snapped)
     fail("snap report: fallbacks", report.fallbacks);
+}
+
+// The clusters a snap used (Denoiser::snapped_level): numbered as a Segmentation, none empty,
+// one report each, and borders on the denoised mesh.
+void check_snapped_level(const Mesh& denoised, const SnappedLevel& level,
+                         const SnapReport& report) {
+  const std::size_t k = level.clusters.size();
+  if (k != report.clusters) fail("snapped level: cluster count", double(k), report.clusters);
+  if (level.labels.size() != denoised.face_count()) fail("snapped level: label count");
+  std::vector<std::uint32_t> faces(k, 0);
+  for (const std::uint32_t label : level.labels) {
+    if (label >= k) fail("snapped level: label", label);
+    ++faces[label];
+  }
+  std::vector<Primitive> primitives;
+  for (std::size_t c = 0; c < k; ++c) {
+    const ClusterReport& r = level.clusters[c];
+    if (r.id != c || r.face_count != faces[c] || faces[c] == 0)
+      fail("snapped level: cluster", double(c), r.face_count);
+    if (c > 0 && level.clusters[c - 1].area < r.area) fail("snapped level: area order", double(c));
+    check_length(r.area, "snapped level: area");
+    check_length(r.rms, "snapped level: rms");
+    check_length(r.max, "snapped level: max");
+    if (r.rms > r.max * (1 + 1e-12)) fail("snapped level: rms above max", r.rms, r.max);
+    check_primitive(r.primitive);
+    primitives.push_back(r.primitive);
+  }
+  check_borders(denoised, cluster_borders(denoised, level.labels, primitives));
 }
 
 Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
@@ -324,6 +352,7 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
   results.denoised = denoiser.mesh();
   check_denoised(*mesh, results.denoised, report,
                  settings.denoise.mode == SnapMode::NearestIncident);
+  check_snapped_level(results.denoised, denoiser.snapped_level(), report);
 
   DistanceOptions distance;
   distance.samples = 200;
