@@ -50,6 +50,8 @@ Command add_info_command(CLI::App& app) {
                   {"non_manifold_edges", i.non_manifold_edges},
                   {"degenerate_triangles", i.degenerate_triangles},
                   {"duplicate_triangles", i.duplicate_triangles},
+                  {"inconsistent_edges", i.inconsistent_edges},
+                  {"inward_components", i.inward_components},
                   {"bbox_min", i.bbox_min},
                   {"bbox_max", i.bbox_max},
                   {"bbox_diagonal", i.bbox_diagonal},
@@ -67,6 +69,14 @@ Command add_info_command(CLI::App& app) {
             std::printf("  non-manifold edges  %u\n", i.non_manifold_edges);
             std::printf("  degenerate triangles %u, duplicate triangles %u\n",
                         i.degenerate_triangles, i.duplicate_triangles);
+            std::string orientation =
+                i.inconsistent_edges == 0
+                    ? std::string("consistent")
+                    : "inconsistent across " + count_of(i.inconsistent_edges, "edge");
+            if (i.inward_components > 0)
+              orientation +=
+                  ", " + count_of(i.inward_components, "closed component") + " facing inwards";
+            std::printf("  orientation         %s\n", orientation.c_str());
             std::printf("  bounding box        [%g %g %g] - [%g %g %g], diagonal %g\n",
                         i.bbox_min[0], i.bbox_min[1], i.bbox_min[2], i.bbox_max[0], i.bbox_max[1],
                         i.bbox_max[2], i.bbox_diagonal);

@@ -917,6 +917,8 @@ faces.)",
             d["non_manifold_edges"] = i.non_manifold_edges;
             d["degenerate_triangles"] = i.degenerate_triangles;
             d["duplicate_triangles"] = i.duplicate_triangles;
+            d["inconsistent_edges"] = i.inconsistent_edges;
+            d["inward_components"] = i.inward_components;
             d["bbox_min"] = vector_list(i.bbox_min);
             d["bbox_max"] = vector_list(i.bbox_max);
             d["bbox_diagonal"] = i.bbox_diagonal;
@@ -927,7 +929,9 @@ faces.)",
 
 What `primseg info` prints, as a dict: vertices, isolated_vertices, faces, polygons (faces of
 more than 3 vertices), triangles, components, boundary_edges, non_manifold_edges,
-degenerate_triangles, duplicate_triangles, bbox_min, bbox_max, bbox_diagonal, and
+degenerate_triangles, duplicate_triangles, inconsistent_edges (edges whose two triangles are
+listed in the same direction along it), inward_components (closed components facing inwards),
+bbox_min, bbox_max, bbox_diagonal, and
 out_of_range: None, or the message the other functions would raise for coordinates too large
 or too spread out to fit reliably.)",
                      cpp_doc("describe_mesh", doc::mesh_info__file),

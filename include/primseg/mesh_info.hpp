@@ -19,6 +19,12 @@ struct MeshInfo {
   std::uint32_t degenerate_triangles = 0;  ///< zero area
   std::uint32_t duplicate_triangles = 0;   ///< same vertex set as an earlier triangle
   std::uint32_t isolated_vertices = 0;     ///< in no face
+  /// Edges of exactly two triangles that run along it the same way: triangles listed with
+  /// inconsistent orientations (0 when every component is consistently oriented).
+  std::uint32_t inconsistent_edges = 0;
+  /// Closed components (every edge has exactly two triangles) listed consistently but facing
+  /// inwards: negative signed volume. Readers that cull back faces show them inside out.
+  std::uint32_t inward_components = 0;
   Vec3 bbox_min{0, 0, 0}, bbox_max{0, 0, 0};
   double bbox_diagonal = 0;
 };

@@ -178,14 +178,27 @@ def test_info_counts_what_the_cli_prints(cli, tmp_path):
     assert info == {
         "vertices": 9, "isolated_vertices": 1, "faces": 4, "polygons": 1, "triangles": 5,
         "components": 2, "boundary_edges": 6, "non_manifold_edges": 1,
-        "degenerate_triangles": 1, "duplicate_triangles": 1, "bbox_min": [0.0, 0.0, 0.0],
+        "degenerate_triangles": 1, "duplicate_triangles": 1, "inconsistent_edges": 0,
+        "inward_components": 0, "bbox_min": [0.0, 0.0, 0.0],
         "bbox_max": [7.0, 1.0, 0.0], "bbox_diagonal": 50 ** 0.5, "out_of_range": None}
     assert json.loads(run_cli(cli, "info", path, "--json", "-")) == info  # the same keys and values
     printed = [line.split() for line in run_cli(cli, "info", path).splitlines()[1:]]
-    assert printed[:6] == [["vertices", "9", "(1", "isolated)"],
+    assert printed[:7] == [["vertices", "9", "(1", "isolated)"],
                            ["faces", "4", "(1", "polygons),", "5", "triangles"],
                            ["components", "2"], ["boundary", "edges", "6"],
                            ["non-manifold", "edges", "1"],
-                           ["degenerate", "triangles", "1,", "duplicate", "triangles", "1"]]
+                           ["degenerate", "triangles", "1,", "duplicate", "triangles", "1"],
+                           ["orientation", "consistent"]]
+    # A tetrahedron listed inside out, then with one face turned back: as the CLI words it.
+    tet = tmp_path / "tet.off"
+    tet.write_text("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 3 1\n3 0 2 3\n3 1 3 2\n")
+    assert primseg.read_mesh(tet).info()["inward_components"] == 1
+    assert ["orientation", "consistent,", "1", "closed", "component", "facing", "inwards"] in [
+        line.split() for line in run_cli(cli, "info", tet).splitlines()]
+    tet.write_text("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 3 1\n3 0 2 3\n3 1 3 2\n")
+    info = primseg.read_mesh(tet).info()
+    assert (info["inconsistent_edges"], info["inward_components"]) == (3, 0)
+    assert ["orientation", "inconsistent", "across", "3", "edges"] in [
+        line.split() for line in run_cli(cli, "info", tet).splitlines()]
     far = primseg.Mesh(np.array([[0, 0, 0], [1e200, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
     assert "vertex 1 has a coordinate of magnitude 1e+200" in far.info()["out_of_range"]

@@ -794,6 +794,8 @@ TEST(Cli, InfoJsonHasEveryCount) {
                          {"non_manifold_edges", 1},
                          {"degenerate_triangles", 1},
                          {"duplicate_triangles", 1},
+                         {"inconsistent_edges", 0},
+                         {"inward_components", 0},
                          {"bbox_min", {0.0, 0.0, 0.0}},
                          {"bbox_max", {7.0, 1.0, 0.0}},
                          {"bbox_diagonal", std::sqrt(50.0)},
