@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "primseg/error.hpp"
+#include "primseg/mesh_info.hpp"
 #include "primseg/mesh_io.hpp"
 
 #ifdef PRIMSEG_FUZZ_DETECT
@@ -72,6 +73,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     if (mesh.face_count() == 0) {
       std::fprintf(stderr, "reader returned a mesh without faces\n");
+      std::abort();
+    }
+    // `primseg info` describes whatever a reader returns, coordinates of any finite size too.
+    const primseg::MeshInfo info = primseg::describe_mesh(mesh);
+    if (info.triangles != mesh.triangle_count() || info.components == 0 ||
+        info.components > info.faces || info.inward_components > info.components ||
+        info.inconsistent_edges > 3 * std::size_t{info.triangles} / 2) {
+      std::fprintf(stderr, "info: inconsistent counts\n");
       std::abort();
     }
   } catch (const primseg::Error&) {
