@@ -137,6 +137,21 @@ std::vector<Eigen::Vector3d> skin_as_gltf(const Glb& file) {
   return out;
 }
 
+// Gives the bone nodes that turn about `rotation.joint` its rotation, as a reader's animation
+// would; returns how many there are.
+std::size_t rotate_bone_nodes(Glb& file, const JointRotation& rotation) {
+  std::size_t rotated = 0;
+  for (json& node : file.gltf["nodes"])
+    if (node.contains("extras") && node["extras"].contains("bone") &&
+        node["extras"]["joint"] == rotation.joint) {
+      const Eigen::Quaterniond q(
+          Eigen::AngleAxisd(rotation.angle, Eigen::Vector3d(rotation.axis.data()).normalized()));
+      node["rotation"] = {q.x(), q.y(), q.z(), q.w()};
+      ++rotated;
+    }
+  return rotated;
+}
+
 // The stick figure's skeleton at its 8 parts and its skin weights.
 struct Rig {
   testing::StickFigure figure = testing::make_stick_figure();
@@ -294,16 +309,7 @@ TEST(SkeletonGltf, RotatingTheNodesPosesTheMeshAsDeformDoes) {
     }
   ASSERT_GE(pose.size(), 4u);
   for (const JointRotation& rotation : pose) {
-    std::size_t hanging = 0;
-    for (json& node : file.gltf["nodes"])
-      if (node.contains("extras") && node["extras"].contains("bone") &&
-          node["extras"]["joint"] == rotation.joint) {
-        const Eigen::Quaterniond q(
-            Eigen::AngleAxisd(rotation.angle, Eigen::Vector3d(rotation.axis.data()).normalized()));
-        node["rotation"] = {q.x(), q.y(), q.z(), q.w()};
-        ++hanging;
-      }
-    ASSERT_EQ(hanging, 1u) << "joint " << rotation.joint;
+    ASSERT_EQ(rotate_bone_nodes(file, rotation), 1u) << "joint " << rotation.joint;
   }
   const auto posed = skin_as_gltf(file);
   const std::vector<Vec3> expected =
@@ -394,13 +400,7 @@ TEST(SkeletonGltf, APartFarFromTheOriginKeepsItsPrecision) {
   for (const Joint& joint : skeleton.joints)
     if (joint.kind == JointKind::Sensitive) elbow.joint = joint.id;
   ASSERT_NE(elbow.joint, kNone);
-  for (json& node : file.gltf["nodes"])
-    if (node.contains("extras") && node["extras"].contains("bone") &&
-        node["extras"]["joint"] == elbow.joint) {
-      const Eigen::Quaterniond q(
-          Eigen::AngleAxisd(elbow.angle, Eigen::Vector3d(elbow.axis.data()).normalized()));
-      node["rotation"] = {q.x(), q.y(), q.z(), q.w()};
-    }
+  ASSERT_EQ(rotate_bone_nodes(file, elbow), 1u);
   const auto posed = skin_as_gltf(file);
   const std::vector<Vec3> expected =
       skin_positions(mesh.positions, weights, pose_bones(skeleton, {&elbow, 1}));
