@@ -22,6 +22,7 @@
 // bit 2: denoise on a bilateral copy, bit 3: stylize, bit 4: denoise at the automatic level,
 // bits 5-7: the scale's exponent), byte 1 = K (mod F), then grid_mesh.hpp's layout.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -311,6 +312,23 @@ void check_snapped_level(const Mesh& denoised, const SnappedLevel& level,
     primitives.push_back(r.primitive);
   }
   check_borders(denoised, cluster_borders(denoised, level.labels, primitives));
+  // Relations: two or more clusters, increasing; a parallel group shares one direction up to
+  // sign, a coaxial set (cylinders) one axis line too.
+  for (const ClusterRelation& relation : level.relations) {
+    const auto& members = relation.clusters;
+    if (members.size() < 2 || !std::is_sorted(members.begin(), members.end()) ||
+        std::adjacent_find(members.begin(), members.end()) != members.end() || members.back() >= k)
+      fail("snapped level: relation members", double(members.size()));
+    const Vec3& direction = primitives[members[0]].axis;
+    for (const std::uint32_t c : members) {
+      const Primitive& p = primitives[c];
+      if (relation.kind == ClusterRelation::Kind::Coaxial && p.type != PrimitiveType::Cylinder)
+        fail("snapped level: coaxial non-cylinder", c);
+      const Vec3 a{std::abs(p.axis[0]), std::abs(p.axis[1]), std::abs(p.axis[2])},
+          b{std::abs(direction[0]), std::abs(direction[1]), std::abs(direction[2])};
+      if (a != b) fail("snapped level: related directions differ", c);
+    }
+  }
 }
 
 Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {

@@ -1412,8 +1412,9 @@ return_rounds=True it returns (V, rounds), rounds a list of dicts like the CLI's
 "denoise" "rounds" (clusters, boundary_vertices, snapped, moved, fallbacks, blocked, mean_move,
 max_move). With return_level=True it returns (V, level), or (V, rounds, level) with both: the
 last round's snap (Denoiser::snapped_level) as a dict of "labels" (int32 (F,), the CLI's
---labels), "clusters" and "borders" (the CLI's --json entries: the clusters after relabelling with
-the primitives the vertices went onto, their borders on the denoised mesh).
+--labels), "clusters", "borders" and "relations" (the CLI's --json entries: the clusters after
+relabelling with the primitives the vertices went onto, their borders on the denoised mesh, and
+the groups of clusters made parallel or coaxial, {kind, clusters}).
 The input is a Mesh, arrays V and F (as segment takes them), or a Hierarchy: its first round
 then snaps onto that tree's level without building it again (smoothing_steps must be 0, and the
 later rounds use its primitives and weights).
@@ -1526,8 +1527,16 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
           for (const ClusterBorder& border : borders) border_list.append(border_dict(border));
           const auto face_count = static_cast<py::ssize_t>(snapped.labels.size());
           snapped_dict["labels"] = adopt<std::int32_t>(std::move(snapped.labels), {face_count});
+          py::list relations;
+          for (const ClusterRelation& relation : snapped.relations) {
+            py::dict related;
+            related["kind"] = std::string(to_string(relation.kind));
+            related["clusters"] = py::cast(relation.clusters);
+            relations.append(related);
+          }
           snapped_dict["clusters"] = clusters;
           snapped_dict["borders"] = border_list;
+          snapped_dict["relations"] = relations;
           result.append(snapped_dict);
         }
         return py::tuple(result);

@@ -446,8 +446,12 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
   });
 }
 
-void Denoiser::regularize(const Segmentation& segmentation,
-                          std::vector<Primitive>& primitives) const {
+std::string_view to_string(ClusterRelation::Kind kind) {
+  return kind == ClusterRelation::Kind::Parallel ? "parallel" : "coaxial";
+}
+
+std::vector<ClusterRelation> Denoiser::regularize(const Segmentation& segmentation,
+                                                  std::vector<Primitive>& primitives) const {
   std::vector<std::vector<Vec3>> points, inlier_points(primitives.size());
   std::vector<std::vector<double>> weights, inlier_weights(primitives.size());
   cluster_vertices(segmentation, primitives.size(), points, weights);
@@ -458,7 +462,17 @@ void Denoiser::regularize(const Segmentation& segmentation,
                    inlier_points[c], inlier_weights[c]);
   detail::RegularityOptions regularity;
   regularity.significance = options_.relation_significance;
-  detail::regularize(primitives, inlier_points, inlier_weights, regularity);
+  std::vector<ClusterRelation> relations;
+  for (const detail::Relation& relation :
+       detail::regularize(primitives, inlier_points, inlier_weights, regularity)) {
+    ClusterRelation& related = relations.emplace_back();
+    related.kind = relation.kind == detail::Relation::Kind::Parallel
+                       ? ClusterRelation::Kind::Parallel
+                       : ClusterRelation::Kind::Coaxial;
+    for (const std::size_t c : relation.members)
+      related.clusters.push_back(static_cast<std::uint32_t>(c));
+  }
+  return relations;
 }
 
 void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
@@ -514,7 +528,8 @@ void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
 SnappedLevel Denoiser::describe_snap(const Segmentation& hierarchy_level,
                                      const Segmentation& relabelled,
                                      const std::vector<Primitive>& hierarchy_fits,
-                                     const std::vector<Primitive>& primitives) const {
+                                     const std::vector<Primitive>& primitives,
+                                     std::vector<ClusterRelation> relations) const {
   const std::size_t k = primitives.size();
   std::vector<ClusterReport> reports(k);
   std::vector<std::uint32_t> lowest_face(k, detail::kNone);
@@ -566,6 +581,15 @@ SnappedLevel Denoiser::describe_snap(const Segmentation& hierarchy_level,
   }
   level.labels.reserve(relabelled.labels.size());
   for (const std::uint32_t c : relabelled.labels) level.labels.push_back(rank[c]);
+  // Related clusters have vertices, so none was emptied.
+  for (ClusterRelation& relation : relations) {
+    for (std::uint32_t& c : relation.clusters) c = rank[c];
+    std::sort(relation.clusters.begin(), relation.clusters.end());
+  }
+  std::sort(relations.begin(), relations.end(), [](const auto& a, const auto& b) {
+    return a.kind != b.kind ? a.kind < b.kind : a.clusters < b.clusters;
+  });
+  level.relations = std::move(relations);
   return level;
 }
 
@@ -585,9 +609,11 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
   Segmentation labelled = segmentation;
   relabel(segmented, primitives, labelled);
+  std::vector<ClusterRelation> relations;
   if (options_.relation_significance > 0 && options_.refit_outlier_threshold > 0)
-    regularize(labelled, primitives);
-  snapped_level_ = describe_snap(segmentation, labelled, hierarchy_fits, primitives);
+    relations = regularize(labelled, primitives);
+  snapped_level_ =
+      describe_snap(segmentation, labelled, hierarchy_fits, primitives, std::move(relations));
 
   SnapReport report;
   report.clusters = static_cast<std::uint32_t>(snapped_level_.clusters.size());

@@ -255,8 +255,9 @@ std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
   return groups;
 }
 
-// The plane with normal ±`direction` (its own side) through its inliers' weighted centroid.
-void align_plane(Primitive& plane, const Eigen::Vector3d& direction, std::span<const Vec3> points,
+// The plane with normal ±`direction` (its own side) through its inliers' weighted centroid;
+// false (the plane unchanged) when they weigh nothing.
+bool align_plane(Primitive& plane, const Eigen::Vector3d& direction, std::span<const Vec3> points,
                  std::span<const double> weights) {
   double total = 0;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -264,9 +265,10 @@ void align_plane(Primitive& plane, const Eigen::Vector3d& direction, std::span<c
     total += weights[k];
     centroid += weights[k] * to_eigen(points[k]);
   }
-  if (!(total > 0)) return;
+  if (!(total > 0)) return false;
   plane.axis = to_vec3(direction.dot(to_eigen(plane.axis)) < 0 ? -direction : direction);
   plane.point = to_vec3(centroid / total);
+  return true;
 }
 
 // Sets of cylinders (indices into `cylinders`, sorted best-located first) whose axes are one line
@@ -299,11 +301,13 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
 }
 
 // Refits the cylinders of a direction group: each coaxial set around one axis line (each member
-// keeping its own radius), the others alone with the group's direction.
+// keeping its own radius), the others alone with the group's direction. Appends the coaxial sets
+// of two or more to `relations`.
 void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylinder> cylinders,
                      double significance2, std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,
-                     const std::vector<std::vector<double>>& weights) {
+                     const std::vector<std::vector<double>>& weights,
+                     std::vector<Relation>& relations) {
   const auto [u, v] = orthonormal_pair(direction);
   std::stable_sort(cylinders.begin(), cylinders.end(),
                    [](const AlignedCylinder& a, const AlignedCylinder& b) {
@@ -344,7 +348,14 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
       sets.push_back({sets[s][worst]});
       sets[s].erase(sets[s].begin() + static_cast<std::ptrdiff_t>(worst));
     }
-    if (sets[s].size() == 1) joint = cylinders[sets[s][0]].fit;
+    if (sets[s].size() == 1) {
+      joint = cylinders[sets[s][0]].fit;
+    } else {
+      Relation& coaxial = relations.emplace_back();
+      coaxial.kind = Relation::Kind::Coaxial;
+      for (const std::size_t k : sets[s]) coaxial.members.push_back(cylinders[k].cluster);
+      std::sort(coaxial.members.begin(), coaxial.members.end());
+    }
     for (std::size_t j = 0; j < sets[s].size(); ++j) {
       Primitive& cylinder = primitives[cylinders[sets[s][j]].cluster];
       cylinder.axis = to_vec3(direction.dot(to_eigen(cylinder.axis)) < 0 ? -direction : direction);
@@ -359,8 +370,11 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
 
 }  // namespace
 
-void regularize(std::vector<Primitive>& primitives, const std::vector<std::vector<Vec3>>& points,
-                const std::vector<std::vector<double>>& weights, const RegularityOptions& options) {
+std::vector<Relation> regularize(std::vector<Primitive>& primitives,
+                                 const std::vector<std::vector<Vec3>>& points,
+                                 const std::vector<std::vector<double>>& weights,
+                                 const RegularityOptions& options) {
+  std::vector<Relation> relations;
   std::vector<Oriented> items;
   for (std::size_t c = 0; c < primitives.size(); ++c) {
     std::optional<Oriented> item;
@@ -374,22 +388,32 @@ void regularize(std::vector<Primitive>& primitives, const std::vector<std::vecto
     if (group.members.size() < 2) continue;
     const auto [u, v] = orthonormal_pair(group.direction);
     std::vector<AlignedCylinder> cylinders;
+    Relation parallel;
     for (const std::size_t i : group.members) {
       const std::size_t c = items[i].cluster;
       Primitive& primitive = primitives[c];
       if (primitive.type == PrimitiveType::Plane) {
-        align_plane(primitive, group.direction, points[c], weights[c]);
+        if (align_plane(primitive, group.direction, points[c], weights[c]))
+          parallel.members.push_back(c);
         continue;
       }
       const CoaxialMember alone{points[c], weights[c], primitive.radius};
       const Eigen::Vector2d centre(u.dot(to_eigen(primitive.point)),
                                    v.dot(to_eigen(primitive.point)));
-      if (std::optional<CoaxialFit> fit = fit_coaxial(group.direction, centre, {&alone, 1}))
+      if (std::optional<CoaxialFit> fit = fit_coaxial(group.direction, centre, {&alone, 1})) {
         cylinders.push_back({c, std::move(*fit)});
+        parallel.members.push_back(c);
+      }
+    }
+    if (parallel.members.size() >= 2) {
+      std::sort(parallel.members.begin(), parallel.members.end());
+      relations.push_back(std::move(parallel));
     }
     align_cylinders(group.direction, std::move(cylinders),
-                    options.significance * options.significance, primitives, points, weights);
+                    options.significance * options.significance, primitives, points, weights,
+                    relations);
   }
+  return relations;
 }
 
 }  // namespace primseg::detail

@@ -4,6 +4,7 @@
 // uncertainty share one direction, estimated from all of them, and cylinders of one direction
 // whose axes agree share one axis line.
 
+#include <cstddef>
 #include <vector>
 
 #include "primseg/primitive.hpp"
@@ -18,14 +19,28 @@ struct RegularityOptions {
   double max_angle_degrees = 20;
 };
 
+/// Primitives that regularize() made share a direction or an axis line.
+struct Relation {
+  enum class Kind {
+    Parallel,  ///< plane normals and cylinder axes made one direction (each keeps its side)
+    Coaxial,   ///< cylinders of one direction group made one axis line (each keeps its radius)
+  };
+  Kind kind = Kind::Parallel;
+  std::vector<std::size_t> members;  ///< indices into the primitives, increasing; two or more
+};
+
 /// Groups the directions of `primitives` (plane normals, cylinder axes; other types are left as
 /// they are) and refits every member of a group of two or more with the group's direction: a
 /// plane through its inliers' weighted centroid, a cylinder by geometric least squares of its
 /// inliers' circle, jointly with the cylinders coaxial with it (one axis line, one radius each).
 /// points[c] and weights[c] are cluster c's inlier vertices (input units) and their weights; a
 /// cluster with too few to estimate its direction's uncertainty is left alone. Deterministic:
-/// clusters are visited by increasing uncertainty, ties by index.
-void regularize(std::vector<Primitive>& primitives, const std::vector<std::vector<Vec3>>& points,
-                const std::vector<std::vector<double>>& weights, const RegularityOptions& options);
+/// clusters are visited by increasing uncertainty, ties by index. Returns the relations made
+/// exact: each direction group's members that were refitted with its direction, then each
+/// coaxial set of its cylinders, in that order.
+std::vector<Relation> regularize(std::vector<Primitive>& primitives,
+                                 const std::vector<std::vector<Vec3>>& points,
+                                 const std::vector<std::vector<double>>& weights,
+                                 const RegularityOptions& options);
 
 }  // namespace primseg::detail

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "eigen_conversions.hpp"
@@ -79,14 +80,22 @@ double angle_between_lines(const Vec3& a, const Vec3& b) {
   return std::atan2(to_eigen(a).cross(to_eigen(b)).norm(), std::abs(to_eigen(a).dot(to_eigen(b))));
 }
 
-void regularize(std::vector<Primitive>& primitives, const std::vector<Cluster>& clusters) {
+using Kind = detail::Relation::Kind;
+
+// The relations regularize() made, as (kind, members) pairs in its order.
+using Relations = std::vector<std::pair<Kind, std::vector<std::size_t>>>;
+
+Relations regularize(std::vector<Primitive>& primitives, const std::vector<Cluster>& clusters) {
   std::vector<std::vector<Vec3>> points;
   std::vector<std::vector<double>> weights;
   for (const Cluster& c : clusters) {
     points.push_back(c.points);
     weights.push_back(c.weights);
   }
-  detail::regularize(primitives, points, weights, {});
+  Relations relations;
+  for (const detail::Relation& relation : detail::regularize(primitives, points, weights, {}))
+    relations.emplace_back(relation.kind, relation.members);
+  return relations;
 }
 
 TEST(Regularity, ParallelPlanesShareOneNormalNearerTheTruth) {
@@ -100,7 +109,7 @@ TEST(Regularity, ParallelPlanesShareOneNormalNearerTheTruth) {
     const double worst = std::max(angle_between_lines(planes[0].axis, to_vec3(z)),
                                   angle_between_lines(planes[1].axis, to_vec3(z)));
     const Vec3 before_second = planes[1].axis;
-    regularize(planes, clusters);
+    EXPECT_EQ(regularize(planes, clusters), (Relations{{Kind::Parallel, {0, 1}}}));
     // One direction, each plane keeping its side.
     EXPECT_NEAR(angle_between_lines(planes[0].axis, planes[1].axis), 0, 1e-12);
     EXPECT_GT(to_eigen(planes[1].axis).dot(to_eigen(before_second)), 0);
@@ -121,7 +130,7 @@ TEST(Regularity, DirectionsFartherApartThanTheirUncertaintyStayApart) {
       noisy_plane(tilted, {0, 0, 1}, 1, 0.001, rng)};
   const std::vector<Primitive> fitted{fitted_plane(clusters[0]), fitted_plane(clusters[1])};
   std::vector<Primitive> planes = fitted;
-  regularize(planes, clusters);
+  EXPECT_TRUE(regularize(planes, clusters).empty());
   for (int c = 0; c < 2; ++c) {
     EXPECT_EQ(planes[c].axis, fitted[c].axis);
     EXPECT_EQ(planes[c].point, fitted[c].point);
@@ -142,7 +151,7 @@ TEST(Regularity, ACylinderAndItsCapsShareTheAxis) {
   const Primitive cylinder =
       fit_geometric(start, clusters[0].points, clusters[0].weights).primitive;
   std::vector<Primitive> primitives{cylinder, fitted_plane(clusters[1]), fitted_plane(clusters[2])};
-  regularize(primitives, clusters);
+  EXPECT_EQ(regularize(primitives, clusters), (Relations{{Kind::Parallel, {0, 1, 2}}}));
   EXPECT_NEAR(angle_between_lines(primitives[0].axis, primitives[1].axis), 0, 1e-12);
   EXPECT_NEAR(angle_between_lines(primitives[0].axis, primitives[2].axis), 0, 1e-12);
   EXPECT_NEAR(primitives[0].radius, 0.5, 0.002);
@@ -160,7 +169,7 @@ TEST(Regularity, ClustersTooSmallToMeasureTheirUncertaintyAreLeftAlone) {
                                       noisy_plane(z, {0, 0, 1}, 1, 0.01, rng, 2)};  // 4 points
   const std::vector<Primitive> fitted{fitted_plane(clusters[0]), fitted_plane(clusters[1])};
   std::vector<Primitive> planes = fitted;
-  regularize(planes, clusters);
+  EXPECT_TRUE(regularize(planes, clusters).empty());
   EXPECT_EQ(planes[0].axis, fitted[0].axis);
   EXPECT_EQ(planes[1].axis, fitted[1].axis);
 }
@@ -193,7 +202,8 @@ TEST(Regularity, ASteppedShaftSharesOneAxisLine) {
                                     fitted_cylinder(clusters[1], z, {0, 0, 1}, 0.3),
                                     fitted_plane(clusters[2])};
   const double offset_before = axis_offset(primitives[0], primitives[1]);
-  regularize(primitives, clusters);
+  EXPECT_EQ(regularize(primitives, clusters),
+            (Relations{{Kind::Parallel, {0, 1, 2}}, {Kind::Coaxial, {0, 1}}}));
   std::printf("stepped shaft: axes %.2g apart before, %.2g after\n", offset_before,
               axis_offset(primitives[0], primitives[1]));
   EXPECT_GT(offset_before, 1e-4);
@@ -216,7 +226,7 @@ TEST(Regularity, ParallelHolesApartStayOnTheirOwnAxes) {
                                       noisy_cylinder(z, {0.45, 0, 0}, 0.2, 1, 0.005, rng)};
   std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.2),
                                     fitted_cylinder(clusters[1], z, {0.45, 0, 0}, 0.2)};
-  regularize(primitives, clusters);
+  EXPECT_EQ(regularize(primitives, clusters), (Relations{{Kind::Parallel, {0, 1}}}));
   EXPECT_NEAR(angle_between_lines(primitives[0].axis, primitives[1].axis), 0, 1e-12);
   EXPECT_NEAR(axis_offset(primitives[0], primitives[1]), 0.45, 0.002);
 }
@@ -235,7 +245,8 @@ TEST(Regularity, ANearlyFlatCylinderJoinsNoAxis) {
   flat.axis = {0, 0, 1};
   flat.radius = 50;
   std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.5), flat};
-  regularize(primitives, clusters);
+  for (const auto& [kind, members] : regularize(primitives, clusters))
+    EXPECT_NE(kind, Kind::Coaxial);
   EXPECT_NEAR(primitives[0].radius, 0.5, 0.002);
   EXPECT_GT(primitives[1].radius, 10);
 }

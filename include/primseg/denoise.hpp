@@ -17,6 +17,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "primseg/auto_level.hpp"
@@ -152,6 +153,24 @@ struct SnapReport {
   double max_move = 0;   ///< input units
 };
 
+/// A relation between clusters' primitives that the snap made exact
+/// (DenoiseOptions::relation_significance): design intent recovered from the fits.
+struct ClusterRelation {
+  enum class Kind {
+    /// Plane normals and cylinder axes made one direction (each keeps its side): opposite faces
+    /// of a box, a cylinder and its caps.
+    Parallel,
+    /// Cylinders of one direction made one axis line, each keeping its radius: a stepped shaft,
+    /// the fragments of one cylinder. Every coaxial set is also part of a Parallel relation.
+    Coaxial,
+  };
+  Kind kind = Kind::Parallel;
+  std::vector<std::uint32_t> clusters;  ///< labels of the snapped level, increasing; two or more
+};
+
+/// "parallel" or "coaxial".
+std::string_view to_string(ClusterRelation::Kind kind);
+
 /// The clusters a snap moved the vertices onto (Denoiser::snapped_level): the level it was given,
 /// after relabelling (DenoiseOptions::relabel_passes), with each cluster's primitive after the
 /// robust refit and the relations. Their borders on the denoised mesh,
@@ -167,6 +186,8 @@ struct SnappedLevel {
   /// by the area of its triangles in the cluster (as the hierarchy's area weights do; `max` leaves
   /// out vertices of zero weight), input units: what the snap took out.
   std::vector<ClusterReport> clusters;
+  /// The relations made exact, ordered by kind (parallel first), then by their clusters.
+  std::vector<ClusterRelation> relations;
 };
 
 /// Step-by-step denoising of one mesh. The vertex and face order never change; only positions do.
@@ -217,12 +238,15 @@ class Denoiser {
   // The snap's clusters (snapped_level) on the current positions, before they move.
   SnappedLevel describe_snap(const Segmentation& hierarchy_level, const Segmentation& relabelled,
                              const std::vector<Primitive>& hierarchy_fits,
-                             const std::vector<Primitive>& primitives) const;
+                             const std::vector<Primitive>& primitives,
+                             std::vector<ClusterRelation> relations) const;
   void cluster_vertices(const Segmentation& segmentation, std::size_t cluster_count,
                         std::vector<std::vector<Vec3>>& points,
                         std::vector<std::vector<double>>& weights) const;
-  // Makes the relations the fits agree with exact (DenoiseOptions::relation_significance).
-  void regularize(const Segmentation& segmentation, std::vector<Primitive>& primitives) const;
+  // Makes the relations the fits agree with exact (DenoiseOptions::relation_significance) and
+  // returns them, on the segmentation's labels.
+  std::vector<ClusterRelation> regularize(const Segmentation& segmentation,
+                                          std::vector<Primitive>& primitives) const;
   // Moves faces to the nearest primitive of their neighbourhood, judged on `judged`'s positions
   // (see DenoiseOptions::relabel_passes), and refits.
   void relabel(const Mesh& judged, std::vector<Primitive>& primitives,

@@ -71,6 +71,7 @@ def test_denoise_matches_the_cli(cli, noisy_fandisk, tmp_path, cli_options, pyth
     assert level["labels"].dtype == np.int32 and level["labels"].shape == (mesh.face_count,)
     np.testing.assert_array_equal(level["labels"], np.loadtxt(tmp_path / "labels.txt"))
     assert level["clusters"] == summary["clusters"]
+    assert level["relations"] == summary["relations"]
     assert json.loads(json.dumps(level["borders"])) == summary["borders"]
     assert len(level["clusters"]) == summary["level"]["clusters"] == rounds[-1]["clusters"]
     np.testing.assert_array_equal(primseg.denoise(mesh, **python_options, return_level=True)[0], V)

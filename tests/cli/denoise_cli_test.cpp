@@ -237,6 +237,14 @@ TEST(CliDenoise, LevelOutputsShowTheSnapOnTheDenoisedMesh) {
         EXPECT_EQ(value.get<double>(), p.value[0]) << p.name;
     }
   }
+  // The relations made exact, as the library made them (the box's opposite faces).
+  ASSERT_EQ(json["relations"].size(), level.relations.size());
+  EXPECT_FALSE(level.relations.empty());
+  for (std::size_t i = 0; i < level.relations.size(); ++i) {
+    EXPECT_EQ(json["relations"][i]["kind"], std::string(to_string(level.relations[i].kind)));
+    EXPECT_EQ(json["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
+              level.relations[i].clusters);
+  }
   // The box's edges (a face may be fitted by a cylinder of radius 45 times its width, whose
   // normal turns by a degree across it).
   ASSERT_EQ(json["borders"].size(), 12u);

@@ -544,6 +544,20 @@ TEST(Denoise, SnappedLevelIsTheBoxsFacesAndItsEdges) {
     EXPECT_EQ(r.algebraic.axis, start.axis);
   }
 
+  // The relations made exact: the three pairs of opposite faces, each sharing one normal.
+  ASSERT_EQ(level.relations.size(), 3u);
+  for (const ClusterRelation& relation : level.relations) {
+    EXPECT_EQ(relation.kind, ClusterRelation::Kind::Parallel);
+    ASSERT_EQ(relation.clusters.size(), 2u);
+    const Primitive &a = level.clusters[relation.clusters[0]].primitive,
+                    &b = level.clusters[relation.clusters[1]].primitive;
+    EXPECT_EQ(a.axis, Vec3({-b.axis[0], -b.axis[1], -b.axis[2]}));
+    const Vec3 &truth_a = box.clean.regions[region_of_cluster[relation.clusters[0]]].axis,
+               &truth_b = box.clean.regions[region_of_cluster[relation.clusters[1]]].axis;
+    EXPECT_NEAR(truth_a[0] * truth_b[0] + truth_a[1] * truth_b[1] + truth_a[2] * truth_b[2], -1,
+                1e-12);
+  }
+
   // Vertices of one cluster only lie on its primitive.
   const Mesh& denoised = denoiser.mesh();
   std::vector<std::vector<std::uint32_t>> clusters_of_vertex(denoised.vertex_count());
