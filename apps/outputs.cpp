@@ -113,7 +113,8 @@ nlohmann::json border_json(const ClusterBorder& border) {
 
 // The border curves as an OBJ file of polylines: the vertices they use, in index order, and one
 // object `border_A_B` (`border_A_boundary` along the mesh's open boundary) of `l` lines per
-// border, a closed curve ending at its first vertex.
+// border, a closed curve ending at its first vertex. A comment under each object gives the
+// border's edge count, length and angle, which OBJ has no field for.
 std::string borders_obj(const Mesh& mesh, std::span<const ClusterBorder> borders) {
   std::vector<std::uint32_t> obj_index(mesh.vertex_count(), 0);  // 1-based, 0: not written
   for (const ClusterBorder& border : borders)
@@ -138,6 +139,13 @@ std::string borders_obj(const Mesh& mesh, std::span<const ClusterBorder> borders
             ? std::snprintf(line, sizeof line, "o border_%u_boundary\n", border.first)
             : std::snprintf(line, sizeof line, "o border_%u_%u\n", border.first, border.second);
     text.append(line, static_cast<std::size_t>(n));
+    const int comment =
+        std::isnan(border.angle)
+            ? std::snprintf(line, sizeof line, "# %u edges, length %.9g, on the open boundary\n",
+                            border.edge_count, border.length)
+            : std::snprintf(line, sizeof line, "# %u edges, length %.9g, angle %.9g degrees\n",
+                            border.edge_count, border.length, border.angle);
+    text.append(line, static_cast<std::size_t>(comment));
     for (const BorderCurve& curve : border.curves) {
       text += 'l';
       const auto append_index = [&](std::uint32_t v) {

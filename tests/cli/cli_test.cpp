@@ -450,6 +450,18 @@ TEST(Cli, SegmentWritesTheBordersInTheJsonAndAsObjPolylines) {
       points.push_back(p);
     } else if (kind == "o") {
       objects.push_back(line);
+      // Its comment: the border's edge count, length and angle.
+      ASSERT_TRUE(std::getline(lines, line));
+      const json& border = borders[objects.size() - 1];
+      unsigned edges = 0;
+      double length = 0, angle = 0;
+      ASSERT_EQ(std::sscanf(line.c_str(), "# %u edges, length %lf, angle %lf degrees", &edges,
+                            &length, &angle),
+                3)
+          << line;
+      EXPECT_EQ(edges, border.at("edges").get<unsigned>());
+      EXPECT_NEAR(length, border.at("length").get<double>(), 1e-8 * length);
+      EXPECT_NEAR(angle, border.at("angle").get<double>(), 1e-6);
     } else if (kind == "l") {
       ASSERT_LT(curve, curves.size());
       std::vector<std::uint32_t> indices;
