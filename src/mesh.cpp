@@ -510,6 +510,14 @@ double bounding_box_diagonal(const Mesh& mesh) {
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
+Vec3 bounding_box_centre(const Mesh& mesh) {
+  if (mesh.polygon_vertices.empty()) return {0, 0, 0};
+  const auto [low, high] = face_vertex_bounds(mesh);
+  // low + half the extent, not (low + high) / 2: no overflow near the largest doubles.
+  return {low[0] + (high[0] - low[0]) / 2, low[1] + (high[1] - low[1]) / 2,
+          low[2] + (high[2] - low[2]) / 2};
+}
+
 void check_geometric_range(const Mesh& mesh) {
   auto formatted = [](double x) {
     char text[32];

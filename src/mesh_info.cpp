@@ -67,16 +67,7 @@ MeshInfo describe_mesh(const Mesh& mesh) {
     begin = end;
   }
   // Signed volumes about the bounding box's centre, as the triangles are listed.
-  Vec3 centre{0, 0, 0};
-  if (mesh.vertex_count() > 0) {
-    Vec3 low = mesh.positions[0], high = mesh.positions[0];
-    for (const Vec3& p : mesh.positions)
-      for (int a = 0; a < 3; ++a) {
-        low[a] = std::min(low[a], p[a]);
-        high[a] = std::max(high[a], p[a]);
-      }
-    for (int a = 0; a < 3; ++a) centre[a] = low[a] + (high[a] - low[a]) / 2;
-  }
+  const Vec3 centre = bounding_box_centre(mesh);
   std::vector<double> volume(info.components, 0.0);
   for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     std::array<Eigen::Vector3d, 3> p;

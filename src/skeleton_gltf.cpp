@@ -239,16 +239,7 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
   // skeleton node stands: float32 then holds a part far from the origin (a scan in survey
   // coordinates) as finely as one at it.
   const std::uint32_t n = mesh.vertex_count();
-  Vec3 origin{0, 0, 0};
-  if (n > 0) {
-    Vec3 low = mesh.positions[0], high = mesh.positions[0];
-    for (const Vec3& p : mesh.positions)
-      for (std::size_t i = 0; i < 3; ++i) {
-        low[i] = std::min(low[i], p[i]);
-        high[i] = std::max(high[i], p[i]);
-      }
-    for (std::size_t i = 0; i < 3; ++i) origin[i] = low[i] + (high[i] - low[i]) / 2;
-  }
+  const Vec3 origin = bounding_box_centre(mesh);
 
   BufferBuilder buffer;
   std::vector<float> positions(3 * std::size_t{n});

@@ -62,6 +62,8 @@ struct Mesh {
 
 /// Axis-aligned bounding box diagonal length of the vertices used by some face (0 for no faces).
 double bounding_box_diagonal(const Mesh& mesh);
+/// Centre of that box, input units ((0, 0, 0) for no faces).
+Vec3 bounding_box_centre(const Mesh& mesh);
 
 /// Largest coordinate magnitude the geometric operations accept (input units). Some of them work
 /// in input units with fourth powers of lengths (area-weighted second moments) and their squares:

@@ -7,7 +7,8 @@
 ///
 /// Layout of the file:
 /// - node 0, "mesh": the triangles (input units, float32 positions relative to the centre of the
-///   mesh's bounding box; area-weighted vertex normals), with attributes JOINTS_n / WEIGHTS_n.
+///   mesh's bounding box, bounding_box_centre(); area-weighted vertex normals), with attributes
+///   JOINTS_n / WEIGHTS_n.
 ///   Triangles are consistently oriented (outward on a closed part) whatever way the input lists
 ///   them, since readers cull back faces: a triangle the dual graph flips (DualGraph::flipped) is
 ///   written with its last two corners swapped;

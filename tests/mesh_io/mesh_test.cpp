@@ -335,12 +335,18 @@ TEST(MeshValidate, DetectsBrokenInvariants) {
   EXPECT_THROW(Mesh{}.validate(), InvalidInputError);
 }
 
-TEST(BoundingBoxDiagonal, IgnoresIsolatedVertices) {
+TEST(BoundingBox, DiagonalAndCentreIgnoreIsolatedVertices) {
   std::vector<Vec3> positions = tetrahedron_positions();
   positions.push_back({100, 100, 100});
   const Mesh mesh = Mesh::from_triangles(positions, tetrahedron_triangles());
   EXPECT_DOUBLE_EQ(bounding_box_diagonal(mesh), std::sqrt(3.0));
   EXPECT_EQ(bounding_box_diagonal(Mesh{}), 0.0);
+  EXPECT_EQ(bounding_box_centre(mesh), Vec3({0.5, 0.5, 0.5}));
+  EXPECT_EQ(bounding_box_centre(Mesh{}), Vec3({0, 0, 0}));
+  // Near the largest doubles, where (low + high) / 2 would overflow.
+  const Mesh far =
+      Mesh::from_triangles({{1.5e308, 0, 0}, {1.7e308, 0, 0}, {1.6e308, 1, 0}}, {{0, 1, 2}});
+  EXPECT_DOUBLE_EQ(bounding_box_centre(far)[0], 1.6e308);
 }
 
 }  // namespace
