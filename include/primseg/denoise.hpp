@@ -180,11 +180,12 @@ struct SnappedLevel {
   /// area (before the snap), ties by lowest face. A cluster relabelling emptied is gone.
   std::vector<std::uint32_t> labels;
   /// One per cluster, in label order, shape (K). `primitive`: what the cluster's vertices were
-  /// snapped onto, input units; `algebraic`: the hierarchy's fit of the level's cluster it came
-  /// from, and `node` that cluster's tree node. `area` (input units²), `face_count`, and `rms`
-  /// and `max`: distances to `primitive` of the cluster's vertices before the snap, each weighted
-  /// by the area of its triangles in the cluster (as the hierarchy's area weights do; `max` leaves
-  /// out vertices of zero weight), input units: what the snap took out.
+  /// snapped onto, input units; `algebraic`: the fit the refit started from (describe_clusters()'s
+  /// of the level's cluster it came from), and `node` that cluster's tree node. `area` (input
+  /// units²), `face_count`, and `rms` and `max`: distances to `primitive` of the cluster's vertices
+  /// before the snap, each weighted by the area of its triangles in the cluster (as the hierarchy's
+  /// area weights do; `max` leaves out vertices of zero weight), input units: what the snap took
+  /// out.
   std::vector<ClusterReport> clusters;
   /// The relations made exact, ordered by kind (parallel first), then by their clusters.
   std::vector<ClusterRelation> relations;
