@@ -176,12 +176,8 @@ void write_level_outputs(const Hierarchy& hierarchy, const Mesh& mesh,
     write_output(*files.labels, text);
   }
   std::vector<ClusterBorder> borders;
-  if (files.json || files.borders) {
-    std::vector<Primitive> primitives;
-    primitives.reserve(reports.size());
-    for (const ClusterReport& report : reports) primitives.push_back(report.primitive);
-    borders = cluster_borders(mesh, labels, primitives);
-  }
+  if (files.json || files.borders)
+    borders = cluster_borders(mesh, labels, cluster_primitives(reports));
   if (files.json) {
     // A level of a cluster per face (a triangle soup at --clusters auto) held about 1.6 KB per
     // cluster as a document, 0.4 KB as text.

@@ -298,7 +298,6 @@ void check_snapped_level(const Mesh& denoised, const SnappedLevel& level,
     if (label >= k) fail("snapped level: label", label);
     ++faces[label];
   }
-  std::vector<Primitive> primitives;
   for (std::size_t c = 0; c < k; ++c) {
     const ClusterReport& r = level.clusters[c];
     if (r.id != c || r.face_count != faces[c] || faces[c] == 0)
@@ -309,11 +308,11 @@ void check_snapped_level(const Mesh& denoised, const SnappedLevel& level,
     check_length(r.max, "snapped level: max");
     if (r.rms > r.max * (1 + 1e-12)) fail("snapped level: rms above max", r.rms, r.max);
     check_primitive(r.primitive);
-    primitives.push_back(r.primitive);
   }
+  const std::vector<Primitive> primitives = cluster_primitives(level.clusters);
   check_borders(denoised, cluster_borders(denoised, level.labels, primitives));
   // Relations: two or more clusters, increasing; a parallel group shares one direction up to
-  // sign, a coaxial set (cylinders) one axis line too.
+  // sign, and a coaxial set holds cylinders only.
   for (const ClusterRelation& relation : level.relations) {
     const auto& members = relation.clusters;
     if (members.size() < 2 || !std::is_sorted(members.begin(), members.end()) ||
@@ -351,10 +350,8 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
     fail("refinement changed the cluster count");
   fuzz::check_cut(hierarchy, results.refined.segmentation);
   check_reports(hierarchy, results.refined.segmentation, results.refined.reports);
-  std::vector<Primitive> primitives;
-  for (const ClusterReport& report : results.refined.reports)
-    primitives.push_back(report.primitive);
-  results.borders = cluster_borders(*mesh, results.refined.segmentation.labels, primitives);
+  results.borders = cluster_borders(*mesh, results.refined.segmentation.labels,
+                                    cluster_primitives(results.refined.reports));
   check_borders(*mesh, results.borders);
 
   results.skeleton = extract_skeleton(hierarchy, results.level);

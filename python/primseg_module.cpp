@@ -1181,9 +1181,8 @@ as lists). json.dumps() takes it as it is.)",
               std::vector<ClusterReport> reports;
               const Segmentation segmentation =
                   refined_level(*self.hierarchy, level, refine, &reports);
-              std::vector<Primitive> primitives;
-              for (const ClusterReport& report : reports) primitives.push_back(report.primitive);
-              borders = cluster_borders(self.hierarchy->mesh(), segmentation.labels, primitives);
+              borders = cluster_borders(self.hierarchy->mesh(), segmentation.labels,
+                                        cluster_primitives(reports));
             }
             py::list list;
             for (const ClusterBorder& border : borders) list.append(border_dict(border));
@@ -1503,10 +1502,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
           }
           if (return_level) {
             snapped = denoiser.snapped_level();
-            std::vector<Primitive> snapped_primitives;
-            for (const ClusterReport& report : snapped.clusters)
-              snapped_primitives.push_back(report.primitive);
-            borders = cluster_borders(denoiser.mesh(), snapped.labels, snapped_primitives);
+            borders = cluster_borders(denoiser.mesh(), snapped.labels,
+                                      cluster_primitives(snapped.clusters));
           }
           positions = denoiser.mesh().positions;
         });

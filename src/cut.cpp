@@ -207,6 +207,13 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
   return reports;
 }
 
+std::vector<Primitive> cluster_primitives(std::span<const ClusterReport> reports) {
+  std::vector<Primitive> primitives;
+  primitives.reserve(reports.size());
+  for (const ClusterReport& report : reports) primitives.push_back(report.primitive);
+  return primitives;
+}
+
 std::vector<ClusterReport> describe_nodes(const Hierarchy& hierarchy,
                                           std::span<const std::uint32_t> nodes,
                                           const DescribeOptions& options) {

@@ -450,11 +450,11 @@ std::string_view to_string(ClusterRelation::Kind kind) {
   return kind == ClusterRelation::Kind::Parallel ? "parallel" : "coaxial";
 }
 
-std::vector<ClusterRelation> Denoiser::regularize(const Segmentation& segmentation,
+std::vector<ClusterRelation> Denoiser::regularize(const std::vector<std::vector<Vec3>>& points,
+                                                  const std::vector<std::vector<double>>& weights,
                                                   std::vector<Primitive>& primitives) const {
-  std::vector<std::vector<Vec3>> points, inlier_points(primitives.size());
-  std::vector<std::vector<double>> weights, inlier_weights(primitives.size());
-  cluster_vertices(segmentation, primitives.size(), points, weights);
+  std::vector<std::vector<Vec3>> inlier_points(primitives.size());
+  std::vector<std::vector<double>> inlier_weights(primitives.size());
   const double floor = 1e-12 * bounding_box_diagonal(mesh_);
   for (std::size_t c = 0; c < primitives.size(); ++c)
     if (!points[c].empty())
@@ -527,6 +527,8 @@ void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
 
 SnappedLevel Denoiser::describe_snap(const Segmentation& hierarchy_level,
                                      const Segmentation& relabelled,
+                                     const std::vector<std::vector<Vec3>>& points,
+                                     const std::vector<std::vector<double>>& weights,
                                      const std::vector<Primitive>& hierarchy_fits,
                                      const std::vector<Primitive>& primitives,
                                      std::vector<ClusterRelation> relations) const {
@@ -547,9 +549,6 @@ SnappedLevel Denoiser::describe_snap(const Segmentation& hierarchy_level,
             .norm() /
         2;
   }
-  std::vector<std::vector<Vec3>> points;
-  std::vector<std::vector<double>> weights;
-  cluster_vertices(relabelled, k, points, weights);
   for (std::size_t c = 0; c < k; ++c) {
     ClusterReport& r = reports[c];
     r.node = hierarchy_level.nodes[c];
@@ -602,18 +601,21 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
     throw InvalidInputError("denoise: the segmentation has " +
                             std::to_string(segmentation.labels.size()) + " labels for " +
                             std::to_string(mesh_.face_count()) + " faces");
-  std::vector<Primitive> hierarchy_fits;
-  for (const ClusterReport& cluster : describe_clusters(hierarchy, segmentation))
-    hierarchy_fits.push_back(cluster.primitive);
+  const std::vector<Primitive> hierarchy_fits =
+      cluster_primitives(describe_clusters(hierarchy, segmentation));
   std::vector<Primitive> primitives = hierarchy_fits;
   if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
   Segmentation labelled = segmentation;
   relabel(segmented, primitives, labelled);
+  // The vertices of each final cluster, for the relations and the snapped level's reports.
+  std::vector<std::vector<Vec3>> points;
+  std::vector<std::vector<double>> weights;
+  cluster_vertices(labelled, primitives.size(), points, weights);
   std::vector<ClusterRelation> relations;
   if (options_.relation_significance > 0 && options_.refit_outlier_threshold > 0)
-    relations = regularize(labelled, primitives);
-  snapped_level_ =
-      describe_snap(segmentation, labelled, hierarchy_fits, primitives, std::move(relations));
+    relations = regularize(points, weights, primitives);
+  snapped_level_ = describe_snap(segmentation, labelled, points, weights, hierarchy_fits,
+                                 primitives, std::move(relations));
 
   SnapReport report;
   report.clusters = static_cast<std::uint32_t>(snapped_level_.clusters.size());

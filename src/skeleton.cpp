@@ -282,11 +282,8 @@ Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_
 }
 
 Skeleton extract_skeleton(const Hierarchy& hierarchy, const Segmentation& segmentation) {
-  const std::vector<ClusterReport> reports = describe_clusters(hierarchy, segmentation);
-  std::vector<Primitive> primitives;
-  primitives.reserve(reports.size());
-  for (const ClusterReport& report : reports) primitives.push_back(report.primitive);
-  return extract_skeleton(hierarchy.mesh(), segmentation.labels, primitives);
+  return extract_skeleton(hierarchy.mesh(), segmentation.labels,
+                          cluster_primitives(describe_clusters(hierarchy, segmentation)));
 }
 
 }  // namespace primseg

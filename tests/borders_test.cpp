@@ -302,9 +302,7 @@ TEST(ClusterBorders, FandiskAtThirtyClusters) {
   const Mesh mesh = read_mesh(testing::cgal_mesh("fandisk.off"));
   const Hierarchy hierarchy = build_hierarchy(mesh);
   const Segmentation level = cut_by_count(hierarchy, 30);
-  std::vector<Primitive> primitives;
-  for (const ClusterReport& report : describe_clusters(hierarchy, level))
-    primitives.push_back(report.primitive);
+  const std::vector<Primitive> primitives = cluster_primitives(describe_clusters(hierarchy, level));
   const auto borders = cluster_borders(mesh, level.labels, primitives);
   expect_curves_cover_the_borders(mesh, level.labels, borders);
   int sharp = 0, tangent = 0;

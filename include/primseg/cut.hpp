@@ -74,6 +74,10 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
                                              const std::vector<Primitive>& start,
                                              const DescribeOptions& options = {});
 
+/// The primitive of each report, in order, shape (K): what cluster_borders() and
+/// extract_skeleton() take beside the labels.
+std::vector<Primitive> cluster_primitives(std::span<const ClusterReport> reports);
+
 /// Reports of tree nodes, in the order given, each the report describe_clusters makes when the
 /// node is a cluster of a cut (same primitive, rms, max and area, bit for bit): what `primseg
 /// view` carries for the levels a user may click. `id` is the node's index in `nodes`. O(size of

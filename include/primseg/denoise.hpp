@@ -237,16 +237,20 @@ class Denoiser {
  private:
   void refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const;
   // The snap's clusters (snapped_level) on the current positions, before they move.
+  // `points` and `weights` are cluster_vertices() of `relabelled`.
   SnappedLevel describe_snap(const Segmentation& hierarchy_level, const Segmentation& relabelled,
+                             const std::vector<std::vector<Vec3>>& points,
+                             const std::vector<std::vector<double>>& weights,
                              const std::vector<Primitive>& hierarchy_fits,
                              const std::vector<Primitive>& primitives,
                              std::vector<ClusterRelation> relations) const;
   void cluster_vertices(const Segmentation& segmentation, std::size_t cluster_count,
                         std::vector<std::vector<Vec3>>& points,
                         std::vector<std::vector<double>>& weights) const;
-  // Makes the relations the fits agree with exact (DenoiseOptions::relation_significance) and
-  // returns them, on the segmentation's labels.
-  std::vector<ClusterRelation> regularize(const Segmentation& segmentation,
+  // Makes the relations the fits agree with exact (DenoiseOptions::relation_significance), from
+  // each cluster's vertices (cluster_vertices()), and returns them on the clusters' labels.
+  std::vector<ClusterRelation> regularize(const std::vector<std::vector<Vec3>>& points,
+                                          const std::vector<std::vector<double>>& weights,
                                           std::vector<Primitive>& primitives) const;
   // Moves faces to the nearest primitive of their neighbourhood, judged on `judged`'s positions
   // (see DenoiseOptions::relabel_passes), and refits.

@@ -572,9 +572,8 @@ TEST(Denoise, SnappedLevelIsTheBoxsFacesAndItsEdges) {
     }
   }
 
-  std::vector<Primitive> primitives;
-  for (const ClusterReport& r : level.clusters) primitives.push_back(r.primitive);
-  const std::vector<ClusterBorder> borders = cluster_borders(denoised, level.labels, primitives);
+  const std::vector<ClusterBorder> borders =
+      cluster_borders(denoised, level.labels, cluster_primitives(level.clusters));
   ASSERT_EQ(borders.size(), 12u);
   double worst = 0;
   for (const ClusterBorder& border : borders) {
