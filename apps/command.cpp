@@ -165,13 +165,17 @@ void add_level_options(CLI::App& command, LevelOptions& options, std::string_vie
   command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
 }
 
-void add_refine_option(CLI::App& command, LevelOptions& options) {
+void add_fit_options(CLI::App& command, LevelOptions& options) {
   command
       .add_option("--refine", options.refine,
                   "Boundary refinement passes after the cut: border faces move to the adjacent "
                   "cluster whose primitive fits them better (0: none)")
       ->check(CLI::Range(0u, 1000u))
       ->capture_default_str();
+  command.add_flag("--regularize", options.regularize,
+                   "Make the fits' design intent exact: plane normals and cylinder axes that "
+                   "agree within their uncertainty share one direction, and cylinders one axis "
+                   "line (listed as \"relations\" in the JSON)");
 }
 
 void validate_level_outputs(LevelOptions& options) {
@@ -203,13 +207,18 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, Chose
   } else {
     reports = describe_clusters(hierarchy, segmentation);
   }
+  std::vector<ClusterRelation> relations;
+  if (options.regularize) {
+    relations = regularize_clusters(hierarchy, segmentation, reports);
+    summary["relations"] = relations_json(relations);
+  }
   summary["timing"]["cut_seconds"] = seconds_since(cut_start);
   summary["level"] = level_summary(options, level, segmentation.cluster_count());
   if (!refinement.is_null()) summary["level"]["refinement"] = std::move(refinement);
   write_level_outputs(hierarchy, hierarchy.mesh(), segmentation.labels, reports, options.files,
                       summary);
   if (options.files.tree) write_output(*options.files.tree, serialize_tree(hierarchy));
-  if (!options.quiet) print_summary(reports);
+  if (!options.quiet) print_summary(reports, relations);
 }
 
 nlohmann::json level_summary(const LevelOptions& options, const ChosenLevel& level,

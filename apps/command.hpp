@@ -95,6 +95,7 @@ struct LevelOptions {
   LevelChoice level;
   OutputFiles files;
   std::uint32_t refine = 0;  // --refine N: boundary refinement passes after the cut
+  bool regularize = false;   // --regularize: make the fits' relations exact and report them
   bool quiet = false;
 };
 
@@ -106,8 +107,9 @@ inline constexpr std::string_view kChosenLevelRule =
 /// files and --quiet to a command.
 void add_level_options(CLI::App& command, LevelOptions& options,
                        std::string_view auto_level = kChosenLevelRule);
-/// Adds --refine (LevelOptions::refine) to a command that reports a hierarchy's level.
-void add_refine_option(CLI::App& command, LevelOptions& options);
+/// Adds --refine and --regularize (LevelOptions::refine and ::regularize) to a command that
+/// reports a hierarchy's level.
+void add_fit_options(CLI::App& command, LevelOptions& options);
 
 /// Checks the output names before any work (validate_output_files) and turns `quiet` on when an
 /// output goes to standard output ('-'), which must then carry that output alone.

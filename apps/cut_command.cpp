@@ -20,7 +20,7 @@ Command add_cut_command(CLI::App& app) {
                    "Tree file written by segment --tree (- for standard input)")
       ->required();
   add_level_options(*cut_command, o->level);
-  add_refine_option(*cut_command, o->level);
+  add_fit_options(*cut_command, o->level);
   add_limit_options(*cut_command, o->limits, kMeshBytesPerFace);
 
   return {cut_command, [o] {

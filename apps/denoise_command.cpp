@@ -165,13 +165,10 @@ Command add_denoise_command(CLI::App& app) {
             summary["level"] =
                 level_summary(o->level, level, static_cast<std::uint32_t>(snapped.clusters.size()));
             summary["level"]["hierarchy_clusters"] = level.segmentation.cluster_count();
-            summary["relations"] = nlohmann::json::array();
-            for (const ClusterRelation& relation : snapped.relations)
-              summary["relations"].push_back(
-                  {{"kind", to_string(relation.kind)}, {"clusters", relation.clusters}});
+            summary["relations"] = relations_json(snapped.relations);
             write_level_outputs(*hierarchy, denoiser.mesh(), snapped.labels, snapped.clusters,
                                 o->level.files, summary);
-            if (!o->level.quiet) print_summary(snapped.clusters);
+            if (!o->level.quiet) print_summary(snapped.clusters, snapped.relations);
           }};
 }
 

@@ -234,7 +234,15 @@ void write_level_outputs(const Hierarchy& hierarchy, const Mesh& mesh,
   }
 }
 
-void print_summary(const std::vector<ClusterReport>& reports, std::size_t max_rows) {
+nlohmann::json relations_json(const std::vector<ClusterRelation>& relations) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const ClusterRelation& relation : relations)
+    list.push_back({{"kind", to_string(relation.kind)}, {"clusters", relation.clusters}});
+  return list;
+}
+
+void print_summary(const std::vector<ClusterReport>& reports,
+                   const std::vector<ClusterRelation>& relations, std::size_t max_rows) {
   std::printf("%s\n", count_of(reports.size(), "cluster").c_str());
   std::printf("%6s  %-8s  %8s  %12s  %12s  %12s\n", "id", "type", "faces", "area", "rms", "max");
   for (std::size_t i = 0; i < reports.size() && i < max_rows; ++i) {
@@ -244,6 +252,13 @@ void print_summary(const std::vector<ClusterReport>& reports, std::size_t max_ro
                 r.max);
   }
   if (reports.size() > max_rows) std::printf("   ... %zu more\n", reports.size() - max_rows);
+  for (std::size_t i = 0; i < relations.size() && i < max_rows; ++i) {
+    std::printf("%s:", std::string(to_string(relations[i].kind)).c_str());
+    for (const std::uint32_t c : relations[i].clusters) std::printf(" %u", c);
+    std::printf("\n");
+  }
+  if (relations.size() > max_rows)
+    std::printf("   ... %zu more relations\n", relations.size() - max_rows);
 }
 
 }  // namespace primseg::cli

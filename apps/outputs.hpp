@@ -11,6 +11,7 @@
 
 #include "../src/json_document.hpp"
 #include "primseg/cut.hpp"
+#include "primseg/relations.hpp"
 
 namespace primseg::cli {
 
@@ -63,7 +64,11 @@ void write_level_outputs(const Hierarchy& hierarchy, const Mesh& mesh,
                          const std::vector<ClusterReport>& reports, const OutputFiles& files,
                          const nlohmann::json& summary);
 
-/// A short human-readable table of the largest clusters, on stdout.
-void print_summary(const std::vector<ClusterReport>& reports, std::size_t max_rows = 12);
+/// The JSON's "relations": [{"kind": "parallel", "clusters": [0, 3]}, ...].
+nlohmann::json relations_json(const std::vector<ClusterRelation>& relations);
+
+/// A short human-readable table of the largest clusters, then the relations, on stdout.
+void print_summary(const std::vector<ClusterReport>& reports,
+                   const std::vector<ClusterRelation>& relations = {}, std::size_t max_rows = 12);
 
 }  // namespace primseg::cli

@@ -22,7 +22,7 @@ Command add_segment_command(CLI::App& app) {
       ->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl; - for standard input)")
       ->required();
   add_level_options(*segment, o->level);
-  add_refine_option(*segment, o->level);
+  add_fit_options(*segment, o->level);
   add_limit_options(*segment, o->limits, kHierarchyBytesPerFace);
   segment->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
       ->capture_default_str();

@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -33,6 +34,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "grid_mesh.hpp"
@@ -43,6 +45,7 @@
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh_distance.hpp"
 #include "primseg/refine.hpp"
+#include "primseg/relations.hpp"
 #include "primseg/render.hpp"
 #include "primseg/skeleton.hpp"
 #include "primseg/skeleton_gltf.hpp"
@@ -286,6 +289,28 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
     fail("snap report: fallbacks", report.fallbacks);
 }
 
+// Relations: two or more clusters, increasing; a parallel group shares one direction up to
+// sign, and a coaxial set holds cylinders only.
+void check_relations(const std::vector<Primitive>& primitives,
+                     const std::vector<ClusterRelation>& relations, const std::string& what) {
+  for (const ClusterRelation& relation : relations) {
+    const auto& members = relation.clusters;
+    if (members.size() < 2 || !std::is_sorted(members.begin(), members.end()) ||
+        std::adjacent_find(members.begin(), members.end()) != members.end() ||
+        members.back() >= primitives.size())
+      fail((what + ": relation members").c_str(), double(members.size()));
+    const Vec3& direction = primitives[members[0]].axis;
+    for (const std::uint32_t c : members) {
+      const Primitive& p = primitives[c];
+      if (relation.kind == ClusterRelation::Kind::Coaxial && p.type != PrimitiveType::Cylinder)
+        fail((what + ": coaxial non-cylinder").c_str(), c);
+      const Vec3 a{std::abs(p.axis[0]), std::abs(p.axis[1]), std::abs(p.axis[2])},
+          b{std::abs(direction[0]), std::abs(direction[1]), std::abs(direction[2])};
+      if (a != b) fail((what + ": related directions differ").c_str(), c);
+    }
+  }
+}
+
 // The clusters a snap used (Denoiser::snapped_level): numbered as a Segmentation, none empty,
 // one report each, and borders on the denoised mesh.
 void check_snapped_level(const Mesh& denoised, const SnappedLevel& level,
@@ -311,23 +336,7 @@ void check_snapped_level(const Mesh& denoised, const SnappedLevel& level,
   }
   const std::vector<Primitive> primitives = cluster_primitives(level.clusters);
   check_borders(denoised, cluster_borders(denoised, level.labels, primitives));
-  // Relations: two or more clusters, increasing; a parallel group shares one direction up to
-  // sign, and a coaxial set holds cylinders only.
-  for (const ClusterRelation& relation : level.relations) {
-    const auto& members = relation.clusters;
-    if (members.size() < 2 || !std::is_sorted(members.begin(), members.end()) ||
-        std::adjacent_find(members.begin(), members.end()) != members.end() || members.back() >= k)
-      fail("snapped level: relation members", double(members.size()));
-    const Vec3& direction = primitives[members[0]].axis;
-    for (const std::uint32_t c : members) {
-      const Primitive& p = primitives[c];
-      if (relation.kind == ClusterRelation::Kind::Coaxial && p.type != PrimitiveType::Cylinder)
-        fail("snapped level: coaxial non-cylinder", c);
-      const Vec3 a{std::abs(p.axis[0]), std::abs(p.axis[1]), std::abs(p.axis[2])},
-          b{std::abs(direction[0]), std::abs(direction[1]), std::abs(direction[2])};
-      if (a != b) fail("snapped level: related directions differ", c);
-    }
-  }
+  check_relations(primitives, level.relations, "snapped level");
 }
 
 Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
@@ -353,6 +362,24 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
   results.borders = cluster_borders(*mesh, results.refined.segmentation.labels,
                                     cluster_primitives(results.refined.reports));
   check_borders(*mesh, results.borders);
+
+  // Relations made exact: members' reports refitted and valid, every other one untouched.
+  std::vector<ClusterReport> regularized = results.refined.reports;
+  const std::vector<ClusterRelation> relations =
+      regularize_clusters(hierarchy, results.refined.segmentation, regularized);
+  check_reports(hierarchy, results.refined.segmentation, regularized);
+  check_relations(cluster_primitives(regularized), relations, "regularized level");
+  std::vector<bool> related(regularized.size(), false);
+  for (const ClusterRelation& relation : relations)
+    for (const std::uint32_t c : relation.clusters) related[c] = true;
+  for (std::size_t c = 0; c < regularized.size(); ++c) {
+    const ClusterReport &a = regularized[c], &b = results.refined.reports[c];
+    if (!related[c] &&
+        (a.primitive.axis != b.primitive.axis || a.primitive.point != b.primitive.point ||
+         std::bit_cast<std::uint64_t>(a.rms) != std::bit_cast<std::uint64_t>(b.rms) ||
+         std::bit_cast<std::uint64_t>(a.max) != std::bit_cast<std::uint64_t>(b.max)))
+      fail("regularized level: a cluster outside every relation changed", double(c));
+  }
 
   results.skeleton = extract_skeleton(hierarchy, results.level);
   results.skin = compute_skin_weights(*mesh, results.skeleton);

@@ -67,8 +67,18 @@ class Hierarchy:
         tolerance: float | None = None,
         relative_tolerance: float | None = None,
         refine: int = 0,
+        regularize: bool = False,
     ) -> list[dict[str, Any]]: ...
     def borders(
+        self,
+        k: _Level = None,
+        *,
+        tolerance: float | None = None,
+        relative_tolerance: float | None = None,
+        refine: int = 0,
+        regularize: bool = False,
+    ) -> list[dict[str, Any]]: ...
+    def relations(
         self,
         k: _Level = None,
         *,

@@ -31,6 +31,7 @@
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
 #include "primseg/refine.hpp"
+#include "primseg/relations.hpp"
 #include "primseg/render.hpp"
 #include "primseg/skeleton.hpp"
 #include "primseg/skeleton_gltf.hpp"
@@ -399,23 +400,32 @@ const char* kRefineArgument =
   better, and the primitives are refitted. Raises InvalidInputError (a ValueError) outside
   0..1000.)";
 
+const char* kRegularizeArgument =
+    R"(regularize: make the fits' relations exact (the CLI's --regularize): plane normals and
+  cylinder axes that agree within their uncertainty share one direction, and cylinders one axis
+  line; Hierarchy.relations() lists them.)";
+
 // The level, refined by up to `refine` boundary passes (0: as cut), with its cluster reports when
-// `reports` is given: what the CLI's --refine N writes.
+// `reports` is given, and their relations made exact when `relations` is given too: what the
+// CLI's --refine N and --regularize write.
 Segmentation refined_level(const Hierarchy& hierarchy, const LevelArguments& level,
-                           std::int64_t refine, std::vector<ClusterReport>* reports) {
+                           std::int64_t refine, std::vector<ClusterReport>* reports,
+                           std::vector<ClusterRelation>* relations = nullptr) {
   if (refine < 0 || refine > kMaxRefinePasses)
     throw InvalidInputError("refine must be a number of passes in [0, " +
                             std::to_string(kMaxRefinePasses) + "], not " + std::to_string(refine));
   Segmentation segmentation = cut_level(hierarchy, level);
-  if (refine == 0) {
-    if (reports) *reports = describe_clusters(hierarchy, segmentation);
-    return segmentation;
+  if (refine > 0) {
+    BoundaryRefinementOptions options;
+    options.max_passes = static_cast<std::uint32_t>(refine);
+    RefinedLevel refined = refine_boundaries(hierarchy, segmentation, options);
+    segmentation = std::move(refined.segmentation);
+    if (reports) *reports = std::move(refined.reports);
+  } else if (reports) {
+    *reports = describe_clusters(hierarchy, segmentation);
   }
-  BoundaryRefinementOptions options;
-  options.max_passes = static_cast<std::uint32_t>(refine);
-  RefinedLevel refined = refine_boundaries(hierarchy, segmentation, options);
-  if (reports) *reports = std::move(refined.reports);
-  return std::move(refined.segmentation);
+  if (reports && relations) *relations = regularize_clusters(hierarchy, segmentation, *reports);
+  return segmentation;
 }
 
 // write_mesh's `positions`: (n, 3) finite floats for the n vertices of `mesh`.
@@ -474,6 +484,18 @@ py::dict cluster_dict(const ClusterReport& report) {
 }
 
 // A border as the CLI's --json "borders" writes it.
+// The CLI's JSON "relations": one dict {kind, clusters} per relation.
+py::list relations_list(const std::vector<ClusterRelation>& relations) {
+  py::list list;
+  for (const ClusterRelation& relation : relations) {
+    py::dict related;
+    related["kind"] = std::string(to_string(relation.kind));
+    related["clusters"] = py::cast(relation.clusters);
+    list.append(related);
+  }
+  return list;
+}
+
 py::dict border_dict(const ClusterBorder& border) {
   py::list curves;
   for (const BorderCurve& curve : border.curves) {
@@ -1145,12 +1167,14 @@ labels as the CLI's --labels.)",
       .def(
           "clusters",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
-             std::optional<double> relative_tolerance, std::int64_t refine) {
+             std::optional<double> relative_tolerance, std::int64_t refine, bool regularize) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterReport> reports;
             {
               py::gil_scoped_release release;
-              refined_level(*self.hierarchy, level, refine, &reports);
+              std::vector<ClusterRelation> relations;
+              refined_level(*self.hierarchy, level, refine, &reports,
+                            regularize ? &relations : nullptr);
             }
             py::list clusters;
             for (const ClusterReport& report : reports) clusters.append(cluster_dict(report));
@@ -1158,14 +1182,16 @@ labels as the CLI's --labels.)",
           },
           py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
           py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
+          py::arg("regularize") = false,
           join_docs(
-              {R"(clusters(k=None, *, tolerance=None, relative_tolerance=None, refine=0) -> list of dict
+              {R"(clusters(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False) -> list of dict
 
 One dict per cluster, in label order, with the keys and values of the CLI's --json "clusters":
 id, type ("plane", "cylinder", "sphere"), faces (count), area, rms, max, and params (input
 units: plane {normal, point}, sphere {center, radius}, cylinder {axis, point, radius}; vectors
 as lists). json.dumps() takes it as it is.)",
-               kLevelArguments, kRefineArgument, cpp_doc("ClusterReport", doc::cut__ClusterReport),
+               kLevelArguments, kRefineArgument, kRegularizeArgument,
+               cpp_doc("ClusterReport", doc::cut__ClusterReport),
                cpp_doc("ClusterReport::rms", doc::cut__ClusterReport__rms),
                cpp_doc("ClusterReport::max", doc::cut__ClusterReport__max),
                cpp_doc("named_parameters", doc::primitive__named_parameters)})
@@ -1173,14 +1199,15 @@ as lists). json.dumps() takes it as it is.)",
       .def(
           "borders",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
-             std::optional<double> relative_tolerance, std::int64_t refine) {
+             std::optional<double> relative_tolerance, std::int64_t refine, bool regularize) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterBorder> borders;
             {
               py::gil_scoped_release release;
               std::vector<ClusterReport> reports;
-              const Segmentation segmentation =
-                  refined_level(*self.hierarchy, level, refine, &reports);
+              std::vector<ClusterRelation> relations;
+              const Segmentation segmentation = refined_level(
+                  *self.hierarchy, level, refine, &reports, regularize ? &relations : nullptr);
               borders = cluster_borders(self.hierarchy->mesh(), segmentation.labels,
                                         cluster_primitives(reports));
             }
@@ -1190,18 +1217,45 @@ as lists). json.dumps() takes it as it is.)",
           },
           py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
           py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
+          py::arg("regularize") = false,
           join_docs(
-              {R"(borders(k=None, *, tolerance=None, relative_tolerance=None, refine=0) -> list of dict
+              {R"(borders(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False) -> list of dict
 
 Where the clusters of the level meet, as the CLI's --json "borders": one dict per border with
 clusters (a, b), b None along the mesh's open boundary; edges (count); length (input units);
 angle (degrees between the two fitted surfaces across it: 0 tangent, 90 a box's edge; None on
 the open boundary); and curves, a list of dicts {closed, vertices} with the vertex indices in
 order along each curve. json.dumps() takes it as it is.)",
-               kLevelArguments, kRefineArgument,
+               kLevelArguments, kRefineArgument, kRegularizeArgument,
                cpp_doc("cluster_borders", doc::borders__cluster_borders),
                cpp_doc("ClusterBorder::angle", doc::borders__ClusterBorder__angle),
                cpp_doc("ClusterBorder::curves", doc::borders__ClusterBorder__curves)})
+              .c_str())
+      .def(
+          "relations",
+          [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
+             std::optional<double> relative_tolerance, std::int64_t refine) {
+            const LevelArguments level{std::move(k), tolerance, relative_tolerance};
+            std::vector<ClusterRelation> relations;
+            {
+              py::gil_scoped_release release;
+              std::vector<ClusterReport> reports;
+              refined_level(*self.hierarchy, level, refine, &reports, &relations);
+            }
+            return relations_list(relations);
+          },
+          py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
+          py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
+          join_docs(
+              {R"(relations(k=None, *, tolerance=None, relative_tolerance=None, refine=0) -> list of dict
+
+The design intent among the level's fits, as the CLI's --regularize writes it in the JSON's
+"relations": one dict per relation with kind ("parallel": plane normals and cylinder axes of one
+direction; "coaxial": cylinders of one axis line) and clusters (their labels, increasing).
+clusters(..., regularize=True) gives the primitives with these relations made exact.)",
+               kLevelArguments, kRefineArgument,
+               cpp_doc("regularize_clusters", doc::relations__regularize_clusters),
+               cpp_doc("relations.hpp", doc::relations__file)})
               .c_str())
       .def(
           "auto_level",
@@ -1524,16 +1578,9 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
           for (const ClusterBorder& border : borders) border_list.append(border_dict(border));
           const auto face_count = static_cast<py::ssize_t>(snapped.labels.size());
           snapped_dict["labels"] = adopt<std::int32_t>(std::move(snapped.labels), {face_count});
-          py::list relations;
-          for (const ClusterRelation& relation : snapped.relations) {
-            py::dict related;
-            related["kind"] = std::string(to_string(relation.kind));
-            related["clusters"] = py::cast(relation.clusters);
-            relations.append(related);
-          }
           snapped_dict["clusters"] = clusters;
           snapped_dict["borders"] = border_list;
-          snapped_dict["relations"] = relations;
+          snapped_dict["relations"] = relations_list(snapped.relations);
           result.append(snapped_dict);
         }
         return py::tuple(result);

@@ -198,26 +198,6 @@ std::optional<Primitive> fit_curved(const Primitive& start, std::span<const Vec3
   return fit.primitive;
 }
 
-// A cluster's inliers: its vertices within `threshold` robust deviations (1.4826 × the median
-// distance, at least `floor`) of the primitive.
-void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
-                  std::span<const double> weights, double threshold, double floor,
-                  std::vector<Vec3>& kept_points, std::vector<double>& kept_weights) {
-  std::vector<double> residuals;
-  residuals.reserve(points.size());
-  for (const Vec3& p : points) residuals.push_back(primitive.distance(p));
-  std::vector<double> sorted = residuals;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double limit = std::max(threshold * 1.4826 * sorted[sorted.size() / 2], floor);
-  kept_points.clear();
-  kept_weights.clear();
-  for (std::size_t i = 0; i < points.size(); ++i)
-    if (residuals[i] <= limit) {
-      kept_points.push_back(points[i]);
-      kept_weights.push_back(weights[i]);
-    }
-}
-
 }  // namespace
 
 void validate(const DenoiseOptions& options) {
@@ -433,8 +413,8 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
     std::vector<double> kept_weights;
     constexpr int kRounds = 3;
     for (int round = 0; round < kRounds; ++round) {
-      keep_inliers(current, points[c], weights[c], options_.refit_outlier_threshold, floor,
-                   kept_points, kept_weights);
+      detail::keep_inliers(current, points[c], weights[c], options_.refit_outlier_threshold, floor,
+                           kept_points, kept_weights);
       const std::optional<Primitive> refit =
           type == PrimitiveType::Plane
               ? fit_plane(kept_points, kept_weights, to_eigen(current.axis))
@@ -446,33 +426,13 @@ void Denoiser::refit(const Segmentation& segmentation, std::vector<Primitive>& p
   });
 }
 
-std::string_view to_string(ClusterRelation::Kind kind) {
-  return kind == ClusterRelation::Kind::Parallel ? "parallel" : "coaxial";
-}
-
 std::vector<ClusterRelation> Denoiser::regularize(const std::vector<std::vector<Vec3>>& points,
                                                   const std::vector<std::vector<double>>& weights,
                                                   std::vector<Primitive>& primitives) const {
-  std::vector<std::vector<Vec3>> inlier_points(primitives.size());
-  std::vector<std::vector<double>> inlier_weights(primitives.size());
-  const double floor = 1e-12 * bounding_box_diagonal(mesh_);
-  for (std::size_t c = 0; c < primitives.size(); ++c)
-    if (!points[c].empty())
-      keep_inliers(primitives[c], points[c], weights[c], options_.refit_outlier_threshold, floor,
-                   inlier_points[c], inlier_weights[c]);
   detail::RegularityOptions regularity;
   regularity.significance = options_.relation_significance;
-  std::vector<ClusterRelation> relations;
-  for (const detail::Relation& relation :
-       detail::regularize(primitives, inlier_points, inlier_weights, regularity)) {
-    ClusterRelation& related = relations.emplace_back();
-    related.kind = relation.kind == detail::Relation::Kind::Parallel
-                       ? ClusterRelation::Kind::Parallel
-                       : ClusterRelation::Kind::Coaxial;
-    for (const std::size_t c : relation.members)
-      related.clusters.push_back(static_cast<std::uint32_t>(c));
-  }
-  return relations;
+  return detail::regularize_inliers(primitives, points, weights, options_.refit_outlier_threshold,
+                                    1e-12 * bounding_box_diagonal(mesh_), regularity);
 }
 
 void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,

@@ -17,6 +17,12 @@
 namespace primseg::detail {
 namespace {
 
+// A fit's residual deviation is never taken below this fraction of its size (a plane's extent,
+// a cylinder's radius). An exact input (a CAD tessellation) has residuals of rounding only, which
+// would make every direction and axis certain beyond its own rounding and no two of them equal;
+// any measured surface has residuals far above it.
+constexpr double kResolution = 1e-9;
+
 // A primitive with a direction (a plane's normal, a cylinder's axis) and how well its inliers
 // determine it.
 struct Oriented {
@@ -60,7 +66,9 @@ std::optional<Oriented> oriented_plane(std::size_t cluster, std::span<const Vec3
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
   item.direction = eigen.eigenvectors().col(0);
-  const double residual_variance = std::max(eigen.eigenvalues()(0), 0.0) / double(n - 3);
+  const double extent2 = std::max(eigen.eigenvalues()(2), 0.0) / double(n);
+  const double residual_variance = std::max(std::max(eigen.eigenvalues()(0), 0.0) / double(n - 3),
+                                            kResolution * kResolution * extent2);
   if (!(eigen.eigenvalues()(1) > 0)) return std::nullopt;
   item.frame.col(0) = eigen.eigenvectors().col(1);
   item.frame.col(1) = eigen.eigenvectors().col(2);
@@ -104,7 +112,8 @@ std::optional<Oriented> oriented_cylinder(std::size_t cluster, const Primitive& 
     information += j * j.transpose();
   }
   const Eigen::Matrix<double, 5, 5> covariance =
-      information.inverse() * (residuals / double(n - 5));
+      information.inverse() *
+      std::max(residuals / double(n - 5), kResolution * kResolution * radius * radius);
   if (!covariance.allFinite()) return std::nullopt;
   item.covariance = covariance.topLeftCorner<2, 2>() / (radius * radius);
   item.variance = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(item.covariance).eigenvalues()(1);
@@ -186,9 +195,13 @@ std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::
   fit.radii.assign(x.data() + 2, x.data() + 2 + m);
   for (Eigen::Index k = 0; k < m; ++k)
     fit.rms.push_back(
-        std::sqrt(member_squares[k] / double(std::max<std::size_t>(member_count[k], 1))));
-  fit.centre_covariance = normal.inverse().topLeftCorner<2, 2>() *
-                          (squares / static_cast<double>(count - static_cast<std::size_t>(2 + m)));
+        std::max(std::sqrt(member_squares[k] / double(std::max<std::size_t>(member_count[k], 1))),
+                 kResolution * fit.radii[static_cast<std::size_t>(k)]));
+  const double largest_radius = x.tail(m).maxCoeff();
+  fit.centre_covariance =
+      normal.inverse().topLeftCorner<2, 2>() *
+      std::max(squares / static_cast<double>(count - static_cast<std::size_t>(2 + m)),
+               kResolution * kResolution * largest_radius * largest_radius);
   if (!fit.centre_covariance.allFinite()) return std::nullopt;
   return fit;
 }
@@ -413,6 +426,49 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                     options.significance * options.significance, primitives, points, weights,
                     relations);
   }
+  return relations;
+}
+
+void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
+                  std::span<const double> weights, double threshold, double floor,
+                  std::vector<Vec3>& kept_points, std::vector<double>& kept_weights) {
+  std::vector<double> residuals;
+  residuals.reserve(points.size());
+  for (const Vec3& p : points) residuals.push_back(primitive.distance(p));
+  std::vector<double> sorted = residuals;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit = std::max(threshold * 1.4826 * sorted[sorted.size() / 2], floor);
+  kept_points.clear();
+  kept_weights.clear();
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (residuals[i] <= limit) {
+      kept_points.push_back(points[i]);
+      kept_weights.push_back(weights[i]);
+    }
+}
+
+std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitives,
+                                                const std::vector<std::vector<Vec3>>& points,
+                                                const std::vector<std::vector<double>>& weights,
+                                                double outlier_threshold, double floor,
+                                                const RegularityOptions& options) {
+  std::vector<std::vector<Vec3>> inlier_points(primitives.size());
+  std::vector<std::vector<double>> inlier_weights(primitives.size());
+  for (std::size_t c = 0; c < primitives.size(); ++c)
+    if (!points[c].empty())
+      keep_inliers(primitives[c], points[c], weights[c], outlier_threshold, floor, inlier_points[c],
+                   inlier_weights[c]);
+  std::vector<ClusterRelation> relations;
+  for (const Relation& relation : regularize(primitives, inlier_points, inlier_weights, options)) {
+    ClusterRelation& related = relations.emplace_back();
+    related.kind = relation.kind == Relation::Kind::Parallel ? ClusterRelation::Kind::Parallel
+                                                             : ClusterRelation::Kind::Coaxial;
+    for (const std::size_t c : relation.members)
+      related.clusters.push_back(static_cast<std::uint32_t>(c));
+  }
+  std::sort(relations.begin(), relations.end(), [](const auto& a, const auto& b) {
+    return a.kind != b.kind ? a.kind < b.kind : a.clusters < b.clusters;
+  });
   return relations;
 }
 

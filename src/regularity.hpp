@@ -5,9 +5,11 @@
 // whose axes agree share one axis line.
 
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "primseg/primitive.hpp"
+#include "primseg/relations.hpp"
 
 namespace primseg::detail {
 
@@ -42,5 +44,20 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,
                                  const RegularityOptions& options);
+
+/// A cluster's inliers: its points within `threshold` robust deviations (1.4826 × the median
+/// distance, at least `floor`) of `primitive`, with their weights. `points` is not empty.
+void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
+                  std::span<const double> weights, double threshold, double floor,
+                  std::vector<Vec3>& kept_points, std::vector<double>& kept_weights);
+
+/// regularize() on each cluster's inliers (keep_inliers() of points[c], weights[c] about
+/// primitives[c]; an empty cluster stays out), as relations between the indices of `primitives`
+/// ordered by kind (parallel first), then by their clusters.
+std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitives,
+                                                const std::vector<std::vector<Vec3>>& points,
+                                                const std::vector<std::vector<double>>& weights,
+                                                double outlier_threshold, double floor,
+                                                const RegularityOptions& options);
 
 }  // namespace primseg::detail

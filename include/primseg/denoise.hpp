@@ -25,6 +25,7 @@
 #include "primseg/cut.hpp"
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh.hpp"
+#include "primseg/relations.hpp"
 
 namespace primseg {
 
@@ -152,24 +153,6 @@ struct SnapReport {
   double mean_move = 0;  ///< over moved vertices, input units (0 when none moved)
   double max_move = 0;   ///< input units
 };
-
-/// A relation between clusters' primitives that the snap made exact
-/// (DenoiseOptions::relation_significance): design intent recovered from the fits.
-struct ClusterRelation {
-  enum class Kind {
-    /// Plane normals and cylinder axes made one direction (each keeps its side): opposite faces
-    /// of a box, a cylinder and its caps.
-    Parallel,
-    /// Cylinders of one direction made one axis line, each keeping its radius: a stepped shaft,
-    /// the fragments of one cylinder. Every coaxial set is also part of a Parallel relation.
-    Coaxial,
-  };
-  Kind kind = Kind::Parallel;
-  std::vector<std::uint32_t> clusters;  ///< labels of the snapped level, increasing; two or more
-};
-
-/// "parallel" or "coaxial".
-std::string_view to_string(ClusterRelation::Kind kind);
 
 /// The clusters a snap moved the vertices onto (Denoiser::snapped_level): the level it was given,
 /// after relabelling (DenoiseOptions::relabel_passes), with each cluster's primitive after the

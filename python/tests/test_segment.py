@@ -50,6 +50,33 @@ def test_borders_match_the_cli(cli, fandisk, fandisk_tree, tmp_path, cli_level, 
     assert json.loads(json.dumps(borders)) == json.loads((tmp_path / "c.json").read_text())["borders"]
 
 
+def test_regularized_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path):
+    run_cli(cli, "segment", fandisk, "--clusters", "30", "--refine", "2", "--regularize",
+            "--json", tmp_path / "c.json", "--quiet")
+    expected = json.loads((tmp_path / "c.json").read_text())
+    relations = fandisk_tree.relations(30, refine=2)
+    assert relations == expected["relations"]
+    clusters = fandisk_tree.clusters(30, refine=2, regularize=True)
+    assert clusters == expected["clusters"]
+    borders = fandisk_tree.borders(30, refine=2, regularize=True)
+    assert json.loads(json.dumps(borders)) == expected["borders"]
+    # The relations are exact: one direction per parallel group, one axis line per coaxial set.
+    kinds = {r["kind"] for r in relations}
+    assert kinds == {"parallel", "coaxial"}
+    for relation in relations:
+        params = [clusters[c]["params"] for c in relation["clusters"]]
+        directions = [np.array(p.get("normal", p.get("axis"))) for p in params]
+        for d in directions:
+            assert np.array_equal(d, directions[0]) or np.array_equal(d, -directions[0])
+        if relation["kind"] == "coaxial":
+            axis, point = directions[0], np.array(params[0]["point"])
+            for p in params:
+                offset = np.array(p["point"]) - point
+                assert np.linalg.norm(np.cross(offset, axis)) < 1e-12
+    # Without regularize, the fits are the level's own.
+    assert fandisk_tree.clusters(30, refine=2) != clusters
+
+
 def test_borders_of_a_capped_cylinder_are_two_circles_at_right_angles():
     V, F, regions = capped_cylinder()
     tree = primseg.segment(V, F)

@@ -21,6 +21,7 @@
 #include "primseg/mesh.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitive.hpp"
+#include "primseg/relations.hpp"
 #include "primseg/shape_generator.hpp"
 #include "support/test_support.hpp"
 
@@ -971,6 +972,64 @@ TEST(Cli, RefineReportsItsPassesAndKeepsEveryFaceLabelled) {
   EXPECT_LE(j["level"]["refinement"]["passes"].get<int>(), 3);
   EXPECT_TRUE(j["timing"].contains("refine_seconds"));
   expect_valid_labels(read_labels(dir / "l.txt"), shape.mesh.face_count(), 7);
+}
+
+// --regularize: the JSON lists the relations made exact, the primitives are the library's
+// regularize_clusters() on the same level, and the text summary lists them too.
+TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
+  TempDir dir("regularize");
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.edge_length = 0.04;
+  options.noise = 0.002;
+  options.seed = 2;
+  options.random_motion = true;
+  write_mesh(dir / "in.off", make_shape("box_with_hole", options).mesh);
+  const Mesh mesh = read_mesh(dir / "in.off");
+  const Hierarchy hierarchy = build_hierarchy(mesh);
+  const Segmentation cut = cut_by_count(hierarchy, 7);
+  std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
+  const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, reports);
+  ASSERT_EQ(relations.size(), 3u);  // top, bottom and the hole's axis; two pairs of sides
+
+  const CliRun text = run("segment " + dir.q("in.off") + " --clusters 7 --regularize --tree " +
+                          dir.q("t.tree") + " --json " + dir.q("s.json"));
+  ASSERT_EXIT_OK(text);
+  ASSERT_EXIT_OK(run("cut " + dir.q("t.tree") + " --clusters 7 --regularize --quiet --json " +
+                     dir.q("c.json")));
+  for (const char* file : {"s.json", "c.json"}) {
+    SCOPED_TRACE(file);
+    const json j = read_json(dir / file);
+    ASSERT_EQ(j["relations"].size(), relations.size());
+    for (std::size_t i = 0; i < relations.size(); ++i) {
+      EXPECT_EQ(j["relations"][i]["kind"], std::string(to_string(relations[i].kind)));
+      EXPECT_EQ(j["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
+                relations[i].clusters);
+    }
+    ASSERT_EQ(j["clusters"].size(), reports.size());
+    for (std::size_t c = 0; c < reports.size(); ++c) {
+      const json& cluster = j["clusters"][c];
+      const Primitive& p = reports[c].primitive;
+      EXPECT_EQ(cluster["rms"].get<double>(), reports[c].rms) << c;
+      const char* direction = p.type == PrimitiveType::Plane ? "normal" : "axis";
+      EXPECT_EQ(cluster["params"][direction].get<std::vector<double>>(),
+                std::vector<double>(p.axis.begin(), p.axis.end()))
+          << c;
+    }
+  }
+  for (const ClusterRelation& relation : relations) {
+    std::string line = std::string(to_string(relation.kind)) + ":";
+    for (const std::uint32_t c : relation.clusters) line += " " + std::to_string(c);
+    EXPECT_NE(text.output.find(line + "\n"), std::string::npos) << line << "\n" << text.output;
+  }
+  // Without it, neither the relations nor the changed fits.
+  ASSERT_EXIT_OK(
+      run("segment " + dir.q("in.off") + " --clusters 7 --quiet --json " + dir.q("plain.json")));
+  const json plain = read_json(dir / "plain.json");
+  EXPECT_FALSE(plain.contains("relations"));
+  const std::vector<ClusterReport> unregularized = describe_clusters(hierarchy, cut);
+  EXPECT_EQ(plain["clusters"][0]["rms"].get<double>(), unregularized[0].rms);
+  EXPECT_NE(plain["clusters"][0]["rms"].get<double>(), reports[0].rms);
 }
 
 TEST(Cli, EvalScoresTheGeneratedShapes) {

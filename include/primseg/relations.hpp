@@ -1,0 +1,72 @@
+#pragma once
+/// @file relations.hpp
+/// Design intent between the fitted primitives of a segmentation: plane normals and cylinder axes
+/// that agree within their fits' uncertainty (opposite faces of a box, a shaft and its end faces)
+/// and cylinders that share an axis line (a stepped shaft, the fragments of one bore). Making
+/// these relations exact is what reverse engineering wants of a scanned part's fits: a box with
+/// parallel faces, a shaft with one axis (after GlobFit, Li et al. 2011).
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "primseg/cut.hpp"
+#include "primseg/hierarchy.hpp"
+
+namespace primseg {
+
+/// A relation between clusters' primitives, made exact.
+struct ClusterRelation {
+  enum class Kind {
+    /// Plane normals and cylinder axes made one direction (each keeps its side): opposite faces
+    /// of a box, a cylinder and its caps.
+    Parallel,
+    /// Cylinders of one direction made one axis line, each keeping its radius: a stepped shaft,
+    /// the fragments of one cylinder. Every coaxial set is also part of a Parallel relation.
+    Coaxial,
+  };
+  Kind kind = Kind::Parallel;
+  std::vector<std::uint32_t> clusters;  ///< cluster labels, increasing; two or more
+};
+
+/// "parallel" or "coaxial".
+std::string_view to_string(ClusterRelation::Kind kind);
+
+/// Options of regularize_clusters().
+struct RelationOptions {
+  /// A direction joins a group when its tilt from the group's direction is within this many
+  /// standard deviations of the two estimates (Mahalanobis). Larger joins more. > 0.
+  double significance = 3.0;
+  /// ... and never when the tilt is larger than this, whatever the uncertainty (degrees, in
+  /// (0, 90)).
+  double max_angle_degrees = 20.0;
+  /// The directions and the refits use each cluster's inlier vertices: those within this many
+  /// robust deviations (1.4826 × the median distance) of its primitive. > 0.
+  double outlier_threshold = 2.5;
+};
+
+/// Throws InvalidInputError when an option is out of its range.
+void validate(const RelationOptions& options);
+
+/// Finds the parallel and coaxial relations among the primitives of a level's clusters and makes
+/// them exact, in place.
+///
+/// `reports` are the level's clusters as describe_clusters() or refine_boundaries() report them
+/// (reports[c] is label c of `segmentation`; shape (K)). Only planes and cylinders take part.
+/// Each cluster's direction and its uncertainty come from its inlier vertices (each mesh vertex
+/// once, weighted by its corners' weights in the hierarchy); clusters with too few vertices to
+/// estimate it (6 for a plane, 12 for a cylinder) stay out. Every member of a relation is
+/// refitted: a plane through its inliers' weighted centroid with the group's normal, a cylinder
+/// by geometric least squares with the group's axis direction, jointly with the cylinders coaxial
+/// with it (one axis line, one radius each). Its report's `primitive`, `rms` and `max` are
+/// replaced (`rms` and `max` measured as describe_clusters() does, on all the cluster's
+/// vertices); every other report is left bit for bit. Deterministic, O(F log F).
+///
+/// Returns the relations made exact, ordered by kind (parallel first), then by their clusters.
+/// Throws InvalidInputError when the segmentation or the reports do not match the hierarchy.
+std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
+                                                 const Segmentation& segmentation,
+                                                 std::vector<ClusterReport>& reports,
+                                                 const RelationOptions& options = {});
+
+}  // namespace primseg

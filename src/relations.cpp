@@ -1,0 +1,115 @@
+#include "primseg/relations.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <tuple>
+
+#include "primseg/error.hpp"
+#include "primseg/geometric_fit.hpp"
+#include "regularity.hpp"
+#include "working_primitive.hpp"
+
+namespace primseg {
+
+std::string_view to_string(ClusterRelation::Kind kind) {
+  return kind == ClusterRelation::Kind::Parallel ? "parallel" : "coaxial";
+}
+
+void validate(const RelationOptions& options) {
+  if (!(options.significance > 0) || !std::isfinite(options.significance))
+    throw InvalidInputError("relations: the significance must be a positive number");
+  if (!(options.max_angle_degrees > 0 && options.max_angle_degrees < 90))
+    throw InvalidInputError("relations: the largest angle must be in (0, 90) degrees");
+  if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
+    throw InvalidInputError("relations: the outlier threshold must be a positive number");
+}
+
+std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
+                                                 const Segmentation& segmentation,
+                                                 std::vector<ClusterReport>& reports,
+                                                 const RelationOptions& options) {
+  validate(options);
+  const Mesh& mesh = hierarchy.mesh();
+  const DualGraph& graph = hierarchy.graph();
+  const WorkingFrame& frame = graph.frame();
+  const std::uint32_t k = segmentation.cluster_count();
+  if (segmentation.labels.size() != mesh.face_count() || reports.size() != k)
+    throw InvalidInputError(
+        "regularize_clusters: the segmentation or the reports do not match "
+        "the mesh");
+  for (const std::uint32_t label : segmentation.labels)
+    if (label >= k)
+      throw InvalidInputError("regularize_clusters: a label is not below the cluster count");
+
+  // Each cluster's vertices once, weighted by the sum of their corners' weights in it (working
+  // frame): repeated corners would make the directions look better determined than they are.
+  std::vector<std::tuple<std::uint32_t, std::uint32_t, double>> corners;
+  corners.reserve(3 * static_cast<std::size_t>(mesh.triangle_count()));
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::uint32_t c = segmentation.labels[mesh.face_of_triangle[t]];
+    const Triangle vertices = graph.corners(t);
+    const std::array<double, 3> weights = graph.corner_weights(t);
+    for (int i = 0; i < 3; ++i) corners.emplace_back(c, vertices[i], weights[i]);
+  }
+  std::sort(corners.begin(), corners.end(), [](const auto& a, const auto& b) {
+    return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
+  });
+  std::vector<std::vector<Vec3>> points(k);
+  std::vector<std::vector<double>> weights(k);
+  for (std::size_t i = 0; i < corners.size();) {
+    const auto [c, v, first_weight] = corners[i];
+    double weight = 0;
+    for (; i < corners.size() && std::get<0>(corners[i]) == c && std::get<1>(corners[i]) == v; ++i)
+      weight += std::get<2>(corners[i]);
+    // Like the fits, a vertex of zero-area triangles only weighs nothing and is left out.
+    if (!(weight > 0)) continue;
+    const Eigen::Vector3d& x = graph.position(v);
+    points[c].push_back({x.x(), x.y(), x.z()});
+    weights[c].push_back(weight);
+  }
+
+  std::vector<Primitive> primitives;
+  primitives.reserve(k);
+  for (const ClusterReport& report : reports)
+    primitives.push_back(detail::to_working(frame, report.primitive));
+  detail::RegularityOptions regularity;
+  regularity.significance = options.significance;
+  regularity.max_angle_degrees = options.max_angle_degrees;
+  // The working frame's bounding box fits in [-1, 1]³.
+  const double floor = 1e-12 * bounding_box_diagonal(mesh) / frame.scale();
+  std::vector<ClusterRelation> relations = detail::regularize_inliers(
+      primitives, points, weights, options.outlier_threshold, floor, regularity);
+
+  // The members' new primitives, measured on every corner as describe_clusters() measures.
+  std::vector<bool> refitted(k, false);
+  for (const ClusterRelation& relation : relations)
+    for (const std::uint32_t c : relation.clusters) refitted[c] = true;
+  std::vector<std::vector<Vec3>> member_corners(k);
+  std::vector<std::vector<double>> member_weights(k);
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::uint32_t c = segmentation.labels[mesh.face_of_triangle[t]];
+    if (!refitted[c]) continue;
+    const Triangle vertices = graph.corners(t);
+    const std::array<double, 3> corner_weights = graph.corner_weights(t);
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d& x = graph.position(vertices[i]);
+      member_corners[c].push_back({x.x(), x.y(), x.z()});
+      member_weights[c].push_back(corner_weights[i]);
+    }
+  }
+  GeometricFitOptions measure_only;
+  measure_only.max_iterations = 0;
+  for (std::uint32_t c = 0; c < k; ++c) {
+    if (!refitted[c]) continue;
+    // From the reported primitive, as describe_clusters() would measure it: the same bits.
+    reports[c].primitive = frame.to_input(primitives[c]);
+    const GeometricFit measured = fit_geometric(detail::to_working(frame, reports[c].primitive),
+                                                member_corners[c], member_weights[c], measure_only);
+    reports[c].rms = std::ldexp(measured.rms, frame.exponent);
+    reports[c].max = std::ldexp(measured.max, frame.exponent);
+  }
+  return relations;
+}
+
+}  // namespace primseg

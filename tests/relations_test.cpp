@@ -1,0 +1,324 @@
+// regularize_clusters: the parallel and coaxial relations among a level's fits, made exact, on
+// generated parts whose design intent is known (exact and noisy) and on fandisk.
+#include "primseg/relations.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "primseg/auto_level.hpp"
+#include "primseg/error.hpp"
+#include "primseg/mesh_io.hpp"
+#include "primseg/shape_generator.hpp"
+#include "support/test_support.hpp"
+
+namespace primseg {
+namespace {
+
+using Groups = std::vector<std::vector<std::uint32_t>>;
+
+GroundTruthShape noisy_shape(const std::string& name, double noise, std::uint64_t seed) {
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.edge_length = 0.04;
+  options.noise = noise;
+  options.seed = seed;
+  options.random_motion = true;
+  return make_shape(name, options);
+}
+
+double dot(const Vec3& a, const Vec3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+double angle_between_lines_degrees(const Vec3& a, const Vec3& b) {
+  return std::atan2(std::sqrt(dot(cross(a, b), cross(a, b))), std::abs(dot(a, b))) * 180 /
+         std::numbers::pi;
+}
+
+bool has_direction(const Primitive& p) {
+  return p.type == PrimitiveType::Plane || p.type == PrimitiveType::Cylinder;
+}
+
+// The region of each cluster, when the cut is the ground truth's partition (else empty).
+std::vector<std::uint32_t> region_of_clusters(const Segmentation& cut,
+                                              const GroundTruthShape& shape) {
+  constexpr std::uint32_t kUnset = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> region(cut.cluster_count(), kUnset);
+  for (std::uint32_t f = 0; f < cut.labels.size(); ++f) {
+    std::uint32_t& r = region[cut.labels[f]];
+    if (r == kUnset) r = shape.region_of_face[f];
+    if (r != shape.region_of_face[f]) return {};
+  }
+  return region;
+}
+
+// The design intent: clusters whose true planes' normals and cylinders' axes are one direction.
+Groups true_parallel_groups(const GroundTruthShape& shape,
+                            const std::vector<std::uint32_t>& region_of_cluster) {
+  Groups groups;
+  std::vector<Vec3> directions;
+  for (std::uint32_t c = 0; c < region_of_cluster.size(); ++c) {
+    const Primitive& truth = shape.regions[region_of_cluster[c]];
+    if (!has_direction(truth)) continue;
+    std::size_t g = 0;
+    while (g < groups.size() && angle_between_lines_degrees(directions[g], truth.axis) > 1e-6) ++g;
+    if (g == groups.size()) {
+      groups.emplace_back();
+      directions.push_back(truth.axis);
+    }
+    groups[g].push_back(c);
+  }
+  std::erase_if(groups, [](const auto& group) { return group.size() < 2; });
+  std::sort(groups.begin(), groups.end());
+  return groups;
+}
+
+Groups clusters_of(const std::vector<ClusterRelation>& relations, ClusterRelation::Kind kind) {
+  Groups groups;
+  for (const ClusterRelation& relation : relations)
+    if (relation.kind == kind) groups.push_back(relation.clusters);
+  return groups;
+}
+
+// Every member has the same direction, up to its side, bit for bit.
+void expect_one_direction(const std::vector<ClusterReport>& reports,
+                          const std::vector<std::uint32_t>& clusters) {
+  const Vec3& first = reports[clusters[0]].primitive.axis;
+  for (const std::uint32_t c : clusters) {
+    const Vec3& axis = reports[c].primitive.axis;
+    const double side = dot(axis, first) < 0 ? -1 : 1;
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(axis[i], side * first[i]) << "cluster " << c;
+  }
+}
+
+TEST(Relations, PartsShowTheirDesignIntentExactAndNoisy) {
+  for (const std::string name :
+       {"box", "slanted_box", "capped_cylinder", "box_with_hole", "box_with_blind_hole",
+        "box_with_boss", "box_with_dome", "stepped_block"})
+    for (const double noise : {0.0, 0.002}) {
+      SCOPED_TRACE(name + " noise " + std::to_string(noise));
+      const GroundTruthShape shape = noisy_shape(name, noise, 2);
+      const Hierarchy hierarchy = build_hierarchy(shape.mesh);
+      const Segmentation cut =
+          cut_by_count(hierarchy, static_cast<std::uint32_t>(shape.regions.size()));
+      const std::vector<std::uint32_t> region_of_cluster = region_of_clusters(cut, shape);
+      ASSERT_FALSE(region_of_cluster.empty()) << "the cut is not the ground truth";
+      std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
+      const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, reports);
+      const Groups parallel = clusters_of(relations, ClusterRelation::Kind::Parallel);
+      EXPECT_EQ(parallel, true_parallel_groups(shape, region_of_cluster));
+      // One cylinder at most: nothing to be coaxial with.
+      EXPECT_TRUE(clusters_of(relations, ClusterRelation::Kind::Coaxial).empty());
+      for (const auto& group : parallel) expect_one_direction(reports, group);
+    }
+}
+
+TEST(Relations, OppositeFacesOfANoisyBoxBecomeParallelNearerTheTruth) {
+  const GroundTruthShape box = noisy_shape("box", 0.002, 1);
+  const Hierarchy hierarchy = build_hierarchy(box.mesh);
+  const Segmentation cut = cut_by_count(hierarchy, 6);
+  const std::vector<std::uint32_t> region_of_cluster = region_of_clusters(cut, box);
+  ASSERT_EQ(region_of_cluster.size(), 6u);
+  const std::vector<ClusterReport> before = describe_clusters(hierarchy, cut);
+  std::vector<ClusterReport> after = before;
+  const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, after);
+  ASSERT_EQ(relations.size(), 3u);
+  double error_before = 0, error_after = 0;
+  for (std::uint32_t c = 0; c < 6; ++c) {
+    SCOPED_TRACE(c);
+    const Vec3& truth = box.regions[region_of_cluster[c]].axis;
+    error_before += angle_between_lines_degrees(before[c].primitive.axis, truth);
+    error_after += angle_between_lines_degrees(after[c].primitive.axis, truth);
+    EXPECT_LT(angle_between_lines_degrees(after[c].primitive.axis, truth), 0.5);
+    EXPECT_GT(dot(after[c].primitive.axis, before[c].primitive.axis), 0);  // its own side
+    // The fit was the best for the cluster alone; one direction for two costs little.
+    EXPECT_GE(after[c].rms, before[c].rms * (1 - 1e-9));
+    EXPECT_LE(after[c].rms, before[c].rms * 1.02);
+    // The tree's node, the starting fit, the area and the faces stay the cluster's.
+    EXPECT_EQ(after[c].id, before[c].id);
+    EXPECT_EQ(after[c].node, before[c].node);
+    EXPECT_EQ(after[c].algebraic.axis, before[c].algebraic.axis);
+    EXPECT_EQ(after[c].area, before[c].area);
+    EXPECT_EQ(after[c].face_count, before[c].face_count);
+  }
+  std::printf("box: summed normal errors %.4g degrees before, %.4g after\n", error_before,
+              error_after);
+  EXPECT_LT(error_after, error_before);
+  for (const ClusterRelation& relation : relations) {
+    ASSERT_EQ(relation.clusters.size(), 2u);
+    // Opposite faces: exactly opposite normals.
+    const Vec3& a = after[relation.clusters[0]].primitive.axis;
+    const Vec3& b = after[relation.clusters[1]].primitive.axis;
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(a[i], -b[i]);
+  }
+
+  // rms and max as describe_clusters measures the new primitives, bit for bit.
+  DescribeOptions measure_only;
+  measure_only.geometric_fit = false;
+  const std::vector<ClusterReport> measured =
+      describe_clusters(hierarchy, cut, cluster_primitives(after), measure_only);
+  for (std::uint32_t c = 0; c < 6; ++c) {
+    EXPECT_TRUE(testing::same_bits(measured[c].rms, after[c].rms)) << c;
+    EXPECT_TRUE(testing::same_bits(measured[c].max, after[c].max)) << c;
+  }
+}
+
+TEST(Relations, ClustersOutsideEveryRelationKeepTheirReportsBitForBit) {
+  // The dome's sphere takes no part; a box face is in no relation when its opposite is cut apart.
+  const GroundTruthShape shape = noisy_shape("box_with_dome", 0.002, 2);
+  const Hierarchy hierarchy = build_hierarchy(shape.mesh);
+  const Segmentation cut = cut_by_count(hierarchy, 7);
+  const std::vector<ClusterReport> before = describe_clusters(hierarchy, cut);
+  std::vector<ClusterReport> after = before;
+  const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, after);
+  std::vector<bool> related(7, false);
+  for (const ClusterRelation& relation : relations)
+    for (const std::uint32_t c : relation.clusters) related[c] = true;
+  int sphere = 0;
+  for (std::uint32_t c = 0; c < 7; ++c) {
+    if (before[c].primitive.type == PrimitiveType::Sphere) {
+      ++sphere;
+      EXPECT_FALSE(related[c]);
+    }
+    if (related[c]) continue;
+    EXPECT_EQ(after[c].primitive.point, before[c].primitive.point) << c;
+    EXPECT_EQ(after[c].primitive.axis, before[c].primitive.axis) << c;
+    EXPECT_TRUE(testing::same_bits(after[c].primitive.radius, before[c].primitive.radius)) << c;
+    EXPECT_TRUE(testing::same_bits(after[c].rms, before[c].rms)) << c;
+    EXPECT_TRUE(testing::same_bits(after[c].max, before[c].max)) << c;
+  }
+  EXPECT_EQ(sphere, 1);
+  EXPECT_EQ(relations.size(), 3u);
+
+  // The same result on a second call, and from the same reports.
+  std::vector<ClusterReport> again = before;
+  EXPECT_EQ(
+      clusters_of(regularize_clusters(hierarchy, cut, again), ClusterRelation::Kind::Parallel),
+      clusters_of(relations, ClusterRelation::Kind::Parallel));
+  for (std::uint32_t c = 0; c < 7; ++c) EXPECT_EQ(again[c].primitive.axis, after[c].primitive.axis);
+}
+
+// Cut finer than its parts, a noisy cylinder comes apart in bands: one axis line again. Whether a
+// band joins is a test at 3 standard deviations, so a band may stay apart (one at most here).
+TEST(Relations, FragmentsOfOneCylinderShareOneAxisLine) {
+  const GroundTruthShape shape = noisy_shape("capped_cylinder", 0.002, 2);
+  const Primitive& truth = shape.regions[0];
+  ASSERT_EQ(truth.type, PrimitiveType::Cylinder);
+  const Hierarchy hierarchy = build_hierarchy(shape.mesh);
+  std::size_t bands = 0, joined = 0;
+  for (const std::uint32_t k : {4u, 5u, 6u}) {
+    SCOPED_TRACE(k);
+    const Segmentation cut = cut_by_count(hierarchy, k);
+    std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
+    std::vector<std::uint32_t> cylinders;
+    for (std::uint32_t c = 0; c < k; ++c)
+      if (reports[c].primitive.type == PrimitiveType::Cylinder) cylinders.push_back(c);
+    ASSERT_EQ(cylinders.size(), k - 2);  // the bands, besides the two caps
+    bands += cylinders.size();
+    const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, reports);
+    const Groups coaxial = clusters_of(relations, ClusterRelation::Kind::Coaxial);
+    ASSERT_EQ(coaxial.size(), 1u);
+    const std::vector<std::uint32_t>& set = coaxial[0];
+    joined += set.size();
+    EXPECT_GE(set.size() + 1, cylinders.size());
+    EXPECT_TRUE(std::includes(cylinders.begin(), cylinders.end(), set.begin(), set.end()));
+    expect_one_direction(reports, set);
+    const Primitive& first = reports[set[0]].primitive;
+    for (const std::uint32_t c : set) {
+      const Primitive& cylinder = reports[c].primitive;
+      const Vec3 offset = {cylinder.point[0] - first.point[0], cylinder.point[1] - first.point[1],
+                           cylinder.point[2] - first.point[2]};
+      EXPECT_LT(std::sqrt(dot(cross(offset, first.axis), cross(offset, first.axis))),
+                1e-12 * truth.radius);
+      EXPECT_NEAR(cylinder.radius, truth.radius, 0.01 * truth.radius);
+      EXPECT_LT(angle_between_lines_degrees(cylinder.axis, truth.axis), 0.1);
+    }
+  }
+  std::printf("capped cylinder: %zu of %zu bands on the shared axis\n", joined, bands);
+}
+
+// Fandisk's fits: its concentric front cylinders are found coaxial, and no relation costs a fit
+// much of its quality.
+TEST(Relations, FandiskRelationsAreExactAndCheap) {
+  const Mesh mesh = read_mesh(testing::cgal_mesh("fandisk.off"));
+  const Hierarchy hierarchy = build_hierarchy(mesh);
+  const Segmentation cut = cut_by_count(hierarchy, choose_level(hierarchy).clusters);
+  const std::vector<ClusterReport> before = describe_clusters(hierarchy, cut);
+  std::vector<ClusterReport> after = before;
+  const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, after);
+  const Groups parallel = clusters_of(relations, ClusterRelation::Kind::Parallel);
+  const Groups coaxial = clusters_of(relations, ClusterRelation::Kind::Coaxial);
+  std::printf("fandisk at %u clusters: %zu parallel groups, %zu coaxial sets\n",
+              cut.cluster_count(), parallel.size(), coaxial.size());
+  EXPECT_GE(parallel.size(), 3u);
+  ASSERT_GE(coaxial.size(), 1u);
+  const double diagonal = bounding_box_diagonal(mesh);
+  for (const auto& group : parallel) {
+    expect_one_direction(after, group);
+    for (const std::uint32_t c : group) {
+      EXPECT_TRUE(has_direction(after[c].primitive));
+      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
+      EXPECT_LT(angle_between_lines_degrees(after[c].primitive.axis, before[c].primitive.axis), 1.0)
+          << c;
+    }
+  }
+  for (const auto& set : coaxial) {
+    // Every coaxial set is within a parallel group.
+    EXPECT_TRUE(std::any_of(parallel.begin(), parallel.end(), [&](const auto& group) {
+      return std::includes(group.begin(), group.end(), set.begin(), set.end());
+    }));
+    const Primitive& first = after[set[0]].primitive;
+    for (const std::uint32_t c : set) {
+      const Primitive& cylinder = after[c].primitive;
+      ASSERT_EQ(cylinder.type, PrimitiveType::Cylinder);
+      const Vec3 offset = {cylinder.point[0] - first.point[0], cylinder.point[1] - first.point[1],
+                           cylinder.point[2] - first.point[2]};
+      EXPECT_LT(std::sqrt(dot(cross(offset, first.axis), cross(offset, first.axis))),
+                1e-12 * diagonal);
+    }
+  }
+}
+
+TEST(Relations, RefusesMismatchedReportsAndBadOptions) {
+  const GroundTruthShape box = noisy_shape("box", 0.002, 1);
+  const Hierarchy hierarchy = build_hierarchy(box.mesh);
+  const Segmentation cut = cut_by_count(hierarchy, 6);
+  std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
+  std::vector<ClusterReport> fewer(reports.begin(), reports.end() - 1);
+  EXPECT_THROW(regularize_clusters(hierarchy, cut, fewer), InvalidInputError);
+  Segmentation short_labels = cut;
+  short_labels.labels.pop_back();
+  EXPECT_THROW(regularize_clusters(hierarchy, short_labels, reports), InvalidInputError);
+  Segmentation bad_label = cut;
+  bad_label.labels[0] = 6;
+  EXPECT_THROW(regularize_clusters(hierarchy, bad_label, reports), InvalidInputError);
+  for (const auto& change : std::vector<void (*)(RelationOptions&)>{
+           [](RelationOptions& o) { o.significance = 0; },
+           [](RelationOptions& o) { o.significance = std::nan(""); },
+           [](RelationOptions& o) { o.max_angle_degrees = 90; },
+           [](RelationOptions& o) { o.max_angle_degrees = 0; },
+           [](RelationOptions& o) { o.outlier_threshold = 0; },
+           [](RelationOptions& o) { o.outlier_threshold = INFINITY; }}) {
+    RelationOptions options;
+    change(options);
+    EXPECT_THROW(validate(options), InvalidInputError);
+    std::vector<ClusterReport> untouched = reports;
+    EXPECT_THROW(regularize_clusters(hierarchy, cut, untouched, options), InvalidInputError);
+  }
+  EXPECT_NO_THROW(validate(RelationOptions{}));
+}
+
+}  // namespace
+}  // namespace primseg
