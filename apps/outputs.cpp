@@ -236,8 +236,12 @@ void write_level_outputs(const Hierarchy& hierarchy, const Mesh& mesh,
 
 nlohmann::json relations_json(const std::vector<ClusterRelation>& relations) {
   nlohmann::json list = nlohmann::json::array();
-  for (const ClusterRelation& relation : relations)
-    list.push_back({{"kind", to_string(relation.kind)}, {"clusters", relation.clusters}});
+  for (const ClusterRelation& relation : relations) {
+    nlohmann::json entry = {{"kind", to_string(relation.kind)}, {"clusters", relation.clusters}};
+    if (relation.kind == ClusterRelation::Kind::Orthogonal)
+      entry["orthogonal_to"] = relation.orthogonal_to;
+    list.push_back(std::move(entry));
+  }
   return list;
 }
 
@@ -255,6 +259,8 @@ void print_summary(const std::vector<ClusterReport>& reports,
   for (std::size_t i = 0; i < relations.size() && i < max_rows; ++i) {
     std::printf("%s:", std::string(to_string(relations[i].kind)).c_str());
     for (const std::uint32_t c : relations[i].clusters) std::printf(" %u", c);
+    if (!relations[i].orthogonal_to.empty()) std::printf(" |");
+    for (const std::uint32_t c : relations[i].orthogonal_to) std::printf(" %u", c);
     std::printf("\n");
   }
   if (relations.size() > max_rows)

@@ -289,25 +289,42 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
     fail("snap report: fallbacks", report.fallbacks);
 }
 
-// Relations: two or more clusters, increasing; a parallel group shares one direction up to
-// sign, and a coaxial set holds cylinders only.
+// Relations: clusters increasing and distinct, two or more (orthogonal: one or more a side); a
+// parallel group and each side of an orthogonal pair share one direction up to sign, the two
+// sides' directions are orthogonal to round-off, and a coaxial set holds cylinders only.
 void check_relations(const std::vector<Primitive>& primitives,
                      const std::vector<ClusterRelation>& relations, const std::string& what) {
-  for (const ClusterRelation& relation : relations) {
-    const auto& members = relation.clusters;
-    if (members.size() < 2 || !std::is_sorted(members.begin(), members.end()) ||
+  auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest) {
+    if (members.size() < fewest || !std::is_sorted(members.begin(), members.end()) ||
         std::adjacent_find(members.begin(), members.end()) != members.end() ||
         members.back() >= primitives.size())
       fail((what + ": relation members").c_str(), double(members.size()));
     const Vec3& direction = primitives[members[0]].axis;
     for (const std::uint32_t c : members) {
-      const Primitive& p = primitives[c];
-      if (relation.kind == ClusterRelation::Kind::Coaxial && p.type != PrimitiveType::Cylinder)
-        fail((what + ": coaxial non-cylinder").c_str(), c);
-      const Vec3 a{std::abs(p.axis[0]), std::abs(p.axis[1]), std::abs(p.axis[2])},
+      const Vec3& axis = primitives[c].axis;
+      const Vec3 a{std::abs(axis[0]), std::abs(axis[1]), std::abs(axis[2])},
           b{std::abs(direction[0]), std::abs(direction[1]), std::abs(direction[2])};
       if (a != b) fail((what + ": related directions differ").c_str(), c);
     }
+  };
+  for (const ClusterRelation& relation : relations) {
+    const bool orthogonal = relation.kind == ClusterRelation::Kind::Orthogonal;
+    check_members(relation.clusters, orthogonal ? 1 : 2);
+    if (relation.kind == ClusterRelation::Kind::Coaxial)
+      for (const std::uint32_t c : relation.clusters)
+        if (primitives[c].type != PrimitiveType::Cylinder)
+          fail((what + ": coaxial non-cylinder").c_str(), c);
+    if (!orthogonal) {
+      if (!relation.orthogonal_to.empty()) fail((what + ": orthogonal_to set").c_str());
+      continue;
+    }
+    check_members(relation.orthogonal_to, 1);
+    if (relation.orthogonal_to[0] <= relation.clusters[0])
+      fail((what + ": orthogonal sides' order").c_str());
+    const Vec3 &a = primitives[relation.clusters[0]].axis,
+               &b = primitives[relation.orthogonal_to[0]].axis;
+    const double cosine = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    if (!(std::abs(cosine) <= 1e-12)) fail((what + ": not orthogonal").c_str(), cosine);
   }
 }
 
@@ -370,8 +387,10 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
   check_reports(hierarchy, results.refined.segmentation, regularized);
   check_relations(cluster_primitives(regularized), relations, "regularized level");
   std::vector<bool> related(regularized.size(), false);
-  for (const ClusterRelation& relation : relations)
+  for (const ClusterRelation& relation : relations) {
     for (const std::uint32_t c : relation.clusters) related[c] = true;
+    for (const std::uint32_t c : relation.orthogonal_to) related[c] = true;
+  }
   for (std::size_t c = 0; c < regularized.size(); ++c) {
     const ClusterReport &a = regularized[c], &b = results.refined.reports[c];
     if (!related[c] &&

@@ -402,8 +402,9 @@ const char* kRefineArgument =
 
 const char* kRegularizeArgument =
     R"(regularize: make the fits' relations exact (the CLI's --regularize): plane normals and
-  cylinder axes that agree within their uncertainty share one direction, and cylinders one axis
-  line; Hierarchy.relations() lists them.)";
+  cylinder axes that agree within their uncertainty share one direction, cylinders one axis line,
+  and directions at right angles within it are made orthogonal; Hierarchy.relations() lists
+  them.)";
 
 // The level, refined by up to `refine` boundary passes (0: as cut), with its cluster reports when
 // `reports` is given, and their relations made exact when `relations` is given too: what the
@@ -491,6 +492,8 @@ py::list relations_list(const std::vector<ClusterRelation>& relations) {
     py::dict related;
     related["kind"] = std::string(to_string(relation.kind));
     related["clusters"] = py::cast(relation.clusters);
+    if (relation.kind == ClusterRelation::Kind::Orthogonal)
+      related["orthogonal_to"] = py::cast(relation.orthogonal_to);
     list.append(related);
   }
   return list;
@@ -1251,7 +1254,9 @@ order along each curve. json.dumps() takes it as it is.)",
 
 The design intent among the level's fits, as the CLI's --regularize writes it in the JSON's
 "relations": one dict per relation with kind ("parallel": plane normals and cylinder axes of one
-direction; "coaxial": cylinders of one axis line) and clusters (their labels, increasing).
+direction; "coaxial": cylinders of one axis line; "orthogonal": two directions at right angles)
+and clusters (their labels, increasing; for "orthogonal", those of one direction, and
+orthogonal_to those of the other).
 clusters(..., regularize=True) gives the primitives with these relations made exact.)",
                kLevelArguments, kRefineArgument,
                cpp_doc("regularize_clusters", doc::relations__regularize_clusters),

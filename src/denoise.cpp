@@ -543,11 +543,13 @@ SnappedLevel Denoiser::describe_snap(const Segmentation& hierarchy_level,
   // Related clusters have vertices, so none was emptied.
   for (ClusterRelation& relation : relations) {
     for (std::uint32_t& c : relation.clusters) c = rank[c];
+    for (std::uint32_t& c : relation.orthogonal_to) c = rank[c];
     std::sort(relation.clusters.begin(), relation.clusters.end());
+    std::sort(relation.orthogonal_to.begin(), relation.orthogonal_to.end());
+    if (!relation.orthogonal_to.empty() && relation.orthogonal_to[0] < relation.clusters[0])
+      std::swap(relation.clusters, relation.orthogonal_to);
   }
-  std::sort(relations.begin(), relations.end(), [](const auto& a, const auto& b) {
-    return a.kind != b.kind ? a.kind < b.kind : a.clusters < b.clusters;
-  });
+  detail::sort_relations(relations);
   level.relations = std::move(relations);
   return level;
 }

@@ -9,6 +9,7 @@
 #include <numeric>
 #include <optional>
 #include <span>
+#include <tuple>
 #include <utility>
 
 #include "eigen_conversions.hpp"
@@ -381,6 +382,74 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
   }
 }
 
+// Pairs of direction groups at right angles within the significance, made exactly so. Pairs are
+// taken by increasing score, each scored again on the directions the pairs kept before it left
+// (two directions orthogonal to a third are nearer their own right angle then). A pair is kept
+// when the directions can be moved to satisfy it with those kept before (each moved along its own
+// covariance: the least-squares correction), every one staying within the significance of its
+// measurement; else it is dropped (a fourth direction orthogonal to three cannot be).
+// Returns the kept pairs (indices into `groups`, first < second), in increasing order.
+std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<DirectionGroup>& groups,
+                                                               const RegularityOptions& options) {
+  const double max_tilt = options.max_angle_degrees * std::numbers::pi / 180;
+  const double significance2 = options.significance * options.significance;
+  std::vector<Eigen::Vector3d> measured;
+  measured.reserve(groups.size());
+  for (const DirectionGroup& group : groups) measured.push_back(group.direction);
+  std::vector<Eigen::Vector3d> solved = measured;
+  std::vector<std::pair<std::size_t, std::size_t>> kept;
+  std::vector<std::vector<bool>> decided(groups.size(), std::vector<bool>(groups.size(), false));
+  for (;;) {
+    std::pair<std::size_t, std::size_t> best{0, 0};
+    double best_score = significance2;
+    bool found = false;
+    for (std::size_t i = 0; i < groups.size(); ++i)
+      for (std::size_t j = i + 1; j < groups.size(); ++j) {
+        if (decided[i][j]) continue;
+        const Eigen::Vector3d &a = solved[i], &b = solved[j];
+        const double cosine = a.dot(b);
+        if (std::abs(std::asin(std::clamp(cosine, -1.0, 1.0))) > max_tilt) continue;
+        const double variance = b.dot(groups[i].covariance * b) + a.dot(groups[j].covariance * a);
+        const double score = cosine * cosine / variance;
+        if (score <= best_score) {
+          best_score = score;
+          best = {i, j};
+          found = true;
+        }
+      }
+    if (!found) break;
+    decided[best.first][best.second] = true;
+    kept.push_back(best);
+    std::vector<Eigen::Vector3d> d = measured;
+    bool converged = false;
+    for (int sweep = 0; sweep < 200 && !converged; ++sweep) {
+      converged = true;
+      for (const auto& [i, j] : kept) {
+        const double cosine = d[i].dot(d[j]);
+        if (std::abs(cosine) > 1e-15) converged = false;
+        const Eigen::Vector3d move_i = groups[i].covariance * d[j];
+        const Eigen::Vector3d move_j = groups[j].covariance * d[i];
+        const double scale = cosine / (d[j].dot(move_i) + d[i].dot(move_j));
+        if (!std::isfinite(scale)) continue;
+        d[i] = (d[i] - scale * move_i).normalized();
+        d[j] = (d[j] - scale * move_j).normalized();
+      }
+    }
+    bool within = converged;
+    for (std::size_t g = 0; within && g < groups.size(); ++g) {
+      const Eigen::Vector3d tilt = d[g] - measured[g];
+      within = tilt.dot(groups[g].information * tilt) <= significance2;
+    }
+    if (within)
+      solved = std::move(d);
+    else
+      kept.pop_back();
+  }
+  for (std::size_t g = 0; g < groups.size(); ++g) groups[g].direction = solved[g];
+  std::sort(kept.begin(), kept.end());
+  return kept;
+}
+
 }  // namespace
 
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
@@ -397,8 +466,16 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
       item = oriented_cylinder(c, primitives[c], points[c]);
     if (item && std::isfinite(item->variance) && item->variance > 0) items.push_back(*item);
   }
-  for (const DirectionGroup& group : group_directions(items, options)) {
-    if (group.members.size() < 2) continue;
+  std::vector<DirectionGroup> groups = group_directions(items, options);
+  std::vector<std::pair<std::size_t, std::size_t>> orthogonal;
+  if (options.orthogonal) orthogonal = orthogonalize(groups, options);
+  std::vector<bool> constrained(groups.size(), false);
+  for (const auto& [i, j] : orthogonal) constrained[i] = constrained[j] = true;
+  // The clusters each group refitted, for the orthogonal relations.
+  std::vector<std::vector<std::size_t>> refitted(groups.size());
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const DirectionGroup& group = groups[g];
+    if (group.members.size() < 2 && !constrained[g]) continue;
     const auto [u, v] = orthonormal_pair(group.direction);
     std::vector<AlignedCylinder> cylinders;
     Relation parallel;
@@ -418,15 +495,36 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
         parallel.members.push_back(c);
       }
     }
-    if (parallel.members.size() >= 2) {
-      std::sort(parallel.members.begin(), parallel.members.end());
-      relations.push_back(std::move(parallel));
-    }
+    std::sort(parallel.members.begin(), parallel.members.end());
+    refitted[g] = parallel.members;
+    if (parallel.members.size() >= 2) relations.push_back(std::move(parallel));
     align_cylinders(group.direction, std::move(cylinders),
                     options.significance * options.significance, primitives, points, weights,
                     relations);
   }
+  std::vector<Relation> right_angles;
+  for (const auto& [i, j] : orthogonal) {
+    if (refitted[i].empty() || refitted[j].empty()) continue;
+    Relation& relation = right_angles.emplace_back();
+    relation.kind = Relation::Kind::Orthogonal;
+    // The group of the lower cluster first.
+    const bool swap = refitted[j].front() < refitted[i].front();
+    relation.members = swap ? refitted[j] : refitted[i];
+    relation.others = swap ? refitted[i] : refitted[j];
+  }
+  std::sort(right_angles.begin(), right_angles.end(), [](const Relation& a, const Relation& b) {
+    return std::tie(a.members, a.others) < std::tie(b.members, b.others);
+  });
+  relations.insert(relations.end(), right_angles.begin(), right_angles.end());
   return relations;
+}
+
+void sort_relations(std::vector<ClusterRelation>& relations) {
+  std::sort(relations.begin(), relations.end(), [](const auto& a, const auto& b) {
+    return a.kind != b.kind           ? a.kind < b.kind
+           : a.clusters != b.clusters ? a.clusters < b.clusters
+                                      : a.orthogonal_to < b.orthogonal_to;
+  });
 }
 
 void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
@@ -461,14 +559,15 @@ std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitiv
   std::vector<ClusterRelation> relations;
   for (const Relation& relation : regularize(primitives, inlier_points, inlier_weights, options)) {
     ClusterRelation& related = relations.emplace_back();
-    related.kind = relation.kind == Relation::Kind::Parallel ? ClusterRelation::Kind::Parallel
-                                                             : ClusterRelation::Kind::Coaxial;
+    related.kind = relation.kind == Relation::Kind::Parallel  ? ClusterRelation::Kind::Parallel
+                   : relation.kind == Relation::Kind::Coaxial ? ClusterRelation::Kind::Coaxial
+                                                              : ClusterRelation::Kind::Orthogonal;
     for (const std::size_t c : relation.members)
       related.clusters.push_back(static_cast<std::uint32_t>(c));
+    for (const std::size_t c : relation.others)
+      related.orthogonal_to.push_back(static_cast<std::uint32_t>(c));
   }
-  std::sort(relations.begin(), relations.end(), [](const auto& a, const auto& b) {
-    return a.kind != b.kind ? a.kind < b.kind : a.clusters < b.clusters;
-  });
+  sort_relations(relations);
   return relations;
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 // Relations between the primitives of a segmentation, and the refit that makes them exact (after
 // GlobFit, Li et al. 2011): planes' normals and cylinders' axes that agree within their fits'
-// uncertainty share one direction, estimated from all of them, and cylinders of one direction
-// whose axes agree share one axis line.
+// uncertainty share one direction, estimated from all of them, directions at right angles within
+// it are made orthogonal, and cylinders of one direction whose axes agree share one axis line.
 
 #include <cstddef>
 #include <span>
@@ -17,33 +17,44 @@ struct RegularityOptions {
   /// A direction joins a group when its tilt from the group's direction is within this many
   /// standard deviations (Mahalanobis, with both estimates' covariances). > 0.
   double significance = 3;
-  /// ... and never farther than this, whatever the uncertainty (degrees).
+  /// ... and never farther than this, whatever the uncertainty (degrees); the same bounds make
+  /// two directions orthogonal.
   double max_angle_degrees = 20;
+  /// Make directions at right angles within the significance exactly orthogonal.
+  bool orthogonal = true;
 };
 
-/// Primitives that regularize() made share a direction or an axis line.
+/// Primitives that regularize() made share a direction or an axis line, or made orthogonal.
 struct Relation {
   enum class Kind {
-    Parallel,  ///< plane normals and cylinder axes made one direction (each keeps its side)
-    Coaxial,   ///< cylinders of one direction group made one axis line (each keeps its radius)
+    Parallel,    ///< plane normals and cylinder axes made one direction (each keeps its side)
+    Coaxial,     ///< cylinders of one direction group made one axis line (each keeps its radius)
+    Orthogonal,  ///< two direction groups made orthogonal: `members` and `others`
   };
   Kind kind = Kind::Parallel;
   std::vector<std::size_t> members;  ///< indices into the primitives, increasing; two or more
+                                     ///< (Orthogonal: one or more)
+  std::vector<std::size_t> others;   ///< Orthogonal: the other direction's, increasing
 };
 
 /// Groups the directions of `primitives` (plane normals, cylinder axes; other types are left as
-/// they are) and refits every member of a group of two or more with the group's direction: a
-/// plane through its inliers' weighted centroid, a cylinder by geometric least squares of its
-/// inliers' circle, jointly with the cylinders coaxial with it (one axis line, one radius each).
-/// points[c] and weights[c] are cluster c's inlier vertices (input units) and their weights; a
-/// cluster with too few to estimate its direction's uncertainty is left alone. Deterministic:
-/// clusters are visited by increasing uncertainty, ties by index. Returns the relations made
-/// exact: each direction group's members that were refitted with its direction, then each
-/// coaxial set of its cylinders, in that order.
+/// they are), makes the groups' directions that are at right angles within the significance
+/// exactly orthogonal (RegularityOptions::orthogonal), and refits every member of a group of two
+/// or more, or of a group in a right angle, with the group's direction: a plane through its
+/// inliers' weighted centroid, a cylinder by geometric least squares of its inliers' circle,
+/// jointly with the cylinders coaxial with it (one axis line, one radius each). points[c] and
+/// weights[c] are cluster c's inlier vertices (input units) and their weights; a cluster with too
+/// few to estimate its direction's uncertainty is left alone. Deterministic: clusters are visited
+/// by increasing uncertainty, ties by index. Returns the relations made exact: each direction
+/// group's members that were refitted with its direction, then each coaxial set of its
+/// cylinders, in that order, then the right angles by their members.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,
                                  const RegularityOptions& options);
+
+/// Orders relations by kind (parallel, coaxial, orthogonal), then by their clusters.
+void sort_relations(std::vector<ClusterRelation>& relations);
 
 /// A cluster's inliers: its points within `threshold` robust deviations (1.4826 × the median
 /// distance, at least `floor`) of `primitive`, with their weights. `points` is not empty.
@@ -53,7 +64,7 @@ void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
 
 /// regularize() on each cluster's inliers (keep_inliers() of points[c], weights[c] about
 /// primitives[c]; an empty cluster stays out), as relations between the indices of `primitives`
-/// ordered by kind (parallel first), then by their clusters.
+/// in sort_relations() order.
 std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitives,
                                                 const std::vector<std::vector<Vec3>>& points,
                                                 const std::vector<std::vector<double>>& weights,

@@ -13,7 +13,15 @@
 namespace primseg {
 
 std::string_view to_string(ClusterRelation::Kind kind) {
-  return kind == ClusterRelation::Kind::Parallel ? "parallel" : "coaxial";
+  switch (kind) {
+    case ClusterRelation::Kind::Parallel:
+      return "parallel";
+    case ClusterRelation::Kind::Coaxial:
+      return "coaxial";
+    case ClusterRelation::Kind::Orthogonal:
+      return "orthogonal";
+  }
+  return "unknown";
 }
 
 void validate(const RelationOptions& options) {
@@ -83,8 +91,10 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
 
   // The members' new primitives, measured on every corner as describe_clusters() measures.
   std::vector<bool> refitted(k, false);
-  for (const ClusterRelation& relation : relations)
+  for (const ClusterRelation& relation : relations) {
     for (const std::uint32_t c : relation.clusters) refitted[c] = true;
+    for (const std::uint32_t c : relation.orthogonal_to) refitted[c] = true;
+  }
   std::vector<std::vector<Vec3>> member_corners(k);
   std::vector<std::vector<double>> member_weights(k);
   for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {

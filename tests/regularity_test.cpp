@@ -137,6 +137,59 @@ TEST(Regularity, DirectionsFartherApartThanTheirUncertaintyStayApart) {
   }
 }
 
+// The orthogonal relations detail::regularize made exact, as (members, others) pairs.
+std::vector<std::pair<std::vector<std::size_t>, std::vector<std::size_t>>> right_angles(
+    std::vector<Primitive>& primitives, const std::vector<Cluster>& clusters) {
+  std::vector<std::vector<Vec3>> points;
+  std::vector<std::vector<double>> weights;
+  for (const Cluster& cluster : clusters) {
+    points.push_back(cluster.points);
+    weights.push_back(cluster.weights);
+  }
+  std::vector<std::pair<std::vector<std::size_t>, std::vector<std::size_t>>> pairs;
+  for (const detail::Relation& relation : detail::regularize(primitives, points, weights, {}))
+    if (relation.kind == Kind::Orthogonal) pairs.emplace_back(relation.members, relation.others);
+  return pairs;
+}
+
+TEST(Regularity, PlanesAtRightAnglesBecomeExactlyOrthogonal) {
+  // The three faces of a corner, each alone in its direction.
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), y = Eigen::Vector3d::UnitY(),
+                        z = Eigen::Vector3d::UnitZ();
+  using Pairs = std::vector<std::pair<std::vector<std::size_t>, std::vector<std::size_t>>>;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{noisy_plane(x, {0.5, 0, 0}, 1, 0.01, rng),
+                                        noisy_plane(y, {0, 0.5, 0}, 1, 0.01, rng),
+                                        noisy_plane(z, {0, 0, 0.5}, 1, 0.01, rng)};
+    std::vector<Primitive> planes;
+    for (const Cluster& cluster : clusters) planes.push_back(fitted_plane(cluster));
+    const std::vector<Primitive> fitted = planes;
+    EXPECT_EQ(right_angles(planes, clusters), (Pairs{{{0}, {1}}, {{0}, {2}}, {{1}, {2}}}));
+    for (int i = 0; i < 3; ++i) {
+      for (int j = i + 1; j < 3; ++j)
+        EXPECT_LT(std::abs(to_eigen(planes[i].axis).dot(to_eigen(planes[j].axis))), 1e-15);
+      // Each keeps its side, moved by about its own uncertainty (0.01 / sqrt(400 / 12)).
+      EXPECT_GT(to_eigen(planes[i].axis).dot(to_eigen(fitted[i].axis)), 0);
+      EXPECT_LT(angle_between_lines(planes[i].axis, fitted[i].axis), 0.005);
+    }
+  }
+}
+
+TEST(Regularity, An88DegreeAngleStaysAsItIs) {
+  // Normals known to about 0.01 degree, 2 degrees from a right angle.
+  std::mt19937_64 rng(5);
+  const double off = 2 * std::numbers::pi / 180;
+  const std::vector<Cluster> clusters{
+      noisy_plane(Eigen::Vector3d::UnitZ(), {0, 0, 0}, 1, 0.001, rng),
+      noisy_plane({std::cos(off), 0, std::sin(off)}, {0.5, 0, 0.5}, 1, 0.001, rng)};
+  std::vector<Primitive> planes{fitted_plane(clusters[0]), fitted_plane(clusters[1])};
+  const std::vector<Primitive> fitted = planes;
+  EXPECT_TRUE(right_angles(planes, clusters).empty());
+  for (int c = 0; c < 2; ++c) EXPECT_EQ(planes[c].axis, fitted[c].axis);
+}
+
 TEST(Regularity, ACylinderAndItsCapsShareTheAxis) {
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
   std::mt19937_64 rng(5);

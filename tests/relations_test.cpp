@@ -64,9 +64,16 @@ std::vector<std::uint32_t> region_of_clusters(const Segmentation& cut,
   return region;
 }
 
-// The design intent: clusters whose true planes' normals and cylinders' axes are one direction.
-Groups true_parallel_groups(const GroundTruthShape& shape,
-                            const std::vector<std::uint32_t>& region_of_cluster) {
+// The design intent: clusters whose true planes' normals and cylinders' axes are one direction
+// (groups of one included), and the pairs of those directions at right angles, as
+// ClusterRelation orders their sides.
+struct TrueRelations {
+  Groups parallel;
+  std::vector<std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>>> orthogonal;
+};
+
+TrueRelations true_relations(const GroundTruthShape& shape,
+                             const std::vector<std::uint32_t>& region_of_cluster) {
   Groups groups;
   std::vector<Vec3> directions;
   for (std::uint32_t c = 0; c < region_of_cluster.size(); ++c) {
@@ -80,16 +87,17 @@ Groups true_parallel_groups(const GroundTruthShape& shape,
     }
     groups[g].push_back(c);
   }
-  std::erase_if(groups, [](const auto& group) { return group.size() < 2; });
-  std::sort(groups.begin(), groups.end());
-  return groups;
-}
-
-Groups clusters_of(const std::vector<ClusterRelation>& relations, ClusterRelation::Kind kind) {
-  Groups groups;
-  for (const ClusterRelation& relation : relations)
-    if (relation.kind == kind) groups.push_back(relation.clusters);
-  return groups;
+  TrueRelations relations;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    if (groups[i].size() >= 2) relations.parallel.push_back(groups[i]);
+    for (std::size_t j = i + 1; j < groups.size(); ++j)
+      if (std::abs(angle_between_lines_degrees(directions[i], directions[j]) - 90) < 1e-6)
+        relations.orthogonal.emplace_back(std::min(groups[i], groups[j]),
+                                          std::max(groups[i], groups[j]));
+  }
+  std::sort(relations.parallel.begin(), relations.parallel.end());
+  std::sort(relations.orthogonal.begin(), relations.orthogonal.end());
+  return relations;
 }
 
 // Every member has the same direction, up to its side, bit for bit.
@@ -101,6 +109,35 @@ void expect_one_direction(const std::vector<ClusterReport>& reports,
     const double side = dot(axis, first) < 0 ? -1 : 1;
     for (int i = 0; i < 3; ++i) EXPECT_EQ(axis[i], side * first[i]) << "cluster " << c;
   }
+}
+
+Groups clusters_of(const std::vector<ClusterRelation>& relations, ClusterRelation::Kind kind) {
+  Groups groups;
+  for (const ClusterRelation& relation : relations)
+    if (relation.kind == kind) groups.push_back(relation.clusters);
+  return groups;
+}
+
+std::vector<std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>>> orthogonal_pairs(
+    const std::vector<ClusterRelation>& relations) {
+  std::vector<std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>>> pairs;
+  for (const ClusterRelation& relation : relations)
+    if (relation.kind == ClusterRelation::Kind::Orthogonal)
+      pairs.emplace_back(relation.clusters, relation.orthogonal_to);
+  return pairs;
+}
+
+// The two sides of each orthogonal relation are at right angles, to round-off.
+void expect_orthogonal(const std::vector<ClusterReport>& reports,
+                       const std::vector<ClusterRelation>& relations) {
+  for (const ClusterRelation& relation : relations)
+    if (relation.kind == ClusterRelation::Kind::Orthogonal) {
+      expect_one_direction(reports, relation.clusters);
+      expect_one_direction(reports, relation.orthogonal_to);
+      EXPECT_LT(std::abs(dot(reports[relation.clusters[0]].primitive.axis,
+                             reports[relation.orthogonal_to[0]].primitive.axis)),
+                1e-14);
+    }
 }
 
 TEST(Relations, PartsShowTheirDesignIntentExactAndNoisy) {
@@ -117,11 +154,24 @@ TEST(Relations, PartsShowTheirDesignIntentExactAndNoisy) {
       ASSERT_FALSE(region_of_cluster.empty()) << "the cut is not the ground truth";
       std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
       const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, reports);
+      const TrueRelations truth = true_relations(shape, region_of_cluster);
       const Groups parallel = clusters_of(relations, ClusterRelation::Kind::Parallel);
-      EXPECT_EQ(parallel, true_parallel_groups(shape, region_of_cluster));
+      EXPECT_EQ(parallel, truth.parallel);
+      // Exact parts show every right angle. A noisy part's are tests at 3 standard deviations of
+      // the cosine: a true one can fail (the noisy box's seed-2 draw misses one at 3.09), a false
+      // one must not pass.
+      const auto orthogonal = orthogonal_pairs(relations);
+      if (noise == 0) {
+        EXPECT_EQ(orthogonal, truth.orthogonal);
+      } else {
+        EXPECT_TRUE(std::includes(truth.orthogonal.begin(), truth.orthogonal.end(),
+                                  orthogonal.begin(), orthogonal.end()));
+        EXPECT_GE(orthogonal.size() + 1, truth.orthogonal.size());
+      }
       // One cylinder at most: nothing to be coaxial with.
       EXPECT_TRUE(clusters_of(relations, ClusterRelation::Kind::Coaxial).empty());
       for (const auto& group : parallel) expect_one_direction(reports, group);
+      expect_orthogonal(reports, relations);
     }
 }
 
@@ -134,7 +184,10 @@ TEST(Relations, OppositeFacesOfANoisyBoxBecomeParallelNearerTheTruth) {
   const std::vector<ClusterReport> before = describe_clusters(hierarchy, cut);
   std::vector<ClusterReport> after = before;
   const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, after);
-  ASSERT_EQ(relations.size(), 3u);
+  // Three pairs of opposite faces, their three directions at right angles.
+  ASSERT_EQ(clusters_of(relations, ClusterRelation::Kind::Parallel).size(), 3u);
+  ASSERT_EQ(orthogonal_pairs(relations).size(), 3u);
+  expect_orthogonal(after, relations);
   double error_before = 0, error_after = 0;
   for (std::uint32_t c = 0; c < 6; ++c) {
     SCOPED_TRACE(c);
@@ -157,6 +210,7 @@ TEST(Relations, OppositeFacesOfANoisyBoxBecomeParallelNearerTheTruth) {
               error_after);
   EXPECT_LT(error_after, error_before);
   for (const ClusterRelation& relation : relations) {
+    if (relation.kind != ClusterRelation::Kind::Parallel) continue;
     ASSERT_EQ(relation.clusters.size(), 2u);
     // Opposite faces: exactly opposite normals.
     const Vec3& a = after[relation.clusters[0]].primitive.axis;
@@ -184,8 +238,10 @@ TEST(Relations, ClustersOutsideEveryRelationKeepTheirReportsBitForBit) {
   std::vector<ClusterReport> after = before;
   const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, after);
   std::vector<bool> related(7, false);
-  for (const ClusterRelation& relation : relations)
+  for (const ClusterRelation& relation : relations) {
     for (const std::uint32_t c : relation.clusters) related[c] = true;
+    for (const std::uint32_t c : relation.orthogonal_to) related[c] = true;
+  }
   int sphere = 0;
   for (std::uint32_t c = 0; c < 7; ++c) {
     if (before[c].primitive.type == PrimitiveType::Sphere) {
@@ -200,7 +256,7 @@ TEST(Relations, ClustersOutsideEveryRelationKeepTheirReportsBitForBit) {
     EXPECT_TRUE(testing::same_bits(after[c].max, before[c].max)) << c;
   }
   EXPECT_EQ(sphere, 1);
-  EXPECT_EQ(relations.size(), 3u);
+  EXPECT_EQ(clusters_of(relations, ClusterRelation::Kind::Parallel).size(), 3u);
 
   // The same result on a second call, and from the same reports.
   std::vector<ClusterReport> again = before;
@@ -249,8 +305,8 @@ TEST(Relations, FragmentsOfOneCylinderShareOneAxisLine) {
   std::printf("capped cylinder: %zu of %zu bands on the shared axis\n", joined, bands);
 }
 
-// Fandisk's fits: its concentric front cylinders are found coaxial, and no relation costs a fit
-// much of its quality.
+// Fandisk's fits: its concentric front cylinders are found coaxial, its right angles exact, and no
+// relation costs a fit much of its quality.
 TEST(Relations, FandiskRelationsAreExactAndCheap) {
   const Mesh mesh = read_mesh(testing::cgal_mesh("fandisk.off"));
   const Hierarchy hierarchy = build_hierarchy(mesh);
@@ -260,10 +316,13 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
   const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, after);
   const Groups parallel = clusters_of(relations, ClusterRelation::Kind::Parallel);
   const Groups coaxial = clusters_of(relations, ClusterRelation::Kind::Coaxial);
-  std::printf("fandisk at %u clusters: %zu parallel groups, %zu coaxial sets\n",
-              cut.cluster_count(), parallel.size(), coaxial.size());
+  std::printf("fandisk at %u clusters: %zu parallel groups, %zu coaxial sets, %zu right angles\n",
+              cut.cluster_count(), parallel.size(), coaxial.size(),
+              orthogonal_pairs(relations).size());
   EXPECT_GE(parallel.size(), 3u);
   ASSERT_GE(coaxial.size(), 1u);
+  EXPECT_GE(orthogonal_pairs(relations).size(), 3u);
+  expect_orthogonal(after, relations);
   const double diagonal = bounding_box_diagonal(mesh);
   for (const auto& group : parallel) {
     expect_one_direction(after, group);

@@ -24,12 +24,20 @@ struct ClusterRelation {
     /// Cylinders of one direction made one axis line, each keeping its radius: a stepped shaft,
     /// the fragments of one cylinder. Every coaxial set is also part of a Parallel relation.
     Coaxial,
+    /// Two directions made exactly orthogonal: `clusters` have one (a plane's normal or a
+    /// cylinder's axis), `orthogonal_to` the other. A box's three directions give three of
+    /// these; a shaft's axis and the faces along it, one.
+    Orthogonal,
   };
   Kind kind = Kind::Parallel;
-  std::vector<std::uint32_t> clusters;  ///< cluster labels, increasing; two or more
+  /// Cluster labels, increasing; two or more (Orthogonal: one or more, its lowest below the
+  /// lowest of `orthogonal_to`).
+  std::vector<std::uint32_t> clusters;
+  /// Orthogonal: the clusters of the other direction, increasing; empty otherwise.
+  std::vector<std::uint32_t> orthogonal_to;
 };
 
-/// "parallel" or "coaxial".
+/// "parallel", "coaxial" or "orthogonal".
 std::string_view to_string(ClusterRelation::Kind kind);
 
 /// Options of regularize_clusters().

@@ -60,14 +60,25 @@ def test_regularized_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path)
     assert clusters == expected["clusters"]
     borders = fandisk_tree.borders(30, refine=2, regularize=True)
     assert json.loads(json.dumps(borders)) == expected["borders"]
-    # The relations are exact: one direction per parallel group, one axis line per coaxial set.
+    # The relations are exact: one direction per parallel group (and per side of a right angle),
+    # one axis line per coaxial set, right angles to round-off.
     kinds = {r["kind"] for r in relations}
-    assert kinds == {"parallel", "coaxial"}
+    assert kinds == {"parallel", "coaxial", "orthogonal"}
+
+    def direction(c):
+        params = clusters[c]["params"]
+        return np.array(params.get("normal", params.get("axis")))
+
     for relation in relations:
+        sides = [relation["clusters"]] + ([relation["orthogonal_to"]] if "orthogonal_to" in relation else [])
+        for side in sides:
+            directions = [direction(c) for c in side]
+            for d in directions:
+                assert np.array_equal(d, directions[0]) or np.array_equal(d, -directions[0])
+        if relation["kind"] == "orthogonal":
+            assert abs(direction(sides[0][0]) @ direction(sides[1][0])) < 1e-14
         params = [clusters[c]["params"] for c in relation["clusters"]]
-        directions = [np.array(p.get("normal", p.get("axis"))) for p in params]
-        for d in directions:
-            assert np.array_equal(d, directions[0]) or np.array_equal(d, -directions[0])
+        directions = [direction(c) for c in relation["clusters"]]
         if relation["kind"] == "coaxial":
             axis, point = directions[0], np.array(params[0]["point"])
             for p in params:

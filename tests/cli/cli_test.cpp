@@ -990,7 +990,8 @@ TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
   const Segmentation cut = cut_by_count(hierarchy, 7);
   std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
   const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, reports);
-  ASSERT_EQ(relations.size(), 3u);  // top, bottom and the hole's axis; two pairs of sides
+  // Top, bottom and the hole's axis; two pairs of sides; their three right angles.
+  ASSERT_EQ(relations.size(), 6u);
 
   const CliRun text = run("segment " + dir.q("in.off") + " --clusters 7 --regularize --tree " +
                           dir.q("t.tree") + " --json " + dir.q("s.json"));
@@ -1005,6 +1006,8 @@ TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
       EXPECT_EQ(j["relations"][i]["kind"], std::string(to_string(relations[i].kind)));
       EXPECT_EQ(j["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
                 relations[i].clusters);
+      EXPECT_EQ(j["relations"][i].value("orthogonal_to", std::vector<std::uint32_t>{}),
+                relations[i].orthogonal_to);
     }
     ASSERT_EQ(j["clusters"].size(), reports.size());
     for (std::size_t c = 0; c < reports.size(); ++c) {
@@ -1020,6 +1023,8 @@ TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
   for (const ClusterRelation& relation : relations) {
     std::string line = std::string(to_string(relation.kind)) + ":";
     for (const std::uint32_t c : relation.clusters) line += " " + std::to_string(c);
+    if (!relation.orthogonal_to.empty()) line += " |";
+    for (const std::uint32_t c : relation.orthogonal_to) line += " " + std::to_string(c);
     EXPECT_NE(text.output.find(line + "\n"), std::string::npos) << line << "\n" << text.output;
   }
   // Without it, neither the relations nor the changed fits.

@@ -544,9 +544,18 @@ TEST(Denoise, SnappedLevelIsTheBoxsFacesAndItsEdges) {
     EXPECT_EQ(r.algebraic.axis, start.axis);
   }
 
-  // The relations made exact: the three pairs of opposite faces, each sharing one normal.
-  ASSERT_EQ(level.relations.size(), 3u);
+  // The relations made exact: the three pairs of opposite faces, each sharing one normal, and
+  // their three directions at right angles.
+  ASSERT_EQ(level.relations.size(), 6u);
   for (const ClusterRelation& relation : level.relations) {
+    if (relation.kind == ClusterRelation::Kind::Orthogonal) {
+      ASSERT_EQ(relation.clusters.size(), 2u);
+      ASSERT_EQ(relation.orthogonal_to.size(), 2u);
+      const Vec3 &a = level.clusters[relation.clusters[0]].primitive.axis,
+                 &b = level.clusters[relation.orthogonal_to[0]].primitive.axis;
+      EXPECT_LT(std::abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]), 1e-15);
+      continue;
+    }
     EXPECT_EQ(relation.kind, ClusterRelation::Kind::Parallel);
     ASSERT_EQ(relation.clusters.size(), 2u);
     const Primitive &a = level.clusters[relation.clusters[0]].primitive,
