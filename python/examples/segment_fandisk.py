@@ -97,6 +97,31 @@ assert all(border["clusters"][1] is not None for border in borders)  # fandisk i
 assert np.sum(angles < 7) >= 5 and np.sum(angles > 80) >= 5
 
 # %% [markdown]
+# ## The design intent
+# Which fits are parallel, coaxial or at right angles within their uncertainty; with
+# `regularize=True` the clusters' primitives have these relations made exact (the CLI's
+# `--regularize`), as a CAD model would have them.
+
+# %%
+relations = tree.relations(30)
+for kind in ("parallel", "coaxial", "orthogonal"):
+    print(f"{kind}: {sum(r['kind'] == kind for r in relations)}")
+exact = tree.clusters(30, regularize=True)
+coaxial = next(r["clusters"] for r in relations if r["kind"] == "coaxial")
+radii = [exact[c]["params"]["radius"] for c in coaxial]
+print("one axis for the cylinders", coaxial, "of radii", np.round(radii, 4))
+axes = np.array([exact[c]["params"]["axis"] for c in coaxial])
+assert np.all(np.abs(axes) == np.abs(axes[0]))  # one direction, bit for bit
+right_angle = next(r for r in relations if r["kind"] == "orthogonal")
+
+
+def direction(c):
+    return np.array(exact[c]["params"].get("normal", exact[c]["params"].get("axis")))
+
+
+assert abs(direction(right_angle["clusters"][0]) @ direction(right_angle["orthogonal_to"][0])) < 1e-14
+
+# %% [markdown]
 # ## Per-face quantities with numpy
 # Labels index the cluster list, so per-face arrays are one fancy-indexing away: here the RMS
 # distance of each face's cluster, ready to colour a mesh viewer with.
