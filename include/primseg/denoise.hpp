@@ -92,7 +92,7 @@ struct DenoiseOptions {
   /// primitive, which lowers what the fits leave of the noise: the generated noisy box and capped
   /// cylinder on their true regions (edges 2% of the diagonal) 12.0x → 18.0x and 13.5x → 23.9x
   /// lower RMS; fandisk with 0.3% noise on the clean mesh's 30 clusters 5.5x → 6.7x, at the
-  /// automatic level 3.79x → 3.99x. Needs the refit (refit_outlier_threshold > 0). 0 disables.
+  /// automatic level 3.79x → 4.05x. Needs the refit (refit_outlier_threshold > 0). 0 disables.
   /// >= 0.
   double relation_significance = 3.0;
   /// The automatic level (Denoiser::automatic_level) cuts a hierarchy without a significant jump
