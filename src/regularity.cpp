@@ -408,8 +408,8 @@ constexpr std::size_t kLargestFrame = 16;
 // Pairs of direction groups at right angles within the significance, made exactly so.
 //
 // Pairs are taken by increasing score, each scored again when it comes up on the directions the
-// pairs kept before it left (two directions made orthogonal to a third are nearer their own right
-// angle then), so pairs up to twice the significance wait in the queue. The kept pairs join the
+// pairs kept before it left (a kept pair moves its component's directions), so pairs up to twice
+// the significance wait in the queue. The kept pairs join the
 // groups into components. In a component of at most kLargestFrame groups (a part's frames: its
 // directions at right angles) every constraint is met by least squares from the measured
 // directions, each moved along its covariance (sweeps of make_orthogonal), and a pair within a

@@ -167,6 +167,8 @@ TEST(Relations, PartsShowTheirDesignIntentExactAndNoisy) {
         EXPECT_TRUE(std::includes(truth.orthogonal.begin(), truth.orthogonal.end(),
                                   orthogonal.begin(), orthogonal.end()));
         EXPECT_GE(orthogonal.size() + 1, truth.orthogonal.size());
+        std::printf("%s, noisy: %zu of %zu right angles\n", name.c_str(), orthogonal.size(),
+                    truth.orthogonal.size());
       }
       // One cylinder at most: nothing to be coaxial with.
       EXPECT_TRUE(clusters_of(relations, ClusterRelation::Kind::Coaxial).empty());
