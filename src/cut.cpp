@@ -10,6 +10,7 @@
 #include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
+#include "triangle_corners.hpp"
 #include "working_primitive.hpp"
 
 namespace primseg {
@@ -132,19 +133,6 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
 
 namespace {
 
-// Appends every triangle corner of triangle t, working frame, with its weight.
-void append_corners(const Hierarchy& hierarchy, std::uint32_t t, std::vector<Vec3>& points,
-                    std::vector<double>& weights) {
-  const DualGraph& graph = hierarchy.graph();
-  const Triangle corners = graph.corners(t);
-  const std::array<double, 3> w = graph.corner_weights(t);
-  for (int corner = 0; corner < 3; ++corner) {
-    const Eigen::Vector3d& x = graph.position(corners[corner]);
-    points.push_back({x.x(), x.y(), x.z()});
-    weights.push_back(w[corner]);
-  }
-}
-
 // Fills the primitive, rms and max of a report from the cluster's corners (working frame, in
 // ascending triangle order: describe_clusters and describe_nodes give the same bits) and its
 // area from the working-frame sum.
@@ -199,7 +187,7 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
     points[thread].clear();
     weights[thread].clear();
     for (std::uint32_t i = offset[c]; i < offset[c + 1]; ++i) {
-      append_corners(hierarchy, triangles[i], points[thread], weights[thread]);
+      detail::append_corners(graph, triangles[i], points[thread], weights[thread]);
       r.area += graph.triangle_area(triangles[i]);
     }
     fit_report(graph.frame(), start[c], points[thread], weights[thread], options, r);
@@ -253,7 +241,7 @@ std::vector<ClusterReport> describe_nodes(const Hierarchy& hierarchy,
     weights[thread].clear();
     for (std::uint32_t face : node_faces)
       for (std::uint32_t t = graph.first_triangle(face); t < graph.first_triangle(face + 1); ++t) {
-        append_corners(hierarchy, t, points[thread], weights[thread]);
+        detail::append_corners(graph, t, points[thread], weights[thread]);
         r.area += graph.triangle_area(t);
       }
     fit_report(graph.frame(), hierarchy.primitive(r.node), points[thread], weights[thread], options,

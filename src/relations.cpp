@@ -8,6 +8,7 @@
 #include "primseg/error.hpp"
 #include "primseg/geometric_fit.hpp"
 #include "regularity.hpp"
+#include "triangle_corners.hpp"
 #include "working_primitive.hpp"
 
 namespace primseg {
@@ -100,13 +101,7 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
   for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     const std::uint32_t c = segmentation.labels[mesh.face_of_triangle[t]];
     if (!refitted[c]) continue;
-    const Triangle vertices = graph.corners(t);
-    const std::array<double, 3> corner_weights = graph.corner_weights(t);
-    for (int i = 0; i < 3; ++i) {
-      const Eigen::Vector3d& x = graph.position(vertices[i]);
-      member_corners[c].push_back({x.x(), x.y(), x.z()});
-      member_weights[c].push_back(corner_weights[i]);
-    }
+    detail::append_corners(graph, t, member_corners[c], member_weights[c]);
   }
   GeometricFitOptions measure_only;
   measure_only.max_iterations = 0;
