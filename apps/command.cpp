@@ -174,8 +174,9 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
       ->capture_default_str();
   command.add_flag("--regularize", options.regularize,
                    "Make the fits' design intent exact: plane normals and cylinder axes that "
-                   "agree within their uncertainty share one direction, and cylinders one axis "
-                   "line (listed as \"relations\" in the JSON)");
+                   "agree within their uncertainty share one direction, directions at right "
+                   "angles become orthogonal, and cylinders share one axis line or one radius "
+                   "(listed as \"relations\" in the JSON)");
 }
 
 void validate_level_outputs(LevelOptions& options) {

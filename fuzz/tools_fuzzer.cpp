@@ -291,14 +291,17 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
 
 // Relations: clusters increasing and distinct, two or more (orthogonal: one or more a side); a
 // parallel group and each side of an orthogonal pair share one direction up to sign, the two
-// sides' directions are orthogonal to round-off, and a coaxial set holds cylinders only.
+// sides' directions are orthogonal to round-off, a coaxial set holds cylinders only, and
+// cylinders of equal radius have one radius, bit for bit.
 void check_relations(const std::vector<Primitive>& primitives,
                      const std::vector<ClusterRelation>& relations, const std::string& what) {
-  auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest) {
+  auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest,
+                           bool one_direction) {
     if (members.size() < fewest || !std::is_sorted(members.begin(), members.end()) ||
         std::adjacent_find(members.begin(), members.end()) != members.end() ||
         members.back() >= primitives.size())
       fail((what + ": relation members").c_str(), double(members.size()));
+    if (!one_direction) return;
     const Vec3& direction = primitives[members[0]].axis;
     for (const std::uint32_t c : members) {
       const Vec3& axis = primitives[c].axis;
@@ -309,16 +312,22 @@ void check_relations(const std::vector<Primitive>& primitives,
   };
   for (const ClusterRelation& relation : relations) {
     const bool orthogonal = relation.kind == ClusterRelation::Kind::Orthogonal;
-    check_members(relation.clusters, orthogonal ? 1 : 2);
-    if (relation.kind == ClusterRelation::Kind::Coaxial)
+    const bool equal_radius = relation.kind == ClusterRelation::Kind::EqualRadius;
+    check_members(relation.clusters, orthogonal ? 1 : 2, !equal_radius);
+    if (relation.kind == ClusterRelation::Kind::Coaxial || equal_radius)
       for (const std::uint32_t c : relation.clusters)
         if (primitives[c].type != PrimitiveType::Cylinder)
-          fail((what + ": coaxial non-cylinder").c_str(), c);
+          fail((what + ": coaxial or equal-radius non-cylinder").c_str(), c);
+    if (equal_radius)
+      for (const std::uint32_t c : relation.clusters)
+        if (std::bit_cast<std::uint64_t>(primitives[c].radius) !=
+            std::bit_cast<std::uint64_t>(primitives[relation.clusters[0]].radius))
+          fail((what + ": equal radii differ").c_str(), primitives[c].radius);
     if (!orthogonal) {
       if (!relation.orthogonal_to.empty()) fail((what + ": orthogonal_to set").c_str());
       continue;
     }
-    check_members(relation.orthogonal_to, 1);
+    check_members(relation.orthogonal_to, 1, true);
     if (relation.orthogonal_to[0] <= relation.clusters[0])
       fail((what + ": orthogonal sides' order").c_str());
     const Vec3 &a = primitives[relation.clusters[0]].axis,

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -124,7 +125,110 @@ std::optional<Oriented> oriented_cylinder(std::size_t cluster, const Primitive& 
   return item;
 }
 
-// One cylinder of a coaxial set: its inliers and its radius.
+// One cylinder of a joint fit: its inliers, and the axis line and the radius it takes (indices
+// into the fit's lines and radii).
+struct CylinderTerm {
+  std::span<const Vec3> points;
+  std::span<const double> weights;
+  std::size_t line = 0;
+  std::size_t radius = 0;
+};
+
+// Axis lines of fixed directions and radii fitted together by geometric least squares: each
+// term's residuals are its points' distances to its line minus its radius. Several terms on one
+// line are coaxial cylinders; several on one radius, cylinders of equal radius.
+struct JointFit {
+  std::vector<Eigen::Vector2d> centres;  // per line, in orthonormal_pair(direction) coordinates
+  std::vector<double> radii;
+  std::vector<double> rms;     // per term, unweighted, at least kResolution × its radius
+  Eigen::MatrixXd covariance;  // of (centres, radii), from the unweighted residuals
+};
+
+// Gauss–Newton from `centres` and `radii` (weighted steps; the uncertainty from the unweighted
+// residuals at the solution). Nothing when it diverges, a radius ends non-positive or the points
+// do not outnumber the parameters.
+std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> directions,
+                                      std::span<const Eigen::Vector2d> centres,
+                                      std::span<const double> radii,
+                                      std::span<const CylinderTerm> terms) {
+  const Eigen::Index lines = static_cast<Eigen::Index>(centres.size());
+  const Eigen::Index size = 2 * lines + static_cast<Eigen::Index>(radii.size());
+  Eigen::VectorXd x(size);
+  for (Eigen::Index l = 0; l < lines; ++l) x.segment<2>(2 * l) = centres[l];
+  for (std::size_t q = 0; q < radii.size(); ++q)
+    x(2 * lines + static_cast<Eigen::Index>(q)) = radii[q];
+  // The points in the plane orthogonal to their line's direction, once for every iteration.
+  std::vector<std::vector<Eigen::Vector2d>> projected(terms.size());
+  for (std::size_t k = 0; k < terms.size(); ++k) {
+    const auto [u, v] = orthonormal_pair(directions[terms[k].line]);
+    for (const Vec3& p : terms[k].points)
+      projected[k].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
+  }
+  Eigen::MatrixXd normal(size, size);
+  Eigen::VectorXd gradient(size);
+  std::vector<double> term_squares(terms.size());
+  std::vector<std::size_t> term_count(terms.size());
+  std::size_t count = 0;
+  auto linearise = [&](bool weighted) {
+    normal.setZero();
+    gradient.setZero();
+    double squares = 0;
+    count = 0;
+    for (std::size_t k = 0; k < terms.size(); ++k) {
+      const Eigen::Index c = 2 * static_cast<Eigen::Index>(terms[k].line);
+      const Eigen::Index r = 2 * lines + static_cast<Eigen::Index>(terms[k].radius);
+      term_squares[k] = 0;
+      term_count[k] = 0;
+      for (std::size_t i = 0; i < projected[k].size(); ++i) {
+        const Eigen::Vector2d d = projected[k][i] - x.segment<2>(c);
+        const double length = d.norm();
+        if (!(length > 0)) continue;
+        const double w = weighted ? terms[k].weights[i] : 1.0;
+        const double e = length - x(r);
+        const Eigen::Vector2d j = -d / length;
+        normal.block<2, 2>(c, c) += w * j * j.transpose();
+        normal.block<2, 1>(c, r) -= w * j;
+        normal(r, r) += w;
+        gradient.segment<2>(c) += w * j * e;
+        gradient(r) -= w * e;
+        squares += e * e;
+        term_squares[k] += e * e;
+        ++term_count[k];
+        ++count;
+      }
+    }
+    // The radii's rows mirror their columns (a centre's own block was summed whole).
+    for (Eigen::Index row = 2 * lines; row < size; ++row)
+      for (Eigen::Index col = 0; col < row; ++col) normal(row, col) = normal(col, row);
+    return squares;
+  };
+  for (int step = 0; step < 30; ++step) {
+    linearise(true);
+    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
+    if (!delta.allFinite()) return std::nullopt;
+    x += delta;
+    if (!(delta.norm() > 1e-14 * x.norm())) break;
+  }
+  const auto fitted_radii = x.tail(size - 2 * lines);
+  if (!x.allFinite() || !(fitted_radii.minCoeff() > 0)) return std::nullopt;
+  const double squares = linearise(false);
+  if (count <= static_cast<std::size_t>(size)) return std::nullopt;
+  JointFit fit;
+  for (Eigen::Index l = 0; l < lines; ++l) fit.centres.emplace_back(x.segment<2>(2 * l));
+  fit.radii.assign(fitted_radii.data(), fitted_radii.data() + fitted_radii.size());
+  for (std::size_t k = 0; k < terms.size(); ++k)
+    fit.rms.push_back(
+        std::max(std::sqrt(term_squares[k] / double(std::max<std::size_t>(term_count[k], 1))),
+                 kResolution * fit.radii[terms[k].radius]));
+  const double largest_radius = fitted_radii.maxCoeff();
+  fit.covariance = normal.inverse() *
+                   std::max(squares / static_cast<double>(count - static_cast<std::size_t>(size)),
+                            kResolution * kResolution * largest_radius * largest_radius);
+  if (!fit.covariance.allFinite()) return std::nullopt;
+  return fit;
+}
+
+// Cylinders on one axis line, each with its own radius.
 struct CoaxialMember {
   std::span<const Vec3> points;
   std::span<const double> weights;
@@ -135,78 +239,27 @@ struct CoaxialFit {
   Eigen::Vector2d centre;
   std::vector<double> radii;
   std::vector<double> rms;  // per member, unweighted
+  std::vector<double> radius_variances;
   Eigen::Matrix2d centre_covariance = Eigen::Matrix2d::Zero();
 };
 
 std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::Vector2d& centre,
                                       std::span<const CoaxialMember> members) {
-  const Eigen::Index m = static_cast<Eigen::Index>(members.size());
-  Eigen::VectorXd x(2 + m);
-  x.head<2>() = centre;
-  for (Eigen::Index k = 0; k < m; ++k) x(2 + k) = members[k].radius;
-  // The points in the plane orthogonal to the axis, once for every iteration.
-  const auto [u, v] = orthonormal_pair(axis);
-  std::vector<std::vector<Eigen::Vector2d>> projected(members.size());
-  for (std::size_t k = 0; k < members.size(); ++k)
-    for (const Vec3& p : members[k].points)
-      projected[k].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
-  Eigen::MatrixXd normal(2 + m, 2 + m);
-  Eigen::VectorXd gradient(2 + m);
-  std::vector<double> member_squares(m);
-  std::vector<std::size_t> member_count(m);
-  std::size_t count = 0;
-  auto linearise = [&](bool weighted) {
-    normal.setZero();
-    gradient.setZero();
-    double squares = 0;
-    count = 0;
-    for (Eigen::Index k = 0; k < m; ++k) {
-      member_squares[k] = 0;
-      member_count[k] = 0;
-      for (std::size_t i = 0; i < projected[k].size(); ++i) {
-        const Eigen::Vector2d d = projected[k][i] - x.head<2>();
-        const double length = d.norm();
-        if (!(length > 0)) continue;
-        const double w = weighted ? members[k].weights[i] : 1.0;
-        const double e = length - x(2 + k);
-        const Eigen::Vector2d j = -d / length;
-        normal.topLeftCorner<2, 2>() += w * j * j.transpose();
-        normal.block(0, 2 + k, 2, 1) -= w * j;
-        normal(2 + k, 2 + k) += w;
-        gradient.head<2>() += w * j * e;
-        gradient(2 + k) -= w * e;
-        squares += e * e;
-        member_squares[k] += e * e;
-        ++member_count[k];
-        ++count;
-      }
-    }
-    normal.block(2, 0, m, 2) = normal.block(0, 2, 2, m).transpose();
-    return squares;
-  };
-  for (int step = 0; step < 30; ++step) {
-    linearise(true);
-    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
-    if (!delta.allFinite()) return std::nullopt;
-    x += delta;
-    if (!(delta.norm() > 1e-14 * x.norm())) break;
+  std::vector<CylinderTerm> terms;
+  std::vector<double> radii;
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    terms.push_back({members[k].points, members[k].weights, 0, k});
+    radii.push_back(members[k].radius);
   }
-  if (!x.allFinite() || !(x.tail(m).minCoeff() > 0)) return std::nullopt;
-  const double squares = linearise(false);
-  if (count <= static_cast<std::size_t>(2 + m)) return std::nullopt;
+  std::optional<JointFit> joint = fit_cylinders({&axis, 1}, {&centre, 1}, radii, terms);
+  if (!joint) return std::nullopt;
   CoaxialFit fit;
-  fit.centre = x.head<2>();
-  fit.radii.assign(x.data() + 2, x.data() + 2 + m);
-  for (Eigen::Index k = 0; k < m; ++k)
-    fit.rms.push_back(
-        std::max(std::sqrt(member_squares[k] / double(std::max<std::size_t>(member_count[k], 1))),
-                 kResolution * fit.radii[static_cast<std::size_t>(k)]));
-  const double largest_radius = x.tail(m).maxCoeff();
-  fit.centre_covariance =
-      normal.inverse().topLeftCorner<2, 2>() *
-      std::max(squares / static_cast<double>(count - static_cast<std::size_t>(2 + m)),
-               kResolution * kResolution * largest_radius * largest_radius);
-  if (!fit.centre_covariance.allFinite()) return std::nullopt;
+  fit.centre = joint->centres[0];
+  fit.radii = std::move(joint->radii);
+  fit.rms = std::move(joint->rms);
+  fit.centre_covariance = joint->covariance.topLeftCorner<2, 2>();
+  for (Eigen::Index k = 0; k < static_cast<Eigen::Index>(members.size()); ++k)
+    fit.radius_variances.push_back(joint->covariance(2 + k, 2 + k));
   return fit;
 }
 
@@ -317,15 +370,52 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
   return sets;
 }
 
+// How far a joint fit explains a member worse than its own fit did: the rise of its residual sum
+// over significance² times its residual variance (estimated with the member's fit's degrees of
+// freedom). Above 1, it does not belong.
+double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2) {
+  const double n = static_cast<double>(count);
+  const double rise = n * (joint_rms * joint_rms - own_rms * own_rms);
+  return rise / (significance2 * own_rms * own_rms * n / (n - 3));
+}
+
+// `cylinder` on the line of `direction` through `centre` (orthonormal_pair(direction)
+// coordinates), its axis on its own side and its point the line's nearest to the old one, so
+// that it stays by the cluster.
+void place_cylinder(Primitive& cylinder, const Eigen::Vector3d& direction,
+                    const Eigen::Vector2d& centre, double radius) {
+  const auto [u, v] = orthonormal_pair(direction);
+  cylinder.axis = to_vec3(direction.dot(to_eigen(cylinder.axis)) < 0 ? -direction : direction);
+  const Eigen::Vector3d on_axis = centre.x() * u + centre.y() * v;
+  cylinder.point = to_vec3(on_axis + direction * direction.dot(to_eigen(cylinder.point) - on_axis));
+  cylinder.radius = radius;
+}
+
+// The cylinders refitted so far, each on an axis line (coaxial ones on a shared one), for the
+// equal radii.
+struct SettledCylinders {
+  struct Line {
+    Eigen::Vector3d direction;
+    Eigen::Vector2d centre;  // orthonormal_pair(direction) coordinates
+  };
+  struct Cylinder {
+    std::size_t cluster = 0;
+    std::size_t line = 0;
+    double radius = 0, radius_variance = 0, rms = 0;
+    std::size_t inliers = 0;
+  };
+  std::vector<Line> lines;
+  std::vector<Cylinder> cylinders;
+};
+
 // Refits the cylinders of a direction group: each coaxial set around one axis line (each member
 // keeping its own radius), the others alone with the group's direction. Appends the coaxial sets
-// of two or more to `relations`.
+// of two or more to `relations`, and every cylinder refitted to `settled`.
 void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylinder> cylinders,
                      double significance2, std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights,
-                     std::vector<Relation>& relations) {
-  const auto [u, v] = orthonormal_pair(direction);
+                     std::vector<Relation>& relations, SettledCylinders& settled) {
   std::stable_sort(cylinders.begin(), cylinders.end(),
                    [](const AlignedCylinder& a, const AlignedCylinder& b) {
                      return a.fit.centre_covariance.trace() < b.fit.centre_covariance.trace();
@@ -348,11 +438,9 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
       std::size_t worst = sets[s].size();
       double worst_excess = 1;
       for (std::size_t j = 0; j < sets[s].size(); ++j) {
-        const double own = cylinders[sets[s][j]].fit.rms[0];
-        const double n = static_cast<double>(members[j].points.size());
-        const double rise = fit ? n * (fit->rms[j] * fit->rms[j] - own * own)
-                                : std::numeric_limits<double>::infinity();
-        const double excess = rise / (significance2 * own * own * n / (n - 3));
+        const double excess = fit ? residual_excess(cylinders[sets[s][j]].fit.rms[0], fit->rms[j],
+                                                    members[j].points.size(), significance2)
+                                  : std::numeric_limits<double>::infinity();
         if (excess > worst_excess) {
           worst_excess = excess;
           worst = j;
@@ -373,14 +461,166 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
       for (const std::size_t k : sets[s]) coaxial.members.push_back(cylinders[k].cluster);
       std::sort(coaxial.members.begin(), coaxial.members.end());
     }
+    const std::size_t line = settled.lines.size();
+    settled.lines.push_back({direction, joint.centre});
     for (std::size_t j = 0; j < sets[s].size(); ++j) {
-      Primitive& cylinder = primitives[cylinders[sets[s][j]].cluster];
-      cylinder.axis = to_vec3(direction.dot(to_eigen(cylinder.axis)) < 0 ? -direction : direction);
-      // The axis point nearest to the old one, so that it stays by the cluster.
-      const Eigen::Vector3d on_axis = joint.centre.x() * u + joint.centre.y() * v;
-      cylinder.point =
-          to_vec3(on_axis + direction * direction.dot(to_eigen(cylinder.point) - on_axis));
-      cylinder.radius = joint.radii[j];
+      const std::size_t c = cylinders[sets[s][j]].cluster;
+      place_cylinder(primitives[c], direction, joint.centre, joint.radii[j]);
+      settled.cylinders.push_back(
+          {c, line, joint.radii[j], joint.radius_variances[j], joint.rms[j], points[c].size()});
+    }
+  }
+}
+
+// Radii known to agree within the significance (and never more than max_radius_difference apart,
+// relative to the larger), pooled by their information: visited from the best-known, each joins
+// the class whose pooled radius it agrees with best, else starts one. A radius known less well
+// than its own size (a nearly flat cylinder) joins none. Returns each cylinder's class.
+std::vector<std::size_t> radius_classes(const std::vector<SettledCylinders::Cylinder>& cylinders,
+                                        const RegularityOptions& options) {
+  std::vector<std::size_t> order(cylinders.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return cylinders[a].radius_variance < cylinders[b].radius_variance;
+  });
+  const double significance2 = options.significance * options.significance;
+  std::vector<double> information, weighted;  // per class: Σ 1/variance, Σ radius/variance
+  std::vector<std::size_t> class_of(cylinders.size());
+  for (const std::size_t k : order) {
+    const double r = cylinders[k].radius, variance = cylinders[k].radius_variance;
+    std::size_t best = information.size();
+    if (variance > 0 && std::sqrt(variance) < r) {
+      double best_score = significance2;
+      for (std::size_t q = 0; q < information.size(); ++q) {
+        const double pooled = weighted[q] / information[q];
+        const double difference = r - pooled;
+        if (std::abs(difference) > options.max_radius_difference * std::max(r, pooled)) continue;
+        const double score = difference * difference / (variance + 1 / information[q]);
+        if (score <= best_score) {
+          best_score = score;
+          best = q;
+        }
+      }
+    }
+    if (best == information.size()) {
+      information.push_back(0);
+      weighted.push_back(0);
+    }
+    if (variance > 0) {
+      information[best] += 1 / variance;
+      weighted[best] += r / variance;
+    }
+    class_of[k] = best;
+  }
+  return class_of;
+}
+
+// Cylinders of equal radius within the significance (radius_classes) share one radius: each
+// component of cylinders joined by a class or by an axis line (a coaxial set) is refitted by one
+// joint least squares over its lines' positions and its radii, the directions kept. As for a
+// coaxial set, a member the joint fit explains worse than its own by more than the significance
+// leaves its class, the worst first. Appends the classes of two or more to `relations`.
+void equalize_radii(const SettledCylinders& settled, const RegularityOptions& options,
+                    std::vector<Primitive>& primitives,
+                    const std::vector<std::vector<Vec3>>& points,
+                    const std::vector<std::vector<double>>& weights,
+                    std::vector<Relation>& relations) {
+  const std::vector<SettledCylinders::Cylinder>& cylinders = settled.cylinders;
+  const std::size_t n = cylinders.size();
+  std::vector<std::size_t> class_of = radius_classes(cylinders, options);
+  std::vector<std::size_t> class_size(n, 0);
+  for (const std::size_t q : class_of) ++class_size[q];
+  // Components: union-find over the cylinders, through shared classes and shared lines.
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  const std::function<std::size_t(std::size_t)> root = [&](std::size_t k) {
+    return parent[k] == k ? k : parent[k] = root(parent[k]);
+  };
+  std::vector<std::size_t> first_of_class(n, n), first_on_line(settled.lines.size(), n);
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t* first : {&first_of_class[class_of[k]], &first_on_line[cylinders[k].line]}) {
+      if (*first == n)
+        *first = k;
+      else
+        parent[root(k)] = root(*first);
+    }
+  }
+  std::vector<std::vector<std::size_t>> components(n);
+  for (std::size_t k = 0; k < n; ++k) components[root(k)].push_back(k);
+  const double significance2 = options.significance * options.significance;
+  for (const std::vector<std::size_t>& component : components) {
+    if (std::none_of(component.begin(), component.end(),
+                     [&](std::size_t k) { return class_size[class_of[k]] >= 2; }))
+      continue;
+    std::optional<JointFit> fit;
+    std::vector<CylinderTerm> terms;
+    std::vector<std::size_t> line_index(settled.lines.size(), n), radius_of_class(n, n);
+    std::vector<Eigen::Vector3d> directions;
+    std::vector<Eigen::Vector2d> centres;
+    std::vector<double> radii;
+    while (true) {
+      terms.clear();
+      directions.clear();
+      centres.clear();
+      radii.clear();
+      std::fill(line_index.begin(), line_index.end(), n);
+      std::fill(radius_of_class.begin(), radius_of_class.end(), n);
+      for (const std::size_t k : component) {
+        const SettledCylinders::Cylinder& cylinder = cylinders[k];
+        std::size_t& line = line_index[cylinder.line];
+        if (line == n) {
+          line = directions.size();
+          directions.push_back(settled.lines[cylinder.line].direction);
+          centres.push_back(settled.lines[cylinder.line].centre);
+        }
+        // A class of two or more has one radius, started from its best-known member's.
+        std::size_t& radius = radius_of_class[class_of[k]];
+        if (radius == n || class_size[class_of[k]] < 2) {
+          radius = radii.size();
+          radii.push_back(cylinder.radius);
+        }
+        terms.push_back({points[cylinder.cluster], weights[cylinder.cluster], line, radius});
+      }
+      fit = fit_cylinders(directions, centres, radii, terms);
+      if (!fit) break;
+      std::size_t worst = component.size();
+      double worst_excess = 1;
+      for (std::size_t j = 0; j < component.size(); ++j) {
+        const SettledCylinders::Cylinder& cylinder = cylinders[component[j]];
+        if (class_size[class_of[component[j]]] < 2) continue;
+        const double excess =
+            residual_excess(cylinder.rms, fit->rms[j], cylinder.inliers, significance2);
+        if (excess > worst_excess) {
+          worst_excess = excess;
+          worst = j;
+        }
+      }
+      if (worst == component.size()) break;
+      // The worst takes a class of its own, under any unused number.
+      --class_size[class_of[component[worst]]];
+      const auto free_class = std::find(class_size.begin(), class_size.end(), 0);
+      class_of[component[worst]] = static_cast<std::size_t>(free_class - class_size.begin());
+      *free_class = 1;
+    }
+    if (!fit) continue;
+    // Written back: the members of classes of two or more, and the cylinders on their lines.
+    std::vector<bool> moved_line(settled.lines.size(), false);
+    for (const std::size_t k : component)
+      if (class_size[class_of[k]] >= 2) moved_line[cylinders[k].line] = true;
+    std::map<std::size_t, std::vector<std::size_t>> members_of_class;
+    for (std::size_t j = 0; j < component.size(); ++j) {
+      const SettledCylinders::Cylinder& cylinder = cylinders[component[j]];
+      if (!moved_line[cylinder.line]) continue;
+      place_cylinder(primitives[cylinder.cluster], directions[terms[j].line],
+                     fit->centres[terms[j].line], fit->radii[terms[j].radius]);
+      if (class_size[class_of[component[j]]] >= 2)
+        members_of_class[class_of[component[j]]].push_back(cylinder.cluster);
+    }
+    for (auto& [unused, members] : members_of_class) {
+      Relation& relation = relations.emplace_back();
+      relation.kind = Relation::Kind::EqualRadius;
+      std::sort(members.begin(), members.end());
+      relation.members = std::move(members);
     }
   }
 }
@@ -552,6 +792,7 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
   for (const auto& [i, j] : orthogonal) constrained[i] = constrained[j] = true;
   // The clusters each group refitted, for the orthogonal relations.
   std::vector<std::vector<std::size_t>> refitted(groups.size());
+  SettledCylinders settled;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const DirectionGroup& group = groups[g];
     if (group.members.size() < 2 && !constrained[g]) continue;
@@ -579,7 +820,28 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     if (parallel.members.size() >= 2) relations.push_back(std::move(parallel));
     align_cylinders(group.direction, std::move(cylinders),
                     options.significance * options.significance, primitives, points, weights,
-                    relations);
+                    relations, settled);
+  }
+  if (options.equal_radii) {
+    // The cylinders no direction relation refitted take part too, each on its own axis (fitted
+    // again with it, for its radius's uncertainty; written back only if it joins a class).
+    std::vector<bool> is_settled(primitives.size(), false);
+    for (const SettledCylinders::Cylinder& cylinder : settled.cylinders)
+      is_settled[cylinder.cluster] = true;
+    for (const Oriented& item : items) {
+      const std::size_t c = item.cluster;
+      if (primitives[c].type != PrimitiveType::Cylinder || is_settled[c]) continue;
+      const auto [u, v] = orthonormal_pair(item.direction);
+      const Eigen::Vector2d centre(u.dot(to_eigen(primitives[c].point)),
+                                   v.dot(to_eigen(primitives[c].point)));
+      const CoaxialMember alone{points[c], weights[c], primitives[c].radius};
+      if (const std::optional<CoaxialFit> fit = fit_coaxial(item.direction, centre, {&alone, 1})) {
+        settled.cylinders.push_back({c, settled.lines.size(), fit->radii[0],
+                                     fit->radius_variances[0], fit->rms[0], points[c].size()});
+        settled.lines.push_back({item.direction, fit->centre});
+      }
+    }
+    equalize_radii(settled, options, primitives, points, weights, relations);
   }
   std::vector<Relation> right_angles;
   for (const auto& [i, j] : orthogonal) {
@@ -638,9 +900,20 @@ std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitiv
   std::vector<ClusterRelation> relations;
   for (const Relation& relation : regularize(primitives, inlier_points, inlier_weights, options)) {
     ClusterRelation& related = relations.emplace_back();
-    related.kind = relation.kind == Relation::Kind::Parallel  ? ClusterRelation::Kind::Parallel
-                   : relation.kind == Relation::Kind::Coaxial ? ClusterRelation::Kind::Coaxial
-                                                              : ClusterRelation::Kind::Orthogonal;
+    switch (relation.kind) {
+      case Relation::Kind::Parallel:
+        related.kind = ClusterRelation::Kind::Parallel;
+        break;
+      case Relation::Kind::Coaxial:
+        related.kind = ClusterRelation::Kind::Coaxial;
+        break;
+      case Relation::Kind::Orthogonal:
+        related.kind = ClusterRelation::Kind::Orthogonal;
+        break;
+      case Relation::Kind::EqualRadius:
+        related.kind = ClusterRelation::Kind::EqualRadius;
+        break;
+    }
     for (const std::size_t c : relation.members)
       related.clusters.push_back(static_cast<std::uint32_t>(c));
     for (const std::size_t c : relation.others)

@@ -2,7 +2,8 @@
 // Relations between the primitives of a segmentation, and the refit that makes them exact (after
 // GlobFit, Li et al. 2011): planes' normals and cylinders' axes that agree within their fits'
 // uncertainty share one direction, estimated from all of them, directions at right angles within
-// it are made orthogonal, and cylinders of one direction whose axes agree share one axis line.
+// it are made orthogonal, cylinders of one direction whose axes agree share one axis line, and
+// cylinders whose radii agree share one radius.
 
 #include <cstddef>
 #include <span>
@@ -22,14 +23,19 @@ struct RegularityOptions {
   double max_angle_degrees = 20;
   /// Make directions at right angles within the significance exactly orthogonal.
   bool orthogonal = true;
+  /// Give cylinders whose radii agree within the significance one radius.
+  bool equal_radii = true;
+  /// ... never when the radii differ by more than this fraction of the larger.
+  double max_radius_difference = 0.05;
 };
 
 /// Primitives that regularize() made share a direction or an axis line, or made orthogonal.
 struct Relation {
   enum class Kind {
-    Parallel,    ///< plane normals and cylinder axes made one direction (each keeps its side)
-    Coaxial,     ///< cylinders of one direction group made one axis line (each keeps its radius)
-    Orthogonal,  ///< two direction groups made orthogonal: `members` and `others`
+    Parallel,     ///< plane normals and cylinder axes made one direction (each keeps its side)
+    Coaxial,      ///< cylinders of one direction group made one axis line (each keeps its radius)
+    Orthogonal,   ///< two direction groups made orthogonal: `members` and `others`
+    EqualRadius,  ///< cylinders made one radius (each keeps its axis line)
   };
   Kind kind = Kind::Parallel;
   std::vector<std::size_t> members;  ///< indices into the primitives, increasing; two or more
@@ -45,9 +51,11 @@ struct Relation {
 /// jointly with the cylinders coaxial with it (one axis line, one radius each). points[c] and
 /// weights[c] are cluster c's inlier vertices (input units) and their weights; a cluster with too
 /// few to estimate its direction's uncertainty is left alone. Deterministic: clusters are visited
-/// by increasing uncertainty, ties by index. Returns the relations made exact: each direction
-/// group's members that were refitted with its direction, then each coaxial set of its
-/// cylinders, in that order, then the right angles by their members.
+/// by increasing uncertainty, ties by index. Then cylinders whose radii agree within the
+/// significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with the
+/// cylinders coaxial with them. Returns the relations made exact: each direction group's members
+/// that were refitted with its direction, then each coaxial set of its cylinders, in that order,
+/// then the classes of equal radii, then the right angles by their members.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,

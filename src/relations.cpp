@@ -21,6 +21,8 @@ std::string_view to_string(ClusterRelation::Kind kind) {
       return "coaxial";
     case ClusterRelation::Kind::Orthogonal:
       return "orthogonal";
+    case ClusterRelation::Kind::EqualRadius:
+      return "equal_radius";
   }
   return "unknown";
 }
@@ -30,6 +32,8 @@ void validate(const RelationOptions& options) {
     throw InvalidInputError("relations: the significance must be a positive number");
   if (!(options.max_angle_degrees > 0 && options.max_angle_degrees < 90))
     throw InvalidInputError("relations: the largest angle must be in (0, 90) degrees");
+  if (!(options.max_radius_difference > 0 && options.max_radius_difference < 1))
+    throw InvalidInputError("relations: the largest radius difference must be in (0, 1)");
   if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
     throw InvalidInputError("relations: the outlier threshold must be a positive number");
 }
@@ -85,6 +89,7 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
   detail::RegularityOptions regularity;
   regularity.significance = options.significance;
   regularity.max_angle_degrees = options.max_angle_degrees;
+  regularity.max_radius_difference = options.max_radius_difference;
   // The working frame's bounding box fits in [-1, 1]³.
   const double floor = 1e-12 * bounding_box_diagonal(mesh) / frame.scale();
   std::vector<ClusterRelation> relations = detail::regularize_inliers(

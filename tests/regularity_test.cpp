@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -272,16 +273,57 @@ TEST(Regularity, ASteppedShaftSharesOneAxisLine) {
 }
 
 TEST(Regularity, ParallelHolesApartStayOnTheirOwnAxes) {
-  // Two holes of one plate 0.05 apart (ten times the noise): parallel, not coaxial.
+  // Two holes of one plate 0.05 apart (ten times the noise): parallel, not coaxial, one radius.
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
   std::mt19937_64 rng(13);
   const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.2, 1, 0.005, rng),
                                       noisy_cylinder(z, {0.45, 0, 0}, 0.2, 1, 0.005, rng)};
   std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.2),
                                     fitted_cylinder(clusters[1], z, {0.45, 0, 0}, 0.2)};
-  EXPECT_EQ(regularize(primitives, clusters), (Relations{{Kind::Parallel, {0, 1}}}));
+  EXPECT_EQ(regularize(primitives, clusters),
+            (Relations{{Kind::Parallel, {0, 1}}, {Kind::EqualRadius, {0, 1}}}));
   EXPECT_NEAR(angle_between_lines(primitives[0].axis, primitives[1].axis), 0, 1e-12);
   EXPECT_NEAR(axis_offset(primitives[0], primitives[1]), 0.45, 0.002);
+  EXPECT_EQ(primitives[0].radius, primitives[1].radius);
+}
+
+// A bolt circle: four holes of radius 0.1, a fifth of 0.104 (40 times its radius's uncertainty
+// away) and a cross hole of 0.1 at right angles to them.
+TEST(Regularity, HolesOfOneRadiusShareItNearerTheTruth) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ(), x = Eigen::Vector3d::UnitX();
+  const std::vector<Eigen::Vector3d> centres{{0.5, 0, 0},  {0, 0.5, 0},   {-0.5, 0, 0},
+                                             {0, -0.5, 0}, {0.4, 0.4, 0}, {0, 0, 1}};
+  const std::vector<double> radii{0.1, 0.1, 0.1, 0.1, 0.104, 0.1};
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    std::vector<Cluster> clusters;
+    std::vector<Primitive> primitives;
+    for (std::size_t c = 0; c < centres.size(); ++c) {
+      const Eigen::Vector3d& axis = c == 5 ? x : z;
+      clusters.push_back(noisy_cylinder(axis, centres[c], radii[c], 0.4, 0.002, rng));
+      primitives.push_back(fitted_cylinder(clusters.back(), axis, centres[c], radii[c]));
+    }
+    const std::vector<Primitive> fitted = primitives;
+    const Relations relations = regularize(primitives, clusters);
+    ASSERT_EQ(std::count(relations.begin(), relations.end(),
+                         std::pair{Kind::EqualRadius, std::vector<std::size_t>{0, 1, 2, 3, 5}}),
+              1);
+    double worst = 0;
+    for (const std::size_t c : {0, 1, 2, 3, 5}) {
+      worst = std::max(worst, std::abs(fitted[c].radius - 0.1));
+      EXPECT_EQ(primitives[c].radius, primitives[0].radius);
+      // Each keeps its own axis line.
+      EXPECT_LT(axis_offset(primitives[c], fitted[c]), 0.002);
+    }
+    EXPECT_LE(std::abs(primitives[0].radius - 0.1), worst);
+    EXPECT_NEAR(primitives[4].radius, 0.104, 0.0005);
+    for (const auto& [kind, members] : relations) {
+      if (kind == Kind::EqualRadius) {
+        EXPECT_EQ(std::count(members.begin(), members.end(), 4), 0);
+      }
+    }
+  }
 }
 
 TEST(Regularity, ANearlyFlatCylinderJoinsNoAxis) {

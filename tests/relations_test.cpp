@@ -16,6 +16,7 @@
 #include "primseg/auto_level.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/refine.hpp"
 #include "primseg/shape_generator.hpp"
 #include "support/test_support.hpp"
 
@@ -170,8 +171,9 @@ TEST(Relations, PartsShowTheirDesignIntentExactAndNoisy) {
         std::printf("%s, noisy: %zu of %zu right angles\n", name.c_str(), orthogonal.size(),
                     truth.orthogonal.size());
       }
-      // One cylinder at most: nothing to be coaxial with.
+      // One cylinder at most: nothing to be coaxial with, or of equal radius.
       EXPECT_TRUE(clusters_of(relations, ClusterRelation::Kind::Coaxial).empty());
+      EXPECT_TRUE(clusters_of(relations, ClusterRelation::Kind::EqualRadius).empty());
       for (const auto& group : parallel) expect_one_direction(reports, group);
       expect_orthogonal(reports, relations);
     }
@@ -318,9 +320,11 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
   const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, after);
   const Groups parallel = clusters_of(relations, ClusterRelation::Kind::Parallel);
   const Groups coaxial = clusters_of(relations, ClusterRelation::Kind::Coaxial);
-  std::printf("fandisk at %u clusters: %zu parallel groups, %zu coaxial sets, %zu right angles\n",
-              cut.cluster_count(), parallel.size(), coaxial.size(),
-              orthogonal_pairs(relations).size());
+  std::printf(
+      "fandisk at %u clusters: %zu parallel groups, %zu coaxial sets, %zu right angles, %zu "
+      "equal radii\n",
+      cut.cluster_count(), parallel.size(), coaxial.size(), orthogonal_pairs(relations).size(),
+      clusters_of(relations, ClusterRelation::Kind::EqualRadius).size());
   EXPECT_GE(parallel.size(), 3u);
   ASSERT_GE(coaxial.size(), 1u);
   EXPECT_GE(orthogonal_pairs(relations).size(), 3u);
@@ -335,6 +339,11 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
           << c;
     }
   }
+  for (const auto& set : clusters_of(relations, ClusterRelation::Kind::EqualRadius))
+    for (const std::uint32_t c : set) {
+      EXPECT_TRUE(testing::same_bits(after[c].primitive.radius, after[set[0]].primitive.radius));
+      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
+    }
   for (const auto& set : coaxial) {
     // Every coaxial set is within a parallel group.
     EXPECT_TRUE(std::any_of(parallel.begin(), parallel.end(), [&](const auto& group) {
@@ -348,6 +357,75 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
                            cylinder.point[2] - first.point[2]};
       EXPECT_LT(std::sqrt(dot(cross(offset, first.axis), cross(offset, first.axis))),
                 1e-12 * diagonal);
+    }
+  }
+}
+
+// Cylinders of a CAD part whose fitted radii agree within `tolerance` (relative), linked one to
+// the next: the part's equal radii, when the tessellation is that exact.
+Groups equal_radii(const std::vector<ClusterReport>& reports, double tolerance) {
+  std::vector<std::uint32_t> cylinders;
+  for (std::uint32_t c = 0; c < reports.size(); ++c)
+    if (reports[c].primitive.type == PrimitiveType::Cylinder) cylinders.push_back(c);
+  std::sort(cylinders.begin(), cylinders.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return reports[a].primitive.radius < reports[b].primitive.radius;
+  });
+  Groups groups;
+  for (std::size_t i = 0; i < cylinders.size(); ++i) {
+    const double r = reports[cylinders[i]].primitive.radius;
+    if (i == 0 || r > reports[cylinders[i - 1]].primitive.radius * (1 + tolerance))
+      groups.emplace_back();
+    groups.back().push_back(cylinders[i]);
+  }
+  std::erase_if(groups, [](const auto& group) { return group.size() < 2; });
+  for (auto& group : groups) std::sort(group.begin(), group.end());
+  std::sort(groups.begin(), groups.end());
+  return groups;
+}
+
+// The hole patterns of two libcgal-demo parts, at their automatic levels with the borders refined
+// (as `segment --refine 2`): couplingdown (an exact tessellation: radii agree to 1e-5) has bolt
+// circles of 3, 3 and 4 holes; anchor_dense (remeshed: to 1%) two of 4. Each pattern is one
+// equal-radius relation, and no other cylinder joins one.
+TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
+  for (const auto& [name, tolerance] :
+       {std::pair{"couplingdown.off", 1e-5}, std::pair{"anchor_dense.off", 1e-2}}) {
+    SCOPED_TRACE(name);
+    const Mesh mesh = read_mesh(testing::cgal_mesh(name));
+    const Hierarchy hierarchy = build_hierarchy(mesh);
+    BoundaryRefinementOptions refine;
+    refine.max_passes = 2;
+    const RefinedLevel level = refine_boundaries(
+        hierarchy, cut_by_count(hierarchy, choose_level(hierarchy).clusters), refine);
+    const std::vector<ClusterReport>& before = level.reports;
+    std::vector<ClusterReport> after = before;
+    const std::vector<ClusterRelation> relations =
+        regularize_clusters(hierarchy, level.segmentation, after);
+    const Groups truth = equal_radii(before, tolerance);
+    const Groups found = clusters_of(relations, ClusterRelation::Kind::EqualRadius);
+    std::printf("%s at %u clusters: %zu hole patterns of", name, level.segmentation.cluster_count(),
+                found.size());
+    for (const auto& group : found)
+      std::printf(" %zu (radius %.6g)", group.size(), after[group[0]].primitive.radius);
+    std::printf("\n");
+    EXPECT_GE(truth.size(), 2u);
+    EXPECT_EQ(found, truth);
+    const double diagonal = bounding_box_diagonal(mesh);
+    for (const auto& group : found) {
+      double lowest = INFINITY, highest = 0;
+      for (const std::uint32_t c : group) {
+        lowest = std::min(lowest, before[c].primitive.radius);
+        highest = std::max(highest, before[c].primitive.radius);
+      }
+      for (const std::uint32_t c : group) {
+        // One radius, bit for bit, as near the members' own as they are to each other (the
+        // directions made parallel move them a little), and each fit about as good.
+        EXPECT_TRUE(
+            testing::same_bits(after[c].primitive.radius, after[group[0]].primitive.radius));
+        EXPECT_GE(after[c].primitive.radius, lowest * (1 - tolerance));
+        EXPECT_LE(after[c].primitive.radius, highest * (1 + tolerance));
+        EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
+      }
     }
   }
 }
@@ -370,6 +448,9 @@ TEST(Relations, RefusesMismatchedReportsAndBadOptions) {
            [](RelationOptions& o) { o.significance = std::nan(""); },
            [](RelationOptions& o) { o.max_angle_degrees = 90; },
            [](RelationOptions& o) { o.max_angle_degrees = 0; },
+           [](RelationOptions& o) { o.max_radius_difference = 0; },
+           [](RelationOptions& o) { o.max_radius_difference = 1; },
+           [](RelationOptions& o) { o.max_radius_difference = std::nan(""); },
            [](RelationOptions& o) { o.outlier_threshold = 0; },
            [](RelationOptions& o) { o.outlier_threshold = INFINITY; }}) {
     RelationOptions options;

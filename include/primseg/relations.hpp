@@ -1,8 +1,9 @@
 #pragma once
 /// @file relations.hpp
 /// Design intent between the fitted primitives of a segmentation: plane normals and cylinder axes
-/// that agree within their fits' uncertainty (opposite faces of a box, a shaft and its end faces)
-/// and cylinders that share an axis line (a stepped shaft, the fragments of one bore). Making
+/// that agree within their fits' uncertainty (opposite faces of a box, a shaft and its end faces),
+/// directions at right angles, cylinders that share an axis line (a stepped shaft, the fragments
+/// of one bore) and cylinders of one radius (a bolt circle's holes). Making
 /// these relations exact is what reverse engineering wants of a scanned part's fits: a box with
 /// parallel faces, a shaft with one axis (after GlobFit, Li et al. 2011).
 
@@ -28,6 +29,9 @@ struct ClusterRelation {
     /// cylinder's axis), `orthogonal_to` the other. A box's three directions give three of
     /// these; a shaft's axis and the faces along it, one.
     Orthogonal,
+    /// Cylinders made one radius, each keeping its own axis line: the holes of a bolt circle,
+    /// fillets of one radius, the fragments of one cylinder (which are coaxial too).
+    EqualRadius,
   };
   Kind kind = Kind::Parallel;
   /// Cluster labels, increasing; two or more (Orthogonal: one or more, its lowest below the
@@ -37,7 +41,7 @@ struct ClusterRelation {
   std::vector<std::uint32_t> orthogonal_to;
 };
 
-/// "parallel", "coaxial" or "orthogonal".
+/// "parallel", "coaxial", "orthogonal" or "equal_radius".
 std::string_view to_string(ClusterRelation::Kind kind);
 
 /// Options of regularize_clusters().
@@ -48,6 +52,9 @@ struct RelationOptions {
   /// ... and never when the tilt is larger than this, whatever the uncertainty (degrees, in
   /// (0, 90)).
   double max_angle_degrees = 20.0;
+  /// Cylinders' radii are made equal when they agree within the significance, and never when
+  /// they differ by more than this fraction of the larger (in (0, 1)).
+  double max_radius_difference = 0.05;
   /// The directions and the refits use each cluster's inlier vertices: those within this many
   /// robust deviations (1.4826 × the median distance) of its primitive. > 0.
   double outlier_threshold = 2.5;
@@ -56,8 +63,8 @@ struct RelationOptions {
 /// Throws InvalidInputError when an option is out of its range.
 void validate(const RelationOptions& options);
 
-/// Finds the parallel and coaxial relations among the primitives of a level's clusters and makes
-/// them exact, in place.
+/// Finds the parallel, orthogonal, coaxial and equal-radius relations among the primitives of a
+/// level's clusters and makes them exact, in place.
 ///
 /// `reports` are the level's clusters as describe_clusters() or refine_boundaries() report them
 /// (reports[c] is label c of `segmentation`; shape (K)). Only planes and cylinders take part.
@@ -66,7 +73,8 @@ void validate(const RelationOptions& options);
 /// estimate it (6 for a plane, 12 for a cylinder) stay out. Every member of a relation is
 /// refitted: a plane through its inliers' weighted centroid with the group's normal, a cylinder
 /// by geometric least squares with the group's axis direction, jointly with the cylinders coaxial
-/// with it (one axis line, one radius each). Its report's `primitive`, `rms` and `max` are
+/// with it (one axis line, one radius each) and those of equal radius (one radius, each on its
+/// own line). Its report's `primitive`, `rms` and `max` are
 /// replaced (`rms` and `max` measured as describe_clusters() does, on all the cluster's
 /// vertices); every other report is left bit for bit. Deterministic, O(F log F).
 ///

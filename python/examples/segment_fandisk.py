@@ -98,13 +98,13 @@ assert np.sum(angles < 7) >= 5 and np.sum(angles > 80) >= 5
 
 # %% [markdown]
 # ## The design intent
-# Which fits are parallel, coaxial or at right angles within their uncertainty; with
+# Which fits are parallel, coaxial, at right angles or of one radius within their uncertainty; with
 # `regularize=True` the clusters' primitives have these relations made exact (the CLI's
 # `--regularize`), as a CAD model would have them.
 
 # %%
 relations = tree.relations(30)
-for kind in ("parallel", "coaxial", "orthogonal"):
+for kind in ("parallel", "coaxial", "orthogonal", "equal_radius"):
     print(f"{kind}: {sum(r['kind'] == kind for r in relations)}")
 exact = tree.clusters(30, regularize=True)
 coaxial = next(r["clusters"] for r in relations if r["kind"] == "coaxial")
@@ -120,6 +120,10 @@ def direction(c):
 
 
 assert abs(direction(right_angle["clusters"][0]) @ direction(right_angle["orthogonal_to"][0])) < 1e-14
+for same in (r["clusters"] for r in relations if r["kind"] == "equal_radius"):
+    radii = {exact[c]["params"]["radius"] for c in same}
+    print("one radius for the cylinders", same, ":", radii)
+    assert len(radii) == 1
 
 # %% [markdown]
 # ## Per-face quantities with numpy

@@ -61,15 +61,18 @@ def test_regularized_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path)
     borders = fandisk_tree.borders(30, refine=2, regularize=True)
     assert json.loads(json.dumps(borders)) == expected["borders"]
     # The relations are exact: one direction per parallel group (and per side of a right angle),
-    # one axis line per coaxial set, right angles to round-off.
+    # one axis line per coaxial set, right angles to round-off, one radius per equal-radius set.
     kinds = {r["kind"] for r in relations}
-    assert kinds == {"parallel", "coaxial", "orthogonal"}
+    assert kinds == {"parallel", "coaxial", "orthogonal", "equal_radius"}
 
     def direction(c):
         params = clusters[c]["params"]
         return np.array(params.get("normal", params.get("axis")))
 
     for relation in relations:
+        if relation["kind"] == "equal_radius":
+            assert len({clusters[c]["params"]["radius"] for c in relation["clusters"]}) == 1
+            continue
         sides = [relation["clusters"]] + ([relation["orthogonal_to"]] if "orthogonal_to" in relation else [])
         for side in sides:
             directions = [direction(c) for c in side]
