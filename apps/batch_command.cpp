@@ -36,6 +36,7 @@ struct BatchOptions {
   unsigned jobs = 0;
   bool resume = false, exact_costs = false, quiet = false;
   LevelChoice level;
+  LevelOptions fit;  // --refine and --regularize only
   ResourceLimits limits;
 };
 
@@ -135,7 +136,10 @@ std::string options_signature(const BatchOptions& o) {
   return "primitives=" + o.primitives + " weights=" + o.weights +
          " exact_costs=" + (o.exact_costs ? "1" : "0") +
          " clusters=" + o.level.clusters.value_or("-") +
-         " tolerance=" + o.level.tolerance.value_or(kDefaultTolerance);
+         " tolerance=" + o.level.tolerance.value_or(kDefaultTolerance) +
+         // Only when set, so that outputs made before these options existed still resume.
+         (o.fit.refine > 0 ? " refine=" + std::to_string(o.fit.refine) : "") +
+         (o.fit.regularize ? " regularize=1" : "");
 }
 
 /// Faces recorded in a complete output made with the same options, or nothing.
@@ -184,6 +188,8 @@ Result process(const Item& item, const BatchOptions& o, const HierarchyOptions& 
   const fs::path base = fs::path(o.out) / item.key;
   LevelOptions level;
   level.level = o.level;
+  level.refine = o.fit.refine;
+  level.regularize = o.fit.regularize;
   level.quiet = true;
   level.files.labels = base.string() + ".labels";
   level.files.json = base.string() + ".json";
@@ -328,6 +334,7 @@ Command add_batch_command(CLI::App& app) {
       ->check(CLI::IsMember({"area", "uniform"}))
       ->capture_default_str();
   batch->add_flag("--exact-costs", o->exact_costs, "Reference mode: exact Euclidean errors");
+  add_fit_options(*batch, o->fit);
   add_limit_options(*batch, o->limits, kHierarchyBytesPerFace);
   batch->add_flag("--quiet,-q", o->quiet, "No progress or summary output");
   return {batch, [o] { run_batch(*o); }};

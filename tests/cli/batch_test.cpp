@@ -121,6 +121,35 @@ TEST(Batch, OneBadFileIsReportedAndDoesNotStopTheOthers) {
   fs::remove_all(dir);
 }
 
+// --refine and --regularize as `segment` takes them: the same JSON clusters and relations per
+// file, and a resumed run with other fit options redoes every file.
+TEST(Batch, RefinedAndRegularizedOutputsAreSegments) {
+  const fs::path dir = testing::temp_directory("batch-fit");
+  const fs::path in = make_data_set(dir);
+  fs::remove(in / "broken.off");
+  const std::string base = "batch '" + in.string() + "' --out '" + (dir / "out").string() +
+                           "' -q --clusters 7 --refine 2";
+  ASSERT_EQ(primseg(base + " --regularize"), 0);
+  ASSERT_EQ(primseg("segment '" + (in / "parts" / "hole.ply").string() +
+                    "' -q --clusters 7 --refine 2 --regularize --json '" +
+                    (dir / "hole.json").string() + "'"),
+            0);
+  json batch = json::parse(testing::file_contents(dir / "out" / "parts" / "hole.ply.json"));
+  json segment = json::parse(testing::file_contents(dir / "hole.json"));
+  ASSERT_TRUE(batch.contains("relations"));
+  EXPECT_FALSE(batch["relations"].empty());
+  EXPECT_EQ(batch["relations"], segment["relations"]);
+  EXPECT_EQ(batch["clusters"], segment["clusters"]);
+  EXPECT_EQ(batch["level"]["refinement"], segment["level"]["refinement"]);
+  // Without --regularize the outputs differ, and --resume does not take the old ones for them.
+  ASSERT_EQ(primseg(base + " --resume"), 0);
+  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
+    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  batch = json::parse(testing::file_contents(dir / "out" / "parts" / "hole.ply.json"));
+  EXPECT_FALSE(batch.contains("relations"));
+  fs::remove_all(dir);
+}
+
 TEST(Batch, ResumeSkipsCompletedOutputsAndRedoesTheRest) {
   const fs::path dir = testing::temp_directory("batch-resume");
   const fs::path in = make_data_set(dir);
