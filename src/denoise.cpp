@@ -432,7 +432,7 @@ std::vector<ClusterRelation> Denoiser::regularize(const std::vector<std::vector<
   detail::RegularityOptions regularity;
   regularity.significance = options_.relation_significance;
   // Equal radii do not lower the error of a snap: fandisk (four noise draws), anchor_dense,
-  // couplingdown and mech-holes-shark at the automatic level moved by -1.3% to +0.9% in RMS
+  // couplingdown and mech-holes-shark at the automatic level moved by -0.9% to +0.9% in RMS
   // (docs/method.md), so the denoiser keeps each cylinder's own radius.
   regularity.equal_radii = false;
   return detail::regularize_inliers(primitives, points, weights, options_.refit_outlier_threshold,

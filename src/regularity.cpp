@@ -474,8 +474,10 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
 
 // Radii known to agree within the significance (and never more than max_radius_difference apart,
 // relative to the larger), pooled by their information: visited from the best-known, each joins
-// the class whose pooled radius it agrees with best, else starts one. A radius known less well
-// than its own size (a nearly flat cylinder) joins none. Returns each cylinder's class.
+// the class whose pooled radius it agrees with best, else starts one. A radius joins none unless
+// its significance interval is narrower than the largest difference: otherwise the bound, not
+// the data, would decide (cylinder patches of a freeform surface; a nearly flat cylinder).
+// Returns each cylinder's class.
 std::vector<std::size_t> radius_classes(const std::vector<SettledCylinders::Cylinder>& cylinders,
                                         const RegularityOptions& options) {
   std::vector<std::size_t> order(cylinders.size());
@@ -489,7 +491,8 @@ std::vector<std::size_t> radius_classes(const std::vector<SettledCylinders::Cyli
   for (const std::size_t k : order) {
     const double r = cylinders[k].radius, variance = cylinders[k].radius_variance;
     std::size_t best = information.size();
-    if (variance > 0 && std::sqrt(variance) < r) {
+    if (variance > 0 &&
+        options.significance * std::sqrt(variance) <= options.max_radius_difference * r) {
       double best_score = significance2;
       for (std::size_t q = 0; q < information.size(); ++q) {
         const double pooled = weighted[q] / information[q];

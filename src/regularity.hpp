@@ -25,7 +25,8 @@ struct RegularityOptions {
   bool orthogonal = true;
   /// Give cylinders whose radii agree within the significance one radius.
   bool equal_radii = true;
-  /// ... never when the radii differ by more than this fraction of the larger.
+  /// ... never when the radii differ by more than this fraction of the larger, nor a radius
+  /// whose significance interval is wider than this fraction of it.
   double max_radius_difference = 0.05;
 };
 

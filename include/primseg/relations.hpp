@@ -53,7 +53,9 @@ struct RelationOptions {
   /// (0, 90)).
   double max_angle_degrees = 20.0;
   /// Cylinders' radii are made equal when they agree within the significance, and never when
-  /// they differ by more than this fraction of the larger (in (0, 1)).
+  /// they differ by more than this fraction of the larger (in (0, 1)). A radius known less
+  /// well than that (significance × its standard deviation above this fraction of it: a
+  /// cylinder patch of a freeform surface) takes part in none.
   double max_radius_difference = 0.05;
   /// The directions and the refits use each cluster's inlier vertices: those within this many
   /// robust deviations (1.4826 × the median distance) of its primitive. > 0.
