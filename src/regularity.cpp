@@ -141,75 +141,126 @@ struct JointFit {
   std::vector<Eigen::Vector2d> centres;  // per line, in orthonormal_pair(direction) coordinates
   std::vector<double> radii;
   std::vector<double> rms;     // per term, unweighted, at least kResolution × its radius
-  Eigen::MatrixXd covariance;  // of (centres, radii), from the unweighted residuals
+  Eigen::MatrixXd covariance;  // of (centres, radii), from the unweighted residuals (if asked)
 };
 
-// Gauss–Newton from `centres` and `radii` (weighted steps; the uncertainty from the unweighted
-// residuals at the solution). Nothing when it diverges, a radius ends non-positive or the points
-// do not outnumber the parameters.
+// Gauss–Newton from `centres` and `radii` (weighted steps; the uncertainty, when asked for, from
+// the unweighted residuals at the solution). Nothing when it diverges, a radius ends non-positive
+// or the points do not outnumber the parameters. A step of one line solves the normal equations
+// whole; a step of several eliminates each line's position first (its 2x2 block couples only to
+// its own terms' radii), so that a plate of n holes of one radius costs O(n), not O(n³).
 std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> directions,
                                       std::span<const Eigen::Vector2d> centres,
                                       std::span<const double> radii,
-                                      std::span<const CylinderTerm> terms) {
+                                      std::span<const CylinderTerm> terms, bool with_covariance) {
   const Eigen::Index lines = static_cast<Eigen::Index>(centres.size());
-  const Eigen::Index size = 2 * lines + static_cast<Eigen::Index>(radii.size());
+  const Eigen::Index radius_count = static_cast<Eigen::Index>(radii.size());
+  const Eigen::Index size = 2 * lines + radius_count;
   Eigen::VectorXd x(size);
   for (Eigen::Index l = 0; l < lines; ++l) x.segment<2>(2 * l) = centres[l];
-  for (std::size_t q = 0; q < radii.size(); ++q)
-    x(2 * lines + static_cast<Eigen::Index>(q)) = radii[q];
+  for (Eigen::Index q = 0; q < radius_count; ++q) x(2 * lines + q) = radii[q];
   // The points in the plane orthogonal to their line's direction, once for every iteration.
   std::vector<std::vector<Eigen::Vector2d>> projected(terms.size());
+  std::vector<std::vector<std::size_t>> terms_on_line(centres.size());
   for (std::size_t k = 0; k < terms.size(); ++k) {
     const auto [u, v] = orthonormal_pair(directions[terms[k].line]);
     for (const Vec3& p : terms[k].points)
       projected[k].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
+    terms_on_line[terms[k].line].push_back(k);
   }
-  Eigen::MatrixXd normal(size, size);
-  Eigen::VectorXd gradient(size);
+  // The normal equations by blocks: each line's own 2x2, each term's coupling of its line and its
+  // radius, each radius's diagonal (radii never couple with each other, lines never with lines).
+  std::vector<Eigen::Matrix2d> line_block(centres.size());
+  std::vector<Eigen::Vector2d> coupling(terms.size()), line_gradient(centres.size());
+  Eigen::VectorXd radius_diagonal(radius_count), radius_gradient(radius_count);
   std::vector<double> term_squares(terms.size());
   std::vector<std::size_t> term_count(terms.size());
   std::size_t count = 0;
   auto linearise = [&](bool weighted) {
-    normal.setZero();
-    gradient.setZero();
+    std::fill(line_block.begin(), line_block.end(), Eigen::Matrix2d::Zero());
+    std::fill(coupling.begin(), coupling.end(), Eigen::Vector2d::Zero());
+    std::fill(line_gradient.begin(), line_gradient.end(), Eigen::Vector2d::Zero());
+    radius_diagonal.setZero();
+    radius_gradient.setZero();
     double squares = 0;
     count = 0;
     for (std::size_t k = 0; k < terms.size(); ++k) {
-      const Eigen::Index c = 2 * static_cast<Eigen::Index>(terms[k].line);
-      const Eigen::Index r = 2 * lines + static_cast<Eigen::Index>(terms[k].radius);
+      const std::size_t l = terms[k].line;
+      const Eigen::Index q = static_cast<Eigen::Index>(terms[k].radius);
+      const Eigen::Vector2d centre = x.segment<2>(2 * static_cast<Eigen::Index>(l));
+      const double radius = x(2 * lines + q);
       term_squares[k] = 0;
       term_count[k] = 0;
       for (std::size_t i = 0; i < projected[k].size(); ++i) {
-        const Eigen::Vector2d d = projected[k][i] - x.segment<2>(c);
+        const Eigen::Vector2d d = projected[k][i] - centre;
         const double length = d.norm();
         if (!(length > 0)) continue;
         const double w = weighted ? terms[k].weights[i] : 1.0;
-        const double e = length - x(r);
+        const double e = length - radius;
         const Eigen::Vector2d j = -d / length;
-        normal.block<2, 2>(c, c) += w * j * j.transpose();
-        normal.block<2, 1>(c, r) -= w * j;
-        normal(r, r) += w;
-        gradient.segment<2>(c) += w * j * e;
-        gradient(r) -= w * e;
+        line_block[l] += w * j * j.transpose();
+        coupling[k] -= w * j;
+        radius_diagonal(q) += w;
+        line_gradient[l] += w * j * e;
+        radius_gradient(q) -= w * e;
         squares += e * e;
         term_squares[k] += e * e;
         ++term_count[k];
         ++count;
       }
     }
-    // The radii's rows mirror their columns (a centre's own block was summed whole).
-    for (Eigen::Index row = 2 * lines; row < size; ++row)
-      for (Eigen::Index col = 0; col < row; ++col) normal(row, col) = normal(col, row);
     return squares;
   };
+  auto whole_system = [&](Eigen::MatrixXd& normal, Eigen::VectorXd& gradient) {
+    normal.setZero(size, size);
+    gradient.resize(size);
+    for (Eigen::Index l = 0; l < lines; ++l) {
+      normal.block<2, 2>(2 * l, 2 * l) = line_block[static_cast<std::size_t>(l)];
+      gradient.segment<2>(2 * l) = line_gradient[static_cast<std::size_t>(l)];
+    }
+    for (std::size_t k = 0; k < terms.size(); ++k)
+      normal.block<2, 1>(2 * static_cast<Eigen::Index>(terms[k].line),
+                         2 * lines + static_cast<Eigen::Index>(terms[k].radius)) += coupling[k];
+    normal.diagonal().tail(radius_count) = radius_diagonal;
+    gradient.tail(radius_count) = radius_gradient;
+    for (Eigen::Index row = 2 * lines; row < size; ++row)
+      for (Eigen::Index col = 0; col < row; ++col) normal(row, col) = normal(col, row);
+  };
+  Eigen::MatrixXd normal;
+  Eigen::VectorXd gradient, delta(size);
+  std::vector<Eigen::Matrix2d> inverse(centres.size());
   for (int step = 0; step < 30; ++step) {
     linearise(true);
-    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
+    if (lines == 1) {
+      whole_system(normal, gradient);
+      delta = normal.ldlt().solve(-gradient);
+    } else {
+      // The radii's Schur complement S = D − Σ Bₗᵀ Aₗ⁻¹ Bₗ, then each line's position.
+      Eigen::MatrixXd schur = radius_diagonal.asDiagonal();
+      Eigen::VectorXd right = -radius_gradient;
+      for (std::size_t l = 0; l < centres.size(); ++l) {
+        inverse[l] = line_block[l].inverse();
+        for (const std::size_t a : terms_on_line[l]) {
+          const Eigen::Vector2d spread = inverse[l] * coupling[a];
+          const Eigen::Index qa = static_cast<Eigen::Index>(terms[a].radius);
+          right(qa) += spread.dot(line_gradient[l]);
+          for (const std::size_t b : terms_on_line[l])
+            schur(qa, static_cast<Eigen::Index>(terms[b].radius)) -= spread.dot(coupling[b]);
+        }
+      }
+      delta.tail(radius_count) = schur.ldlt().solve(right);
+      for (std::size_t l = 0; l < centres.size(); ++l) {
+        Eigen::Vector2d rest = -line_gradient[l];
+        for (const std::size_t a : terms_on_line[l])
+          rest -= coupling[a] * delta(2 * lines + static_cast<Eigen::Index>(terms[a].radius));
+        delta.segment<2>(2 * static_cast<Eigen::Index>(l)) = inverse[l] * rest;
+      }
+    }
     if (!delta.allFinite()) return std::nullopt;
     x += delta;
     if (!(delta.norm() > 1e-14 * x.norm())) break;
   }
-  const auto fitted_radii = x.tail(size - 2 * lines);
+  const auto fitted_radii = x.tail(radius_count);
   if (!x.allFinite() || !(fitted_radii.minCoeff() > 0)) return std::nullopt;
   const double squares = linearise(false);
   if (count <= static_cast<std::size_t>(size)) return std::nullopt;
@@ -220,11 +271,14 @@ std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> direction
     fit.rms.push_back(
         std::max(std::sqrt(term_squares[k] / double(std::max<std::size_t>(term_count[k], 1))),
                  kResolution * fit.radii[terms[k].radius]));
-  const double largest_radius = fitted_radii.maxCoeff();
-  fit.covariance = normal.inverse() *
-                   std::max(squares / static_cast<double>(count - static_cast<std::size_t>(size)),
-                            kResolution * kResolution * largest_radius * largest_radius);
-  if (!fit.covariance.allFinite()) return std::nullopt;
+  if (with_covariance) {
+    whole_system(normal, gradient);
+    const double largest_radius = fitted_radii.maxCoeff();
+    fit.covariance = normal.inverse() *
+                     std::max(squares / static_cast<double>(count - static_cast<std::size_t>(size)),
+                              kResolution * kResolution * largest_radius * largest_radius);
+    if (!fit.covariance.allFinite()) return std::nullopt;
+  }
   return fit;
 }
 
@@ -251,7 +305,7 @@ std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::
     terms.push_back({members[k].points, members[k].weights, 0, k});
     radii.push_back(members[k].radius);
   }
-  std::optional<JointFit> joint = fit_cylinders({&axis, 1}, {&centre, 1}, radii, terms);
+  std::optional<JointFit> joint = fit_cylinders({&axis, 1}, {&centre, 1}, radii, terms, true);
   if (!joint) return std::nullopt;
   CoaxialFit fit;
   fit.centre = joint->centres[0];
@@ -472,48 +526,77 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
   }
 }
 
-// Radii known to agree within the significance (and never more than max_radius_difference apart,
-// relative to the larger), pooled by their information: visited from the best-known, each joins
-// the class whose pooled radius it agrees with best, else starts one. A radius joins none unless
-// its significance interval is narrower than the largest difference: otherwise the bound, not
-// the data, would decide (cylinder patches of a freeform surface; a nearly flat cylinder).
-// Returns each cylinder's class.
+// The χ² value a sum of `freedom` squared standard normals exceeds as rarely as one normal exceeds
+// `significance` in magnitude: exact for one and two degrees of freedom, Wilson–Hilferty's
+// approximation beyond (within 2% from three on at a significance of 3).
+double chi_square_bound(double significance, std::size_t freedom) {
+  if (freedom == 1) return significance * significance;
+  const double tail = std::erfc(significance / std::numbers::sqrt2);
+  if (freedom == 2) return -2 * std::log(tail);
+  const double k = static_cast<double>(freedom), spread = 2 / (9 * k);
+  return k * std::pow(1 - spread + significance * std::sqrt(spread), 3);
+}
+
+// The significance at which each of `tests` tests must be passed for all of them to fail together
+// as rarely as one test at `significance` does (Bonferroni: the two-sided normal tail divided by
+// their number).
+double family_significance(double significance, std::size_t tests) {
+  const double tail = std::erfc(significance / std::numbers::sqrt2) / static_cast<double>(tests);
+  double low = significance, high = significance + 40;
+  for (int step = 0; step < 100; ++step) {
+    const double middle = (low + high) / 2;
+    (std::erfc(middle / std::numbers::sqrt2) > tail ? low : high) = middle;
+  }
+  return high;
+}
+
+// Classes of radii that are one radius within the significance: in increasing order of radius,
+// a class grows while its radii stay consistent with their information-weighted mean (their χ²
+// about it within chi_square_bound of its degrees of freedom) and its largest is within
+// max_radius_difference of its largest. A radius whose significance interval is wider than that
+// bound joins none: any two such radii within the bound would pass, so the bound and not the data
+// would decide (cylinder patches of a freeform surface; a nearly flat cylinder). Returns each
+// cylinder's class.
 std::vector<std::size_t> radius_classes(const std::vector<SettledCylinders::Cylinder>& cylinders,
                                         const RegularityOptions& options) {
-  std::vector<std::size_t> order(cylinders.size());
+  const std::size_t n = cylinders.size();
+  std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return cylinders[a].radius_variance < cylinders[b].radius_variance;
+    return cylinders[a].radius < cylinders[b].radius;
   });
-  const double significance2 = options.significance * options.significance;
-  std::vector<double> information, weighted;  // per class: Σ 1/variance, Σ radius/variance
-  std::vector<std::size_t> class_of(cylinders.size());
+  std::vector<std::size_t> class_of(n);
+  std::size_t classes = 0, open = 0;
+  // The open class: its first radius, and Σ 1/σ², Σ d/σ², Σ d²/σ² of its radii's differences d
+  // from that first one (differences keep the sums exact on CAD radii known to 1e-9).
+  double first = 0, information = 0, moment = 0, square = 0;
+  std::size_t members = 0;
   for (const std::size_t k : order) {
     const double r = cylinders[k].radius, variance = cylinders[k].radius_variance;
-    std::size_t best = information.size();
-    if (variance > 0 &&
-        options.significance * std::sqrt(variance) <= options.max_radius_difference * r) {
-      double best_score = significance2;
-      for (std::size_t q = 0; q < information.size(); ++q) {
-        const double pooled = weighted[q] / information[q];
-        const double difference = r - pooled;
-        if (std::abs(difference) > options.max_radius_difference * std::max(r, pooled)) continue;
-        const double score = difference * difference / (variance + 1 / information[q]);
-        if (score <= best_score) {
-          best_score = score;
-          best = q;
-        }
-      }
+    if (!(variance > 0) ||
+        options.significance * std::sqrt(variance) > options.max_radius_difference * r) {
+      class_of[k] = classes++;  // a class of its own
+      continue;
     }
-    if (best == information.size()) {
-      information.push_back(0);
-      weighted.push_back(0);
+    const double d = r - first;
+    const double joined_information = information + 1 / variance,
+                 joined_moment = moment + d / variance, joined_square = square + d * d / variance;
+    const double spread = joined_square - joined_moment * joined_moment / joined_information;
+    if (members == 0 || r - first > options.max_radius_difference * r ||
+        spread > chi_square_bound(options.significance, members)) {
+      first = r;
+      information = 1 / variance;
+      moment = square = 0;
+      members = 1;
+      open = classes++;
+      class_of[k] = open;
+      continue;
     }
-    if (variance > 0) {
-      information[best] += 1 / variance;
-      weighted[best] += r / variance;
-    }
-    class_of[k] = best;
+    information = joined_information;
+    moment = joined_moment;
+    square = joined_square;
+    ++members;
+    class_of[k] = open;
   }
   return class_of;
 }
@@ -550,7 +633,6 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
   }
   std::vector<std::vector<std::size_t>> components(n);
   for (std::size_t k = 0; k < n; ++k) components[root(k)].push_back(k);
-  const double significance2 = options.significance * options.significance;
   for (const std::vector<std::size_t>& component : components) {
     if (std::none_of(component.begin(), component.end(),
                      [&](std::size_t k) { return class_size[class_of[k]] >= 2; }))
@@ -576,7 +658,7 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
           directions.push_back(settled.lines[cylinder.line].direction);
           centres.push_back(settled.lines[cylinder.line].centre);
         }
-        // A class of two or more has one radius, started from its best-known member's.
+        // A class of two or more has one radius, started from its first member's.
         std::size_t& radius = radius_of_class[class_of[k]];
         if (radius == n || class_size[class_of[k]] < 2) {
           radius = radii.size();
@@ -584,15 +666,21 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
         }
         terms.push_back({points[cylinder.cluster], weights[cylinder.cluster], line, radius});
       }
-      fit = fit_cylinders(directions, centres, radii, terms);
+      fit = fit_cylinders(directions, centres, radii, terms, false);
       if (!fit) break;
+      // One test per member: at the significance each, a plate of a hundred equal holes would
+      // lose one in four times.
+      const std::size_t tested = static_cast<std::size_t>(
+          std::count_if(component.begin(), component.end(),
+                        [&](std::size_t k) { return class_size[class_of[k]] >= 2; }));
+      const double bound = family_significance(options.significance, tested);
       std::size_t worst = component.size();
       double worst_excess = 1;
       for (std::size_t j = 0; j < component.size(); ++j) {
         const SettledCylinders::Cylinder& cylinder = cylinders[component[j]];
         if (class_size[class_of[component[j]]] < 2) continue;
         const double excess =
-            residual_excess(cylinder.rms, fit->rms[j], cylinder.inliers, significance2);
+            residual_excess(cylinder.rms, fit->rms[j], cylinder.inliers, bound * bound);
         if (excess > worst_excess) {
           worst_excess = excess;
           worst = j;

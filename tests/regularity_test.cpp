@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <utility>
 #include <vector>
@@ -324,6 +325,33 @@ TEST(Regularity, HolesOfOneRadiusShareItNearerTheTruth) {
       }
     }
   }
+}
+
+// A perforated plate: a grid of 400 holes of one radius, each its own axis line, is one class
+// (no hole lost to 400 tests at 3 standard deviations), refitted by one least squares over every
+// hole's position and the shared radius.
+TEST(Regularity, APerforatedPlateHasOneHoleRadius) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  std::mt19937_64 rng(5);
+  const int side = 20;
+  std::vector<Cluster> clusters;
+  std::vector<Primitive> primitives;
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j) {
+      const Eigen::Vector3d centre(0.3 * i, 0.3 * j, 0);
+      clusters.push_back(noisy_cylinder(z, centre, 0.1, 0.2, 0.001, rng, 4));
+      primitives.push_back(fitted_cylinder(clusters.back(), z, centre, 0.1));
+    }
+  const std::vector<Primitive> fitted = primitives;
+  std::vector<std::size_t> all(clusters.size());
+  std::iota(all.begin(), all.end(), 0);
+  const Relations relations = regularize(primitives, clusters);
+  EXPECT_EQ(std::count(relations.begin(), relations.end(), std::pair{Kind::EqualRadius, all}), 1);
+  for (std::size_t c = 0; c < clusters.size(); ++c) {
+    EXPECT_EQ(primitives[c].radius, primitives[0].radius);
+    EXPECT_LT(axis_offset(primitives[c], fitted[c]), 0.001);
+  }
+  EXPECT_NEAR(primitives[0].radius, 0.1, 1e-4);
 }
 
 // Two holes 4% apart in radius, each known only to about 3.5% (noise of 30% of the radius over 72
