@@ -552,8 +552,8 @@ double family_significance(double significance, std::size_t tests) {
 
 // Classes of radii that are one radius within the significance: in increasing order of radius,
 // a class grows while its radii stay consistent with their information-weighted mean (their χ²
-// about it within chi_square_bound of its degrees of freedom) and its largest is within
-// max_radius_difference of its largest. A radius whose significance interval is wider than that
+// about it within chi_square_bound of its degrees of freedom) and its smallest within
+// max_radius_difference of its largest (relative to the largest). A radius whose significance interval is wider than that
 // bound joins none: any two such radii within the bound would pass, so the bound and not the data
 // would decide (cylinder patches of a freeform surface; a nearly flat cylinder). Returns each
 // cylinder's class.
@@ -619,8 +619,11 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
   // Components: union-find over the cylinders, through shared classes and shared lines.
   std::vector<std::size_t> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
-  const std::function<std::size_t(std::size_t)> root = [&](std::size_t k) {
-    return parent[k] == k ? k : parent[k] = root(parent[k]);
+  auto root = [&](std::size_t k) {
+    std::size_t top = k;
+    while (parent[top] != top) top = parent[top];
+    while (parent[k] != top) k = std::exchange(parent[k], top);
+    return top;
   };
   std::vector<std::size_t> first_of_class(n, n), first_on_line(settled.lines.size(), n);
   for (std::size_t k = 0; k < n; ++k) {
