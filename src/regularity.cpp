@@ -424,6 +424,19 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
   return sets;
 }
 
+// The significance at which each of `tests` tests must be passed for all of them to fail together
+// as rarely as one test at `significance` does (Bonferroni: the two-sided normal tail divided by
+// their number).
+double family_significance(double significance, std::size_t tests) {
+  const double tail = std::erfc(significance / std::numbers::sqrt2) / static_cast<double>(tests);
+  double low = significance, high = significance + 40;
+  for (int step = 0; step < 100; ++step) {
+    const double middle = (low + high) / 2;
+    (std::erfc(middle / std::numbers::sqrt2) > tail ? low : high) = middle;
+  }
+  return high;
+}
+
 // How far a joint fit explains a member worse than its own fit did: the rise of its residual sum
 // over significance² times its residual variance (estimated with the member's fit's degrees of
 // freedom). Above 1, it does not belong.
@@ -477,9 +490,10 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
   std::vector<std::vector<std::size_t>> sets = coaxial_sets(cylinders, significance2);
   for (std::size_t s = 0; s < sets.size(); ++s) {
     CoaxialFit joint;
-    // The joint fit must explain each member as its own fit did, within the significance: a
-    // member whose residual sum rises by more than significance² times its residual variance
-    // (it has 2 degrees of freedom fewer) leaves the set, the worst first.
+    // The joint fit must explain each member as its own fit did, within the significance
+    // corrected for the number of members: a member whose residual sum rises by more than its
+    // square times its residual variance (it has 2 degrees of freedom fewer) leaves the set, the
+    // worst first.
     while (sets[s].size() > 1) {
       std::vector<CoaxialMember> members;
       PooledCentre pooled;
@@ -489,11 +503,12 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
         pooled.add(cylinders[k].fit);
       }
       const std::optional<CoaxialFit> fit = fit_coaxial(direction, pooled.centre(), members);
+      const double bound = family_significance(std::sqrt(significance2), sets[s].size());
       std::size_t worst = sets[s].size();
       double worst_excess = 1;
       for (std::size_t j = 0; j < sets[s].size(); ++j) {
         const double excess = fit ? residual_excess(cylinders[sets[s][j]].fit.rms[0], fit->rms[j],
-                                                    members[j].points.size(), significance2)
+                                                    members[j].points.size(), bound * bound)
                                   : std::numeric_limits<double>::infinity();
         if (excess > worst_excess) {
           worst_excess = excess;
@@ -537,26 +552,13 @@ double chi_square_bound(double significance, std::size_t freedom) {
   return k * std::pow(1 - spread + significance * std::sqrt(spread), 3);
 }
 
-// The significance at which each of `tests` tests must be passed for all of them to fail together
-// as rarely as one test at `significance` does (Bonferroni: the two-sided normal tail divided by
-// their number).
-double family_significance(double significance, std::size_t tests) {
-  const double tail = std::erfc(significance / std::numbers::sqrt2) / static_cast<double>(tests);
-  double low = significance, high = significance + 40;
-  for (int step = 0; step < 100; ++step) {
-    const double middle = (low + high) / 2;
-    (std::erfc(middle / std::numbers::sqrt2) > tail ? low : high) = middle;
-  }
-  return high;
-}
-
 // Classes of radii that are one radius within the significance: in increasing order of radius,
 // a class grows while its radii stay consistent with their information-weighted mean (their χ²
 // about it within chi_square_bound of its degrees of freedom) and its smallest within
-// max_radius_difference of its largest (relative to the largest). A radius whose significance interval is wider than that
-// bound joins none: any two such radii within the bound would pass, so the bound and not the data
-// would decide (cylinder patches of a freeform surface; a nearly flat cylinder). Returns each
-// cylinder's class.
+// max_radius_difference of its largest (relative to the largest). A radius whose significance
+// interval is wider than that bound joins none: any two such radii within the bound would pass, so
+// the bound and not the data would decide (cylinder patches of a freeform surface; a nearly flat
+// cylinder). Returns each cylinder's class.
 std::vector<std::size_t> radius_classes(const std::vector<SettledCylinders::Cylinder>& cylinders,
                                         const RegularityOptions& options) {
   const std::size_t n = cylinders.size();

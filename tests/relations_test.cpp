@@ -270,8 +270,9 @@ TEST(Relations, ClustersOutsideEveryRelationKeepTheirReportsBitForBit) {
   for (std::uint32_t c = 0; c < 7; ++c) EXPECT_EQ(again[c].primitive.axis, after[c].primitive.axis);
 }
 
-// Cut finer than its parts, a noisy cylinder comes apart in bands: one axis line again. Whether a
-// band joins is a test at 3 standard deviations, so a band may stay apart (one at most here).
+// Cut finer than its parts, a noisy cylinder comes apart in bands: one axis line and one radius
+// again. Whether a band joins is a test at 3 standard deviations (the guard's corrected for the
+// number of bands), so a band may stay apart (one at most here; none on this draw).
 TEST(Relations, FragmentsOfOneCylinderShareOneAxisLine) {
   const GroundTruthShape shape = noisy_shape("capped_cylinder", 0.002, 2);
   const Primitive& truth = shape.regions[0];
@@ -294,6 +295,9 @@ TEST(Relations, FragmentsOfOneCylinderShareOneAxisLine) {
     joined += set.size();
     EXPECT_GE(set.size() + 1, cylinders.size());
     EXPECT_TRUE(std::includes(cylinders.begin(), cylinders.end(), set.begin(), set.end()));
+    const Groups equal = clusters_of(relations, ClusterRelation::Kind::EqualRadius);
+    ASSERT_EQ(equal.size(), 1u);
+    EXPECT_TRUE(std::includes(equal[0].begin(), equal[0].end(), set.begin(), set.end()));
     expect_one_direction(reports, set);
     const Primitive& first = reports[set[0]].primitive;
     for (const std::uint32_t c : set) {
