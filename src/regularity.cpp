@@ -317,6 +317,16 @@ std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::
   return fit;
 }
 
+// `cylinder` refitted alone on its inliers with the axis direction `direction`, from its own axis
+// point and radius.
+std::optional<CoaxialFit> fit_alone(const Primitive& cylinder, const Eigen::Vector3d& direction,
+                                    std::span<const Vec3> points, std::span<const double> weights) {
+  const auto [u, v] = orthonormal_pair(direction);
+  const Eigen::Vector2d centre(u.dot(to_eigen(cylinder.point)), v.dot(to_eigen(cylinder.point)));
+  const CoaxialMember alone{points, weights, cylinder.radius};
+  return fit_coaxial(direction, centre, {&alone, 1});
+}
+
 // A cylinder of a direction group, refitted alone with the group's direction.
 struct AlignedCylinder {
   std::size_t cluster = 0;
@@ -469,7 +479,6 @@ struct SettledCylinders {
     std::size_t cluster = 0;
     std::size_t line = 0;
     double radius = 0, radius_variance = 0, rms = 0;
-    std::size_t inliers = 0;
   };
   std::vector<Line> lines;
   std::vector<Cylinder> cylinders;
@@ -479,7 +488,7 @@ struct SettledCylinders {
 // keeping its own radius), the others alone with the group's direction. Appends the coaxial sets
 // of two or more to `relations`, and every cylinder refitted to `settled`.
 void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylinder> cylinders,
-                     double significance2, std::vector<Primitive>& primitives,
+                     double significance, std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights,
                      std::vector<Relation>& relations, SettledCylinders& settled) {
@@ -487,7 +496,7 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
                    [](const AlignedCylinder& a, const AlignedCylinder& b) {
                      return a.fit.centre_covariance.trace() < b.fit.centre_covariance.trace();
                    });
-  std::vector<std::vector<std::size_t>> sets = coaxial_sets(cylinders, significance2);
+  std::vector<std::vector<std::size_t>> sets = coaxial_sets(cylinders, significance * significance);
   for (std::size_t s = 0; s < sets.size(); ++s) {
     CoaxialFit joint;
     // The joint fit must explain each member as its own fit did, within the significance
@@ -503,7 +512,7 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
         pooled.add(cylinders[k].fit);
       }
       const std::optional<CoaxialFit> fit = fit_coaxial(direction, pooled.centre(), members);
-      const double bound = family_significance(std::sqrt(significance2), sets[s].size());
+      const double bound = family_significance(significance, sets[s].size());
       std::size_t worst = sets[s].size();
       double worst_excess = 1;
       for (std::size_t j = 0; j < sets[s].size(); ++j) {
@@ -536,7 +545,7 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
       const std::size_t c = cylinders[sets[s][j]].cluster;
       place_cylinder(primitives[c], direction, joint.centre, joint.radii[j]);
       settled.cylinders.push_back(
-          {c, line, joint.radii[j], joint.radius_variances[j], joint.rms[j], points[c].size()});
+          {c, line, joint.radii[j], joint.radius_variances[j], joint.rms[j]});
     }
   }
 }
@@ -638,13 +647,15 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
   }
   std::vector<std::vector<std::size_t>> components(n);
   for (std::size_t k = 0; k < n; ++k) components[root(k)].push_back(k);
+  // A component's lines and radii, numbered in the joint fit; only its own entries are reset, so
+  // that many small components cost no more than one large one.
+  std::vector<std::size_t> line_index(settled.lines.size(), n), radius_of_class(n, n);
   for (const std::vector<std::size_t>& component : components) {
     if (std::none_of(component.begin(), component.end(),
                      [&](std::size_t k) { return class_size[class_of[k]] >= 2; }))
       continue;
     std::optional<JointFit> fit;
     std::vector<CylinderTerm> terms;
-    std::vector<std::size_t> line_index(settled.lines.size(), n), radius_of_class(n, n);
     std::vector<Eigen::Vector3d> directions;
     std::vector<Eigen::Vector2d> centres;
     std::vector<double> radii;
@@ -653,8 +664,10 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
       directions.clear();
       centres.clear();
       radii.clear();
-      std::fill(line_index.begin(), line_index.end(), n);
-      std::fill(radius_of_class.begin(), radius_of_class.end(), n);
+      for (const std::size_t k : component) {
+        line_index[cylinders[k].line] = n;
+        radius_of_class[class_of[k]] = n;
+      }
       for (const std::size_t k : component) {
         const SettledCylinders::Cylinder& cylinder = cylinders[k];
         std::size_t& line = line_index[cylinder.line];
@@ -684,8 +697,8 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
       for (std::size_t j = 0; j < component.size(); ++j) {
         const SettledCylinders::Cylinder& cylinder = cylinders[component[j]];
         if (class_size[class_of[component[j]]] < 2) continue;
-        const double excess =
-            residual_excess(cylinder.rms, fit->rms[j], cylinder.inliers, bound * bound);
+        const double excess = residual_excess(cylinder.rms, fit->rms[j],
+                                              points[cylinder.cluster].size(), bound * bound);
         if (excess > worst_excess) {
           worst_excess = excess;
           worst = j;
@@ -892,7 +905,6 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const DirectionGroup& group = groups[g];
     if (group.members.size() < 2 && !constrained[g]) continue;
-    const auto [u, v] = orthonormal_pair(group.direction);
     std::vector<AlignedCylinder> cylinders;
     Relation parallel;
     for (const std::size_t i : group.members) {
@@ -903,10 +915,8 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
           parallel.members.push_back(c);
         continue;
       }
-      const CoaxialMember alone{points[c], weights[c], primitive.radius};
-      const Eigen::Vector2d centre(u.dot(to_eigen(primitive.point)),
-                                   v.dot(to_eigen(primitive.point)));
-      if (std::optional<CoaxialFit> fit = fit_coaxial(group.direction, centre, {&alone, 1})) {
+      if (std::optional<CoaxialFit> fit =
+              fit_alone(primitive, group.direction, points[c], weights[c])) {
         cylinders.push_back({c, std::move(*fit)});
         parallel.members.push_back(c);
       }
@@ -914,9 +924,8 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     std::sort(parallel.members.begin(), parallel.members.end());
     refitted[g] = parallel.members;
     if (parallel.members.size() >= 2) relations.push_back(std::move(parallel));
-    align_cylinders(group.direction, std::move(cylinders),
-                    options.significance * options.significance, primitives, points, weights,
-                    relations, settled);
+    align_cylinders(group.direction, std::move(cylinders), options.significance, primitives, points,
+                    weights, relations, settled);
   }
   if (options.equal_radii) {
     // The cylinders no direction relation refitted take part too, each on its own axis (fitted
@@ -927,13 +936,10 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     for (const Oriented& item : items) {
       const std::size_t c = item.cluster;
       if (primitives[c].type != PrimitiveType::Cylinder || is_settled[c]) continue;
-      const auto [u, v] = orthonormal_pair(item.direction);
-      const Eigen::Vector2d centre(u.dot(to_eigen(primitives[c].point)),
-                                   v.dot(to_eigen(primitives[c].point)));
-      const CoaxialMember alone{points[c], weights[c], primitives[c].radius};
-      if (const std::optional<CoaxialFit> fit = fit_coaxial(item.direction, centre, {&alone, 1})) {
-        settled.cylinders.push_back({c, settled.lines.size(), fit->radii[0],
-                                     fit->radius_variances[0], fit->rms[0], points[c].size()});
+      if (const std::optional<CoaxialFit> fit =
+              fit_alone(primitives[c], item.direction, points[c], weights[c])) {
+        settled.cylinders.push_back(
+            {c, settled.lines.size(), fit->radii[0], fit->radius_variances[0], fit->rms[0]});
         settled.lines.push_back({item.direction, fit->centre});
       }
     }
@@ -996,20 +1002,7 @@ std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitiv
   std::vector<ClusterRelation> relations;
   for (const Relation& relation : regularize(primitives, inlier_points, inlier_weights, options)) {
     ClusterRelation& related = relations.emplace_back();
-    switch (relation.kind) {
-      case Relation::Kind::Parallel:
-        related.kind = ClusterRelation::Kind::Parallel;
-        break;
-      case Relation::Kind::Coaxial:
-        related.kind = ClusterRelation::Kind::Coaxial;
-        break;
-      case Relation::Kind::Orthogonal:
-        related.kind = ClusterRelation::Kind::Orthogonal;
-        break;
-      case Relation::Kind::EqualRadius:
-        related.kind = ClusterRelation::Kind::EqualRadius;
-        break;
-    }
+    related.kind = relation.kind;
     for (const std::size_t c : relation.members)
       related.clusters.push_back(static_cast<std::uint32_t>(c));
     for (const std::size_t c : relation.others)

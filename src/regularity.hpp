@@ -30,14 +30,10 @@ struct RegularityOptions {
   double max_radius_difference = 0.05;
 };
 
-/// Primitives that regularize() made share a direction or an axis line, or made orthogonal.
+/// Primitives that regularize() made share a direction, an axis line or a radius, or made
+/// orthogonal. The kinds are the public ones (ClusterRelation::Kind).
 struct Relation {
-  enum class Kind {
-    Parallel,     ///< plane normals and cylinder axes made one direction (each keeps its side)
-    Coaxial,      ///< cylinders of one direction group made one axis line (each keeps its radius)
-    Orthogonal,   ///< two direction groups made orthogonal: `members` and `others`
-    EqualRadius,  ///< cylinders made one radius (each keeps its axis line)
-  };
+  using Kind = ClusterRelation::Kind;
   Kind kind = Kind::Parallel;
   std::vector<std::size_t> members;  ///< indices into the primitives, increasing; two or more
                                      ///< (Orthogonal: one or more)
