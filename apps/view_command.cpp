@@ -2,8 +2,9 @@
 //
 // The page gets the mesh and the merge tree as little-endian typed arrays in base64 (the layout
 // is documented by their reader, web/src/data.js), and cuts levels itself. It also gets the
-// automatic levels (auto_level.hpp) and, with --skeleton, the skeleton of one level and its skin
-// weights, which it poses itself as primseg deform does.
+// automatic levels (auto_level.hpp); with --skeleton, the skeleton of one level and its skin
+// weights, which it poses itself as primseg deform does; with --regularize, the relations of
+// every coarse level (relations.hpp) and the fits they make exact.
 
 #include <algorithm>
 #include <bit>
@@ -12,15 +13,18 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <numeric>
 #include <string>
 
 #include "../src/file_io.hpp"
+#include "../src/parallel.hpp"
 #include "command.hpp"
 #include "limits.hpp"
 #include "primseg/auto_level.hpp"
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/relations.hpp"
 #include "primseg/skeleton.hpp"
 #include "primseg/skinning.hpp"
 #include "primseg/tree_io.hpp"
@@ -36,6 +40,13 @@ static_assert(std::endian::native == std::endian::little,
 /// at most this many clusters (at most twice as many nodes). Finer levels show their clusters'
 /// type and RMS estimate only (a 1M-face page would otherwise carry 180 MB of them).
 constexpr std::uint32_t kMaxClustersWithParameters = 16385;
+/// --regularize: the relations of every level of up to this many clusters, or up to the level the
+/// page opens at if it is finer, up to kMaxDefaultRelationClusters (each level costs about a cut
+/// --regularize of the whole mesh).
+constexpr std::uint32_t kRelationClusters = 100;
+constexpr std::uint32_t kMaxDefaultRelationClusters = 1000;
+static_assert(kRelationClusters <= kMaxDefaultRelationClusters &&
+              kMaxDefaultRelationClusters <= kMaxClustersWithParameters);
 
 std::string base64(const void* data, std::size_t size) {
   static constexpr char kAlphabet[] =
@@ -150,11 +161,118 @@ nlohmann::json append_skeleton(std::string& html, const Mesh& mesh, const PageSk
           {"band", page.band}};
 }
 
-/// The page's data. `fit_seconds`: set to the time the geometric fits took.
+/// Appends a report's primitive (9 values: point relative to `center`, axis, radius,
+/// minor_radius, half_angle) and its errors (rms, max), as the page reads them.
+void append_fit(const ClusterReport& report, const Vec3& center, std::vector<double>& parameters,
+                std::vector<double>& errors) {
+  const Primitive& p = report.primitive;
+  for (int a = 0; a < 3; ++a) parameters.push_back(p.point[a] - center[a]);
+  for (int a = 0; a < 3; ++a) parameters.push_back(p.axis[a]);
+  parameters.push_back(p.radius);
+  parameters.push_back(p.minor_radius);
+  parameters.push_back(p.half_angle);
+  errors.push_back(report.rms);
+  errors.push_back(report.max);
+}
+
+/// The relations of one level and the fits they changed.
+struct LevelRelations {
+  std::vector<ClusterRelation> relations;
+  std::vector<std::uint32_t> nodes;     ///< tree node of each cluster label, shape (K)
+  std::vector<std::uint32_t> members;   ///< labels of the clusters in a relation, increasing
+  std::vector<ClusterReport> refitted;  ///< their reports after regularize_clusters()
+};
+
+/// The relations `cut --clusters K --regularize` finds, for every level K from the fewest
+/// clusters to `max_clusters`, and the fits they make exact (layout in web/src/data.js).
+/// `carried` (increasing) and `reports` are the nodes the page carries and their reports, which
+/// include every cluster of these levels. Levels run on `threads` threads; each is the same as
+/// on one.
+nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
+                                const std::vector<std::uint32_t>& carried,
+                                const std::vector<ClusterReport>& reports,
+                                std::uint32_t max_clusters, const Vec3& center, unsigned threads) {
+  const std::uint32_t first = hierarchy.component_count();
+  const std::uint32_t last = std::min(max_clusters, hierarchy.face_count());
+  const std::uint32_t level_count = last >= first ? last - first + 1 : 0;
+  std::vector<LevelRelations> levels(level_count);
+  detail::parallel_for_threads(
+      level_count, detail::thread_count(threads), [&](std::size_t i, unsigned) {
+        LevelRelations& level = levels[i];
+        const Segmentation segmentation =
+            cut_by_count(hierarchy, first + static_cast<std::uint32_t>(i));
+        std::vector<ClusterReport> level_reports;
+        level_reports.reserve(segmentation.cluster_count());
+        for (const std::uint32_t node : segmentation.nodes) {
+          const auto at = std::lower_bound(carried.begin(), carried.end(), node);
+          level_reports.push_back(reports[static_cast<std::size_t>(at - carried.begin())]);
+          level_reports.back().id = static_cast<std::uint32_t>(level_reports.size() - 1);
+        }
+        level.relations = regularize_clusters(hierarchy, segmentation, level_reports);
+        std::vector<bool> member(segmentation.cluster_count(), false);
+        for (const ClusterRelation& relation : level.relations) {
+          for (const std::uint32_t c : relation.clusters) member[c] = true;
+          for (const std::uint32_t c : relation.orthogonal_to) member[c] = true;
+        }
+        for (std::uint32_t c = 0; c < segmentation.cluster_count(); ++c)
+          if (member[c]) {
+            level.members.push_back(c);
+            level.refitted.push_back(level_reports[c]);
+          }
+        level.nodes = segmentation.nodes;
+      });
+
+  std::vector<std::uint32_t> level_offsets{0}, member_offsets{0}, members, first_side;
+  std::vector<std::uint8_t> kinds;
+  std::vector<std::uint32_t> fit_offsets{0}, fit_nodes;
+  std::vector<double> parameters, errors;
+  for (const LevelRelations& level : levels) {
+    for (const ClusterRelation& relation : level.relations) {
+      kinds.push_back(static_cast<std::uint8_t>(relation.kind));
+      for (const std::uint32_t c : relation.clusters) members.push_back(level.nodes[c]);
+      for (const std::uint32_t c : relation.orthogonal_to) members.push_back(level.nodes[c]);
+      first_side.push_back(static_cast<std::uint32_t>(relation.clusters.size()));
+      member_offsets.push_back(static_cast<std::uint32_t>(members.size()));
+    }
+    level_offsets.push_back(static_cast<std::uint32_t>(kinds.size()));
+    // By increasing node, for the page's binary search.
+    std::vector<std::uint32_t> order(level.members.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return level.nodes[level.members[a]] < level.nodes[level.members[b]];
+    });
+    for (const std::uint32_t m : order) {
+      fit_nodes.push_back(level.nodes[level.members[m]]);
+      append_fit(level.refitted[m], center, parameters, errors);
+    }
+    fit_offsets.push_back(static_cast<std::uint32_t>(fit_nodes.size()));
+  }
+  append_array(html, "relations-level-offsets", level_offsets);
+  append_array(html, "relations-kinds", kinds);
+  append_array(html, "relations-member-offsets", member_offsets);
+  append_array(html, "relations-members", members);
+  append_array(html, "relations-first-side", first_side);
+  append_array(html, "relations-fit-offsets", fit_offsets);
+  append_array(html, "relations-fit-nodes", fit_nodes);
+  append_array(html, "relations-fit-parameters", parameters);
+  append_array(html, "relations-fit-errors", errors);
+  nlohmann::json kind_names = nlohmann::json::array();
+  for (const auto kind : {ClusterRelation::Kind::Parallel, ClusterRelation::Kind::Coaxial,
+                          ClusterRelation::Kind::Orthogonal, ClusterRelation::Kind::EqualRadius})
+    kind_names.push_back(to_string(kind));
+  return {{"firstClusters", first},
+          {"levels", level_count},
+          {"relations", kinds.size()},
+          {"fits", fit_nodes.size()},
+          {"kinds", std::move(kind_names)}};
+}
+
+/// The page's data. `fit_seconds`, `relations_seconds`: set to the time the geometric fits and
+/// the relations (of the levels of at most `relation_clusters` clusters; 0: none) took.
 std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
                       std::uint32_t initial_clusters, const AutoLevel& automatic,
-                      const std::optional<PageSkeleton>& skeleton, unsigned threads,
-                      double& fit_seconds) {
+                      const std::optional<PageSkeleton>& skeleton, std::uint32_t relation_clusters,
+                      unsigned threads, double& fit_seconds, double& relations_seconds) {
   const Mesh& mesh = hierarchy.mesh();
   const std::uint32_t f = hierarchy.face_count();
   const auto merges = hierarchy.merges();
@@ -210,15 +328,14 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
   std::vector<double> parameters, errors;
   parameters.reserve(carried.size() * 9);
   errors.reserve(carried.size() * 2);
-  for (const ClusterReport& r : reports) {
-    const Primitive& p = r.primitive;
-    for (int a = 0; a < 3; ++a) parameters.push_back(p.point[a] - center[a]);
-    for (int a = 0; a < 3; ++a) parameters.push_back(p.axis[a]);
-    parameters.push_back(p.radius);
-    parameters.push_back(p.minor_radius);
-    parameters.push_back(p.half_angle);
-    errors.push_back(r.rms);
-    errors.push_back(r.max);
+  for (const ClusterReport& r : reports) append_fit(r, center, parameters, errors);
+  std::string relation_arrays;
+  nlohmann::json relation_header;
+  if (relation_clusters > 0) {
+    const auto relations_start = Clock::now();
+    relation_header = append_relations(relation_arrays, hierarchy, carried, reports,
+                                       relation_clusters, center, threads);
+    relations_seconds = seconds_since(relations_start);
   }
 
   nlohmann::json header = {
@@ -242,6 +359,7 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
   header["levels"] = std::move(levels);
   std::string skeleton_arrays;
   if (skeleton) header["skeleton"] = append_skeleton(skeleton_arrays, mesh, *skeleton);
+  if (!relation_header.is_null()) header["relations"] = std::move(relation_header);
   std::string html = "<script type=\"application/json\" id=\"primseg-header\">";
   html += script_safe(header);
   html += "</script>\n";
@@ -261,7 +379,7 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
     for (std::uint32_t face = 0; face < f; ++face) leaf_rms[face] = hierarchy.rms_estimate(face);
     append_array(html, "leaf-rms", leaf_rms);
   }
-  return html + skeleton_arrays;
+  return html + skeleton_arrays + relation_arrays;
 }
 
 bool same_mesh(const Mesh& a, const Mesh& b) {
@@ -278,6 +396,8 @@ Command add_view_command(CLI::App& app) {
     std::optional<std::string> clusters;  // K or auto
     bool skeleton = false;
     std::optional<std::string> skeleton_clusters;  // K or auto; default: the page's level
+    bool regularize = false;
+    std::optional<std::uint32_t> regularize_clusters;  // default: kRelationClusters
     double band = SkinningOptions{}.band;
     unsigned threads = 0;
     bool quiet = false;
@@ -305,6 +425,17 @@ Command add_view_command(CLI::App& app) {
                    "--skeleton: skinning blend half-width on each side of a boundary, in bone "
                    "radii")
       ->capture_default_str();
+  view->add_flag("--regularize", o->regularize,
+                 "List the relations cut --regularize finds (parallel, orthogonal, coaxial, "
+                 "equal radius) at every level of up to --regularize-clusters clusters, highlight "
+                 "their clusters, and show the fits they make exact");
+  view->add_option("--regularize-clusters", o->regularize_clusters,
+                   "The levels of --regularize: every level of up to this many clusters (at most " +
+                       std::to_string(kMaxClustersWithParameters) + "; default " +
+                       std::to_string(kRelationClusters) +
+                       ", or the level the page opens at if finer, up to " +
+                       std::to_string(kMaxDefaultRelationClusters) + "); implies --regularize")
+      ->check(CLI::Range(1u, kMaxClustersWithParameters));
   view->add_option("--primitives", o->primitives,
                    "Primitive types when the hierarchy is built, comma-separated")
       ->capture_default_str();
@@ -361,23 +492,35 @@ Command add_view_command(CLI::App& app) {
           SkinWeights weights = compute_skin_weights(*mesh, extracted, skinning);
           skeleton = PageSkeleton{std::move(extracted), std::move(weights), o->band};
         }
+        const std::uint32_t relation_clusters =
+            o->regularize_clusters
+                ? *o->regularize_clusters
+                : (o->regularize
+                       ? std::clamp(initial, kRelationClusters, kMaxDefaultRelationClusters)
+                       : 0);
         std::string html(page.substr(0, marker));
-        double fit_seconds = 0;
+        double fit_seconds = 0, relations_seconds = 0;
         html += page_data(hierarchy, input_name(std::filesystem::path(o->mesh_path).filename()),
-                          initial, automatic, skeleton, o->threads, fit_seconds);
+                          initial, automatic, skeleton, relation_clusters, o->threads, fit_seconds,
+                          relations_seconds);
         html += page.substr(marker + kViewerDataMarker.size());
         detail::write_file_atomically(o->output, html);
         if (!o->quiet) {
           const std::string bones =
               skeleton ? ", skeleton of " + count_of(skeleton->skeleton.cluster_count(), "bone")
                        : "";
+          char relations[96] = "";
+          if (relation_clusters > 0)
+            std::snprintf(relations, sizeof relations,
+                          ", relations of the levels of up to %u clusters in %.3f s",
+                          relation_clusters, relations_seconds);
           std::printf(
-              "%s: %s, hierarchy %s in %.3f s, geometric fits in %.3f s; %s: %.1f MB, opens "
+              "%s: %s, hierarchy %s in %.3f s, geometric fits in %.3f s%s; %s: %.1f MB, opens "
               "at %s (automatic level %u)%s\n",
               input_name(o->mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
-              o->tree_path ? "read" : "built", build_seconds, fit_seconds, o->output.c_str(),
-              static_cast<double>(html.size()) / 1e6, count_of(initial, "cluster").c_str(),
-              automatic.clusters, bones.c_str());
+              o->tree_path ? "read" : "built", build_seconds, fit_seconds, relations,
+              o->output.c_str(), static_cast<double>(html.size()) / 1e6,
+              count_of(initial, "cluster").c_str(), automatic.clusters, bones.c_str());
         }
       }};
 }

@@ -46,6 +46,17 @@ async function readArray(document, name, ArrayType, required = true) {
  * bonePoints Float64Array (K*3), boneOrder/boneParentJoint/boneParentBone Uint32Array (K, the
  * bone tree of skinning.hpp, 0xffffffff for none), weightOffsets Uint32Array (V+1), weightBones
  * Uint32Array, weightValues Float64Array (skin weights), faceLabels Uint32Array (F).
+ *
+ * header.relations (primseg view --regularize): {firstClusters K0, levels L, relations R, fits M,
+ * kinds [names by kind code]}: the relations `primseg cut --clusters K --regularize` finds, for
+ * each level K = K0 .. K0 + L - 1, and the fits they make exact. Then `relations` holds
+ * levelOffsets Uint32Array (L+1: level K's relations are [levelOffsets[K - K0],
+ * levelOffsets[K - K0 + 1])), kinds Uint8Array (R), memberOffsets Uint32Array (R+1) and members
+ * Uint32Array (tree nodes: a relation's clusters, then for an orthogonal one the clusters of the
+ * other direction), firstSide Uint32Array (R: how many members are its clusters), fitOffsets
+ * Uint32Array (L+1: level K's fits, as levelOffsets), fitNodes Uint32Array (M: the nodes the
+ * relations refitted, increasing within a level), fitParameters Float64Array (9 per fit, as
+ * parameters) and fitErrors Float64Array (2 per fit, as errors).
  */
 export async function readPageData(document) {
   const headerElement = document.getElementById('primseg-header');
@@ -79,8 +90,39 @@ export async function readPageData(document) {
     parameterNodes.every((node, i) => node < 2 * F - 1 && (i === 0 || node > parameterNodes[i - 1])),
   'primitive parameters');
   const skeleton = header.skeleton ? await readSkeleton(document, header, check) : null;
+  const relations = header.relations ? await readRelations(document, header, check) : null;
   return { header, positions, triangles, faceOfTriangle, children, rms, types, parameterNodes, parameters, errors,
-    leafRms, skeleton };
+    leafRms, skeleton, relations };
+}
+
+const RELATION_ARRAYS = {
+  levelOffsets: Uint32Array, kinds: Uint8Array, memberOffsets: Uint32Array, members: Uint32Array,
+  firstSide: Uint32Array, fitOffsets: Uint32Array, fitNodes: Uint32Array, fitParameters: Float64Array,
+  fitErrors: Float64Array,
+};
+
+/** Reads the named arrays 'PREFIX-kebab-case-key' of `types` ({key: ArrayType}). */
+async function readArrays(document, prefix, types) {
+  const arrays = {};
+  for (const [key, ArrayType] of Object.entries(types)) {
+    const name = prefix + '-' + key.replace(/[A-Z]/g, (c) => '-' + c.toLowerCase());
+    arrays[key] = await readArray(document, name, ArrayType);
+  }
+  return arrays;
+}
+
+async function readRelations(document, header, check) {
+  const r = await readArrays(document, 'relations', RELATION_ARRAYS);
+  const { levels: L, relations: R, fits: M } = header.relations, nodes = 2 * header.faces - 1;
+  const offsets = (array, length, total) => array.length === length + 1 && array[0] === 0 &&
+    array[length] === total && array.every((x, i) => i === 0 || x >= array[i - 1]);
+  check(offsets(r.levelOffsets, L, R) && offsets(r.fitOffsets, L, M), 'relation levels');
+  check(r.kinds.length === R && r.kinds.every((k) => k < header.relations.kinds.length) &&
+    r.firstSide.length === R && offsets(r.memberOffsets, R, r.members.length) &&
+    r.members.every((node) => node < nodes), 'relations');
+  check(r.fitNodes.length === M && r.fitParameters.length === 9 * M && r.fitErrors.length === 2 * M &&
+    r.fitNodes.every((node) => node < nodes), 'relation fits');
+  return r;
 }
 
 const SKELETON_ARRAYS = {
@@ -92,11 +134,7 @@ const SKELETON_ARRAYS = {
 };
 
 async function readSkeleton(document, header, check) {
-  const skeleton = {};
-  for (const [key, ArrayType] of Object.entries(SKELETON_ARRAYS)) {
-    const name = 'skeleton-' + key.replace(/[A-Z]/g, (c) => '-' + c.toLowerCase());
-    skeleton[key] = await readArray(document, name, ArrayType);
-  }
+  const skeleton = await readArrays(document, 'skeleton', SKELETON_ARRAYS);
   const J = header.skeleton.joints, K = header.skeleton.clusters, V = header.vertices;
   const s = skeleton;
   check(s.rest.length === 3 * V && s.weightOffsets.length === V + 1, 'skeleton rest positions');

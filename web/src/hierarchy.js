@@ -48,6 +48,16 @@ export class Cut {
   }
 }
 
+/** The first index in [low, high) of an increasing array whose value is not below `value`. */
+export function lowerBound(sorted, value, low = 0, high = sorted.length) {
+  while (low < high) {
+    const middle = (low + high) >>> 1;
+    if (sorted[middle] < value) low = middle + 1;
+    else high = middle;
+  }
+  return low;
+}
+
 export class Tree {
   constructor(data) {
     const { header, children, triangles } = data;
@@ -121,13 +131,8 @@ export class Tree {
   /** Index of a node among those whose primitive the page carries, or -1. O(log). */
   parameterIndex(node) {
     const nodes = this.data.parameterNodes;
-    let low = 0, high = nodes.length;
-    while (low < high) {
-      const middle = (low + high) >>> 1;
-      if (nodes[middle] < node) low = middle + 1;
-      else high = middle;
-    }
-    return low < nodes.length && nodes[low] === node ? low : -1;
+    const i = lowerBound(nodes, node);
+    return i < nodes.length && nodes[i] === node ? i : -1;
   }
 
   /**
@@ -176,6 +181,16 @@ export class Tree {
       else stack.push(children[2 * (node - F) + 1], children[2 * (node - F)]);
     }
     return new Cut(Uint32Array.from(nodes), this);
+  }
+
+  /**
+   * Whether a cut is the level cutByCount(cut.size) gives (a cut by tolerance may not be one):
+   * it is when all its nodes are among that level's applied merges and leaves, since a partition
+   * finer than a level with as many clusters is that level. O(K).
+   */
+  isCountCut(cut) {
+    const F = this.faceCount, end = F + Math.min(this.realMerges, F - cut.size);
+    return cut.nodes.every((node) => node < end);
   }
 
   /** The level of tolerance T (input units), as primseg cut --tolerance T. O(K). */

@@ -1,6 +1,7 @@
 // The page of `primseg view`: the mesh coloured by the clusters of a level, sliders over the
 // number of clusters and the tolerance (cuts made here, in linear time), the fitted primitives,
-// the error curve, and the details of a clicked cluster.
+// the error curve, the details of a clicked cluster and, on pages written with --regularize, the
+// relations of the level (relations.js).
 //
 // `?test` in the URL selects the test mode: unlit, no antialiasing, each cluster drawn in the
 // colour (i + 1) as 24-bit RGB, i its index in the cut, so that a test can count clusters in
@@ -14,6 +15,7 @@ import { clusterErrors, facePlane, primitiveSurface } from './primitives.js';
 import { ErrorPlot } from './plot.js';
 import { BorderLines } from './borders.js';
 import { createOverlays } from './hooks.js';
+import { LevelRelations, RELATION_MEANINGS } from './relations.js';
 import './skeleton.js';
 
 const testMode = new URLSearchParams(location.search).has('test');
@@ -52,8 +54,12 @@ class Viewer {
     this.data = data;
     this.header = data.header;
     this.tree = new Tree(data);
+    this.relations = data.relations ? new LevelRelations(data, this.tree) : null;
     this.colorMode = 'cluster';
     this.selected = -1;
+    // The relation whose clusters stand out (-1: none): the one under the pointer, else the
+    // one clicked (pinned).
+    this.emphasized = this.pinned = -1;
     this.stepTimes = [];
     this.setUpScene();
     this.setUpControls();
@@ -205,6 +211,10 @@ class Viewer {
       this.render();
     });
 
+    if (this.relations) {
+      $('relations-row').style.display = '';
+      $('relations-range').textContent = `up to ${this.relations.last.toLocaleString('en')} clusters`;
+    }
     this.plot = new ErrorPlot($('plot'), this.tree.errorCurve, this.tree.minClusters, (K) => this.setClusters(K));
     if (Array.isArray(this.header.levels)) this.showLevels(this.header.levels, this.header.autoLevel);
 
@@ -261,6 +271,9 @@ class Viewer {
     this.deferRender = true;
     this.cut = cut;
     this.selected = -1;
+    this.levelRelations = this.relationsOf(cut);
+    this.emphasized = this.pinned = -1;
+    this.updateAxisLine();
     $('info').style.display = 'none';
     this.recolor();
     this.updatePrimitives();
@@ -275,6 +288,7 @@ class Viewer {
     $('tolerance-slider').value = String(shown > 0 ? Math.round(((Math.log(shown) - a) / (b - a)) * 1000) : 0);
     $('tolerance-value').textContent = `${format(shown)} (${format((100 * shown) / this.header.bboxDiagonal)}%)`;
     this.plot.setCurrent(K);
+    if (this.relations) this.listRelations();
     const ms = performance.now() - start;
     this.stepTimes.push(ms);
     this.deferRender = false;
@@ -307,6 +321,13 @@ class Viewer {
     } else {
       const representative = tree.representative;
       for (let c = 0; c < K; ++c) words[c] = this.leafColor(representative[nodes[c]]);
+    }
+    if (this.emphasized >= 0) {
+      // The relation's clusters keep their colours; the others fade (to the background in test
+      // mode, so that a test sees only the members' codes).
+      const member = this.emphasizedClusters();
+      const faded = testMode ? 0xff000000 : pack([96, 100, 110]);
+      for (let c = 0; c < K; ++c) if (!member[c]) words[c] = faded;
     }
     if (this.selected >= 0 && this.selected < K && !testMode) {
       const w = words[this.selected];
@@ -409,8 +430,11 @@ class Viewer {
     const { offsets, triangles } = this.trianglesByCluster();
     const positions = this.data.positions, meshTriangles = this.data.triangles;
     const vertices = [], colors = [], indices = [];
+    // An emphasised relation: its members' surfaces only.
+    const shown = this.emphasized >= 0 ? this.emphasizedClusters() : null;
     for (let c = 0; c < cut.size; ++c) {
-      const primitive = this.tree.primitive(cut.nodes[c]);
+      if (shown && !shown[c]) continue;
+      const primitive = this.primitiveOf(c);
       if (!primitive) continue;
       const count = offsets[c + 1] - offsets[c];
       const stride = Math.max(1, Math.floor((3 * count) / MAX_SHAPE_POINTS));
@@ -451,6 +475,144 @@ class Viewer {
     this.render();
   }
 
+  /**
+   * The fit primseg reports for cluster c of the current cut: made exact by the level's
+   * relations when the page has them (cut --regularize), else the cluster's own. Or null.
+   */
+  primitiveOf(c) {
+    return this.exactFit(c)?.primitive ?? this.tree.primitive(this.cut.nodes[c]);
+  }
+
+  /** Cluster c's fit and errors as the level's relations made them, or null. */
+  exactFit(c) {
+    return this.levelRelations ? this.relations.fit(this.cut.size, this.cut.nodes[c]) : null;
+  }
+
+  /**
+   * The relations of a cut, each with its members' indices in the cut (members; others: the
+   * other direction of an orthogonal one), or null when the page has none for it: a level
+   * beyond --regularize-clusters, or a cut by tolerance that no number of clusters gives.
+   */
+  relationsOf(cut) {
+    const list = this.relations?.at(cut.size);
+    if (!list || !this.tree.isCountCut(cut)) return null;
+    const index = new Map();
+    cut.nodes.forEach((node, c) => index.set(node, c));
+    return list.map((r) => ({ ...r, members: r.nodes.map((n) => index.get(n)),
+      others: r.otherNodes.map((n) => index.get(n)) }));
+  }
+
+  /**
+   * The current level's relations with cluster ids as primseg numbers them, as `primseg cut
+   * --regularize --json` lists them: [{kind, clusters, orthogonal_to?}], or null.
+   */
+  currentRelations() {
+    if (!this.levelRelations) return null;
+    const ids = this.tree.clusterIds(this.cut);
+    const sorted = (list) => list.map((c) => ids[c]).sort((a, b) => a - b);
+    return this.levelRelations.map(({ kind, members, others }) =>
+      (kind === 'orthogonal' ? { kind, clusters: sorted(members), orthogonal_to: sorted(others) }
+        : { kind, clusters: sorted(members) }));
+  }
+
+  /** A relation as the CLI's summary writes it: "parallel: 2 7 24", "orthogonal: 0 | 8 9". */
+  relationText(relation) {
+    return `${relation.kind.replace('_', ' ')}: ${relation.clusters.join(' ')}` +
+      (relation.orthogonal_to ? ` | ${relation.orthogonal_to.join(' ')}` : '');
+  }
+
+  /** Lists the current level's relations; a row under the pointer, or clicked, emphasises them. */
+  listRelations() {
+    const box = $('relations');
+    box.textContent = '';
+    const relations = this.currentRelations();
+    if (!relations) {
+      const K = this.cut.size;
+      $('relations-summary').textContent = K > this.relations.last
+        ? `none listed beyond ${this.relations.last.toLocaleString('en')} clusters (view --regularize-clusters)`
+        : 'listed for the levels by number of clusters';
+      return;
+    }
+    $('relations-summary').textContent = relations.length ? '' : 'none at this level';
+    relations.forEach((relation, i) => {
+      const row = document.createElement('div');
+      row.className = 'relation';
+      row.dataset.index = String(i);
+      let text = this.relationText(relation);
+      if (relation.kind === 'equal_radius') text += `, r = ${format(this.primitiveOf(this.levelRelations[i].members[0]).radius)}`;
+      row.textContent = text;
+      row.title = RELATION_MEANINGS[relation.kind] ?? relation.kind;
+      row.addEventListener('pointerenter', () => this.emphasize(i));
+      row.addEventListener('pointerleave', () => this.emphasize(this.pinned));
+      row.addEventListener('click', () => {
+        this.pinned = this.pinned === i ? -1 : i;
+        this.emphasize(this.pinned);
+      });
+      box.appendChild(row);
+    });
+  }
+
+  /** Makes relation i of the current level stand out (-1: none): its clusters alone in colour
+   *  and with their primitives drawn. */
+  emphasize(i) {
+    if (!this.levelRelations || i >= this.levelRelations.length) i = -1;
+    if (i === this.emphasized) return;
+    this.emphasized = i;
+    for (const row of $('relations').children)
+      row.classList.toggle('emphasized', Number(row.dataset.index) === i || Number(row.dataset.index) === this.pinned);
+    this.deferRender = true;
+    this.recolor();
+    this.updatePrimitives();
+    this.updateAxisLine();
+    this.deferRender = false;
+    this.render();
+  }
+
+  /**
+   * The shared axis of an emphasised coaxial relation, drawn through the mesh over the length of
+   * its clusters (plus a tenth at each end): this.axisLine, its ends [2][3] relative to
+   * header.center, or null.
+   */
+  updateAxisLine() {
+    if (this.axisObject) {
+      this.scene.remove(this.axisObject);
+      this.axisObject.geometry.dispose();
+      this.axisObject = null;
+    }
+    this.axisLine = null;
+    const relation = this.emphasized >= 0 ? this.levelRelations[this.emphasized] : null;
+    if (relation?.kind !== 'coaxial') return;
+    const { point, axis } = this.primitiveOf(relation.members[0]);
+    const { offsets, triangles } = this.trianglesByCluster();
+    const positions = this.data.positions, meshTriangles = this.data.triangles;
+    let low = Infinity, high = -Infinity;
+    for (const c of relation.members)
+      for (let i = offsets[c]; i < offsets[c + 1]; ++i)
+        for (let k = 0; k < 3; ++k) {
+          const v = 3 * meshTriangles[3 * triangles[i] + k];
+          const t = (positions[v] - point[0]) * axis[0] + (positions[v + 1] - point[1]) * axis[1] +
+            (positions[v + 2] - point[2]) * axis[2];
+          low = Math.min(low, t);
+          high = Math.max(high, t);
+        }
+    const margin = (high - low) / 10;
+    this.axisLine = [low - margin, high + margin].map((t) => point.map((x, a) => x + t * axis[a]));
+    if (testMode) return;  // the pixels stay cluster codes
+    const geometry = new THREE.BufferGeometry().setFromPoints(this.axisLine.map((p) => new THREE.Vector3(...p)));
+    this.axisObject = new THREE.Line(geometry, new THREE.LineBasicMaterial({ color: 0xffd36b, depthTest: false, transparent: true }));
+    this.axisObject.renderOrder = 5;
+    this.scene.add(this.axisObject);
+  }
+
+  /** 1 for each cluster of the current cut in the emphasised relation (Uint8Array, K). */
+  emphasizedClusters() {
+    const member = new Uint8Array(this.cut.size);
+    const { members, others } = this.levelRelations[this.emphasized];
+    for (const c of members) member[c] = 1;
+    for (const c of others) member[c] = 1;
+    return member;
+  }
+
   /** The cluster under a point of the window (client coordinates), or -1. */
   clusterAt(x, y) {
     const rect = this.renderer.domElement.getBoundingClientRect();
@@ -484,7 +646,9 @@ class Viewer {
     const tree = this.tree, node = this.cut.nodes[c], header = this.header;
     const { offsets, triangles } = this.trianglesByCluster();
     const ids = triangles.subarray(offsets[c], offsets[c + 1]);
-    const primitive = tree.primitive(node) ?? (tree.isLeaf(node) ? facePlane(this.data.positions, this.data.triangles, ids) : null);
+    const exact = this.exactFit(c);
+    const primitive = exact?.primitive ?? tree.primitive(node) ??
+      (tree.isLeaf(node) ? facePlane(this.data.positions, this.data.triangles, ids) : null);
     const clusterIds = tree.clusterIds(this.cut);
     const info = {
       id: clusterIds[c], clusters: this.cut.size, node, face,
@@ -494,7 +658,7 @@ class Viewer {
     if (primitive) {
       // primseg's own figures where the page carries them; else (a single face of a fine level)
       // measured here, on the page's float32 positions.
-      const { rms, max } = tree.errors(node) ??
+      const { rms, max } = exact?.errors ?? tree.errors(node) ??
         clusterErrors(primitive, this.data.positions, this.data.triangles, ids, this.cornerWeight());
       info.rms = rms;
       info.max = max;
@@ -507,7 +671,11 @@ class Viewer {
     }
     // Its borders: the neighbouring clusters (ids as primseg numbers them, null for the open
     // boundary), with the angle between the fitted surfaces across each.
-    info.borders = this.borderLines.clusterBorders(this.cut, c, (k) => tree.primitive(this.cut.nodes[k]))
+    if (this.levelRelations) {
+      info.relations = this.currentRelations().filter((r, i) =>
+        this.levelRelations[i].members.includes(c) || this.levelRelations[i].others.includes(c));
+    }
+    info.borders = this.borderLines.clusterBorders(this.cut, c, (k) => this.primitiveOf(k))
       .map((b) => ({ ...b, cluster: b.cluster < 0 ? null : clusterIds[b.cluster],
         type: b.cluster < 0 ? null : TYPE_NAMES[tree.type(this.cut.nodes[b.cluster])] }));
     return info;
@@ -528,6 +696,7 @@ class Viewer {
     if (info.params) for (const [key, value] of Object.entries(info.params)) rows.push([key, Array.isArray(value) ? formatVector(value) : format(value)]);
     else rows.push(['parameters', 'not in the page at this level (too fine)']);
     if (info.rms !== undefined) rows.push(['RMS', format(info.rms)], ['max error', format(info.max)]);
+    if (info.relations?.length) rows.push(['relations', info.relations.map((r) => this.relationText(r)).join('<br>')]);
     rows.push(['RMS estimate', format(info.rmsEstimate)]);
     // The longest borders: whom it meets, and how (0 degrees tangent, 90 a square edge).
     const shown = info.borders.slice(0, 6).map((b) => (b.cluster === null ? 'open boundary'

@@ -410,6 +410,131 @@ test('fandisk: a cluster\'s panel lists its borders as primseg cut reports them'
   await page.close();
 });
 
+test('fandisk --regularize: each level lists primseg cut --regularize\'s relations and reports its exact fits', async () => {
+  const html = join(work, 'fandisk-relations.html'), tree = join(work, 'fandisk.tree');
+  primseg('view', fandisk, '--tree', tree, '--clusters', '27', '--regularize', '-o', html, '--quiet');
+  const { page, errors } = await openViewer(browser, html);
+  const diagonal = await page.evaluate(async () => (await window.primseg.ready).header.bboxDiagonal);
+  const kinds = new Set();
+  let refitted = 0;
+  for (const K of [1, 10, 27, 34, 60, 100]) {
+    const labelsFile = join(work, 'r.labels'), jsonFile = join(work, 'r.json');
+    primseg('cut', tree, '--clusters', String(K), '--regularize', '--labels', labelsFile, '--json', jsonFile, '--quiet');
+    const cliLabels = readLabels(labelsFile), cli = JSON.parse(readFileSync(jsonFile, 'utf8'));
+    const shown = await page.evaluate(async (k) => {
+      const viewer = await window.primseg.ready;
+      viewer.setClusters(k);
+      const first = new Int32Array(viewer.cut.size).fill(-1);
+      viewer.cut.faceCluster.forEach((c, f) => { if (first[c] < 0) first[c] = f; });
+      return { labels: viewer.labels(), relations: viewer.currentRelations(),
+        rows: Array.from(document.querySelectorAll('#relations .relation'), (row) => row.textContent),
+        panels: Array.from(first, (face, c) => ({ face, ...viewer.describe(c, face) })) };
+    }, K);
+    // Page ids to primseg's, through the faces (ids of near-equal areas may differ).
+    const cliOf = new Map();
+    shown.labels.forEach((p, f) => cliOf.set(p, cliLabels[f]));
+    const asCli = (ids) => ids.map((id) => cliOf.get(id)).sort((a, b) => a - b);
+    const relations = shown.relations.map((r) => ({ ...r, clusters: asCli(r.clusters),
+      ...(r.orthogonal_to ? { orthogonal_to: asCli(r.orthogonal_to) } : {}) }));
+    assert.deepEqual(relations, cli.relations, `K = ${K}: the relations`);
+    assert.equal(shown.rows.length, cli.relations.length, `K = ${K}: one row per relation`);
+    for (const r of cli.relations) kinds.add(r.kind);
+    // Every cluster's panel: the fit as cut --regularize reports it (the members' made exact),
+    // and the relations it is in.
+    for (const info of shown.panels) {
+      const expected = cli.clusters[cliLabels[info.face]];
+      assertSameReport(info, expected, diagonal, `K = ${K}, cluster ${expected.id}`);
+      const member = cli.relations.filter((r) => r.clusters.includes(expected.id) || r.orthogonal_to?.includes(expected.id));
+      assert.equal(info.relations.length, member.length, `K = ${K}, cluster ${expected.id}: its relations`);
+      if (member.length) ++refitted;
+    }
+  }
+  for (const kind of ['parallel', 'coaxial', 'orthogonal', 'equal_radius']) assert.ok(kinds.has(kind), `a ${kind} relation is compared`);
+  assert.ok(refitted > 50, `${refitted} exact fits compared`);
+  // Beyond the page's levels, and on a cut by tolerance no count gives, none is listed; a cut by
+  // tolerance that is a level by count lists that level's.
+  const beyond = await page.evaluate(async () => {
+    const viewer = await window.primseg.ready;
+    viewer.setClusters(101);
+    const shown = { relations: viewer.currentRelations(), summary: document.getElementById('relations-summary').textContent };
+    const byTolerance = [];
+    for (const tolerance of [1e-4, 3e-4, 1e-3, 3e-3, 1e-2]) {
+      viewer.setTolerance(tolerance * viewer.header.bboxDiagonal);
+      const K = viewer.cut.size, relations = viewer.currentRelations(), countCut = viewer.tree.isCountCut(viewer.cut);
+      viewer.setClusters(K);
+      byTolerance.push({ K, countCut, relations, byCount: viewer.currentRelations() });
+    }
+    return { ...shown, byTolerance };
+  });
+  assert.equal(beyond.relations, null);
+  assert.match(beyond.summary, /none listed beyond 100 clusters/);
+  for (const { K, countCut, relations, byCount } of beyond.byTolerance) {
+    if (K > 100) continue;
+    assert.deepEqual(relations, countCut ? byCount : null, `tolerance level of ${K} clusters`);
+  }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('fandisk --regularize: a relation under the pointer, or clicked, leaves only its clusters in colour', async () => {
+  const html = join(work, 'fandisk-relations.html');
+  const { page, errors } = await openViewer(browser, html, { test: true, width: 640, height: 480 });
+  const all = await drawnClusters(page);
+  const relations = await page.evaluate(async () => (await window.primseg.ready).levelRelations
+    .map(({ kind, members, others }) => ({ kind, members: [...members, ...others] })));
+  assert.ok(relations.length >= 4);
+  for (const [i, relation] of relations.entries()) {
+    if (i > 0 && relation.kind === relations[i - 1].kind) continue;  // one of each kind
+    await page.click(`#relations .relation[data-index="${i}"]`);
+    const drawn = await drawnClusters(page);
+    const members = new Set(relation.members);
+    assert.deepEqual(drawn, new Set(relation.members.filter((c) => all.has(c))), `${relation.kind} ${i}: only its clusters in colour`);
+    assert.ok(drawn.size >= 1 && [...drawn].every((c) => members.has(c)));
+    if (relation.kind === 'coaxial') {
+      // Its axis is drawn: a line on every member's axis.
+      const { line, axes } = await page.evaluate(async (members) => {
+        const viewer = await window.primseg.ready;
+        return { line: viewer.axisLine, axes: members.map((c) => viewer.primitiveOf(c)) };
+      }, relation.members);
+      for (const end of line)
+        for (const { point, axis } of axes) {
+          const d = end.map((x, a) => x - point[a]), t = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2];
+          assert.ok(Math.hypot(...d.map((x, a) => x - t * axis[a])) < 1e-9, 'the axis line is on each member\'s axis');
+        }
+      assert.ok(Math.hypot(...line[0].map((x, a) => x - line[1][a])) > 0.05, 'the line spans the members');
+    }
+    await page.click(`#relations .relation[data-index="${i}"]`);  // unpinned
+  }
+  assert.equal(await page.evaluate(async () => (await window.primseg.ready).axisLine), null);
+  await page.mouse.move(5, 470);
+  assert.deepEqual(await drawnClusters(page), all, 'every cluster in colour again');
+  // Pointing at a row emphasises its relation without a click.
+  await page.hover('#relations .relation[data-index="0"]');
+  assert.deepEqual(await drawnClusters(page), new Set(relations[0].members.filter((c) => all.has(c))));
+  assert.deepEqual(errors, []);
+  await page.close();
+
+  // A picture for the eye: the fitted primitives, made exact, and a coaxial set pinned.
+  const shown = await openViewer(browser, html, { width: 1100, height: 700 });
+  await shown.page.check('#show-primitives');
+  const coaxial = relations.findIndex((r) => r.kind === 'coaxial');
+  await shown.page.click(`#relations .relation[data-index="${coaxial}"]`);
+  await shown.page.screenshot({ path: join(artifacts, 'fandisk-relations.png') });
+  assert.deepEqual(shown.errors, []);
+  await shown.page.close();
+});
+
+test('a page without --regularize shows no relations', async () => {
+  const { page, errors } = await openViewer(browser, join(work, 'fandisk.html'));
+  const state = await page.evaluate(async () => {
+    const viewer = await window.primseg.ready;
+    return { relations: viewer.currentRelations(), row: getComputedStyle(document.getElementById('relations-row')).display };
+  });
+  assert.deepEqual(state, { relations: null, row: 'none' });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('the page is the same bytes from the mesh alone or with its tree', () => {
   const html = join(work, 'again.html');
   primseg('view', fandisk, '--clusters', '27', '-o', html, '--quiet');
@@ -429,6 +554,8 @@ test('bad input: a clear error and exit status 1', () => {
     [['view', fandisk], /output/i],
     [['view', fandisk, '--skeleton-clusters', 'many', '-o', join(work, 'x.html')], /--clusters: 'many'/],
     [['view', fandisk, '--skeleton', '--band', '-1', '-o', join(work, 'x.html')], /--band/],
+    [['view', fandisk, '--regularize-clusters', '0', '-o', join(work, 'x.html')], /--regularize-clusters/],
+    [['view', fandisk, '--regularize-clusters', '16386', '-o', join(work, 'x.html')], /--regularize-clusters/],
     // --max-faces and --max-memory, as segment has them (tests/cli/batch_test.cpp, without viewer).
     [['view', fandisk, '--max-faces', '12945', '-o', join(work, 'x.html')],
       /the mesh has 12946 faces, more than --max-faces 12945/],
