@@ -291,8 +291,8 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
 
 // Relations: clusters increasing and distinct, two or more (orthogonal: one or more a side); a
 // parallel group and each side of an orthogonal pair share one direction up to sign, the two
-// sides' directions are orthogonal to round-off, a coaxial set holds cylinders only, and
-// cylinders of equal radius have one radius, bit for bit.
+// sides' directions are orthogonal to round-off, a coaxial set holds cylinders only, and an
+// equal-radius set cylinders and spheres of one radius, bit for bit.
 void check_relations(const std::vector<Primitive>& primitives,
                      const std::vector<ClusterRelation>& relations, const std::string& what) {
   auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest,
@@ -314,10 +314,13 @@ void check_relations(const std::vector<Primitive>& primitives,
     const bool orthogonal = relation.kind == ClusterRelation::Kind::Orthogonal;
     const bool equal_radius = relation.kind == ClusterRelation::Kind::EqualRadius;
     check_members(relation.clusters, orthogonal ? 1 : 2, !equal_radius);
-    if (relation.kind == ClusterRelation::Kind::Coaxial || equal_radius)
-      for (const std::uint32_t c : relation.clusters)
-        if (primitives[c].type != PrimitiveType::Cylinder)
-          fail((what + ": coaxial or equal-radius non-cylinder").c_str(), c);
+    for (const std::uint32_t c : relation.clusters) {
+      const PrimitiveType type = primitives[c].type;
+      if (relation.kind == ClusterRelation::Kind::Coaxial && type != PrimitiveType::Cylinder)
+        fail((what + ": coaxial non-cylinder").c_str(), c);
+      if (equal_radius && type != PrimitiveType::Cylinder && type != PrimitiveType::Sphere)
+        fail((what + ": equal radius of a surface without one").c_str(), c);
+    }
     if (equal_radius)
       for (const std::uint32_t c : relation.clusters)
         if (std::bit_cast<std::uint64_t>(primitives[c].radius) !=

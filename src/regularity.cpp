@@ -134,31 +134,51 @@ struct CylinderTerm {
   std::size_t radius = 0;
 };
 
-// Axis lines of fixed directions and radii fitted together by geometric least squares: each
-// term's residuals are its points' distances to its line minus its radius. Several terms on one
-// line are coaxial cylinders; several on one radius, cylinders of equal radius.
-struct JointFit {
-  std::vector<Eigen::Vector2d> centres;  // per line, in orthonormal_pair(direction) coordinates
-  std::vector<double> radii;
-  std::vector<double> rms;     // per term, unweighted, at least kResolution × its radius
-  Eigen::MatrixXd covariance;  // of (centres, radii), from the unweighted residuals (if asked)
+// A sphere's points: sphere s of a joint fit has its own centre and one of its radii.
+struct SphereTerm {
+  std::span<const Vec3> points;
+  std::span<const double> weights;
+  std::size_t radius = 0;
 };
 
-// Gauss–Newton from `centres` and `radii` (weighted steps; the uncertainty, when asked for, from
-// the unweighted residuals at the solution). Nothing when it diverges, a radius ends non-positive
-// or the points do not outnumber the parameters. A step of one line solves the normal equations
-// whole; a step of several eliminates each line's position first (its 2x2 block couples only to
-// its own terms' radii), so that a plate of n holes of one radius costs O(n), not O(n³).
-std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> directions,
-                                      std::span<const Eigen::Vector2d> centres,
-                                      std::span<const double> radii,
-                                      std::span<const CylinderTerm> terms, bool with_covariance) {
+// Axis lines of fixed directions, sphere centres and radii fitted together by geometric least
+// squares: each cylinder term's residuals are its points' distances to its line minus its radius,
+// each sphere's their distances to its centre minus its radius. Several terms on one line are
+// coaxial cylinders; several on one radius, cylinders (and spheres) of equal radius.
+struct JointFit {
+  std::vector<Eigen::Vector2d> centres;  // per line, in orthonormal_pair(direction) coordinates
+  std::vector<Eigen::Vector3d> sphere_centres;
+  std::vector<double> radii;
+  // Per cylinder term, then per sphere; unweighted, at least kResolution × the radius.
+  std::vector<double> rms;
+  // Of (line centres, sphere centres, radii), from the unweighted residuals (if asked).
+  Eigen::MatrixXd covariance;
+};
+
+// Gauss–Newton from `centres`, `sphere_centres` and `radii` (weighted steps; the uncertainty,
+// when asked for, from the unweighted residuals at the solution). Nothing when it diverges, a
+// radius ends non-positive or the points do not outnumber the parameters. A step of one line
+// and no sphere solves the normal equations whole; otherwise it eliminates each line's and each
+// sphere's position first (a 2x2 or 3x3 block that couples only to its own terms' radii), so that
+// a plate of n holes of one radius costs O(n), not O(n³).
+std::optional<JointFit> fit_cylinders_and_spheres(std::span<const Eigen::Vector3d> directions,
+                                                  std::span<const Eigen::Vector2d> centres,
+                                                  std::span<const Eigen::Vector3d> sphere_centres,
+                                                  std::span<const double> radii,
+                                                  std::span<const CylinderTerm> terms,
+                                                  std::span<const SphereTerm> spheres,
+                                                  bool with_covariance) {
   const Eigen::Index lines = static_cast<Eigen::Index>(centres.size());
+  const Eigen::Index sphere_count = static_cast<Eigen::Index>(spheres.size());
   const Eigen::Index radius_count = static_cast<Eigen::Index>(radii.size());
-  const Eigen::Index size = 2 * lines + radius_count;
+  // x = (line centres 2 each, sphere centres 3 each, radii).
+  const Eigen::Index first_radius = 2 * lines + 3 * sphere_count;
+  const Eigen::Index size = first_radius + radius_count;
   Eigen::VectorXd x(size);
   for (Eigen::Index l = 0; l < lines; ++l) x.segment<2>(2 * l) = centres[l];
-  for (Eigen::Index q = 0; q < radius_count; ++q) x(2 * lines + q) = radii[q];
+  for (Eigen::Index s = 0; s < sphere_count; ++s)
+    x.segment<3>(2 * lines + 3 * s) = sphere_centres[static_cast<std::size_t>(s)];
+  for (Eigen::Index q = 0; q < radius_count; ++q) x(first_radius + q) = radii[q];
   // The points in the plane orthogonal to their line's direction, once for every iteration.
   std::vector<std::vector<Eigen::Vector2d>> projected(terms.size());
   std::vector<std::vector<std::size_t>> terms_on_line(centres.size());
@@ -172,14 +192,20 @@ std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> direction
   // radius, each radius's diagonal (radii never couple with each other, lines never with lines).
   std::vector<Eigen::Matrix2d> line_block(centres.size());
   std::vector<Eigen::Vector2d> coupling(terms.size()), line_gradient(centres.size());
+  std::vector<Eigen::Matrix3d> sphere_block(spheres.size());
+  std::vector<Eigen::Vector3d> sphere_coupling(spheres.size()), sphere_gradient(spheres.size());
   Eigen::VectorXd radius_diagonal(radius_count), radius_gradient(radius_count);
-  std::vector<double> term_squares(terms.size());
-  std::vector<std::size_t> term_count(terms.size());
+  // Per cylinder term, then per sphere.
+  std::vector<double> term_squares(terms.size() + spheres.size());
+  std::vector<std::size_t> term_count(terms.size() + spheres.size());
   std::size_t count = 0;
   auto linearise = [&](bool weighted) {
     std::fill(line_block.begin(), line_block.end(), Eigen::Matrix2d::Zero());
     std::fill(coupling.begin(), coupling.end(), Eigen::Vector2d::Zero());
     std::fill(line_gradient.begin(), line_gradient.end(), Eigen::Vector2d::Zero());
+    std::fill(sphere_block.begin(), sphere_block.end(), Eigen::Matrix3d::Zero());
+    std::fill(sphere_coupling.begin(), sphere_coupling.end(), Eigen::Vector3d::Zero());
+    std::fill(sphere_gradient.begin(), sphere_gradient.end(), Eigen::Vector3d::Zero());
     radius_diagonal.setZero();
     radius_gradient.setZero();
     double squares = 0;
@@ -188,7 +214,7 @@ std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> direction
       const std::size_t l = terms[k].line;
       const Eigen::Index q = static_cast<Eigen::Index>(terms[k].radius);
       const Eigen::Vector2d centre = x.segment<2>(2 * static_cast<Eigen::Index>(l));
-      const double radius = x(2 * lines + q);
+      const double radius = x(first_radius + q);
       term_squares[k] = 0;
       term_count[k] = 0;
       for (std::size_t i = 0; i < projected[k].size(); ++i) {
@@ -209,6 +235,31 @@ std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> direction
         ++count;
       }
     }
+    for (std::size_t s = 0; s < spheres.size(); ++s) {
+      const Eigen::Index q = static_cast<Eigen::Index>(spheres[s].radius);
+      const Eigen::Vector3d centre = x.segment<3>(2 * lines + 3 * static_cast<Eigen::Index>(s));
+      const double radius = x(first_radius + q);
+      const std::size_t k = terms.size() + s;
+      term_squares[k] = 0;
+      term_count[k] = 0;
+      for (std::size_t i = 0; i < spheres[s].points.size(); ++i) {
+        const Eigen::Vector3d d = to_eigen(spheres[s].points[i]) - centre;
+        const double length = d.norm();
+        if (!(length > 0)) continue;
+        const double w = weighted ? spheres[s].weights[i] : 1.0;
+        const double e = length - radius;
+        const Eigen::Vector3d j = -d / length;
+        sphere_block[s] += w * j * j.transpose();
+        sphere_coupling[s] -= w * j;
+        radius_diagonal(q) += w;
+        sphere_gradient[s] += w * j * e;
+        radius_gradient(q) -= w * e;
+        squares += e * e;
+        term_squares[k] += e * e;
+        ++term_count[k];
+        ++count;
+      }
+    }
     return squares;
   };
   auto whole_system = [&](Eigen::MatrixXd& normal, Eigen::VectorXd& gradient) {
@@ -220,22 +271,32 @@ std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> direction
     }
     for (std::size_t k = 0; k < terms.size(); ++k)
       normal.block<2, 1>(2 * static_cast<Eigen::Index>(terms[k].line),
-                         2 * lines + static_cast<Eigen::Index>(terms[k].radius)) += coupling[k];
+                         first_radius + static_cast<Eigen::Index>(terms[k].radius)) += coupling[k];
+    for (Eigen::Index s = 0; s < sphere_count; ++s) {
+      const std::size_t k = static_cast<std::size_t>(s);
+      normal.block<3, 3>(2 * lines + 3 * s, 2 * lines + 3 * s) = sphere_block[k];
+      gradient.segment<3>(2 * lines + 3 * s) = sphere_gradient[k];
+      normal.block<3, 1>(2 * lines + 3 * s,
+                         first_radius + static_cast<Eigen::Index>(spheres[k].radius)) +=
+          sphere_coupling[k];
+    }
     normal.diagonal().tail(radius_count) = radius_diagonal;
     gradient.tail(radius_count) = radius_gradient;
-    for (Eigen::Index row = 2 * lines; row < size; ++row)
+    for (Eigen::Index row = first_radius; row < size; ++row)
       for (Eigen::Index col = 0; col < row; ++col) normal(row, col) = normal(col, row);
   };
   Eigen::MatrixXd normal;
   Eigen::VectorXd gradient, delta(size);
   std::vector<Eigen::Matrix2d> inverse(centres.size());
+  std::vector<Eigen::Matrix3d> sphere_inverse(spheres.size());
   for (int step = 0; step < 30; ++step) {
     linearise(true);
-    if (lines == 1) {
+    if (lines == 1 && sphere_count == 0) {
       whole_system(normal, gradient);
       delta = normal.ldlt().solve(-gradient);
     } else {
-      // The radii's Schur complement S = D − Σ Bₗᵀ Aₗ⁻¹ Bₗ, then each line's position.
+      // The radii's Schur complement S = D − Σ Bₗᵀ Aₗ⁻¹ Bₗ, then each line's and sphere's
+      // position.
       Eigen::MatrixXd schur = radius_diagonal.asDiagonal();
       Eigen::VectorXd right = -radius_gradient;
       for (std::size_t l = 0; l < centres.size(); ++l) {
@@ -248,12 +309,25 @@ std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> direction
             schur(qa, static_cast<Eigen::Index>(terms[b].radius)) -= spread.dot(coupling[b]);
         }
       }
+      for (std::size_t s = 0; s < spheres.size(); ++s) {
+        sphere_inverse[s] = sphere_block[s].inverse();
+        const Eigen::Vector3d spread = sphere_inverse[s] * sphere_coupling[s];
+        const Eigen::Index q = static_cast<Eigen::Index>(spheres[s].radius);
+        right(q) += spread.dot(sphere_gradient[s]);
+        schur(q, q) -= spread.dot(sphere_coupling[s]);
+      }
       delta.tail(radius_count) = schur.ldlt().solve(right);
       for (std::size_t l = 0; l < centres.size(); ++l) {
         Eigen::Vector2d rest = -line_gradient[l];
         for (const std::size_t a : terms_on_line[l])
-          rest -= coupling[a] * delta(2 * lines + static_cast<Eigen::Index>(terms[a].radius));
+          rest -= coupling[a] * delta(first_radius + static_cast<Eigen::Index>(terms[a].radius));
         delta.segment<2>(2 * static_cast<Eigen::Index>(l)) = inverse[l] * rest;
+      }
+      for (std::size_t s = 0; s < spheres.size(); ++s) {
+        const Eigen::Vector3d rest =
+            -sphere_gradient[s] -
+            sphere_coupling[s] * delta(first_radius + static_cast<Eigen::Index>(spheres[s].radius));
+        delta.segment<3>(2 * lines + 3 * static_cast<Eigen::Index>(s)) = sphere_inverse[s] * rest;
       }
     }
     if (!delta.allFinite()) return std::nullopt;
@@ -266,11 +340,14 @@ std::optional<JointFit> fit_cylinders(std::span<const Eigen::Vector3d> direction
   if (count <= static_cast<std::size_t>(size)) return std::nullopt;
   JointFit fit;
   for (Eigen::Index l = 0; l < lines; ++l) fit.centres.emplace_back(x.segment<2>(2 * l));
+  for (Eigen::Index s = 0; s < sphere_count; ++s)
+    fit.sphere_centres.emplace_back(x.segment<3>(2 * lines + 3 * s));
   fit.radii.assign(fitted_radii.data(), fitted_radii.data() + fitted_radii.size());
-  for (std::size_t k = 0; k < terms.size(); ++k)
-    fit.rms.push_back(
-        std::max(std::sqrt(term_squares[k] / double(std::max<std::size_t>(term_count[k], 1))),
-                 kResolution * fit.radii[terms[k].radius]));
+  for (std::size_t k = 0; k < terms.size() + spheres.size(); ++k)
+    fit.rms.push_back(std::max(
+        std::sqrt(term_squares[k] / double(std::max<std::size_t>(term_count[k], 1))),
+        kResolution *
+            fit.radii[k < terms.size() ? terms[k].radius : spheres[k - terms.size()].radius]));
   if (with_covariance) {
     whole_system(normal, gradient);
     const double largest_radius = fitted_radii.maxCoeff();
@@ -305,7 +382,8 @@ std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::
     terms.push_back({members[k].points, members[k].weights, 0, k});
     radii.push_back(members[k].radius);
   }
-  std::optional<JointFit> joint = fit_cylinders({&axis, 1}, {&centre, 1}, radii, terms, true);
+  std::optional<JointFit> joint =
+      fit_cylinders_and_spheres({&axis, 1}, {&centre, 1}, {}, radii, terms, {}, true);
   if (!joint) return std::nullopt;
   CoaxialFit fit;
   fit.centre = joint->centres[0];
@@ -448,12 +526,13 @@ double family_significance(double significance, std::size_t tests) {
 }
 
 // How far a joint fit explains a member worse than its own fit did: the rise of its residual sum
-// over significance² times its residual variance (estimated with the member's fit's degrees of
-// freedom). Above 1, it does not belong.
-double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2) {
+// over significance² times its residual variance (estimated with the degrees of freedom of the
+// member's own fit, of `parameters` parameters). Above 1, it does not belong.
+double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2,
+                       int parameters) {
   const double n = static_cast<double>(count);
   const double rise = n * (joint_rms * joint_rms - own_rms * own_rms);
-  return rise / (significance2 * own_rms * own_rms * n / (n - 3));
+  return rise / (significance2 * own_rms * own_rms * n / (n - parameters));
 }
 
 // `cylinder` on the line of `direction` through `centre` (orthonormal_pair(direction)
@@ -468,20 +547,23 @@ void place_cylinder(Primitive& cylinder, const Eigen::Vector3d& direction,
   cylinder.radius = radius;
 }
 
-// The cylinders refitted so far, each on an axis line (coaxial ones on a shared one), for the
-// equal radii.
-struct SettledCylinders {
+// The surfaces with a radius, for the equal radii: the cylinders refitted so far, each on an
+// axis line (coaxial ones on a shared one), and the spheres, each on its centre.
+struct SettledSurfaces {
   struct Line {
     Eigen::Vector3d direction;
     Eigen::Vector2d centre;  // orthonormal_pair(direction) coordinates
   };
-  struct Cylinder {
+  struct Surface {
     std::size_t cluster = 0;
-    std::size_t line = 0;
+    bool sphere = false;
+    std::size_t line = 0;    // a cylinder's, into `lines`
+    std::size_t centre = 0;  // a sphere's, into `centres`
     double radius = 0, radius_variance = 0, rms = 0;
   };
   std::vector<Line> lines;
-  std::vector<Cylinder> cylinders;
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<Surface> surfaces;
 };
 
 // Refits the cylinders of a direction group: each coaxial set around one axis line (each member
@@ -491,7 +573,7 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
                      double significance, std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights,
-                     std::vector<Relation>& relations, SettledCylinders& settled) {
+                     std::vector<Relation>& relations, SettledSurfaces& settled) {
   std::stable_sort(cylinders.begin(), cylinders.end(),
                    [](const AlignedCylinder& a, const AlignedCylinder& b) {
                      return a.fit.centre_covariance.trace() < b.fit.centre_covariance.trace();
@@ -517,7 +599,7 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
       double worst_excess = 1;
       for (std::size_t j = 0; j < sets[s].size(); ++j) {
         const double excess = fit ? residual_excess(cylinders[sets[s][j]].fit.rms[0], fit->rms[j],
-                                                    members[j].points.size(), bound * bound)
+                                                    members[j].points.size(), bound * bound, 3)
                                   : std::numeric_limits<double>::infinity();
         if (excess > worst_excess) {
           worst_excess = excess;
@@ -544,8 +626,8 @@ void align_cylinders(const Eigen::Vector3d& direction, std::vector<AlignedCylind
     for (std::size_t j = 0; j < sets[s].size(); ++j) {
       const std::size_t c = cylinders[sets[s][j]].cluster;
       place_cylinder(primitives[c], direction, joint.centre, joint.radii[j]);
-      settled.cylinders.push_back(
-          {c, line, joint.radii[j], joint.radius_variances[j], joint.rms[j]});
+      settled.surfaces.push_back(
+          {c, false, line, 0, joint.radii[j], joint.radius_variances[j], joint.rms[j]});
     }
   }
 }
@@ -567,14 +649,14 @@ double chi_square_bound(double significance, std::size_t freedom) {
 // max_radius_difference of its largest (relative to the largest). A radius whose significance
 // interval is wider than that bound joins none: any two such radii within the bound would pass, so
 // the bound and not the data would decide (cylinder patches of a freeform surface; a nearly flat
-// cylinder). Returns each cylinder's class.
-std::vector<std::size_t> radius_classes(const std::vector<SettledCylinders::Cylinder>& cylinders,
+// cylinder). Returns each surface's class.
+std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surface>& surfaces,
                                         const RegularityOptions& options) {
-  const std::size_t n = cylinders.size();
+  const std::size_t n = surfaces.size();
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return cylinders[a].radius < cylinders[b].radius;
+    return surfaces[a].radius < surfaces[b].radius;
   });
   std::vector<std::size_t> class_of(n);
   std::size_t classes = 0, open = 0;
@@ -583,7 +665,7 @@ std::vector<std::size_t> radius_classes(const std::vector<SettledCylinders::Cyli
   double first = 0, information = 0, moment = 0, square = 0;
   std::size_t members = 0;
   for (const std::size_t k : order) {
-    const double r = cylinders[k].radius, variance = cylinders[k].radius_variance;
+    const double r = surfaces[k].radius, variance = surfaces[k].radius_variance;
     if (!(variance > 0) ||
         options.significance * std::sqrt(variance) > options.max_radius_difference * r) {
       class_of[k] = classes++;  // a class of its own
@@ -612,22 +694,23 @@ std::vector<std::size_t> radius_classes(const std::vector<SettledCylinders::Cyli
   return class_of;
 }
 
-// Cylinders of equal radius within the significance (radius_classes) share one radius: each
-// component of cylinders joined by a class or by an axis line (a coaxial set) is refitted by one
-// joint least squares over its lines' positions and its radii, the directions kept. As for a
-// coaxial set, a member the joint fit explains worse than its own by more than the significance
-// leaves its class, the worst first. Appends the classes of two or more to `relations`.
-void equalize_radii(const SettledCylinders& settled, const RegularityOptions& options,
+// Cylinders and spheres of equal radius within the significance (radius_classes) share one
+// radius: each component of surfaces joined by a class or by an axis line (a coaxial set) is
+// refitted by one joint least squares over its lines' positions, its spheres' centres and its
+// radii, the directions kept. As for a coaxial set, a member the joint fit explains worse than
+// its own by more than the significance leaves its class, the worst first. Appends the classes
+// of two or more to `relations`.
+void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& options,
                     std::vector<Primitive>& primitives,
                     const std::vector<std::vector<Vec3>>& points,
                     const std::vector<std::vector<double>>& weights,
                     std::vector<Relation>& relations) {
-  const std::vector<SettledCylinders::Cylinder>& cylinders = settled.cylinders;
-  const std::size_t n = cylinders.size();
-  std::vector<std::size_t> class_of = radius_classes(cylinders, options);
+  const std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
+  const std::size_t n = surfaces.size();
+  std::vector<std::size_t> class_of = radius_classes(surfaces, options);
   std::vector<std::size_t> class_size(n, 0);
   for (const std::size_t q : class_of) ++class_size[q];
-  // Components: union-find over the cylinders, through shared classes and shared lines.
+  // Components: union-find over the surfaces, through shared classes and shared lines.
   std::vector<std::size_t> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   auto root = [&](std::size_t k) {
@@ -636,14 +719,16 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
     while (parent[k] != top) k = std::exchange(parent[k], top);
     return top;
   };
+  auto join = [&](std::size_t& first, std::size_t k) {
+    if (first == n)
+      first = k;
+    else
+      parent[root(k)] = root(first);
+  };
   std::vector<std::size_t> first_of_class(n, n), first_on_line(settled.lines.size(), n);
   for (std::size_t k = 0; k < n; ++k) {
-    for (std::size_t* first : {&first_of_class[class_of[k]], &first_on_line[cylinders[k].line]}) {
-      if (*first == n)
-        *first = k;
-      else
-        parent[root(k)] = root(*first);
-    }
+    join(first_of_class[class_of[k]], k);
+    if (!surfaces[k].sphere) join(first_on_line[surfaces[k].line], k);
   }
   std::vector<std::vector<std::size_t>> components(n);
   for (std::size_t k = 0; k < n; ++k) components[root(k)].push_back(k);
@@ -656,35 +741,48 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
       continue;
     std::optional<JointFit> fit;
     std::vector<CylinderTerm> terms;
-    std::vector<Eigen::Vector3d> directions;
+    std::vector<SphereTerm> spheres;
+    std::vector<Eigen::Vector3d> directions, sphere_centres;
     std::vector<Eigen::Vector2d> centres;
     std::vector<double> radii;
+    // Each member's term: its index among the fit's cylinder terms, or among its spheres.
+    std::vector<std::size_t> term_of(component.size());
     while (true) {
       terms.clear();
+      spheres.clear();
       directions.clear();
+      sphere_centres.clear();
       centres.clear();
       radii.clear();
       for (const std::size_t k : component) {
-        line_index[cylinders[k].line] = n;
+        if (!surfaces[k].sphere) line_index[surfaces[k].line] = n;
         radius_of_class[class_of[k]] = n;
       }
-      for (const std::size_t k : component) {
-        const SettledCylinders::Cylinder& cylinder = cylinders[k];
-        std::size_t& line = line_index[cylinder.line];
+      for (std::size_t j = 0; j < component.size(); ++j) {
+        const SettledSurfaces::Surface& surface = surfaces[component[j]];
+        // A class of two or more has one radius, started from its first member's.
+        std::size_t& radius = radius_of_class[class_of[component[j]]];
+        if (radius == n || class_size[class_of[component[j]]] < 2) {
+          radius = radii.size();
+          radii.push_back(surface.radius);
+        }
+        if (surface.sphere) {
+          term_of[j] = spheres.size();
+          spheres.push_back({points[surface.cluster], weights[surface.cluster], radius});
+          sphere_centres.push_back(settled.centres[surface.centre]);
+          continue;
+        }
+        std::size_t& line = line_index[surface.line];
         if (line == n) {
           line = directions.size();
-          directions.push_back(settled.lines[cylinder.line].direction);
-          centres.push_back(settled.lines[cylinder.line].centre);
+          directions.push_back(settled.lines[surface.line].direction);
+          centres.push_back(settled.lines[surface.line].centre);
         }
-        // A class of two or more has one radius, started from its first member's.
-        std::size_t& radius = radius_of_class[class_of[k]];
-        if (radius == n || class_size[class_of[k]] < 2) {
-          radius = radii.size();
-          radii.push_back(cylinder.radius);
-        }
-        terms.push_back({points[cylinder.cluster], weights[cylinder.cluster], line, radius});
+        term_of[j] = terms.size();
+        terms.push_back({points[surface.cluster], weights[surface.cluster], line, radius});
       }
-      fit = fit_cylinders(directions, centres, radii, terms, false);
+      fit = fit_cylinders_and_spheres(directions, centres, sphere_centres, radii, terms, spheres,
+                                      false);
       if (!fit) break;
       // One test per member: at the significance each, a plate of a hundred equal holes would
       // lose one in four times.
@@ -695,10 +793,12 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
       std::size_t worst = component.size();
       double worst_excess = 1;
       for (std::size_t j = 0; j < component.size(); ++j) {
-        const SettledCylinders::Cylinder& cylinder = cylinders[component[j]];
+        const SettledSurfaces::Surface& surface = surfaces[component[j]];
         if (class_size[class_of[component[j]]] < 2) continue;
-        const double excess = residual_excess(cylinder.rms, fit->rms[j],
-                                              points[cylinder.cluster].size(), bound * bound);
+        const double rms = fit->rms[surface.sphere ? terms.size() + term_of[j] : term_of[j]];
+        // A sphere's own fit has 4 parameters, a cylinder's (on its direction) 3.
+        const double excess = residual_excess(surface.rms, rms, points[surface.cluster].size(),
+                                              bound * bound, surface.sphere ? 4 : 3);
         if (excess > worst_excess) {
           worst_excess = excess;
           worst = j;
@@ -715,15 +815,23 @@ void equalize_radii(const SettledCylinders& settled, const RegularityOptions& op
     // Written back: the members of classes of two or more, and the cylinders on their lines.
     std::vector<bool> moved_line(settled.lines.size(), false);
     for (const std::size_t k : component)
-      if (class_size[class_of[k]] >= 2) moved_line[cylinders[k].line] = true;
+      if (class_size[class_of[k]] >= 2 && !surfaces[k].sphere) moved_line[surfaces[k].line] = true;
     std::map<std::size_t, std::vector<std::size_t>> members_of_class;
     for (std::size_t j = 0; j < component.size(); ++j) {
-      const SettledCylinders::Cylinder& cylinder = cylinders[component[j]];
-      if (!moved_line[cylinder.line]) continue;
-      place_cylinder(primitives[cylinder.cluster], directions[terms[j].line],
-                     fit->centres[terms[j].line], fit->radii[terms[j].radius]);
-      if (class_size[class_of[component[j]]] >= 2)
-        members_of_class[class_of[component[j]]].push_back(cylinder.cluster);
+      const SettledSurfaces::Surface& surface = surfaces[component[j]];
+      const bool member = class_size[class_of[component[j]]] >= 2;
+      Primitive& primitive = primitives[surface.cluster];
+      if (surface.sphere) {
+        if (!member) continue;
+        primitive.point = to_vec3(fit->sphere_centres[term_of[j]]);
+        primitive.radius = fit->radii[spheres[term_of[j]].radius];
+      } else {
+        if (!moved_line[surface.line]) continue;
+        const CylinderTerm& term = terms[term_of[j]];
+        place_cylinder(primitive, directions[term.line], fit->centres[term.line],
+                       fit->radii[term.radius]);
+      }
+      if (member) members_of_class[class_of[component[j]]].push_back(surface.cluster);
     }
     for (auto& [unused, members] : members_of_class) {
       Relation& relation = relations.emplace_back();
@@ -901,7 +1009,7 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
   for (const auto& [i, j] : orthogonal) constrained[i] = constrained[j] = true;
   // The clusters each group refitted, for the orthogonal relations.
   std::vector<std::vector<std::size_t>> refitted(groups.size());
-  SettledCylinders settled;
+  SettledSurfaces settled;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const DirectionGroup& group = groups[g];
     if (group.members.size() < 2 && !constrained[g]) continue;
@@ -929,18 +1037,30 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
   }
   if (options.equal_radii) {
     // The cylinders no direction relation refitted take part too, each on its own axis (fitted
-    // again with it, for its radius's uncertainty; written back only if it joins a class).
+    // again with it, for its radius's uncertainty; written back only if it joins a class), and
+    // the spheres, each fitted again on its own.
     std::vector<bool> is_settled(primitives.size(), false);
-    for (const SettledCylinders::Cylinder& cylinder : settled.cylinders)
-      is_settled[cylinder.cluster] = true;
+    for (const SettledSurfaces::Surface& surface : settled.surfaces)
+      is_settled[surface.cluster] = true;
     for (const Oriented& item : items) {
       const std::size_t c = item.cluster;
       if (primitives[c].type != PrimitiveType::Cylinder || is_settled[c]) continue;
       if (const std::optional<CoaxialFit> fit =
               fit_alone(primitives[c], item.direction, points[c], weights[c])) {
-        settled.cylinders.push_back(
-            {c, settled.lines.size(), fit->radii[0], fit->radius_variances[0], fit->rms[0]});
+        settled.surfaces.push_back({c, false, settled.lines.size(), 0, fit->radii[0],
+                                    fit->radius_variances[0], fit->rms[0]});
         settled.lines.push_back({item.direction, fit->centre});
+      }
+    }
+    for (std::size_t c = 0; c < primitives.size(); ++c) {
+      if (primitives[c].type != PrimitiveType::Sphere || points[c].empty()) continue;
+      const Eigen::Vector3d centre = to_eigen(primitives[c].point);
+      const SphereTerm term{points[c], weights[c], 0};
+      if (const std::optional<JointFit> fit = fit_cylinders_and_spheres(
+              {}, {}, {&centre, 1}, {&primitives[c].radius, 1}, {}, {&term, 1}, true)) {
+        settled.surfaces.push_back({c, true, 0, settled.centres.size(), fit->radii[0],
+                                    fit->covariance(3, 3), fit->rms[0]});
+        settled.centres.push_back(fit->sphere_centres[0]);
       }
     }
     equalize_radii(settled, options, primitives, points, weights, relations);

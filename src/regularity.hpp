@@ -3,7 +3,7 @@
 // GlobFit, Li et al. 2011): planes' normals and cylinders' axes that agree within their fits'
 // uncertainty share one direction, estimated from all of them, directions at right angles within
 // it are made orthogonal, cylinders of one direction whose axes agree share one axis line, and
-// cylinders whose radii agree share one radius.
+// cylinders and spheres whose radii agree share one radius.
 
 #include <cstddef>
 #include <span>
@@ -23,7 +23,7 @@ struct RegularityOptions {
   double max_angle_degrees = 20;
   /// Make directions at right angles within the significance exactly orthogonal.
   bool orthogonal = true;
-  /// Give cylinders whose radii agree within the significance one radius.
+  /// Give cylinders and spheres whose radii agree within the significance one radius.
   bool equal_radii = true;
   /// ... never when the radii differ by more than this fraction of the larger, nor a radius
   /// whose significance interval is wider than this fraction of it.
@@ -48,9 +48,9 @@ struct Relation {
 /// jointly with the cylinders coaxial with it (one axis line, one radius each). points[c] and
 /// weights[c] are cluster c's inlier vertices (input units) and their weights; a cluster with too
 /// few to estimate its direction's uncertainty is left alone. Deterministic: clusters are visited
-/// by increasing uncertainty, ties by index. Then cylinders whose radii agree within the
-/// significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with the
-/// cylinders coaxial with them. Returns the relations made exact: each direction group's members
+/// by increasing uncertainty, ties by index. Then cylinders and spheres whose radii agree within
+/// the significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with
+/// the cylinders coaxial with them (each sphere on its own centre). Returns the relations made exact: each direction group's members
 /// that were refitted with its direction, then each coaxial set of its cylinders, in that order,
 /// then the classes of equal radii, then the right angles by their members.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,

@@ -62,6 +62,25 @@ Cluster noisy_cylinder(const Eigen::Vector3d& axis, const Eigen::Vector3d& centr
   return cluster;
 }
 
+// A spherical cap of radius `radius` about `centre`, facing `pole`: 10 rings of 24 points from
+// the pole down to `polar_angle` (radians), moved radially by Gaussian noise of deviation `sigma`.
+Cluster noisy_sphere_cap(const Eigen::Vector3d& centre, double radius, const Eigen::Vector3d& pole,
+                         double polar_angle, double sigma, std::mt19937_64& rng) {
+  const Eigen::Vector3d u = pole.unitOrthogonal(), v = pole.cross(u);
+  std::normal_distribution<double> noise(0, sigma);
+  Cluster cluster;
+  for (int i = 1; i <= 10; ++i)
+    for (int k = 0; k < 24; ++k) {
+      const double polar = polar_angle * i / 10, azimuth = 2 * std::numbers::pi * k / 24;
+      const Eigen::Vector3d radial =
+          std::cos(polar) * pole +
+          std::sin(polar) * (std::cos(azimuth) * u + std::sin(azimuth) * v);
+      cluster.points.push_back(to_vec3(centre + (radius + noise(rng)) * radial));
+      cluster.weights.push_back(1);
+    }
+  return cluster;
+}
+
 // Least-squares plane (PCA), as the denoiser's refit gives it.
 Primitive fitted_plane(const Cluster& cluster) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -322,6 +341,57 @@ TEST(Regularity, HolesOfOneRadiusShareItNearerTheTruth) {
     for (const auto& [kind, members] : relations) {
       if (kind == Kind::EqualRadius) {
         EXPECT_EQ(std::count(members.begin(), members.end(), 4), 0);
+      }
+    }
+  }
+}
+
+Primitive fitted_sphere(const Cluster& cluster, const Eigen::Vector3d& centre, double radius) {
+  Primitive start;
+  start.type = PrimitiveType::Sphere;
+  start.point = to_vec3(centre);
+  start.radius = radius;
+  return fit_geometric(start, cluster.points, cluster.weights).primitive;
+}
+
+// A cylinder closed by a hemisphere of its radius, and a row of ball seats of one radius beside a
+// seat 4% larger: the cylinder, its cap and the equal seats share one radius, nearer the truth than
+// the worst of their own fits; each sphere keeps its own centre; the larger seat stays apart.
+TEST(Regularity, SpheresShareTheRadiusOfEqualSpheresAndCylinders) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  const std::vector<Eigen::Vector3d> seats{{1, 0, 0}, {1.5, 0, 0}, {2, 0, 0}, {2.5, 0, 0}};
+  const std::vector<double> seat_radii{0.2, 0.2, 0.2, 0.208};
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    std::vector<Cluster> clusters{
+        noisy_cylinder(z, {0, 0, 0}, 0.2, 0.6, 0.001, rng),
+        noisy_sphere_cap({0, 0, 0.3}, 0.2, z, std::numbers::pi / 2, 0.001, rng)};
+    std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.2),
+                                      fitted_sphere(clusters[1], {0, 0, 0.3}, 0.2)};
+    for (std::size_t k = 0; k < seats.size(); ++k) {
+      clusters.push_back(noisy_sphere_cap(seats[k], seat_radii[k], -z, 1.0, 0.001, rng));
+      primitives.push_back(fitted_sphere(clusters.back(), seats[k], seat_radii[k]));
+    }
+    const std::vector<Primitive> fitted = primitives;
+    const Relations relations = regularize(primitives, clusters);
+    const std::vector<std::size_t> equal{0, 1, 2, 3, 4};
+    ASSERT_EQ(std::count(relations.begin(), relations.end(), std::pair{Kind::EqualRadius, equal}),
+              1);
+    double worst = 0;
+    for (const std::size_t c : equal) {
+      worst = std::max(worst, std::abs(fitted[c].radius - 0.2));
+      EXPECT_EQ(primitives[c].radius, primitives[0].radius);
+      // Each keeps its own axis line or centre, moved within its fit's uncertainty.
+      EXPECT_LT(c == 0 ? axis_offset(primitives[0], fitted[0])
+                       : (to_eigen(primitives[c].point) - to_eigen(fitted[c].point)).norm(),
+                0.002);
+    }
+    EXPECT_LE(std::abs(primitives[0].radius - 0.2), worst);
+    EXPECT_NEAR(primitives[5].radius, 0.208, 0.001);
+    for (const auto& [kind, members] : relations) {
+      if (kind == Kind::EqualRadius) {
+        EXPECT_EQ(std::count(members.begin(), members.end(), 5), 0);
       }
     }
   }

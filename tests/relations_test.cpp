@@ -179,6 +179,45 @@ TEST(Relations, PartsShowTheirDesignIntentExactAndNoisy) {
     }
 }
 
+// A cylinder closed by a hemisphere of its radius (0.5): on its true regions, exact and noisy,
+// the cylinder and its cap are one equal-radius relation, their radius one, bit for bit, and no
+// farther from the truth than the farther of their own fits; the sphere keeps its centre.
+TEST(Relations, ACylinderAndTheHemisphereClosingItShareOneRadius) {
+  for (const double noise : {0.0, 0.002})
+    for (const std::uint64_t seed : {1u, 2u, 3u}) {
+      SCOPED_TRACE(std::to_string(noise) + " seed " + std::to_string(seed));
+      const GroundTruthShape shape = noisy_shape("cylinder_with_sphere_cap", noise, seed);
+      const Hierarchy hierarchy = build_hierarchy(shape.mesh);
+      // The true regions (the tree's level of 3 clusters is not them on the exact shape), each
+      // fitted from its true primitive.
+      Segmentation cut;
+      cut.labels = shape.region_of_face;
+      cut.nodes.assign(shape.regions.size(), 0);
+      const std::vector<ClusterReport> before = describe_clusters(hierarchy, cut, shape.regions);
+      std::vector<ClusterReport> after = before;
+      const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, after);
+      std::vector<std::uint32_t> round;
+      for (std::uint32_t c = 0; c < before.size(); ++c)
+        if (before[c].primitive.type != PrimitiveType::Plane) round.push_back(c);
+      ASSERT_EQ(round.size(), 2u);
+      ASSERT_EQ(clusters_of(relations, ClusterRelation::Kind::EqualRadius), Groups{round});
+      const std::uint32_t sphere =
+          before[round[0]].primitive.type == PrimitiveType::Sphere ? round[0] : round[1];
+      ASSERT_EQ(before[sphere].primitive.type, PrimitiveType::Sphere);
+      EXPECT_TRUE(
+          testing::same_bits(after[round[0]].primitive.radius, after[round[1]].primitive.radius));
+      const double worst = std::max(std::abs(before[round[0]].primitive.radius - 0.5),
+                                    std::abs(before[round[1]].primitive.radius - 0.5));
+      EXPECT_LE(std::abs(after[sphere].primitive.radius - 0.5), worst + 1e-12);
+      const Vec3& centre = after[sphere].primitive.point;
+      const Vec3& own = before[sphere].primitive.point;
+      const Vec3 moved{centre[0] - own[0], centre[1] - own[1], centre[2] - own[2]};
+      EXPECT_LT(std::sqrt(dot(moved, moved)), 0.01);
+      // The one radius costs each fit little.
+      for (const std::uint32_t c : round) EXPECT_LE(after[c].rms, before[c].rms * 1.25 + 1e-12);
+    }
+}
+
 TEST(Relations, OppositeFacesOfANoisyBoxBecomeParallelNearerTheTruth) {
   const GroundTruthShape box = noisy_shape("box", 0.002, 1);
   const Hierarchy hierarchy = build_hierarchy(box.mesh);
@@ -365,21 +404,23 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
   }
 }
 
-// Cylinders of a CAD part whose fitted radii agree within `tolerance` (relative), linked one to
-// the next: the part's equal radii, when the tessellation is that exact.
+// Cylinders and spheres of a CAD part whose fitted radii agree within `tolerance` (relative),
+// linked one to the next: the part's equal radii, when the tessellation is that exact.
 Groups equal_radii(const std::vector<ClusterReport>& reports, double tolerance) {
-  std::vector<std::uint32_t> cylinders;
+  std::vector<std::uint32_t> round;
   for (std::uint32_t c = 0; c < reports.size(); ++c)
-    if (reports[c].primitive.type == PrimitiveType::Cylinder) cylinders.push_back(c);
-  std::sort(cylinders.begin(), cylinders.end(), [&](std::uint32_t a, std::uint32_t b) {
+    if (reports[c].primitive.type == PrimitiveType::Cylinder ||
+        reports[c].primitive.type == PrimitiveType::Sphere)
+      round.push_back(c);
+  std::sort(round.begin(), round.end(), [&](std::uint32_t a, std::uint32_t b) {
     return reports[a].primitive.radius < reports[b].primitive.radius;
   });
   Groups groups;
-  for (std::size_t i = 0; i < cylinders.size(); ++i) {
-    const double r = reports[cylinders[i]].primitive.radius;
-    if (i == 0 || r > reports[cylinders[i - 1]].primitive.radius * (1 + tolerance))
+  for (std::size_t i = 0; i < round.size(); ++i) {
+    const double r = reports[round[i]].primitive.radius;
+    if (i == 0 || r > reports[round[i - 1]].primitive.radius * (1 + tolerance))
       groups.emplace_back();
-    groups.back().push_back(cylinders[i]);
+    groups.back().push_back(round[i]);
   }
   std::erase_if(groups, [](const auto& group) { return group.size() < 2; });
   for (auto& group : groups) std::sort(group.begin(), group.end());
@@ -389,8 +430,9 @@ Groups equal_radii(const std::vector<ClusterReport>& reports, double tolerance) 
 
 // The hole patterns of two libcgal-demo parts, at their automatic levels with the borders refined
 // (as `segment --refine 2`): couplingdown (an exact tessellation: radii agree to 1e-5) has bolt
-// circles of 3, 3 and 4 holes; anchor_dense (remeshed: to 1%) two of 4. Each pattern is one
-// equal-radius relation, and no other cylinder joins one.
+// circles of 3, 3 and 4 holes, spherical seats of 4 and 3 and two pairs of spheres; anchor_dense
+// (remeshed: to 1%) two circles of 4 holes. Each pattern is one equal-radius relation, and no
+// other cylinder or sphere joins one.
 TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
   for (const auto& [name, tolerance] :
        {std::pair{"couplingdown.off", 1e-5}, std::pair{"anchor_dense.off", 1e-2}}) {
@@ -407,8 +449,8 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
         regularize_clusters(hierarchy, level.segmentation, after);
     const Groups truth = equal_radii(before, tolerance);
     const Groups found = clusters_of(relations, ClusterRelation::Kind::EqualRadius);
-    std::printf("%s at %u clusters: %zu hole patterns of", name, level.segmentation.cluster_count(),
-                found.size());
+    std::printf("%s at %u clusters: %zu equal-radius sets of", name,
+                level.segmentation.cluster_count(), found.size());
     for (const auto& group : found)
       std::printf(" %zu (radius %.6g)", group.size(), after[group[0]].primitive.radius);
     std::printf("\n");

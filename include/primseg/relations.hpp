@@ -3,7 +3,7 @@
 /// Design intent between the fitted primitives of a segmentation: plane normals and cylinder axes
 /// that agree within their fits' uncertainty (opposite faces of a box, a shaft and its end faces),
 /// directions at right angles, cylinders that share an axis line (a stepped shaft, the fragments
-/// of one bore) and cylinders of one radius (a bolt circle's holes). Making
+/// of one bore) and cylinders and spheres of one radius (a bolt circle's holes). Making
 /// these relations exact is what reverse engineering wants of a scanned part's fits: a box with
 /// parallel faces, a shaft with one axis (after GlobFit, Li et al. 2011).
 
@@ -29,8 +29,9 @@ struct ClusterRelation {
     /// cylinder's axis), `orthogonal_to` the other. A box's three directions give three of
     /// these; a shaft's axis and the faces along it, one.
     Orthogonal,
-    /// Cylinders made one radius, each keeping its own axis line: the holes of a bolt circle,
-    /// fillets of one radius, the fragments of one cylinder (which are coaxial too).
+    /// Cylinders and spheres made one radius, each keeping its own axis line or centre: the holes
+    /// of a bolt circle, fillets of one radius, the spherical seats of a pattern, a cylinder and
+    /// the hemisphere that closes it, the fragments of one cylinder (which are coaxial too).
     EqualRadius,
   };
   Kind kind = Kind::Parallel;
@@ -69,15 +70,15 @@ void validate(const RelationOptions& options);
 /// level's clusters and makes them exact, in place.
 ///
 /// `reports` are the level's clusters as describe_clusters() or refine_boundaries() report them
-/// (reports[c] is label c of `segmentation`; shape (K)). Only planes and cylinders take part.
-/// Each cluster's direction and its uncertainty come from its inlier vertices (each mesh vertex
-/// once, weighted by its corners' weights in the hierarchy); clusters with too few vertices to
-/// estimate it (6 for a plane, 12 for a cylinder) stay out. Every member of a relation is
-/// refitted: a plane through its inliers' weighted centroid with the group's normal, a cylinder
-/// by geometric least squares with the group's axis direction, jointly with the cylinders coaxial
-/// with it (one axis line, one radius each) and those of equal radius (one radius, each on its
-/// own line). Its report's `primitive`, `rms` and `max` are
-/// replaced (`rms` and `max` measured as describe_clusters() does, on all the cluster's
+/// (reports[c] is label c of `segmentation`; shape (K)). Planes and cylinders take part, and
+/// spheres in the equal radii. Each cluster's direction and its uncertainty come from its inlier
+/// vertices (each mesh vertex once, weighted by its corners' weights in the hierarchy); clusters
+/// with too few vertices to estimate it (6 for a plane, 12 for a cylinder) stay out. Every member
+/// of a relation is refitted: a plane through its inliers' weighted centroid with the group's
+/// normal, a cylinder by geometric least squares with the group's axis direction, jointly with
+/// the cylinders coaxial with it (one axis line, one radius each) and the cylinders and spheres of
+/// equal radius (one radius, each on its own line or centre). Its report's `primitive`, `rms` and
+/// `max` are replaced (`rms` and `max` measured as describe_clusters() does, on all the cluster's
 /// vertices); every other report is left bit for bit. Deterministic, O(F log F).
 ///
 /// Returns the relations made exact, ordered by kind (parallel first), then by their clusters.

@@ -122,7 +122,7 @@ def direction(c):
 assert abs(direction(right_angle["clusters"][0]) @ direction(right_angle["orthogonal_to"][0])) < 1e-14
 for same in (r["clusters"] for r in relations if r["kind"] == "equal_radius"):
     radii = {exact[c]["params"]["radius"] for c in same}
-    print("one radius for the cylinders", same, ":", radii)
+    print("one radius for the clusters", same, ":", radii)
     assert len(radii) == 1
 
 # %% [markdown]

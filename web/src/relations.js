@@ -9,7 +9,7 @@ export const RELATION_MEANINGS = {
   parallel: 'plane normals and cylinder axes made one direction',
   coaxial: 'cylinders made one axis line, each keeping its radius',
   orthogonal: 'two directions made exactly orthogonal (the clusters before | against those after)',
-  equal_radius: 'cylinders made one radius, each keeping its axis line',
+  equal_radius: 'cylinders and spheres made one radius, each keeping its axis line or centre',
 };
 
 export class LevelRelations {
