@@ -513,7 +513,7 @@ Command add_view_command(CLI::App& app) {
           if (relation_clusters > 0)
             std::snprintf(relations, sizeof relations,
                           ", relations of the levels of up to %u clusters in %.3f s",
-                          relation_clusters, relations_seconds);
+                          std::min(relation_clusters, mesh->face_count()), relations_seconds);
           std::printf(
               "%s: %s, hierarchy %s in %.3f s, geometric fits in %.3f s%s; %s: %.1f MB, opens "
               "at %s (automatic level %u)%s\n",

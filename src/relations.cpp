@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
-#include <tuple>
 
 #include "primseg/error.hpp"
 #include "primseg/geometric_fit.hpp"
@@ -55,31 +55,50 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
     if (label >= k)
       throw InvalidInputError("regularize_clusters: a label is not below the cluster count");
 
-  // Each cluster's vertices once, weighted by the sum of their corners' weights in it (working
-  // frame): repeated corners would make the directions look better determined than they are.
-  std::vector<std::tuple<std::uint32_t, std::uint32_t, double>> corners;
-  corners.reserve(3 * static_cast<std::size_t>(mesh.triangle_count()));
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
-    const std::uint32_t c = segmentation.labels[mesh.face_of_triangle[t]];
-    const Triangle vertices = graph.corners(t);
-    const std::array<double, 3> weights = graph.corner_weights(t);
-    for (int i = 0; i < 3; ++i) corners.emplace_back(c, vertices[i], weights[i]);
+  // Each cluster's vertices once, in increasing order, weighted by the sum of their corners'
+  // weights in it (working frame), summed in increasing triangle order: repeated corners would
+  // make the directions look better determined than they are. The triangles are grouped by
+  // cluster (counting sort) and each vertex's weight gathered in a vertex-indexed scratch entry,
+  // O(T + Σ V_c log V_c).
+  std::vector<std::uint32_t> triangle_offsets(static_cast<std::size_t>(k) + 1, 0);
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
+    ++triangle_offsets[segmentation.labels[mesh.face_of_triangle[t]] + 1];
+  for (std::uint32_t c = 0; c < k; ++c) triangle_offsets[c + 1] += triangle_offsets[c];
+  std::vector<std::uint32_t> triangles_by_cluster(mesh.triangle_count());
+  {
+    std::vector<std::uint32_t> next(triangle_offsets.begin(), triangle_offsets.end() - 1);
+    for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
+      triangles_by_cluster[next[segmentation.labels[mesh.face_of_triangle[t]]]++] = t;
   }
-  std::sort(corners.begin(), corners.end(), [](const auto& a, const auto& b) {
-    return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
-  });
+  constexpr std::uint32_t kUnseen = std::numeric_limits<std::uint32_t>::max();
+  std::vector<double> vertex_weight(mesh.vertex_count(), 0.0);
+  std::vector<std::uint32_t> seen_in(mesh.vertex_count(), kUnseen), touched;
   std::vector<std::vector<Vec3>> points(k);
   std::vector<std::vector<double>> weights(k);
-  for (std::size_t i = 0; i < corners.size();) {
-    const auto [c, v, first_weight] = corners[i];
-    double weight = 0;
-    for (; i < corners.size() && std::get<0>(corners[i]) == c && std::get<1>(corners[i]) == v; ++i)
-      weight += std::get<2>(corners[i]);
-    // Like the fits, a vertex of zero-area triangles only weighs nothing and is left out.
-    if (!(weight > 0)) continue;
-    const Eigen::Vector3d& x = graph.position(v);
-    points[c].push_back({x.x(), x.y(), x.z()});
-    weights[c].push_back(weight);
+  for (std::uint32_t c = 0; c < k; ++c) {
+    touched.clear();
+    for (std::uint32_t i = triangle_offsets[c]; i < triangle_offsets[c + 1]; ++i) {
+      const std::uint32_t t = triangles_by_cluster[i];
+      const Triangle vertices = graph.corners(t);
+      const std::array<double, 3> corner_weights = graph.corner_weights(t);
+      for (int j = 0; j < 3; ++j) {
+        const std::uint32_t v = vertices[j];
+        if (seen_in[v] != c) {
+          seen_in[v] = c;
+          vertex_weight[v] = 0;
+          touched.push_back(v);
+        }
+        vertex_weight[v] += corner_weights[j];
+      }
+    }
+    std::sort(touched.begin(), touched.end());
+    for (const std::uint32_t v : touched) {
+      // Like the fits, a vertex of zero-area triangles only weighs nothing and is left out.
+      if (!(vertex_weight[v] > 0)) continue;
+      const Eigen::Vector3d& x = graph.position(v);
+      points[c].push_back({x.x(), x.y(), x.z()});
+      weights[c].push_back(vertex_weight[v]);
+    }
   }
 
   std::vector<Primitive> primitives;
