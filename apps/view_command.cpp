@@ -13,7 +13,6 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
-#include <numeric>
 #include <string>
 
 #include "../src/file_io.hpp"
@@ -178,9 +177,10 @@ void append_fit(const ClusterReport& report, const Vec3& center, std::vector<dou
 /// The relations of one level and the fits they changed.
 struct LevelRelations {
   std::vector<ClusterRelation> relations;
-  std::vector<std::uint32_t> nodes;     ///< tree node of each cluster label, shape (K)
-  std::vector<std::uint32_t> members;   ///< labels of the clusters in a relation, increasing
-  std::vector<ClusterReport> refitted;  ///< their reports after regularize_clusters()
+  std::vector<std::uint32_t> nodes;  ///< tree node of each cluster label, shape (K)
+  /// The reports of the relations' clusters after regularize_clusters(), with their nodes, by
+  /// increasing node (the page looks them up by node).
+  std::vector<std::pair<std::uint32_t, ClusterReport>> fits;
 };
 
 /// The relations `cut --clusters K --regularize` finds, for every level K from the fewest
@@ -215,10 +215,9 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
           for (const std::uint32_t c : relation.orthogonal_to) member[c] = true;
         }
         for (std::uint32_t c = 0; c < segmentation.cluster_count(); ++c)
-          if (member[c]) {
-            level.members.push_back(c);
-            level.refitted.push_back(level_reports[c]);
-          }
+          if (member[c]) level.fits.emplace_back(segmentation.nodes[c], level_reports[c]);
+        std::sort(level.fits.begin(), level.fits.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
         level.nodes = segmentation.nodes;
       });
 
@@ -235,15 +234,9 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
       member_offsets.push_back(static_cast<std::uint32_t>(members.size()));
     }
     level_offsets.push_back(static_cast<std::uint32_t>(kinds.size()));
-    // By increasing node, for the page's binary search.
-    std::vector<std::uint32_t> order(level.members.size());
-    std::iota(order.begin(), order.end(), 0u);
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return level.nodes[level.members[a]] < level.nodes[level.members[b]];
-    });
-    for (const std::uint32_t m : order) {
-      fit_nodes.push_back(level.nodes[level.members[m]]);
-      append_fit(level.refitted[m], center, parameters, errors);
+    for (const auto& [node, report] : level.fits) {
+      fit_nodes.push_back(node);
+      append_fit(report, center, parameters, errors);
     }
     fit_offsets.push_back(static_cast<std::uint32_t>(fit_nodes.size()));
   }
