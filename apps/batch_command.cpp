@@ -36,7 +36,7 @@ struct BatchOptions {
   unsigned jobs = 0;
   bool resume = false, exact_costs = false, quiet = false;
   LevelChoice level;
-  LevelOptions fit;  // --refine and --regularize only
+  LevelOptions fit;  // --refine, --regularize and its options only
   ResourceLimits limits;
 };
 
@@ -139,7 +139,7 @@ std::string options_signature(const BatchOptions& o) {
          " tolerance=" + o.level.tolerance.value_or(kDefaultTolerance) +
          // Only when set, so that outputs made before these options existed still resume.
          (o.fit.refine > 0 ? " refine=" + std::to_string(o.fit.refine) : "") +
-         (o.fit.regularize ? " regularize=1" : "");
+         (o.fit.regularize ? " regularize=1" + relation_options_signature(o.fit.relations) : "");
 }
 
 /// Faces recorded in a complete output made with the same options, or nothing.
@@ -190,6 +190,7 @@ Result process(const Item& item, const BatchOptions& o, const HierarchyOptions& 
   level.level = o.level;
   level.refine = o.fit.refine;
   level.regularize = o.fit.regularize;
+  level.relations = o.fit.relations;
   level.quiet = true;
   level.files.labels = base.string() + ".labels";
   level.files.json = base.string() + ".json";
@@ -251,6 +252,7 @@ void run_batch(const BatchOptions& o) {
   options.exact_costs = o.exact_costs;
   options.threads = 1;  // The workers are the parallelism: one file each.
   validate(options);
+  validate(o.fit.relations);
   validate_level(o.level, UINT32_MAX);
   const auto [shard, shards] = parse_shard(o.shard);
 

@@ -175,11 +175,44 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
   command.add_flag("--regularize", options.regularize,
                    "Make the fits' design intent exact: plane normals and cylinder axes that "
                    "agree within their uncertainty share one direction, directions at right "
-                   "angles become orthogonal, and cylinders share one axis line or one radius "
-                   "(listed as \"relations\" in the JSON)");
+                   "angles become orthogonal, cylinders share one axis line, and cylinders and "
+                   "spheres one radius (listed as \"relations\" in the JSON)");
+  add_relation_options(command, options.relations);
+}
+
+void add_relation_options(CLI::App& command, RelationOptions& options) {
+  command
+      .add_option("--relation-significance", options.significance,
+                  "--regularize: directions, axis lines and radii agree when they are within "
+                  "this many standard deviations of their fits (> 0; larger finds more)")
+      ->capture_default_str();
+  command
+      .add_option("--max-relation-angle", options.max_angle_degrees,
+                  "--regularize: directions never agree, nor are made orthogonal, beyond this "
+                  "angle, whatever their uncertainty (degrees, in (0, 90))")
+      ->capture_default_str();
+  command
+      .add_option("--max-radius-difference", options.max_radius_difference,
+                  "--regularize: radii never agree when they differ by more than this fraction "
+                  "of the larger, nor does a radius known less well (in (0, 1); lower it for "
+                  "fewer chance relations on freeform parts)")
+      ->capture_default_str();
+}
+
+std::string relation_options_signature(const RelationOptions& options) {
+  const RelationOptions defaults;
+  std::string signature;
+  auto add = [&](const char* name, double value, double default_value) {
+    if (value != default_value) signature += std::string(" ") + name + "=" + std::to_string(value);
+  };
+  add("relation_significance", options.significance, defaults.significance);
+  add("max_relation_angle", options.max_angle_degrees, defaults.max_angle_degrees);
+  add("max_radius_difference", options.max_radius_difference, defaults.max_radius_difference);
+  return signature;
 }
 
 void validate_level_outputs(LevelOptions& options) {
+  validate(options.relations);
   validate_output_files(options.files);
   if (writes_to_standard_output(options.files)) options.quiet = true;
 }
@@ -210,7 +243,7 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, Chose
   }
   std::vector<ClusterRelation> relations;
   if (options.regularize) {
-    relations = regularize_clusters(hierarchy, segmentation, reports);
+    relations = regularize_clusters(hierarchy, segmentation, reports, options.relations);
     summary["relations"] = relations_json(relations);
   }
   summary["timing"]["cut_seconds"] = seconds_since(cut_start);

@@ -94,8 +94,9 @@ nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy)
 struct LevelOptions {
   LevelChoice level;
   OutputFiles files;
-  std::uint32_t refine = 0;  // --refine N: boundary refinement passes after the cut
-  bool regularize = false;   // --regularize: make the fits' relations exact and report them
+  std::uint32_t refine = 0;   // --refine N: boundary refinement passes after the cut
+  bool regularize = false;    // --regularize: make the fits' relations exact and report them
+  RelationOptions relations;  // --relation-significance, --max-relation-angle, ...
   bool quiet = false;
 };
 
@@ -108,8 +109,14 @@ inline constexpr std::string_view kChosenLevelRule =
 void add_level_options(CLI::App& command, LevelOptions& options,
                        std::string_view auto_level = kChosenLevelRule);
 /// Adds --refine and --regularize (LevelOptions::refine and ::regularize) to a command that
-/// reports a hierarchy's level.
+/// reports a hierarchy's level, and the options of --regularize (add_relation_options).
 void add_fit_options(CLI::App& command, LevelOptions& options);
+/// Adds --relation-significance, --max-relation-angle and --max-radius-difference (the
+/// RelationOptions of --regularize), checked by validate(RelationOptions) when the command runs.
+void add_relation_options(CLI::App& command, RelationOptions& options);
+/// The options of `relations` that differ from the defaults, as " name=value" pairs (a resumed
+/// batch redoes outputs made with others): empty for the defaults.
+std::string relation_options_signature(const RelationOptions& options);
 
 /// Checks the output names before any work (validate_output_files) and turns `quiet` on when an
 /// output goes to standard output ('-'), which must then carry that output alone.

@@ -191,7 +191,8 @@ struct LevelRelations {
 nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
                                 const std::vector<std::uint32_t>& carried,
                                 const std::vector<ClusterReport>& reports,
-                                std::uint32_t max_clusters, const Vec3& center, unsigned threads) {
+                                std::uint32_t max_clusters, const RelationOptions& options,
+                                const Vec3& center, unsigned threads) {
   const std::uint32_t first = hierarchy.component_count();
   const std::uint32_t last = std::min(max_clusters, hierarchy.face_count());
   const std::uint32_t level_count = last >= first ? last - first + 1 : 0;
@@ -208,7 +209,7 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
           level_reports.push_back(reports[static_cast<std::size_t>(at - carried.begin())]);
           level_reports.back().id = static_cast<std::uint32_t>(level_reports.size() - 1);
         }
-        level.relations = regularize_clusters(hierarchy, segmentation, level_reports);
+        level.relations = regularize_clusters(hierarchy, segmentation, level_reports, options);
         std::vector<bool> member(segmentation.cluster_count(), false);
         for (const ClusterRelation& relation : level.relations) {
           for (const std::uint32_t c : relation.clusters) member[c] = true;
@@ -265,7 +266,8 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
 std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
                       std::uint32_t initial_clusters, const AutoLevel& automatic,
                       const std::optional<PageSkeleton>& skeleton, std::uint32_t relation_clusters,
-                      unsigned threads, double& fit_seconds, double& relations_seconds) {
+                      const RelationOptions& relation_options, unsigned threads,
+                      double& fit_seconds, double& relations_seconds) {
   const Mesh& mesh = hierarchy.mesh();
   const std::uint32_t f = hierarchy.face_count();
   const auto merges = hierarchy.merges();
@@ -327,7 +329,7 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
   if (relation_clusters > 0) {
     const auto relations_start = Clock::now();
     relation_header = append_relations(relation_arrays, hierarchy, carried, reports,
-                                       relation_clusters, center, threads);
+                                       relation_clusters, relation_options, center, threads);
     relations_seconds = seconds_since(relations_start);
   }
 
@@ -391,6 +393,7 @@ Command add_view_command(CLI::App& app) {
     std::optional<std::string> skeleton_clusters;  // K or auto; default: the page's level
     bool regularize = false;
     std::optional<std::uint32_t> regularize_clusters;  // default: kRelationClusters
+    RelationOptions relations;
     double band = SkinningOptions{}.band;
     unsigned threads = 0;
     bool quiet = false;
@@ -429,6 +432,7 @@ Command add_view_command(CLI::App& app) {
                        ", or the level the page opens at if finer, up to " +
                        std::to_string(kMaxDefaultRelationClusters) + "); implies --regularize")
       ->check(CLI::Range(1u, kMaxClustersWithParameters));
+  add_relation_options(*view, o->relations);
   view->add_option("--primitives", o->primitives,
                    "Primitive types when the hierarchy is built, comma-separated")
       ->capture_default_str();
@@ -450,6 +454,7 @@ Command add_view_command(CLI::App& app) {
         options.primitives = parse_primitives(o->primitives);
         options.threads = o->threads;
         validate(options);
+        validate(o->relations);
         if (o->tree_path == kStandardInput && o->mesh_path == kStandardInput)
           throw InvalidInputError("view: only one of MESH and --tree can be standard input ('-')");
         auto mesh = std::make_shared<const Mesh>(
@@ -494,8 +499,8 @@ Command add_view_command(CLI::App& app) {
         std::string html(page.substr(0, marker));
         double fit_seconds = 0, relations_seconds = 0;
         html += page_data(hierarchy, input_name(std::filesystem::path(o->mesh_path).filename()),
-                          initial, automatic, skeleton, relation_clusters, o->threads, fit_seconds,
-                          relations_seconds);
+                          initial, automatic, skeleton, relation_clusters, o->relations, o->threads,
+                          fit_seconds, relations_seconds);
         html += page.substr(marker + kViewerDataMarker.size());
         detail::write_file_atomically(o->output, html);
         if (!o->quiet) {

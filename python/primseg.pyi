@@ -68,6 +68,9 @@ class Hierarchy:
         relative_tolerance: float | None = None,
         refine: int = 0,
         regularize: bool = False,
+        relation_significance: float = 3.0,
+        max_relation_angle: float = 20.0,
+        max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def borders(
         self,
@@ -77,6 +80,9 @@ class Hierarchy:
         relative_tolerance: float | None = None,
         refine: int = 0,
         regularize: bool = False,
+        relation_significance: float = 3.0,
+        max_relation_angle: float = 20.0,
+        max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def relations(
         self,
@@ -85,6 +91,9 @@ class Hierarchy:
         tolerance: float | None = None,
         relative_tolerance: float | None = None,
         refine: int = 0,
+        relation_significance: float = 3.0,
+        max_relation_angle: float = 20.0,
+        max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def auto_level(self) -> dict[str, Any]: ...
     def error_curve(self) -> NDArray[np.float64]: ...

@@ -403,15 +403,32 @@ const char* kRefineArgument =
 const char* kRegularizeArgument =
     R"(regularize: make the fits' relations exact (the CLI's --regularize): plane normals and
   cylinder axes that agree within their uncertainty share one direction, cylinders one axis line,
-  and directions at right angles within it are made orthogonal; Hierarchy.relations() lists
-  them.)";
+  directions at right angles within it are made orthogonal, and cylinders and spheres of one
+  radius share it; Hierarchy.relations() lists them.)";
+
+const char* kRelationArguments =
+    R"(relation_significance, max_relation_angle, max_radius_difference: the CLI's options of the
+  same names (RelationOptions significance, max_angle_degrees, max_radius_difference): fits agree
+  within relation_significance standard deviations (> 0), never beyond max_relation_angle degrees
+  (in (0, 90)) or radii more than max_radius_difference apart (in (0, 1)). Raise
+  InvalidInputError (a ValueError) outside these ranges.)";
+
+// The RelationOptions of relation_significance, max_relation_angle and max_radius_difference.
+RelationOptions relation_arguments(double significance, double max_angle, double max_difference) {
+  RelationOptions options;
+  options.significance = significance;
+  options.max_angle_degrees = max_angle;
+  options.max_radius_difference = max_difference;
+  return options;
+}
 
 // The level, refined by up to `refine` boundary passes (0: as cut), with its cluster reports when
 // `reports` is given, and their relations made exact when `relations` is given too: what the
 // CLI's --refine N and --regularize write.
 Segmentation refined_level(const Hierarchy& hierarchy, const LevelArguments& level,
                            std::int64_t refine, std::vector<ClusterReport>* reports,
-                           std::vector<ClusterRelation>* relations = nullptr) {
+                           std::vector<ClusterRelation>* relations = nullptr,
+                           const RelationOptions& relation_options = {}) {
   if (refine < 0 || refine > kMaxRefinePasses)
     throw InvalidInputError("refine must be a number of passes in [0, " +
                             std::to_string(kMaxRefinePasses) + "], not " + std::to_string(refine));
@@ -425,7 +442,8 @@ Segmentation refined_level(const Hierarchy& hierarchy, const LevelArguments& lev
   } else if (reports) {
     *reports = describe_clusters(hierarchy, segmentation);
   }
-  if (reports && relations) *relations = regularize_clusters(hierarchy, segmentation, *reports);
+  if (reports && relations)
+    *relations = regularize_clusters(hierarchy, segmentation, *reports, relation_options);
   return segmentation;
 }
 
@@ -1170,14 +1188,16 @@ labels as the CLI's --labels.)",
       .def(
           "clusters",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
-             std::optional<double> relative_tolerance, std::int64_t refine, bool regularize) {
+             std::optional<double> relative_tolerance, std::int64_t refine, bool regularize,
+             double significance, double max_angle, double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterReport> reports;
             {
               py::gil_scoped_release release;
               std::vector<ClusterRelation> relations;
               refined_level(*self.hierarchy, level, refine, &reports,
-                            regularize ? &relations : nullptr);
+                            regularize ? &relations : nullptr,
+                            relation_arguments(significance, max_angle, max_difference));
             }
             py::list clusters;
             for (const ClusterReport& report : reports) clusters.append(cluster_dict(report));
@@ -1186,14 +1206,17 @@ labels as the CLI's --labels.)",
           py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
           py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
           py::arg("regularize") = false,
+          py::arg("relation_significance") = RelationOptions{}.significance,
+          py::arg("max_relation_angle") = RelationOptions{}.max_angle_degrees,
+          py::arg("max_radius_difference") = RelationOptions{}.max_radius_difference,
           join_docs(
-              {R"(clusters(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False) -> list of dict
+              {R"(clusters(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False, relation_significance=3.0, max_relation_angle=20.0, max_radius_difference=0.05) -> list of dict
 
 One dict per cluster, in label order, with the keys and values of the CLI's --json "clusters":
 id, type ("plane", "cylinder", "sphere"), faces (count), area, rms, max, and params (input
 units: plane {normal, point}, sphere {center, radius}, cylinder {axis, point, radius}; vectors
 as lists). json.dumps() takes it as it is.)",
-               kLevelArguments, kRefineArgument, kRegularizeArgument,
+               kLevelArguments, kRefineArgument, kRegularizeArgument, kRelationArguments,
                cpp_doc("ClusterReport", doc::cut__ClusterReport),
                cpp_doc("ClusterReport::rms", doc::cut__ClusterReport__rms),
                cpp_doc("ClusterReport::max", doc::cut__ClusterReport__max),
@@ -1202,7 +1225,8 @@ as lists). json.dumps() takes it as it is.)",
       .def(
           "borders",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
-             std::optional<double> relative_tolerance, std::int64_t refine, bool regularize) {
+             std::optional<double> relative_tolerance, std::int64_t refine, bool regularize,
+             double significance, double max_angle, double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterBorder> borders;
             {
@@ -1210,7 +1234,8 @@ as lists). json.dumps() takes it as it is.)",
               std::vector<ClusterReport> reports;
               std::vector<ClusterRelation> relations;
               const Segmentation segmentation = refined_level(
-                  *self.hierarchy, level, refine, &reports, regularize ? &relations : nullptr);
+                  *self.hierarchy, level, refine, &reports, regularize ? &relations : nullptr,
+                  relation_arguments(significance, max_angle, max_difference));
               borders = cluster_borders(self.hierarchy->mesh(), segmentation.labels,
                                         cluster_primitives(reports));
             }
@@ -1221,15 +1246,18 @@ as lists). json.dumps() takes it as it is.)",
           py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
           py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
           py::arg("regularize") = false,
+          py::arg("relation_significance") = RelationOptions{}.significance,
+          py::arg("max_relation_angle") = RelationOptions{}.max_angle_degrees,
+          py::arg("max_radius_difference") = RelationOptions{}.max_radius_difference,
           join_docs(
-              {R"(borders(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False) -> list of dict
+              {R"(borders(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False, relation_significance=3.0, max_relation_angle=20.0, max_radius_difference=0.05) -> list of dict
 
 Where the clusters of the level meet, as the CLI's --json "borders": one dict per border with
 clusters (a, b), b None along the mesh's open boundary; edges (count); length (input units);
 angle (degrees between the two fitted surfaces across it: 0 tangent, 90 a box's edge; None on
 the open boundary); and curves, a list of dicts {closed, vertices} with the vertex indices in
 order along each curve. json.dumps() takes it as it is.)",
-               kLevelArguments, kRefineArgument, kRegularizeArgument,
+               kLevelArguments, kRefineArgument, kRegularizeArgument, kRelationArguments,
                cpp_doc("cluster_borders", doc::borders__cluster_borders),
                cpp_doc("ClusterBorder::angle", doc::borders__ClusterBorder__angle),
                cpp_doc("ClusterBorder::curves", doc::borders__ClusterBorder__curves)})
@@ -1237,20 +1265,25 @@ order along each curve. json.dumps() takes it as it is.)",
       .def(
           "relations",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
-             std::optional<double> relative_tolerance, std::int64_t refine) {
+             std::optional<double> relative_tolerance, std::int64_t refine, double significance,
+             double max_angle, double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterRelation> relations;
             {
               py::gil_scoped_release release;
               std::vector<ClusterReport> reports;
-              refined_level(*self.hierarchy, level, refine, &reports, &relations);
+              refined_level(*self.hierarchy, level, refine, &reports, &relations,
+                            relation_arguments(significance, max_angle, max_difference));
             }
             return relations_list(relations);
           },
           py::arg("k") = py::none(), py::kw_only(), py::arg("tolerance") = py::none(),
           py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
+          py::arg("relation_significance") = RelationOptions{}.significance,
+          py::arg("max_relation_angle") = RelationOptions{}.max_angle_degrees,
+          py::arg("max_radius_difference") = RelationOptions{}.max_radius_difference,
           join_docs(
-              {R"(relations(k=None, *, tolerance=None, relative_tolerance=None, refine=0) -> list of dict
+              {R"(relations(k=None, *, tolerance=None, relative_tolerance=None, refine=0, relation_significance=3.0, max_relation_angle=20.0, max_radius_difference=0.05) -> list of dict
 
 The design intent among the level's fits, as the CLI's --regularize writes it in the JSON's
 "relations": one dict per relation with kind ("parallel": plane normals and cylinder axes of one
@@ -1258,7 +1291,7 @@ direction; "coaxial": cylinders of one axis line; "orthogonal": two directions a
 "equal_radius": cylinders and spheres of one radius) and clusters (their labels, increasing; for
 "orthogonal", those of one direction, and orthogonal_to those of the other).
 clusters(..., regularize=True) gives the primitives with these relations made exact.)",
-               kLevelArguments, kRefineArgument,
+               kLevelArguments, kRefineArgument, kRelationArguments,
                cpp_doc("regularize_clusters", doc::relations__regularize_clusters),
                cpp_doc("relations.hpp", doc::relations__file)})
               .c_str())

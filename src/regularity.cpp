@@ -210,6 +210,24 @@ std::optional<JointFit> fit_cylinders_and_spheres(std::span<const Eigen::Vector3
     radius_gradient.setZero();
     double squares = 0;
     count = 0;
+    // A point's residual |d| − radius (d from the centre: in the line's plane, or in space for a
+    // sphere) added to its position's block, coupling and gradient, its radius's, and term k's.
+    auto add_point = [&](const auto& d, double radius, double w, auto& block, auto& term_coupling,
+                         auto& position_gradient, Eigen::Index q, std::size_t k) {
+      const double length = d.norm();
+      if (!(length > 0)) return;
+      const double e = length - radius;
+      const auto j = (-d / length).eval();
+      block += w * j * j.transpose();
+      term_coupling -= w * j;
+      radius_diagonal(q) += w;
+      position_gradient += w * j * e;
+      radius_gradient(q) -= w * e;
+      squares += e * e;
+      term_squares[k] += e * e;
+      ++term_count[k];
+      ++count;
+    };
     for (std::size_t k = 0; k < terms.size(); ++k) {
       const std::size_t l = terms[k].line;
       const Eigen::Index q = static_cast<Eigen::Index>(terms[k].radius);
@@ -217,23 +235,9 @@ std::optional<JointFit> fit_cylinders_and_spheres(std::span<const Eigen::Vector3
       const double radius = x(first_radius + q);
       term_squares[k] = 0;
       term_count[k] = 0;
-      for (std::size_t i = 0; i < projected[k].size(); ++i) {
-        const Eigen::Vector2d d = projected[k][i] - centre;
-        const double length = d.norm();
-        if (!(length > 0)) continue;
-        const double w = weighted ? terms[k].weights[i] : 1.0;
-        const double e = length - radius;
-        const Eigen::Vector2d j = -d / length;
-        line_block[l] += w * j * j.transpose();
-        coupling[k] -= w * j;
-        radius_diagonal(q) += w;
-        line_gradient[l] += w * j * e;
-        radius_gradient(q) -= w * e;
-        squares += e * e;
-        term_squares[k] += e * e;
-        ++term_count[k];
-        ++count;
-      }
+      for (std::size_t i = 0; i < projected[k].size(); ++i)
+        add_point((projected[k][i] - centre).eval(), radius, weighted ? terms[k].weights[i] : 1.0,
+                  line_block[l], coupling[k], line_gradient[l], q, k);
     }
     for (std::size_t s = 0; s < spheres.size(); ++s) {
       const Eigen::Index q = static_cast<Eigen::Index>(spheres[s].radius);
@@ -242,23 +246,10 @@ std::optional<JointFit> fit_cylinders_and_spheres(std::span<const Eigen::Vector3
       const std::size_t k = terms.size() + s;
       term_squares[k] = 0;
       term_count[k] = 0;
-      for (std::size_t i = 0; i < spheres[s].points.size(); ++i) {
-        const Eigen::Vector3d d = to_eigen(spheres[s].points[i]) - centre;
-        const double length = d.norm();
-        if (!(length > 0)) continue;
-        const double w = weighted ? spheres[s].weights[i] : 1.0;
-        const double e = length - radius;
-        const Eigen::Vector3d j = -d / length;
-        sphere_block[s] += w * j * j.transpose();
-        sphere_coupling[s] -= w * j;
-        radius_diagonal(q) += w;
-        sphere_gradient[s] += w * j * e;
-        radius_gradient(q) -= w * e;
-        squares += e * e;
-        term_squares[k] += e * e;
-        ++term_count[k];
-        ++count;
-      }
+      for (std::size_t i = 0; i < spheres[s].points.size(); ++i)
+        add_point((to_eigen(spheres[s].points[i]) - centre).eval(), radius,
+                  weighted ? spheres[s].weights[i] : 1.0, sphere_block[s], sphere_coupling[s],
+                  sphere_gradient[s], q, k);
     }
     return squares;
   };

@@ -91,6 +91,26 @@ def test_regularized_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path)
     assert fandisk_tree.clusters(30, refine=2) != clusters
 
 
+def test_relation_options_are_the_clis(cli, fandisk, fandisk_tree, tmp_path):
+    # The options of --regularize, as keywords: the same relations and fits as the CLI's, fewer
+    # equal radii with a tighter radius bound, and out-of-range values refused.
+    options = ["--relation-significance", "2.5", "--max-relation-angle", "10", "--max-radius-difference", "0.001"]
+    run_cli(cli, "segment", fandisk, "--clusters", "60", "--regularize", *options,
+            "--json", tmp_path / "c.json", "--quiet")
+    expected = json.loads((tmp_path / "c.json").read_text())
+    keywords = dict(relation_significance=2.5, max_relation_angle=10.0, max_radius_difference=0.001)
+    relations = fandisk_tree.relations(60, **keywords)
+    assert relations == expected["relations"]
+    assert fandisk_tree.clusters(60, regularize=True, **keywords) == expected["clusters"]
+    borders = fandisk_tree.borders(60, regularize=True, **keywords)
+    assert json.loads(json.dumps(borders)) == expected["borders"]
+    equal = [r for r in fandisk_tree.relations(60) if r["kind"] == "equal_radius"]
+    assert len([r for r in relations if r["kind"] == "equal_radius"]) < len(equal)
+    for bad in (dict(relation_significance=0.0), dict(max_relation_angle=90.0), dict(max_radius_difference=1.0)):
+        with pytest.raises(ValueError):
+            fandisk_tree.relations(60, **bad)
+
+
 def test_borders_of_a_capped_cylinder_are_two_circles_at_right_angles():
     V, F, regions = capped_cylinder()
     tree = primseg.segment(V, F)

@@ -147,6 +147,14 @@ TEST(Batch, RefinedAndRegularizedOutputsAreSegments) {
     EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
   batch = json::parse(testing::file_contents(dir / "out" / "parts" / "hole.ply.json"));
   EXPECT_FALSE(batch.contains("relations"));
+  // The options of --regularize are the outputs' too: a resumed run with others redoes them.
+  ASSERT_EQ(primseg(base + " --regularize"), 0);
+  ASSERT_EQ(primseg(base + " --regularize --max-relation-angle 5 --resume"), 0);
+  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
+    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  batch = json::parse(testing::file_contents(dir / "out" / "parts" / "hole.ply.json"));
+  EXPECT_NE(batch["batch_options"].get<std::string>().find("max_relation_angle=5"),
+            std::string::npos);
   fs::remove_all(dir);
 }
 

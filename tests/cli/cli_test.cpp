@@ -974,17 +974,22 @@ TEST(Cli, RefineReportsItsPassesAndKeepsEveryFaceLabelled) {
   expect_valid_labels(read_labels(dir / "l.txt"), shape.mesh.face_count(), 7);
 }
 
-// --regularize: the JSON lists the relations made exact, the primitives are the library's
-// regularize_clusters() on the same level, and the text summary lists them too.
-TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
-  TempDir dir("regularize");
+// A box with a hole, 0.2% noise, moved at random: directions known to a fraction of a degree.
+void write_noisy_box_with_hole(const fs::path& path) {
   ShapeOptions options;
   options.tessellation = Tessellation::Uniform;
   options.edge_length = 0.04;
   options.noise = 0.002;
   options.seed = 2;
   options.random_motion = true;
-  write_mesh(dir / "in.off", make_shape("box_with_hole", options).mesh);
+  write_mesh(path, make_shape("box_with_hole", options).mesh);
+}
+
+// --regularize: the JSON lists the relations made exact, the primitives are the library's
+// regularize_clusters() on the same level, and the text summary lists them too.
+TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
+  TempDir dir("regularize");
+  write_noisy_box_with_hole(dir / "in.off");
   const Mesh mesh = read_mesh(dir / "in.off");
   const Hierarchy hierarchy = build_hierarchy(mesh);
   const Segmentation cut = cut_by_count(hierarchy, 7);
@@ -1037,6 +1042,38 @@ TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
   EXPECT_NE(plain["clusters"][0]["rms"].get<double>(), reports[0].rms);
 }
 
+// The options of --regularize reach the library: the relations and fits are those of
+// regularize_clusters() with them, and a bound tighter than the noise's tilts leaves no direction
+// relation.
+TEST(Cli, RegularizeOptionsAreTheLibrarys) {
+  TempDir dir("regularize-options");
+  write_noisy_box_with_hole(dir / "in.off");
+  const Hierarchy hierarchy = build_hierarchy(read_mesh(dir / "in.off"));
+  const Segmentation cut = cut_by_count(hierarchy, 7);
+  RelationOptions relation_options;
+  relation_options.significance = 2.5;
+  relation_options.max_angle_degrees = 1e-4;
+  relation_options.max_radius_difference = 0.01;
+  std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
+  const std::vector<ClusterRelation> relations =
+      regularize_clusters(hierarchy, cut, reports, relation_options);
+  for (const ClusterRelation& relation : relations)
+    EXPECT_EQ(relation.kind, ClusterRelation::Kind::EqualRadius);  // none of directions
+
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") +
+                     " --clusters 7 --regularize --relation-significance 2.5 "
+                     "--max-relation-angle 1e-4 --max-radius-difference 0.01 --quiet --json " +
+                     dir.q("s.json")));
+  const json j = read_json(dir / "s.json");
+  ASSERT_EQ(j["relations"].size(), relations.size());
+  for (std::size_t i = 0; i < relations.size(); ++i)
+    EXPECT_EQ(j["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
+              relations[i].clusters);
+  ASSERT_EQ(j["clusters"].size(), reports.size());
+  for (std::size_t c = 0; c < reports.size(); ++c)
+    EXPECT_EQ(j["clusters"][c]["rms"].get<double>(), reports[c].rms) << c;
+}
+
 TEST(Cli, EvalScoresTheGeneratedShapes) {
   TempDir dir("eval");
   const CliRun r =
@@ -1071,6 +1108,15 @@ TEST(Cli, BadOptionsAreRejectedWithAMessage) {
       {"--clusters abc", "segment " + mesh + " --clusters abc", {"clusters"}, false},
       {"--clusters automatic", "segment " + mesh + " --clusters automatic", {"clusters", "auto"}},
       {"--refine -1", "segment " + mesh + " --refine -1", {"refine"}, false},
+      {"--relation-significance 0",
+       "segment " + mesh + " --regularize --relation-significance 0",
+       {"significance", "positive"}},
+      {"--max-relation-angle 90",
+       "segment " + mesh + " --regularize --max-relation-angle 90",
+       {"angle", "(0, 90)"}},
+      {"--max-radius-difference 1",
+       "segment " + mesh + " --regularize --max-radius-difference 1",
+       {"radius difference", "(0, 1)"}},
       {"eval --variants banana", "eval --variants banana", {"variants", "banana"}},
       {"eval --shapes banana", "eval --shapes banana", {"banana"}},
       {"eval --seeds 0", "eval --seeds 0", {"seeds"}, false},
