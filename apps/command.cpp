@@ -202,8 +202,10 @@ void add_relation_options(CLI::App& command, RelationOptions& options) {
 std::string relation_options_signature(const RelationOptions& options) {
   const RelationOptions defaults;
   std::string signature;
+  // Round-trip digits: options that differ only beyond a fixed number of decimals still differ.
   auto add = [&](const char* name, double value, double default_value) {
-    if (value != default_value) signature += std::string(" ") + name + "=" + std::to_string(value);
+    if (value != default_value)
+      signature += std::string(" ") + name + "=" + nlohmann::json(value).dump();
   };
   add("relation_significance", options.significance, defaults.significance);
   add("max_relation_angle", options.max_angle_degrees, defaults.max_angle_degrees);

@@ -120,21 +120,20 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
     for (const std::uint32_t c : relation.clusters) refitted[c] = true;
     for (const std::uint32_t c : relation.orthogonal_to) refitted[c] = true;
   }
-  std::vector<std::vector<Vec3>> member_corners(k);
-  std::vector<std::vector<double>> member_weights(k);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
-    const std::uint32_t c = segmentation.labels[mesh.face_of_triangle[t]];
-    if (!refitted[c]) continue;
-    detail::append_corners(graph, t, member_corners[c], member_weights[c]);
-  }
   GeometricFitOptions measure_only;
   measure_only.max_iterations = 0;
+  std::vector<Vec3> corners;
+  std::vector<double> corner_weights;
   for (std::uint32_t c = 0; c < k; ++c) {
     if (!refitted[c]) continue;
+    corners.clear();
+    corner_weights.clear();
+    for (std::uint32_t i = triangle_offsets[c]; i < triangle_offsets[c + 1]; ++i)
+      detail::append_corners(graph, triangles_by_cluster[i], corners, corner_weights);
     // From the reported primitive, as describe_clusters() would measure it: the same bits.
     reports[c].primitive = frame.to_input(primitives[c]);
     const GeometricFit measured = fit_geometric(detail::to_working(frame, reports[c].primitive),
-                                                member_corners[c], member_weights[c], measure_only);
+                                                corners, corner_weights, measure_only);
     reports[c].rms = std::ldexp(measured.rms, frame.exponent);
     reports[c].max = std::ldexp(measured.max, frame.exponent);
   }

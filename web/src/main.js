@@ -504,11 +504,12 @@ class Viewer {
 
   /**
    * The current level's relations with cluster ids as primseg numbers them, as `primseg cut
-   * --regularize --json` lists them: [{kind, clusters, orthogonal_to?}], or null.
+   * --regularize --json` lists them: [{kind, clusters, orthogonal_to?}], or null. `ids`: the
+   * cut's cluster ids (Tree.clusterIds), when the caller has them.
    */
-  currentRelations() {
+  currentRelations(ids = null) {
     if (!this.levelRelations) return null;
-    const ids = this.tree.clusterIds(this.cut);
+    ids ??= this.tree.clusterIds(this.cut);
     const sorted = (list) => list.map((c) => ids[c]).sort((a, b) => a - b);
     return this.levelRelations.map(({ kind, members, others }) =>
       (kind === 'orthogonal' ? { kind, clusters: sorted(members), orthogonal_to: sorted(others) }
@@ -669,12 +670,12 @@ class Viewer {
         torus: { center: point, axis: primitive.axis, major_radius: primitive.radius, minor_radius: primitive.minorRadius } };
       info.params = p[TYPE_NAMES[primitive.type]];
     }
-    // Its borders: the neighbouring clusters (ids as primseg numbers them, null for the open
-    // boundary), with the angle between the fitted surfaces across each.
     if (this.levelRelations) {
-      info.relations = this.currentRelations().filter((r, i) =>
+      info.relations = this.currentRelations(clusterIds).filter((r, i) =>
         this.levelRelations[i].members.includes(c) || this.levelRelations[i].others.includes(c));
     }
+    // Its borders: the neighbouring clusters (ids as primseg numbers them, null for the open
+    // boundary), with the angle between the fitted surfaces across each.
     info.borders = this.borderLines.clusterBorders(this.cut, c, (k) => this.primitiveOf(k))
       .map((b) => ({ ...b, cluster: b.cluster < 0 ? null : clusterIds[b.cluster],
         type: b.cluster < 0 ? null : TYPE_NAMES[tree.type(this.cut.nodes[b.cluster])] }));
