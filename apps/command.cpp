@@ -1,5 +1,7 @@
 #include <unistd.h>
 
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <span>
@@ -175,27 +177,54 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
   command.add_flag("--regularize", options.regularize,
                    "Make the fits' design intent exact: plane normals and cylinder axes that "
                    "agree within their uncertainty share one direction, directions at right "
-                   "angles become orthogonal, cylinders share one axis line, and cylinders and "
-                   "spheres one radius (listed as \"relations\" in the JSON)");
+                   "angles become orthogonal, cylinders share one axis line and spheres are "
+                   "centred on it, and cylinders and spheres share one radius (listed as "
+                   "\"relations\" in the JSON)");
   add_relation_options(command, options.relations);
 }
+
+namespace {
+
+// Accepts a finite number above `low` and, when given, below `high`; otherwise the error names
+// the range (CLI11 prefixes the option's name), as `range` says it. The help shows the interval.
+CLI::Validator open_range(double low, std::optional<double> high, const std::string& range) {
+  const std::string interval =
+      high ? "in (" + CLI::detail::to_string(low) + ", " + CLI::detail::to_string(*high) + ")"
+           : "> " + CLI::detail::to_string(low);
+  return CLI::Validator(
+      [=](const std::string& text) -> std::string {
+        double value = 0;
+        const char* end = text.data() + text.size();
+        const auto [stop, error] = std::from_chars(text.data(), end, value);
+        const bool number = error == std::errc() && stop == end && std::isfinite(value);
+        if (number && value > low && (!high || value < *high)) return {};
+        return "the value " + text + " must be " + range;
+      },
+      interval);
+}
+
+}  // namespace
 
 void add_relation_options(CLI::App& command, RelationOptions& options) {
   command
       .add_option("--relation-significance", options.significance,
                   "--regularize: directions, axis lines and radii agree when they are within "
                   "this many standard deviations of their fits (> 0; larger finds more)")
+      ->check(open_range(0, std::nullopt, "a positive number of standard deviations"))
       ->capture_default_str();
   command
       .add_option("--max-relation-angle", options.max_angle_degrees,
                   "--regularize: directions never agree, nor are made orthogonal, beyond this "
                   "angle, whatever their uncertainty (degrees, in (0, 90))")
+      ->check(open_range(0, 90, "an angle in (0, 90) degrees"))
       ->capture_default_str();
   command
       .add_option("--max-radius-difference", options.max_radius_difference,
                   "--regularize: radii never agree when they differ by more than this fraction "
-                  "of the larger, nor does a radius known less well (in (0, 1); lower it for "
-                  "fewer chance relations on freeform parts)")
+                  "of the larger, nor does a radius known less well; nor is a sphere centred on "
+                  "an axis farther than this fraction of its radius from it, or known less well "
+                  "(in (0, 1); lower it for fewer chance relations on freeform parts)")
+      ->check(open_range(0, 1, "a fraction in (0, 1) of the larger radius"))
       ->capture_default_str();
 }
 

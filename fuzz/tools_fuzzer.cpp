@@ -291,8 +291,9 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
 
 // Relations: clusters increasing and distinct, two or more (orthogonal: one or more a side); a
 // parallel group and each side of an orthogonal pair share one direction up to sign, the two
-// sides' directions are orthogonal to round-off, a coaxial set holds cylinders only, and an
-// equal-radius set cylinders and spheres of one radius, bit for bit.
+// sides' directions are orthogonal to round-off, a coaxial set holds cylinders of one direction
+// and spheres, every cylinder's axis and sphere's centre on its first cylinder's axis line to
+// round-off, and an equal-radius set cylinders and spheres of one radius, bit for bit.
 void check_relations(const std::vector<Primitive>& primitives,
                      const std::vector<ClusterRelation>& relations, const std::string& what) {
   auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest,
@@ -302,8 +303,14 @@ void check_relations(const std::vector<Primitive>& primitives,
         members.back() >= primitives.size())
       fail((what + ": relation members").c_str(), double(members.size()));
     if (!one_direction) return;
-    const Vec3& direction = primitives[members[0]].axis;
+    // A coaxial set's spheres have no direction.
+    const auto first = std::find_if(members.begin(), members.end(), [&](std::uint32_t c) {
+      return primitives[c].type != PrimitiveType::Sphere;
+    });
+    if (first == members.end()) fail((what + ": no direction in a relation").c_str());
+    const Vec3& direction = primitives[*first].axis;
     for (const std::uint32_t c : members) {
+      if (primitives[c].type == PrimitiveType::Sphere) continue;
       const Vec3& axis = primitives[c].axis;
       const Vec3 a{std::abs(axis[0]), std::abs(axis[1]), std::abs(axis[2])},
           b{std::abs(direction[0]), std::abs(direction[1]), std::abs(direction[2])};
@@ -316,10 +323,29 @@ void check_relations(const std::vector<Primitive>& primitives,
     check_members(relation.clusters, orthogonal ? 1 : 2, !equal_radius);
     for (const std::uint32_t c : relation.clusters) {
       const PrimitiveType type = primitives[c].type;
-      if (relation.kind == ClusterRelation::Kind::Coaxial && type != PrimitiveType::Cylinder)
-        fail((what + ": coaxial non-cylinder").c_str(), c);
+      if (relation.kind == ClusterRelation::Kind::Coaxial && type != PrimitiveType::Cylinder &&
+          type != PrimitiveType::Sphere)
+        fail((what + ": coaxial surface without an axis or a centre").c_str(), c);
       if (equal_radius && type != PrimitiveType::Cylinder && type != PrimitiveType::Sphere)
         fail((what + ": equal radius of a surface without one").c_str(), c);
+    }
+    if (relation.kind == ClusterRelation::Kind::Coaxial) {
+      const Primitive& line = primitives[*std::find_if(
+          relation.clusters.begin(), relation.clusters.end(),
+          [&](std::uint32_t c) { return primitives[c].type == PrimitiveType::Cylinder; })];
+      for (const std::uint32_t c : relation.clusters) {
+        const Vec3& p = primitives[c].point;
+        const Vec3 d{p[0] - line.point[0], p[1] - line.point[1], p[2] - line.point[2]};
+        const Vec3& a = line.axis;
+        const Vec3 across{d[1] * a[2] - d[2] * a[1], d[2] * a[0] - d[0] * a[2],
+                          d[0] * a[1] - d[1] * a[0]};
+        const double off =
+            std::sqrt(across[0] * across[0] + across[1] * across[1] + across[2] * across[2]);
+        const double scale = std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) +
+                             std::abs(line.point[0]) + std::abs(line.point[1]) +
+                             std::abs(line.point[2]) + line.radius;
+        if (!(off <= 1e-9 * scale)) fail((what + ": coaxial member off the axis").c_str(), off);
+      }
     }
     if (equal_radius)
       for (const std::uint32_t c : relation.clusters)

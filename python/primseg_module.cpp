@@ -402,19 +402,30 @@ const char* kRefineArgument =
 
 const char* kRegularizeArgument =
     R"(regularize: make the fits' relations exact (the CLI's --regularize): plane normals and
-  cylinder axes that agree within their uncertainty share one direction, cylinders one axis line,
-  directions at right angles within it are made orthogonal, and cylinders and spheres of one
-  radius share it; Hierarchy.relations() lists them.)";
+  cylinder axes that agree within their uncertainty share one direction, cylinders one axis line
+  (with the spheres centred on it), directions at right angles within it are made orthogonal,
+  and cylinders and spheres of one radius share it; Hierarchy.relations() lists them.)";
 
 const char* kRelationArguments =
     R"(relation_significance, max_relation_angle, max_radius_difference: the CLI's options of the
   same names (RelationOptions significance, max_angle_degrees, max_radius_difference): fits agree
   within relation_significance standard deviations (> 0), never beyond max_relation_angle degrees
-  (in (0, 90)) or radii more than max_radius_difference apart (in (0, 1)). Raise
+  (in (0, 90)) or radii more than max_radius_difference apart (in (0, 1); a sphere's centre is
+  put on an axis no farther than that fraction of its radius from it). Raise
   InvalidInputError (a ValueError) outside these ranges.)";
 
-// The RelationOptions of relation_significance, max_relation_angle and max_radius_difference.
+// The RelationOptions of relation_significance, max_relation_angle and max_radius_difference;
+// InvalidInputError, naming the keyword, outside their ranges.
 RelationOptions relation_arguments(double significance, double max_angle, double max_difference) {
+  auto refuse = [](const char* keyword, double value, const char* range) {
+    throw InvalidInputError(std::string(keyword) + " is " + std::to_string(value) + ", must be " +
+                            range);
+  };
+  if (!(significance > 0 && std::isfinite(significance)))
+    refuse("relation_significance", significance, "a positive number");
+  if (!(max_angle > 0 && max_angle < 90)) refuse("max_relation_angle", max_angle, "in (0, 90)");
+  if (!(max_difference > 0 && max_difference < 1))
+    refuse("max_radius_difference", max_difference, "in (0, 1)");
   RelationOptions options;
   options.significance = significance;
   options.max_angle_degrees = max_angle;
@@ -1287,7 +1298,8 @@ order along each curve. json.dumps() takes it as it is.)",
 
 The design intent among the level's fits, as the CLI's --regularize writes it in the JSON's
 "relations": one dict per relation with kind ("parallel": plane normals and cylinder axes of one
-direction; "coaxial": cylinders of one axis line; "orthogonal": two directions at right angles;
+direction; "coaxial": cylinders of one axis line and spheres centred on it; "orthogonal": two
+directions at right angles;
 "equal_radius": cylinders and spheres of one radius) and clusters (their labels, increasing; for
 "orthogonal", those of one direction, and orthogonal_to those of the other).
 clusters(..., regularize=True) gives the primitives with these relations made exact.)",

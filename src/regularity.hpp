@@ -2,8 +2,9 @@
 // Relations between the primitives of a segmentation, and the refit that makes them exact (after
 // GlobFit, Li et al. 2011): planes' normals and cylinders' axes that agree within their fits'
 // uncertainty share one direction, estimated from all of them, directions at right angles within
-// it are made orthogonal, cylinders of one direction whose axes agree share one axis line, and
-// cylinders and spheres whose radii agree share one radius.
+// it are made orthogonal, cylinders of one direction whose axes agree share one axis line, spheres
+// centred on such a line within it are centred on it, and cylinders and spheres whose radii agree
+// share one radius.
 
 #include <cstddef>
 #include <span>
@@ -23,10 +24,14 @@ struct RegularityOptions {
   double max_angle_degrees = 20;
   /// Make directions at right angles within the significance exactly orthogonal.
   bool orthogonal = true;
+  /// Centre a sphere whose centre is on a cylinder's axis line within the significance on it (a
+  /// ball end, a hemispherical cap): one parameter along the line instead of three.
+  bool spheres_on_axes = true;
   /// Give cylinders and spheres whose radii agree within the significance one radius.
   bool equal_radii = true;
   /// ... never when the radii differ by more than this fraction of the larger, nor a radius
-  /// whose significance interval is wider than this fraction of it.
+  /// whose significance interval is wider than this fraction of it; likewise a sphere's centre's
+  /// distance from an axis line, as a fraction of the sphere's radius.
   double max_radius_difference = 0.05;
 };
 
@@ -48,11 +53,15 @@ struct Relation {
 /// jointly with the cylinders coaxial with it (one axis line, one radius each). points[c] and
 /// weights[c] are cluster c's inlier vertices (input units) and their weights; a cluster with too
 /// few to estimate its direction's uncertainty is left alone. Deterministic: clusters are visited
-/// by increasing uncertainty, ties by index. Then cylinders and spheres whose radii agree within
-/// the significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with
-/// the cylinders coaxial with them (each sphere on its own centre). Returns the relations made exact: each direction group's members
-/// that were refitted with its direction, then each coaxial set of its cylinders, in that order,
-/// then the classes of equal radii, then the right angles by their members.
+/// by increasing uncertainty, ties by index. Then spheres centred on an axis line within the
+/// significance (RegularityOptions::spheres_on_axes) are refitted with their line's cylinders,
+/// one parameter along it each, and cylinders and spheres whose radii agree within the
+/// significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with the
+/// surfaces on their lines (each free sphere on its own centre). Returns the relations made
+/// exact: each direction group's members that were refitted with its direction, then each
+/// coaxial set of its cylinders (spheres added when they join it), in that order, then the
+/// coaxial sets a sphere started with one cylinder, then the classes of equal radii, then the
+/// right angles by their members.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,

@@ -28,14 +28,18 @@ std::string_view to_string(ClusterRelation::Kind kind) {
 }
 
 void validate(const RelationOptions& options) {
+  auto refuse = [](const char* field, double value, const char* range) {
+    throw InvalidInputError("relations: RelationOptions::" + std::string(field) + " is " +
+                            std::to_string(value) + ", must be " + range);
+  };
   if (!(options.significance > 0) || !std::isfinite(options.significance))
-    throw InvalidInputError("relations: the significance must be a positive number");
+    refuse("significance", options.significance, "a positive number");
   if (!(options.max_angle_degrees > 0 && options.max_angle_degrees < 90))
-    throw InvalidInputError("relations: the largest angle must be in (0, 90) degrees");
+    refuse("max_angle_degrees", options.max_angle_degrees, "in (0, 90) degrees");
   if (!(options.max_radius_difference > 0 && options.max_radius_difference < 1))
-    throw InvalidInputError("relations: the largest radius difference must be in (0, 1)");
+    refuse("max_radius_difference", options.max_radius_difference, "in (0, 1)");
   if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
-    throw InvalidInputError("relations: the outlier threshold must be a positive number");
+    refuse("outlier_threshold", options.outlier_threshold, "a positive number");
 }
 
 std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,

@@ -397,6 +397,80 @@ TEST(Regularity, SpheresShareTheRadiusOfEqualSpheresAndCylinders) {
   }
 }
 
+// The weighted least-squares objective of a cylinder and spheres: Σ w (distance to the axis −
+// radius)² + Σ w (distance to the centre − radius)².
+double joint_objective(const Primitive& cylinder, const Cluster& shaft,
+                       const std::vector<std::pair<Primitive, const Cluster*>>& spheres) {
+  double sum = 0;
+  const Eigen::Vector3d axis = to_eigen(cylinder.axis).normalized();
+  for (std::size_t i = 0; i < shaft.points.size(); ++i) {
+    const Eigen::Vector3d d = to_eigen(shaft.points[i]) - to_eigen(cylinder.point);
+    const double e = (d - d.dot(axis) * axis).norm() - cylinder.radius;
+    sum += shaft.weights[i] * e * e;
+  }
+  for (const auto& [sphere, cluster] : spheres)
+    for (std::size_t i = 0; i < cluster->points.size(); ++i) {
+      const double e =
+          (to_eigen(cluster->points[i]) - to_eigen(sphere.point)).norm() - sphere.radius;
+      sum += cluster->weights[i] * e * e;
+    }
+  return sum;
+}
+
+// A shaft of radius 0.3 with a ball end of radius 0.4 centred on its axis, and a seat of radius
+// 0.25 whose centre is 2% of its radius off the axis (about 40 times its uncertainty): the ball is
+// centred on the shaft's axis, exactly, by the least squares of both (moving the shared line, the
+// ball along it or either radius only raises their residuals), nearer the truth than the farther
+// of their own fits; the seat stays where its own fit put it.
+TEST(Regularity, ABallEndIsCentredOnTheShaftAxis) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d ball_centre(0, 0, 0.5), seat_centre(0.005, 0, -0.8);
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.3, 1, 0.002, rng),
+                                        noisy_sphere_cap(ball_centre, 0.4, z, 2.2, 0.002, rng),
+                                        noisy_sphere_cap(seat_centre, 0.25, -z, 1.2, 0.0005, rng)};
+    std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.3),
+                                      fitted_sphere(clusters[1], ball_centre, 0.4),
+                                      fitted_sphere(clusters[2], seat_centre, 0.25)};
+    const std::vector<Primitive> own = primitives;
+    ASSERT_EQ(regularize(primitives, clusters), (Relations{{Kind::Coaxial, {0, 1}}}));
+    const Primitive &shaft = primitives[0], &ball = primitives[1];
+    EXPECT_LT(axis_offset(shaft, Primitive{PrimitiveType::Sphere, ball.point, {0, 0, 1}}), 1e-14);
+    EXPECT_LT(angle_between_lines(shaft.axis, own[0].axis), 1e-14);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(primitives[2].point[i], own[2].point[i]);
+    EXPECT_EQ(primitives[2].radius, own[2].radius);
+    // A minimum of the joint objective over the line's position, the ball's place along it and
+    // the radii.
+    const Eigen::Vector3d axis = to_eigen(shaft.axis);
+    const Eigen::Vector3d across = axis.unitOrthogonal(), other = axis.cross(across);
+    const std::vector<std::pair<Primitive, const Cluster*>> ball_only{{ball, &clusters[1]}};
+    const double best = joint_objective(shaft, clusters[0], ball_only);
+    for (const double h : {-1e-4, 1e-4}) {
+      for (const Eigen::Vector3d& move : {across, other}) {
+        Primitive moved_shaft = shaft, moved_ball = ball;
+        moved_shaft.point = to_vec3(to_eigen(shaft.point) + h * move);
+        moved_ball.point = to_vec3(to_eigen(ball.point) + h * move);
+        EXPECT_GT(joint_objective(moved_shaft, clusters[0], {{moved_ball, &clusters[1]}}), best);
+      }
+      Primitive along = ball, wider_ball = ball, wider_shaft = shaft;
+      along.point = to_vec3(to_eigen(ball.point) + h * axis);
+      wider_ball.radius += h;
+      wider_shaft.radius += h;
+      EXPECT_GT(joint_objective(shaft, clusters[0], {{along, &clusters[1]}}), best);
+      EXPECT_GT(joint_objective(shaft, clusters[0], {{wider_ball, &clusters[1]}}), best);
+      EXPECT_GT(joint_objective(wider_shaft, clusters[0], ball_only), best);
+    }
+    // The shared line passes no farther from the true centre than the farther of the ball's own
+    // centre (from the true axis) and the shaft's own axis (from the true centre).
+    const Primitive true_axis{PrimitiveType::Cylinder, {0, 0, 0}, {0, 0, 1}};
+    const Primitive true_ball{PrimitiveType::Sphere, to_vec3(ball_centre), {0, 0, 1}};
+    EXPECT_LE(axis_offset(shaft, true_ball),
+              std::max(axis_offset(true_axis, own[1]), axis_offset(own[0], true_ball)));
+  }
+}
+
 // A perforated plate: a grid of 400 holes of one radius, each its own axis line, is one class
 // (no hole lost to 400 tests at 3 standard deviations), refitted by one least squares over every
 // hole's position and the shared radius.

@@ -128,6 +128,14 @@ std::vector<std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>>> o
   return pairs;
 }
 
+// The distance of `point` from the axis line of `cylinder`.
+double distance_from_axis(const Vec3& point, const Primitive& cylinder) {
+  const Vec3 offset = {point[0] - cylinder.point[0], point[1] - cylinder.point[1],
+                       point[2] - cylinder.point[2]};
+  const Vec3 across = cross(offset, cylinder.axis);
+  return std::sqrt(dot(across, across) / dot(cylinder.axis, cylinder.axis));
+}
+
 // The two sides of each orthogonal relation are at right angles, to round-off.
 void expect_orthogonal(const std::vector<ClusterReport>& reports,
                        const std::vector<ClusterRelation>& relations) {
@@ -179,10 +187,12 @@ TEST(Relations, PartsShowTheirDesignIntentExactAndNoisy) {
     }
 }
 
-// A cylinder closed by a hemisphere of its radius (0.5): on its true regions, exact and noisy,
-// the cylinder and its cap are one equal-radius relation, their radius one, bit for bit, and no
-// farther from the truth than the farther of their own fits; the sphere keeps its centre.
-TEST(Relations, ACylinderAndTheHemisphereClosingItShareOneRadius) {
+// A cylinder closed by a hemisphere of its radius (0.5): on its true regions, exact and noisy, the
+// cylinder and its cap are one coaxial relation (the sphere centred on the cylinder's axis, to
+// round-off, and no farther from the truth than the farther of their own fits) and one equal-radius
+// relation (their radius one, bit for bit, and no farther from the truth than the farther of their
+// own fits).
+TEST(Relations, ACylinderAndTheHemisphereClosingItShareOneAxisAndOneRadius) {
   for (const double noise : {0.0, 0.002})
     for (const std::uint64_t seed : {1u, 2u, 3u}) {
       SCOPED_TRACE(std::to_string(noise) + " seed " + std::to_string(seed));
@@ -213,6 +223,21 @@ TEST(Relations, ACylinderAndTheHemisphereClosingItShareOneRadius) {
       const Vec3& own = before[sphere].primitive.point;
       const Vec3 moved{centre[0] - own[0], centre[1] - own[1], centre[2] - own[2]};
       EXPECT_LT(std::sqrt(dot(moved, moved)), 0.01);
+      ASSERT_EQ(clusters_of(relations, ClusterRelation::Kind::Coaxial), Groups{round});
+      const std::uint32_t cylinder = round[0] == sphere ? round[1] : round[0];
+      EXPECT_LT(distance_from_axis(centre, after[cylinder].primitive), 1e-12);
+      // The shared line passes no farther from the true centre than the farther of the sphere's
+      // own centre (from the true axis) and the cylinder's own axis (from the true centre).
+      const auto truth_of = [&](PrimitiveType type) {
+        return *std::find_if(shape.regions.begin(), shape.regions.end(),
+                             [&](const Primitive& p) { return p.type == type; });
+      };
+      const Primitive true_cylinder = truth_of(PrimitiveType::Cylinder);
+      const Vec3 true_centre = truth_of(PrimitiveType::Sphere).point;
+      const double own_worst =
+          std::max(distance_from_axis(own, true_cylinder),
+                   distance_from_axis(true_centre, before[cylinder].primitive));
+      EXPECT_LE(distance_from_axis(true_centre, after[cylinder].primitive), own_worst + 1e-15);
       // The one radius costs each fit little.
       for (const std::uint32_t c : round) EXPECT_LE(after[c].rms, before[c].rms * 1.25 + 1e-12);
     }
@@ -388,20 +413,32 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
       EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
     }
   for (const auto& set : coaxial) {
-    // Every coaxial set is within a parallel group.
-    EXPECT_TRUE(std::any_of(parallel.begin(), parallel.end(), [&](const auto& group) {
-      return std::includes(group.begin(), group.end(), set.begin(), set.end());
-    }));
-    const Primitive& first = after[set[0]].primitive;
+    // The cylinders of a coaxial set are one line and, when several, within a parallel group;
+    // its spheres are centred on that line.
+    std::vector<std::uint32_t> cylinders;
+    for (const std::uint32_t c : set)
+      if (after[c].primitive.type == PrimitiveType::Cylinder) cylinders.push_back(c);
+    ASSERT_FALSE(cylinders.empty());
+    if (cylinders.size() >= 2) {
+      EXPECT_TRUE(std::any_of(parallel.begin(), parallel.end(), [&](const auto& group) {
+        return std::includes(group.begin(), group.end(), cylinders.begin(), cylinders.end());
+      }));
+    }
+    const Primitive& line = after[cylinders[0]].primitive;
     for (const std::uint32_t c : set) {
-      const Primitive& cylinder = after[c].primitive;
-      ASSERT_EQ(cylinder.type, PrimitiveType::Cylinder);
-      const Vec3 offset = {cylinder.point[0] - first.point[0], cylinder.point[1] - first.point[1],
-                           cylinder.point[2] - first.point[2]};
-      EXPECT_LT(std::sqrt(dot(cross(offset, first.axis), cross(offset, first.axis))),
-                1e-12 * diagonal);
+      ASSERT_TRUE(after[c].primitive.type == PrimitiveType::Cylinder ||
+                  after[c].primitive.type == PrimitiveType::Sphere);
+      EXPECT_LT(distance_from_axis(after[c].primitive.point, line), 1e-12 * diagonal);
+      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
     }
   }
+  // fandisk's large sphere is centred on the axis of the cylinder beside it, to 0.07% of its
+  // radius: one surface of revolution.
+  EXPECT_TRUE(std::any_of(coaxial.begin(), coaxial.end(), [&](const auto& set) {
+    return std::any_of(set.begin(), set.end(), [&](std::uint32_t c) {
+      return after[c].primitive.type == PrimitiveType::Sphere;
+    });
+  }));
 }
 
 // Cylinders and spheres of a CAD part whose fitted radii agree within `tolerance` (relative),
@@ -432,7 +469,7 @@ Groups equal_radii(const std::vector<ClusterReport>& reports, double tolerance) 
 // (as `segment --refine 2`): couplingdown (an exact tessellation: radii agree to 1e-5) has bolt
 // circles of 3, 3 and 4 holes, spherical seats of 4 and 3 and two pairs of spheres; anchor_dense
 // (remeshed: to 1%) two circles of 4 holes. Each pattern is one equal-radius relation, and no
-// other cylinder or sphere joins one.
+// other cylinder or sphere joins one. The spheres centred on a cylinder's axis are centred on it.
 TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
   for (const auto& [name, tolerance] :
        {std::pair{"couplingdown.off", 1e-5}, std::pair{"anchor_dense.off", 1e-2}}) {
@@ -473,6 +510,37 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
         EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
       }
     }
+    // Spheres centred on a cylinder's axis: those whose own centres are within the tolerance
+    // (relative to their radius) of a cylinder's own axis. Every one found is such a sphere,
+    // centred on its set's axis to round-off, and at most one is missed (couplingdown's seventh
+    // seat, whose residual sum the axis raises 1.23 times what is allowed).
+    std::vector<std::uint32_t> on_axis, centred;
+    for (std::uint32_t s = 0; s < before.size(); ++s) {
+      if (before[s].primitive.type != PrimitiveType::Sphere) continue;
+      for (const ClusterReport& cylinder : before)
+        if (cylinder.primitive.type == PrimitiveType::Cylinder &&
+            distance_from_axis(before[s].primitive.point, cylinder.primitive) <
+                tolerance * before[s].primitive.radius) {
+          on_axis.push_back(s);
+          break;
+        }
+    }
+    for (const auto& set : clusters_of(relations, ClusterRelation::Kind::Coaxial)) {
+      const auto line = std::find_if(set.begin(), set.end(), [&](std::uint32_t c) {
+        return after[c].primitive.type == PrimitiveType::Cylinder;
+      });
+      ASSERT_NE(line, set.end());
+      for (const std::uint32_t c : set) {
+        EXPECT_LT(distance_from_axis(after[c].primitive.point, after[*line].primitive),
+                  1e-12 * diagonal);
+        if (after[c].primitive.type == PrimitiveType::Sphere) centred.push_back(c);
+      }
+    }
+    std::sort(centred.begin(), centred.end());
+    std::printf("%s: %zu of %zu spheres on an axis centred on it\n", name, centred.size(),
+                on_axis.size());
+    EXPECT_TRUE(std::includes(on_axis.begin(), on_axis.end(), centred.begin(), centred.end()));
+    EXPECT_GE(centred.size() + 1, on_axis.size());
   }
 }
 
@@ -489,19 +557,29 @@ TEST(Relations, RefusesMismatchedReportsAndBadOptions) {
   Segmentation bad_label = cut;
   bad_label.labels[0] = 6;
   EXPECT_THROW(regularize_clusters(hierarchy, bad_label, reports), InvalidInputError);
-  for (const auto& change : std::vector<void (*)(RelationOptions&)>{
-           [](RelationOptions& o) { o.significance = 0; },
-           [](RelationOptions& o) { o.significance = std::nan(""); },
-           [](RelationOptions& o) { o.max_angle_degrees = 90; },
-           [](RelationOptions& o) { o.max_angle_degrees = 0; },
-           [](RelationOptions& o) { o.max_radius_difference = 0; },
-           [](RelationOptions& o) { o.max_radius_difference = 1; },
-           [](RelationOptions& o) { o.max_radius_difference = std::nan(""); },
-           [](RelationOptions& o) { o.outlier_threshold = 0; },
-           [](RelationOptions& o) { o.outlier_threshold = INFINITY; }}) {
+  // Each refused with a message that names the field.
+  using Change = std::pair<const char*, void (*)(RelationOptions&)>;
+  for (const auto& [field, change] : std::vector<Change>{
+           {"significance", [](RelationOptions& o) { o.significance = 0; }},
+           {"significance", [](RelationOptions& o) { o.significance = std::nan(""); }},
+           {"max_angle_degrees", [](RelationOptions& o) { o.max_angle_degrees = 90; }},
+           {"max_angle_degrees", [](RelationOptions& o) { o.max_angle_degrees = 0; }},
+           {"max_radius_difference", [](RelationOptions& o) { o.max_radius_difference = 0; }},
+           {"max_radius_difference", [](RelationOptions& o) { o.max_radius_difference = 1; }},
+           {"max_radius_difference",
+            [](RelationOptions& o) { o.max_radius_difference = std::nan(""); }},
+           {"outlier_threshold", [](RelationOptions& o) { o.outlier_threshold = 0; }},
+           {"outlier_threshold", [](RelationOptions& o) { o.outlier_threshold = INFINITY; }}}) {
     RelationOptions options;
     change(options);
-    EXPECT_THROW(validate(options), InvalidInputError);
+    try {
+      validate(options);
+      ADD_FAILURE() << field << " accepted";
+    } catch (const InvalidInputError& error) {
+      EXPECT_NE(std::string(error.what()).find(std::string("RelationOptions::") + field),
+                std::string::npos)
+          << error.what();
+    }
     std::vector<ClusterReport> untouched = reports;
     EXPECT_THROW(regularize_clusters(hierarchy, cut, untouched, options), InvalidInputError);
   }

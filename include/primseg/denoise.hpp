@@ -84,18 +84,18 @@ struct DenoiseOptions {
   /// with them within this many standard deviations (each fit's uncertainty from its residuals
   /// and Jacobian): plane normals and cylinder axes at most 20 degrees apart become parallel
   /// (one direction, estimated from all of them), directions at right angles become orthogonal,
-  /// and cylinders of one direction whose axes are one line become coaxial (each keeps its
-  /// radius; a member whose fit the shared axis worsens beyond the same significance stays
-  /// alone). The members are refitted on their inliers (regularize_clusters() does the same for
-  /// a level's fits, and also gives cylinders of equal radius one radius, which does not lower
-  /// a snap's error and is left out here). A relation of the part (opposite faces of a box, a
-  /// cylinder and its caps, a stepped shaft, a box's corner) then costs one direction or one axis
-  /// instead of one per primitive, which lowers what the fits leave of the noise: the generated
-  /// noisy box and capped cylinder on their true regions (edges 2% of the diagonal) 12.0x → 18.0x
-  /// and 13.5x → 23.9x lower RMS; fandisk with 0.3% noise on the clean mesh's 30 clusters 5.5x
-  /// → 6.7x, at the automatic level 3.79x → 4.05x. Needs the refit (refit_outlier_threshold > 0). 0
-  /// disables.
-  /// >= 0.
+  /// cylinders of one direction whose axes are one line become coaxial (each keeps its radius; a
+  /// member whose fit the shared axis worsens beyond the same significance stays alone), and
+  /// spheres centred on such a line are centred on it. The members are refitted on their inliers
+  /// (regularize_clusters() does the same for a level's fits, and also gives cylinders and
+  /// spheres of equal radius one radius, which does not lower a snap's error and is left out
+  /// here). A relation of the part (opposite faces of a box, a cylinder and its caps, a stepped
+  /// shaft, a ball end, a box's corner) then costs one direction or one axis instead of one per
+  /// primitive, which lowers what the fits leave of the noise: the generated noisy box and
+  /// capped cylinder on their true regions (edges 2% of the diagonal) 12.0x → 18.0x and 13.5x →
+  /// 23.9x lower RMS; fandisk with 0.3% noise on the clean mesh's 30 clusters 5.5x → 6.7x, at
+  /// the automatic level 3.79x → 4.07x. Needs the refit (refit_outlier_threshold > 0). 0
+  /// disables. >= 0.
   double relation_significance = 3.0;
   /// The automatic level (Denoiser::automatic_level) cuts a hierarchy without a significant jump
   /// at this multiple of the noise estimate (estimate_noise). Unset: by the copy that is

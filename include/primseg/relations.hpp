@@ -2,8 +2,9 @@
 /// @file relations.hpp
 /// Design intent between the fitted primitives of a segmentation: plane normals and cylinder axes
 /// that agree within their fits' uncertainty (opposite faces of a box, a shaft and its end faces),
-/// directions at right angles, cylinders that share an axis line (a stepped shaft, the fragments
-/// of one bore) and cylinders and spheres of one radius (a bolt circle's holes). Making
+/// directions at right angles, cylinders that share an axis line and spheres centred on it (a
+/// stepped shaft, the fragments of one bore, a ball end, a hole's spherical seat) and cylinders and
+/// spheres of one radius (a bolt circle's holes). Making
 /// these relations exact is what reverse engineering wants of a scanned part's fits: a box with
 /// parallel faces, a shaft with one axis (after GlobFit, Li et al. 2011).
 
@@ -22,8 +23,11 @@ struct ClusterRelation {
     /// Plane normals and cylinder axes made one direction (each keeps its side): opposite faces
     /// of a box, a cylinder and its caps.
     Parallel,
-    /// Cylinders of one direction made one axis line, each keeping its radius: a stepped shaft,
-    /// the fragments of one cylinder. Every coaxial set is also part of a Parallel relation.
+    /// Cylinders of one direction made one axis line, each keeping its radius, and spheres
+    /// centred on that line, each keeping its radius and its place along it: a stepped shaft, the
+    /// fragments of one cylinder, a shaft's ball end, the hemisphere closing a cylinder, a hole's
+    /// spherical seat. It holds one cylinder or more; two or more are also part of a Parallel
+    /// relation.
     Coaxial,
     /// Two directions made exactly orthogonal: `clusters` have one (a plane's normal or a
     /// cylinder's axis), `orthogonal_to` the other. A box's three directions give three of
@@ -53,10 +57,12 @@ struct RelationOptions {
   /// ... and never when the tilt is larger than this, whatever the uncertainty (degrees, in
   /// (0, 90)).
   double max_angle_degrees = 20.0;
-  /// Cylinders' radii are made equal when they agree within the significance, and never when
-  /// they differ by more than this fraction of the larger (in (0, 1)). A radius known less
-  /// well than that (significance × its standard deviation above this fraction of it: a
-  /// cylinder patch of a freeform surface) takes part in none.
+  /// Cylinders' and spheres' radii are made equal when they agree within the significance, and
+  /// never when they differ by more than this fraction of the larger (in (0, 1)). A radius known
+  /// less well than that (significance × its standard deviation above this fraction of it: a
+  /// cylinder patch of a freeform surface) takes part in none. The same fraction of a sphere's
+  /// radius bounds its centre's distance from a cylinder's axis, and how well that distance must
+  /// be known, for the sphere to be centred on the axis.
   double max_radius_difference = 0.05;
   /// The directions and the refits use each cluster's inlier vertices: those within this many
   /// robust deviations (1.4826 × the median distance) of its primitive. > 0.
@@ -71,15 +77,16 @@ void validate(const RelationOptions& options);
 ///
 /// `reports` are the level's clusters as describe_clusters() or refine_boundaries() report them
 /// (reports[c] is label c of `segmentation`; shape (K)). Planes and cylinders take part, and
-/// spheres in the equal radii. Each cluster's direction and its uncertainty come from its inlier
-/// vertices (each mesh vertex once, weighted by its corners' weights in the hierarchy); clusters
-/// with too few vertices to estimate it (6 for a plane, 12 for a cylinder) stay out. Every member
-/// of a relation is refitted: a plane through its inliers' weighted centroid with the group's
-/// normal, a cylinder by geometric least squares with the group's axis direction, jointly with
-/// the cylinders coaxial with it (one axis line, one radius each) and the cylinders and spheres of
-/// equal radius (one radius, each on its own line or centre). Its report's `primitive`, `rms` and
-/// `max` are replaced (`rms` and `max` measured as describe_clusters() does, on all the cluster's
-/// vertices); every other report is left bit for bit. Deterministic, O(F log F).
+/// spheres in the coaxial sets and the equal radii. Each cluster's direction and its uncertainty
+/// come from its inlier vertices (each mesh vertex once, weighted by its corners' weights in the
+/// hierarchy); clusters with too few vertices to estimate it (6 for a plane, 12 for a cylinder)
+/// stay out. Every member of a relation is refitted: a plane through its inliers' weighted centroid
+/// with the group's normal, a cylinder by geometric least squares with the group's axis direction,
+/// jointly with the cylinders and spheres coaxial with it (one axis line; one radius each, and each
+/// sphere one position along the line) and the cylinders and spheres of equal radius (one radius,
+/// each on its own line or centre). Its report's `primitive`, `rms` and `max` are replaced (`rms`
+/// and `max` measured as describe_clusters() does, on all the cluster's vertices); every other
+/// report is left bit for bit. Deterministic, O(F log F).
 ///
 /// Returns the relations made exact, ordered by kind (parallel first), then by their clusters.
 /// Throws InvalidInputError when the segmentation or the reports do not match the hierarchy.

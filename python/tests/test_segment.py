@@ -75,17 +75,18 @@ def test_regularized_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path)
             continue
         sides = [relation["clusters"]] + ([relation["orthogonal_to"]] if "orthogonal_to" in relation else [])
         for side in sides:
-            directions = [direction(c) for c in side]
+            # A coaxial set's spheres have no direction, only a centre on its axis line.
+            directions = [direction(c) for c in side if clusters[c]["type"] != "sphere"]
             for d in directions:
                 assert np.array_equal(d, directions[0]) or np.array_equal(d, -directions[0])
         if relation["kind"] == "orthogonal":
             assert abs(direction(sides[0][0]) @ direction(sides[1][0])) < 1e-14
-        params = [clusters[c]["params"] for c in relation["clusters"]]
-        directions = [direction(c) for c in relation["clusters"]]
         if relation["kind"] == "coaxial":
-            axis, point = directions[0], np.array(params[0]["point"])
+            params = [clusters[c]["params"] for c in relation["clusters"]]
+            line = next(p for p in params if "axis" in p)
+            axis, point = np.array(line["axis"]), np.array(line["point"])
             for p in params:
-                offset = np.array(p["point"]) - point
+                offset = np.array(p.get("point", p.get("center"))) - point
                 assert np.linalg.norm(np.cross(offset, axis)) < 1e-12
     # Without regularize, the fits are the level's own.
     assert fandisk_tree.clusters(30, refine=2) != clusters
@@ -107,7 +108,8 @@ def test_relation_options_are_the_clis(cli, fandisk, fandisk_tree, tmp_path):
     equal = [r for r in fandisk_tree.relations(60) if r["kind"] == "equal_radius"]
     assert len([r for r in relations if r["kind"] == "equal_radius"]) < len(equal)
     for bad in (dict(relation_significance=0.0), dict(max_relation_angle=90.0), dict(max_radius_difference=1.0)):
-        with pytest.raises(ValueError):
+        (keyword,) = bad
+        with pytest.raises(ValueError, match=keyword):  # named as the caller spells it
             fandisk_tree.relations(60, **bad)
 
 

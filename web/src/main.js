@@ -570,8 +570,8 @@ class Viewer {
   }
 
   /**
-   * The shared axis of an emphasised coaxial relation, drawn through the mesh over the length of
-   * its clusters (plus a tenth at each end): this.axisLine, its ends [2][3] relative to
+   * The shared axis of an emphasised coaxial relation (its cylinders' axis, its spheres' centres),
+   * drawn through the mesh over the length of its clusters (plus a tenth at each end): this.axisLine, its ends [2][3] relative to
    * header.center, or null.
    */
   updateAxisLine() {
@@ -583,7 +583,9 @@ class Viewer {
     this.axisLine = null;
     const relation = this.emphasized >= 0 ? this.levelRelations[this.emphasized] : null;
     if (relation?.kind !== 'coaxial') return;
-    const { point, axis } = this.primitiveOf(relation.members[0]);
+    // Its line is its cylinders' (its spheres are centred on it).
+    const cylinder = relation.members.find((c) => TYPE_NAMES[this.primitiveOf(c).type] === 'cylinder');
+    const { point, axis } = this.primitiveOf(cylinder);
     const { offsets, triangles } = this.trianglesByCluster();
     const positions = this.data.positions, meshTriangles = this.data.triangles;
     let low = Infinity, high = -Infinity;

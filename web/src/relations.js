@@ -7,7 +7,7 @@ import { lowerBound } from './hierarchy.js';
 /** What each kind means, for the rows' tooltips (relations.hpp). */
 export const RELATION_MEANINGS = {
   parallel: 'plane normals and cylinder axes made one direction',
-  coaxial: 'cylinders made one axis line, each keeping its radius',
+  coaxial: 'cylinders made one axis line, each keeping its radius, and spheres centred on it',
   orthogonal: 'two directions made exactly orthogonal (the clusters before | against those after)',
   equal_radius: 'cylinders and spheres made one radius, each keeping its axis line or centre',
 };

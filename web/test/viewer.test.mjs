@@ -491,16 +491,23 @@ test('fandisk --regularize: a relation under the pointer, or clicked, leaves onl
     assert.deepEqual(drawn, new Set(relation.members.filter((c) => all.has(c))), `${relation.kind} ${i}: only its clusters in colour`);
     assert.ok(drawn.size >= 1 && [...drawn].every((c) => members.has(c)));
     if (relation.kind === 'coaxial') {
-      // Its axis is drawn: a line on every member's axis.
-      const { line, axes } = await page.evaluate(async (members) => {
+      // Its axis is drawn: a line on every cylinder's axis, through every sphere's centre.
+      const { line, primitives } = await page.evaluate(async (members) => {
         const viewer = await window.primseg.ready;
-        return { line: viewer.axisLine, axes: members.map((c) => viewer.primitiveOf(c)) };
+        return { line: viewer.axisLine, primitives: members.map((c) => viewer.primitiveOf(c)) };
       }, relation.members);
-      for (const end of line)
-        for (const { point, axis } of axes) {
-          const d = end.map((x, a) => x - point[a]), t = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2];
-          assert.ok(Math.hypot(...d.map((x, a) => x - t * axis[a])) < 1e-9, 'the axis line is on each member\'s axis');
+      for (const { type, point, axis } of primitives) {
+        if (type === 2) {  // a sphere: its centre is on the line
+          const along = line[1].map((x, a) => x - line[0][a]), d = point.map((x, a) => x - line[0][a]);
+          const t = (d[0] * along[0] + d[1] * along[1] + d[2] * along[2]) / (along[0] ** 2 + along[1] ** 2 + along[2] ** 2);
+          assert.ok(Math.hypot(...d.map((x, a) => x - t * along[a])) < 1e-9, 'a sphere of the set is centred on the line');
+          continue;
         }
+        for (const end of line) {
+          const d = end.map((x, a) => x - point[a]), t = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2];
+          assert.ok(Math.hypot(...d.map((x, a) => x - t * axis[a])) < 1e-9, 'the axis line is on each cylinder\'s axis');
+        }
+      }
       assert.ok(Math.hypot(...line[0].map((x, a) => x - line[1][a])) > 0.05, 'the line spans the members');
     }
     await page.click(`#relations .relation[data-index="${i}"]`);  // unpinned
