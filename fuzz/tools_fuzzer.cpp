@@ -307,7 +307,7 @@ void check_relations(const std::vector<Primitive>& primitives,
     const auto first = std::find_if(members.begin(), members.end(), [&](std::uint32_t c) {
       return primitives[c].type != PrimitiveType::Sphere;
     });
-    if (first == members.end()) fail((what + ": no direction in a relation").c_str());
+    if (first == members.end()) return;  // a coaxial set of spheres, checked below
     const Vec3& direction = primitives[*first].axis;
     for (const std::uint32_t c : members) {
       if (primitives[c].type == PrimitiveType::Sphere) continue;
@@ -330,9 +330,29 @@ void check_relations(const std::vector<Primitive>& primitives,
         fail((what + ": equal radius of a surface without one").c_str(), c);
     }
     if (relation.kind == ClusterRelation::Kind::Coaxial) {
-      const Primitive& line = primitives[*std::find_if(
+      const auto cylinder = std::find_if(
           relation.clusters.begin(), relation.clusters.end(),
-          [&](std::uint32_t c) { return primitives[c].type == PrimitiveType::Cylinder; })];
+          [&](std::uint32_t c) { return primitives[c].type == PrimitiveType::Cylinder; });
+      // Without a cylinder, three spheres or more on the line through the two farthest centres.
+      Primitive line;
+      if (cylinder != relation.clusters.end()) {
+        line = primitives[*cylinder];
+      } else {
+        if (relation.clusters.size() < 3) fail((what + ": coaxial spheres, fewer than 3").c_str());
+        double longest = 0;
+        for (const std::uint32_t a : relation.clusters)
+          for (const std::uint32_t b : relation.clusters) {
+            const Vec3 &p = primitives[a].point, &q = primitives[b].point;
+            const Vec3 d{q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+            const double length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            if (length > longest) {
+              longest = length;
+              line.point = p;
+              line.axis = {d[0] / length, d[1] / length, d[2] / length};
+            }
+          }
+        if (!(longest > 0)) continue;  // concentric spheres
+      }
       for (const std::uint32_t c : relation.clusters) {
         const Vec3& p = primitives[c].point;
         const Vec3 d{p[0] - line.point[0], p[1] - line.point[1], p[2] - line.point[2]};

@@ -25,7 +25,8 @@ struct RegularityOptions {
   /// Make directions at right angles within the significance exactly orthogonal.
   bool orthogonal = true;
   /// Centre a sphere whose centre is on a cylinder's axis line within the significance on it (a
-  /// ball end, a hemispherical cap): one parameter along the line instead of three.
+  /// ball end, a hemispherical cap): one parameter along the line instead of three; and three
+  /// spheres or more on one line of a direction made exact (a revolved profile's arcs).
   bool spheres_on_axes = true;
   /// Give cylinders and spheres whose radii agree within the significance one radius.
   bool equal_radii = true;
@@ -55,13 +56,14 @@ struct Relation {
 /// few to estimate its direction's uncertainty is left alone. Deterministic: clusters are visited
 /// by increasing uncertainty, ties by index. Then spheres centred on an axis line within the
 /// significance (RegularityOptions::spheres_on_axes) are refitted with their line's cylinders,
-/// one parameter along it each, and cylinders and spheres whose radii agree within the
+/// one parameter along it each, as are three spheres or more centred on one line of a direction
+/// made exact with no cylinder on it, and cylinders and spheres whose radii agree within the
 /// significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with the
 /// surfaces on their lines (each free sphere on its own centre). Returns the relations made
 /// exact: each direction group's members that were refitted with its direction, then each
 /// coaxial set of its cylinders (spheres added when they join it), in that order, then the
-/// coaxial sets a sphere started with one cylinder, then the classes of equal radii, then the
-/// right angles by their members.
+/// coaxial sets a sphere started with one cylinder, then the lines of spheres alone, then the
+/// classes of equal radii, then the right angles by their members.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,

@@ -19,7 +19,9 @@ Mesh box() {
   return make_shape("box", options).mesh;
 }
 
-void flip(Mesh& mesh, std::uint32_t t) { std::swap(mesh.triangles[t][1], mesh.triangles[t][2]); }
+void flip(Mesh& mesh, std::uint32_t t) {
+  std::swap(mesh.triangles[t][1], mesh.triangles[t][2]);
+}
 
 // `mesh` and, beside it, `other` moved by `offset` along x: two components.
 Mesh with_copy(const Mesh& mesh, const Mesh& other, double offset) {

@@ -26,8 +26,9 @@ struct ClusterRelation {
     /// Cylinders of one direction made one axis line, each keeping its radius, and spheres
     /// centred on that line, each keeping its radius and its place along it: a stepped shaft, the
     /// fragments of one cylinder, a shaft's ball end, the hemisphere closing a cylinder, a hole's
-    /// spherical seat. It holds one cylinder or more; two or more are also part of a Parallel
-    /// relation.
+    /// spherical seat. Two or more cylinders are also part of a Parallel relation. A set without
+    /// a cylinder has three spheres or more, centred on a line of a direction of the part (one a
+    /// Parallel or Orthogonal relation made exact): the arcs of a revolved profile.
     Coaxial,
     /// Two directions made exactly orthogonal: `clusters` have one (a plane's normal or a
     /// cylinder's axis), `orthogonal_to` the other. A box's three directions give three of

@@ -107,8 +107,9 @@ relations = tree.relations(30)
 for kind in ("parallel", "coaxial", "orthogonal", "equal_radius"):
     print(f"{kind}: {sum(r['kind'] == kind for r in relations)}")
 exact = tree.clusters(30, regularize=True)
-coaxial = next(r["clusters"] for r in relations if r["kind"] == "coaxial")
-coaxial = [c for c in coaxial if exact[c]["type"] == "cylinder"]  # and spheres centred on the axis
+# The cylinders of a coaxial set (which may also hold spheres centred on their axis).
+coaxial = next(cylinders for r in relations if r["kind"] == "coaxial"
+               for cylinders in [[c for c in r["clusters"] if exact[c]["type"] == "cylinder"]] if cylinders)
 radii = [exact[c]["params"]["radius"] for c in coaxial]
 print("one axis for the cylinders", coaxial, "of radii", np.round(radii, 4))
 axes = np.array([exact[c]["params"]["axis"] for c in coaxial])

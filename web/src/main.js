@@ -583,9 +583,23 @@ class Viewer {
     this.axisLine = null;
     const relation = this.emphasized >= 0 ? this.levelRelations[this.emphasized] : null;
     if (relation?.kind !== 'coaxial') return;
-    // Its line is its cylinders' (its spheres are centred on it).
+    // Its line is its cylinders' (its spheres are centred on it), or without a cylinder the one
+    // through its spheres' centres (the two farthest apart; none when they are one point).
     const cylinder = relation.members.find((c) => TYPE_NAMES[this.primitiveOf(c).type] === 'cylinder');
-    const { point, axis } = this.primitiveOf(cylinder);
+    let point, axis;
+    if (cylinder !== undefined) {
+      ({ point, axis } = this.primitiveOf(cylinder));
+    } else {
+      const centres = relation.members.map((c) => this.primitiveOf(c).point);
+      let far = [0, 0], longest = 0;
+      centres.forEach((a, i) => centres.forEach((b, j) => {
+        const d = Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+        if (d > longest) [longest, far] = [d, [i, j]];
+      }));
+      if (!(longest > 0)) return;
+      point = centres[far[0]];
+      axis = centres[far[1]].map((x, a) => (x - point[a]) / longest);
+    }
     const { offsets, triangles } = this.trianglesByCluster();
     const positions = this.data.positions, meshTriangles = this.data.triangles;
     let low = Infinity, high = -Infinity;
