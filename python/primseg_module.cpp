@@ -1298,8 +1298,8 @@ order along each curve. json.dumps() takes it as it is.)",
 
 The design intent among the level's fits, as the CLI's --regularize writes it in the JSON's
 "relations": one dict per relation with kind ("parallel": plane normals and cylinder axes of one
-direction; "coaxial": cylinders of one axis line and spheres centred on it; "orthogonal": two
-directions at right angles;
+direction; "coaxial": cylinders of one axis line and spheres centred on it, or three spheres or
+more centred on one line with no cylinder; "orthogonal": two directions at right angles;
 "equal_radius": cylinders and spheres of one radius) and clusters (their labels, increasing; for
 "orthogonal", those of one direction, and orthogonal_to those of the other).
 clusters(..., regularize=True) gives the primitives with these relations made exact.)",

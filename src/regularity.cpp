@@ -657,6 +657,15 @@ Eigen::Matrix2d tilt_in_frame(const Eigen::Vector3d& direction, const Eigen::Mat
   return frame.transpose() * covariance * frame;
 }
 
+// Whether a 2D position of covariance `covariance` is known to within `bound` at the
+// significance, in its worst direction (the interval rule of the spheres' centres).
+bool known_within(const Eigen::Matrix2d& covariance, double significance, double bound) {
+  const double half_difference = (covariance(0, 0) - covariance(1, 1)) / 2;
+  const double largest =
+      (covariance(0, 0) + covariance(1, 1)) / 2 + std::hypot(half_difference, covariance(0, 1));
+  return significance * std::sqrt(largest) <= bound;
+}
+
 // Not in a relation yet.
 constexpr std::size_t kNoRelation = std::numeric_limits<std::size_t>::max();
 
@@ -927,10 +936,7 @@ void centre_spheres_on_axes(SettledSurfaces& settled, const RegularityOptions& o
       const double height = line.direction.dot(centre) - line.middle;
       const Eigen::Matrix2d combined =
           frame * covariance * frame.transpose() + line.covariance + height * height * line.tilt;
-      const double half_difference = (combined(0, 0) - combined(1, 1)) / 2;
-      const double largest_variance =
-          (combined(0, 0) + combined(1, 1)) / 2 + std::hypot(half_difference, combined(0, 1));
-      if (!(significance * std::sqrt(largest_variance) <= largest_offset)) continue;
+      if (!known_within(combined, significance, largest_offset)) continue;
       const double score = offset.dot(combined.ldlt().solve(offset));
       if (score <= nearest_score) {
         nearest_score = score;
@@ -991,11 +997,8 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
       const Eigen::Vector3d& centre = settled.centres[sphere.centre];
       const Eigen::Matrix2d covariance =
           frame * settled.centre_covariances[sphere.centre] * frame.transpose();
-      const double largest =
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(covariance, Eigen::EigenvaluesOnly)
-              .eigenvalues()(1);
-      if (!(options.significance * std::sqrt(largest) <=
-            options.max_radius_difference * sphere.radius))
+      if (!known_within(covariance, options.significance,
+                        options.max_radius_difference * sphere.radius))
         continue;
       placed.push_back({k, frame * centre, covariance, direction.dot(centre)});
     }
