@@ -174,6 +174,16 @@ void append_fit(const ClusterReport& report, const Vec3& center, std::vector<dou
   errors.push_back(report.max);
 }
 
+/// Whether `node` is a cluster of a level of at most `merges` more clusters than components: its
+/// parent is one of the last `merges` real merges, a trailing merge or none (component roots).
+bool is_cluster_of_a_level(const Hierarchy& hierarchy, std::uint32_t node, std::uint32_t merges) {
+  const std::uint32_t f = hierarchy.face_count();
+  const std::uint32_t real = f - hierarchy.component_count();
+  const std::uint32_t parent = hierarchy.parents()[node];
+  return parent == std::numeric_limits<std::uint32_t>::max() ||
+         parent - f >= real - std::min(real, merges);
+}
+
 /// The relations of one level and the fits they changed.
 struct LevelRelations {
   std::vector<ClusterRelation> relations;
@@ -197,29 +207,30 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
   const std::uint32_t last = std::min(max_clusters, hierarchy.face_count());
   const std::uint32_t level_count = last >= first ? last - first + 1 : 0;
   std::vector<LevelRelations> levels(level_count);
+  // The clusters of these levels alone.
+  std::vector<std::uint32_t> level_nodes;
+  std::vector<ClusterReport> level_reports;
+  for (std::size_t i = 0; i < carried.size(); ++i)
+    if (is_cluster_of_a_level(hierarchy, carried[i], last - std::min(last, first))) {
+      level_nodes.push_back(carried[i]);
+      level_reports.push_back(reports[i]);
+    }
+  const LevelRegularizer regularizer(hierarchy, level_nodes, level_reports, options, threads);
   detail::parallel_for_threads(
       level_count, detail::thread_count(threads), [&](std::size_t i, unsigned) {
         LevelRelations& level = levels[i];
-        const Segmentation segmentation =
-            cut_by_count(hierarchy, first + static_cast<std::uint32_t>(i));
-        std::vector<ClusterReport> level_reports;
-        level_reports.reserve(segmentation.cluster_count());
-        for (const std::uint32_t node : segmentation.nodes) {
-          const auto at = std::lower_bound(carried.begin(), carried.end(), node);
-          level_reports.push_back(reports[static_cast<std::size_t>(at - carried.begin())]);
-          level_reports.back().id = static_cast<std::uint32_t>(level_reports.size() - 1);
-        }
-        level.relations = regularize_clusters(hierarchy, segmentation, level_reports, options);
-        std::vector<bool> member(segmentation.cluster_count(), false);
+        RegularizedLevel regularized = regularizer.level(first + static_cast<std::uint32_t>(i));
+        level.relations = std::move(regularized.relations);
+        std::vector<bool> member(regularized.nodes.size(), false);
         for (const ClusterRelation& relation : level.relations) {
           for (const std::uint32_t c : relation.clusters) member[c] = true;
           for (const std::uint32_t c : relation.orthogonal_to) member[c] = true;
         }
-        for (std::uint32_t c = 0; c < segmentation.cluster_count(); ++c)
-          if (member[c]) level.fits.emplace_back(segmentation.nodes[c], level_reports[c]);
+        for (std::size_t c = 0; c < regularized.nodes.size(); ++c)
+          if (member[c]) level.fits.emplace_back(regularized.nodes[c], regularized.reports[c]);
         std::sort(level.fits.begin(), level.fits.end(),
                   [](const auto& a, const auto& b) { return a.first < b.first; });
-        level.nodes = segmentation.nodes;
+        level.nodes = std::move(regularized.nodes);
       });
 
   std::vector<std::uint32_t> level_offsets{0}, member_offsets{0}, members, first_side;
@@ -308,12 +319,8 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
           : std::min(real, kMaxClustersWithParameters - components);
   std::vector<std::uint32_t> carried;
   if (components <= kMaxClustersWithParameters)
-    for (std::uint32_t node = 0; node < f + real; ++node) {
-      const std::uint32_t parent = hierarchy.parents()[node];
-      if (parent == std::numeric_limits<std::uint32_t>::max() ||
-          parent - f >= real - carried_merges)
-        carried.push_back(node);
-    }
+    for (std::uint32_t node = 0; node < f + real; ++node)
+      if (is_cluster_of_a_level(hierarchy, node, carried_merges)) carried.push_back(node);
   // Their primitives as every cut reports them: the geometric fit and its exact errors.
   DescribeOptions describe;
   describe.threads = threads;

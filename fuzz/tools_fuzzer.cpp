@@ -458,6 +458,37 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
       fail("regularized level: a cluster outside every relation changed", double(c));
   }
 
+  // The level as `primseg view --regularize` regularizes it, from its nodes' reports: the same
+  // clusters, relations and reports as the cut's, bit for bit.
+  {
+    std::vector<std::uint32_t> nodes = results.level.nodes;
+    std::sort(nodes.begin(), nodes.end());
+    const LevelRegularizer regularizer(hierarchy, nodes, describe_nodes(hierarchy, nodes, describe),
+                                       {}, 1);
+    const RegularizedLevel viewed = regularizer.level(clusters);
+    std::vector<ClusterReport> cut_reports = results.reports;
+    const std::vector<ClusterRelation> cut_relations =
+        regularize_clusters(hierarchy, results.level, cut_reports);
+    if (viewed.nodes != results.level.nodes) fail("level regularizer: nodes");
+    if (viewed.relations.size() != cut_relations.size())
+      fail("level regularizer: relations", double(viewed.relations.size()),
+           double(cut_relations.size()));
+    for (std::size_t r = 0; r < cut_relations.size(); ++r)
+      if (viewed.relations[r].kind != cut_relations[r].kind ||
+          viewed.relations[r].clusters != cut_relations[r].clusters ||
+          viewed.relations[r].orthogonal_to != cut_relations[r].orthogonal_to)
+        fail("level regularizer: relation", double(r));
+    for (std::size_t c = 0; c < cut_reports.size(); ++c) {
+      const ClusterReport &a = viewed.reports[c], &b = cut_reports[c];
+      if (a.primitive.axis != b.primitive.axis || a.primitive.point != b.primitive.point ||
+          std::bit_cast<std::uint64_t>(a.primitive.radius) !=
+              std::bit_cast<std::uint64_t>(b.primitive.radius) ||
+          std::bit_cast<std::uint64_t>(a.rms) != std::bit_cast<std::uint64_t>(b.rms) ||
+          std::bit_cast<std::uint64_t>(a.max) != std::bit_cast<std::uint64_t>(b.max))
+        fail("level regularizer: report", double(c));
+    }
+  }
+
   results.skeleton = extract_skeleton(hierarchy, results.level);
   results.skin = compute_skin_weights(*mesh, results.skeleton);
   check_skeleton(*mesh, results.level, results.skeleton, results.skin);

@@ -7,6 +7,8 @@
 #include <numeric>
 #include <string>
 
+#include "cluster_numbering.hpp"
+#include "leaf_order.hpp"
 #include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
@@ -33,10 +35,8 @@ Segmentation number_clusters(const Hierarchy& hierarchy, std::vector<std::uint32
     lowest[cluster_of_face[f]] = std::min(lowest[cluster_of_face[f]], f);
   std::vector<std::uint32_t> order(k);
   std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    if (area[a] != area[b]) return area[a] > area[b];
-    return lowest[a] < lowest[b];
-  });
+  detail::sort_into_label_order(
+      order, [&](std::uint32_t c) { return area[c]; }, [&](std::uint32_t c) { return lowest[c]; });
   std::vector<std::uint32_t> rank(k);
   Segmentation result;
   result.nodes.resize(k);
@@ -212,15 +212,7 @@ std::vector<ClusterReport> describe_nodes(const Hierarchy& hierarchy,
     if (node >= hierarchy.node_count() || (node >= f && merges[node - f].trailing))
       throw InvalidInputError("describe_nodes: " + std::to_string(node) +
                               " is not a node of the tree, or joins components");
-  // Leaf order: the faces of every node are contiguous, from leaf_start[node].
-  std::vector<std::uint32_t> leaf_start(hierarchy.node_count(), 0);
-  for (std::uint32_t node = hierarchy.node_count(); node-- > f;) {
-    const Merge& merge = merges[node - f];
-    leaf_start[merge.first] = leaf_start[node];
-    leaf_start[merge.second] = leaf_start[node] + hierarchy.face_count(merge.first);
-  }
-  std::vector<std::uint32_t> leaf_order(f);
-  for (std::uint32_t face = 0; face < f; ++face) leaf_order[leaf_start[face]] = face;
+  const detail::LeafOrder leaves(hierarchy);
 
   std::vector<ClusterReport> reports(nodes.size());
   const unsigned threads = detail::thread_count(options.threads);
@@ -232,11 +224,8 @@ std::vector<ClusterReport> describe_nodes(const Hierarchy& hierarchy,
     r.id = static_cast<std::uint32_t>(i);
     r.node = nodes[i];
     r.face_count = hierarchy.face_count(r.node);
-    // Its faces in ascending order: their triangles are then in ascending order, as a cut's.
     std::vector<std::uint32_t>& node_faces = faces[thread];
-    node_faces.assign(leaf_order.begin() + leaf_start[r.node],
-                      leaf_order.begin() + leaf_start[r.node] + r.face_count);
-    std::sort(node_faces.begin(), node_faces.end());
+    leaves.ascending_faces(hierarchy, r.node, node_faces);
     points[thread].clear();
     weights[thread].clear();
     for (std::uint32_t face : node_faces)

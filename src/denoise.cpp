@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 
+#include "cluster_numbering.hpp"
 #include "eigen_conversions.hpp"
 #include "no_index.hpp"
 #include "parallel.hpp"
@@ -532,10 +533,9 @@ SnappedLevel Denoiser::describe_snap(const Segmentation& hierarchy_level,
   std::vector<std::uint32_t> order;
   for (std::uint32_t c = 0; c < k; ++c)
     if (reports[c].face_count > 0) order.push_back(c);
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    if (reports[a].area != reports[b].area) return reports[a].area > reports[b].area;
-    return lowest_face[a] < lowest_face[b];
-  });
+  detail::sort_into_label_order(
+      order, [&](std::uint32_t c) { return reports[c].area; },
+      [&](std::uint32_t c) { return lowest_face[c]; });
   SnappedLevel level;
   std::vector<std::uint32_t> rank(k, detail::kNone);
   for (std::uint32_t r = 0; r < order.size(); ++r) {

@@ -1011,12 +1011,12 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
           options.max_radius_difference * settled.surfaces[sphere.surface].radius;
       std::size_t joined = sets.size();
       for (std::size_t s = 0; s < sets.size() && joined == sets.size(); ++s) {
-        const Eigen::Matrix2d pooled = sets[s].pooled.covariance();
         const Eigen::Vector2d offset = sphere.position - sets[s].pooled.centre();
+        if (!(offset.norm() <= largest_offset)) continue;  // most pairs, before any covariance
         const double height = sphere.height - sets[s].height;
-        const Eigen::Matrix2d combined = sphere.covariance + pooled + height * height * tilt;
-        if (offset.norm() <= largest_offset && offset.dot(combined.ldlt().solve(offset)) <= bound)
-          joined = s;
+        const Eigen::Matrix2d combined =
+            sphere.covariance + sets[s].pooled.covariance() + height * height * tilt;
+        if (offset.dot(combined.ldlt().solve(offset)) <= bound) joined = s;
       }
       if (joined == sets.size()) sets.emplace_back().height = sphere.height;
       sets[joined].surfaces.push_back(sphere.surface);
@@ -1513,17 +1513,10 @@ void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
     }
 }
 
-std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitives,
-                                                const std::vector<std::vector<Vec3>>& points,
-                                                const std::vector<std::vector<double>>& weights,
-                                                double outlier_threshold, double floor,
-                                                const RegularityOptions& options) {
-  std::vector<std::vector<Vec3>> inlier_points(primitives.size());
-  std::vector<std::vector<double>> inlier_weights(primitives.size());
-  for (std::size_t c = 0; c < primitives.size(); ++c)
-    if (!points[c].empty())
-      keep_inliers(primitives[c], points[c], weights[c], outlier_threshold, floor, inlier_points[c],
-                   inlier_weights[c]);
+std::vector<ClusterRelation> regularize_kept(std::vector<Primitive>& primitives,
+                                             const std::vector<std::vector<Vec3>>& inlier_points,
+                                             const std::vector<std::vector<double>>& inlier_weights,
+                                             const RegularityOptions& options) {
   std::vector<ClusterRelation> relations;
   for (const Relation& relation : regularize(primitives, inlier_points, inlier_weights, options)) {
     ClusterRelation& related = relations.emplace_back();
@@ -1535,6 +1528,20 @@ std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitiv
   }
   sort_relations(relations);
   return relations;
+}
+
+std::vector<ClusterRelation> regularize_inliers(std::vector<Primitive>& primitives,
+                                                const std::vector<std::vector<Vec3>>& points,
+                                                const std::vector<std::vector<double>>& weights,
+                                                double outlier_threshold, double floor,
+                                                const RegularityOptions& options) {
+  std::vector<std::vector<Vec3>> inlier_points(primitives.size());
+  std::vector<std::vector<double>> inlier_weights(primitives.size());
+  for (std::size_t c = 0; c < primitives.size(); ++c)
+    if (!points[c].empty())
+      keep_inliers(primitives[c], points[c], weights[c], outlier_threshold, floor, inlier_points[c],
+                   inlier_weights[c]);
+  return regularize_kept(primitives, inlier_points, inlier_weights, options);
 }
 
 }  // namespace primseg::detail

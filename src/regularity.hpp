@@ -78,6 +78,13 @@ void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
                   std::span<const double> weights, double threshold, double floor,
                   std::vector<Vec3>& kept_points, std::vector<double>& kept_weights);
 
+/// regularize() on clusters' inliers (keep_inliers()), as relations between the indices of
+/// `primitives` in sort_relations() order.
+std::vector<ClusterRelation> regularize_kept(std::vector<Primitive>& primitives,
+                                             const std::vector<std::vector<Vec3>>& inlier_points,
+                                             const std::vector<std::vector<double>>& inlier_weights,
+                                             const RegularityOptions& options);
+
 /// regularize() on each cluster's inliers (keep_inliers() of points[c], weights[c] about
 /// primitives[c]; an empty cluster stays out), as relations between the indices of `primitives`
 /// in sort_relations() order.

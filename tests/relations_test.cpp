@@ -10,7 +10,9 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "primseg/auto_level.hpp"
@@ -556,6 +558,131 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
     // couplingdown's seven spheres centred on one line along z, with no cylinder there: one set.
     EXPECT_EQ(spheres_alone, name == std::string("couplingdown.off") ? 1u : 0u);
   }
+}
+
+// A noisy box with a hole and, apart from it, a cylinder of quadrilateral faces: two
+// components, and input faces of two triangles each.
+Mesh box_and_quadrilateral_cylinder() {
+  const Mesh box = noisy_shape("box_with_hole", 0.002, 3).mesh;
+  std::vector<Vec3> positions = box.positions;
+  std::vector<std::uint32_t> offsets{0}, loops;
+  for (std::uint32_t f = 0; f < box.face_count(); ++f) {
+    for (const std::uint32_t v : box.polygon(f)) loops.push_back(v);
+    offsets.push_back(static_cast<std::uint32_t>(loops.size()));
+  }
+  constexpr std::uint32_t kRings = 12, kAround = 24;
+  const auto first = static_cast<std::uint32_t>(positions.size());
+  for (std::uint32_t i = 0; i < kRings; ++i)
+    for (std::uint32_t j = 0; j < kAround; ++j) {
+      const double angle = 2 * std::numbers::pi * j / kAround;
+      positions.push_back({5 + 0.4 * std::cos(angle), 0.4 * std::sin(angle), 0.1 * i});
+    }
+  for (std::uint32_t i = 0; i + 1 < kRings; ++i)
+    for (std::uint32_t j = 0; j < kAround; ++j) {
+      const std::uint32_t next = (j + 1) % kAround;
+      for (const std::uint32_t v :
+           {i * kAround + j, i * kAround + next, (i + 1) * kAround + next, (i + 1) * kAround + j})
+        loops.push_back(first + v);
+      offsets.push_back(static_cast<std::uint32_t>(loops.size()));
+    }
+  return Mesh::from_polygons(std::move(positions), std::move(offsets), std::move(loops));
+}
+
+void expect_same_primitive(const Primitive& a, const Primitive& b, const std::string& where) {
+  EXPECT_EQ(a.type, b.type) << where;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_TRUE(testing::same_bits(a.point[i], b.point[i])) << where;
+    EXPECT_TRUE(testing::same_bits(a.axis[i], b.axis[i])) << where;
+  }
+  EXPECT_TRUE(testing::same_bits(a.radius, b.radius)) << where;
+  EXPECT_TRUE(testing::same_bits(a.minor_radius, b.minor_radius)) << where;
+  EXPECT_TRUE(testing::same_bits(a.half_angle, b.half_angle)) << where;
+}
+
+// What `primseg view --regularize` shows at each level is what `cut --clusters K --regularize`
+// finds there, bit for bit: the same clusters in the same order, relations and reports, with the
+// levels asked from two threads at once and in any order, and asked again from the remembered
+// measures.
+TEST(Relations, LevelRegularizerGivesEveryLevelAsACutWould) {
+  const Mesh mesh = box_and_quadrilateral_cylinder();
+  const Hierarchy hierarchy = build_hierarchy(mesh);
+  ASSERT_EQ(hierarchy.component_count(), 2u);
+  constexpr std::uint32_t kLast = 40;
+  std::vector<std::uint32_t> nodes;
+  for (std::uint32_t k = 1; k <= kLast; ++k)
+    for (const std::uint32_t node : cut_by_count(hierarchy, k).nodes) nodes.push_back(node);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  const LevelRegularizer regularizer(hierarchy, nodes, describe_nodes(hierarchy, nodes));
+
+  std::vector<RegularizedLevel> levels(kLast + 1);
+  std::thread descending([&] {
+    for (std::uint32_t k = kLast; k >= 1; k -= 2) levels[k] = regularizer.level(k);
+  });
+  for (std::uint32_t k = 1; k <= kLast; k += 2) levels[k] = regularizer.level(k);
+  descending.join();
+
+  std::map<ClusterRelation::Kind, int> kinds;
+  for (std::uint32_t k = 1; k <= kLast; ++k) {
+    const std::string where = "level " + std::to_string(k);
+    const Segmentation cut = cut_by_count(hierarchy, k);
+    std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
+    const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, reports);
+    const RegularizedLevel& level = levels[k];
+    EXPECT_EQ(level.nodes, cut.nodes) << where;
+    ASSERT_EQ(level.relations.size(), relations.size()) << where;
+    for (std::size_t r = 0; r < relations.size(); ++r) {
+      EXPECT_EQ(level.relations[r].kind, relations[r].kind) << where;
+      EXPECT_EQ(level.relations[r].clusters, relations[r].clusters) << where;
+      EXPECT_EQ(level.relations[r].orthogonal_to, relations[r].orthogonal_to) << where;
+      ++kinds[relations[r].kind];
+    }
+    ASSERT_EQ(level.reports.size(), reports.size()) << where;
+    for (std::size_t c = 0; c < reports.size(); ++c) {
+      const std::string cluster = where + ", cluster " + std::to_string(c);
+      EXPECT_EQ(level.reports[c].id, reports[c].id) << cluster;
+      EXPECT_EQ(level.reports[c].node, reports[c].node) << cluster;
+      EXPECT_EQ(level.reports[c].face_count, reports[c].face_count) << cluster;
+      expect_same_primitive(level.reports[c].primitive, reports[c].primitive, cluster);
+      expect_same_primitive(level.reports[c].algebraic, reports[c].algebraic, cluster);
+      EXPECT_TRUE(testing::same_bits(level.reports[c].area, reports[c].area)) << cluster;
+      EXPECT_TRUE(testing::same_bits(level.reports[c].rms, reports[c].rms)) << cluster;
+      EXPECT_TRUE(testing::same_bits(level.reports[c].max, reports[c].max)) << cluster;
+    }
+  }
+  // The levels hold every kind of relation the part has: its faces' directions, the hole's axis
+  // shared with the separate cylinder's (both along z), and right angles.
+  EXPECT_GT(kinds[ClusterRelation::Kind::Parallel], 0);
+  EXPECT_GT(kinds[ClusterRelation::Kind::Orthogonal], 0);
+  EXPECT_GT(kinds[ClusterRelation::Kind::EqualRadius] + kinds[ClusterRelation::Kind::Coaxial], 0);
+
+  // A level asked again is the same.
+  const RegularizedLevel again = regularizer.level(kLast);
+  ASSERT_EQ(again.reports.size(), levels[kLast].reports.size());
+  for (std::size_t c = 0; c < again.reports.size(); ++c)
+    EXPECT_TRUE(testing::same_bits(again.reports[c].rms, levels[kLast].reports[c].rms));
+
+  // A level with a cluster that was not given, and levels that do not exist, are refused.
+  try {
+    (void)regularizer.level(kLast + 10);
+    ADD_FAILURE() << "a level beyond the nodes given was accepted";
+  } catch (const InvalidInputError& error) {
+    EXPECT_NE(std::string(error.what()).find("was not given"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW((void)regularizer.level(0), InvalidInputError);
+  EXPECT_THROW((void)regularizer.level(hierarchy.face_count() + 1), InvalidInputError);
+  // Constructor contracts: increasing nodes of the tree, one report each.
+  const std::vector<ClusterReport> reports = describe_nodes(hierarchy, nodes);
+  std::vector<std::uint32_t> reversed(nodes.rbegin(), nodes.rend());
+  EXPECT_THROW(LevelRegularizer(hierarchy, reversed, reports), InvalidInputError);
+  EXPECT_THROW(LevelRegularizer(hierarchy, nodes, std::span(reports).first(reports.size() - 1)),
+               InvalidInputError);
+  std::vector<std::uint32_t> outside = nodes;
+  outside.back() = hierarchy.node_count();
+  EXPECT_THROW(LevelRegularizer(hierarchy, outside, reports), InvalidInputError);
+  RelationOptions bad;
+  bad.significance = -1;
+  EXPECT_THROW(LevelRegularizer(hierarchy, nodes, reports, bad), InvalidInputError);
 }
 
 TEST(Relations, RefusesMismatchedReportsAndBadOptions) {

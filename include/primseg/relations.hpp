@@ -9,6 +9,8 @@
 /// parallel faces, a shaft with one axis (after GlobFit, Li et al. 2011).
 
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -95,5 +97,48 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
                                                  const Segmentation& segmentation,
                                                  std::vector<ClusterReport>& reports,
                                                  const RelationOptions& options = {});
+
+/// One level of LevelRegularizer: its clusters and relations, as cut_by_count(),
+/// describe_clusters() and regularize_clusters() give them.
+struct RegularizedLevel {
+  std::vector<std::uint32_t> nodes;    ///< tree node of each cluster label, shape (K)
+  std::vector<ClusterReport> reports;  ///< shape (K); members of a relation refitted
+  std::vector<ClusterRelation> relations;
+};
+
+/// The relations of many levels of one hierarchy, each what regularize_clusters() finds on
+/// cut_by_count()'s level with describe_clusters()' reports, bit for bit: for browsing the
+/// relations level by level (`primseg view --regularize`). regularize_clusters() gathers every
+/// cluster's vertices and inliers from all F faces at each level; this gathers each node's once,
+/// so that a level costs its regularization alone (bunny00's 391 levels: see docs/method.md).
+class LevelRegularizer {
+ public:
+  /// `nodes` (strictly increasing) must hold every cluster of the levels asked for, and
+  /// `reports` are their describe_nodes() reports, in the same order; `hierarchy` must outlive
+  /// this. Gathers each node's vertices and inliers on `threads` threads (0: all cores):
+  /// O(Σ node sizes) time and memory.
+  /// Throws InvalidInputError when a node is not one describe_nodes() reports, the nodes are not
+  /// increasing or the sizes differ, or for options out of range.
+  LevelRegularizer(const Hierarchy& hierarchy, std::span<const std::uint32_t> nodes,
+                   std::span<const ClusterReport> reports, const RelationOptions& options = {},
+                   unsigned threads = 0);
+
+  /// The level of `clusters` clusters (cut_by_count()'s: the component count at least): its
+  /// nodes by label, their reports (`id` the label) and its relations, refitted members
+  /// measured as describe_clusters() measures. O(K log K + the members' regularization and
+  /// measure). Safe to call from several threads at once. Throws InvalidInputError when a
+  /// cluster of the level is not among the constructor's nodes, or `clusters` is 0 or above F.
+  RegularizedLevel level(std::uint32_t clusters) const;
+
+  ~LevelRegularizer();
+  LevelRegularizer(LevelRegularizer&&) noexcept;
+  LevelRegularizer& operator=(LevelRegularizer&&) noexcept;
+
+ private:
+  struct Nodes;  // each node's triangles, inliers and measures
+  const Hierarchy* hierarchy_;
+  RelationOptions options_;
+  std::unique_ptr<Nodes> nodes_;
+};
 
 }  // namespace primseg
