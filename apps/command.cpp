@@ -177,9 +177,9 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
   command.add_flag("--regularize", options.regularize,
                    "Make the fits' design intent exact: plane normals and cylinder axes that "
                    "agree within their uncertainty share one direction, directions at right "
-                   "angles become orthogonal, cylinders share one axis line and spheres are "
-                   "centred on it, and cylinders and spheres share one radius (listed as "
-                   "\"relations\" in the JSON)");
+                   "angles become orthogonal, fragments of one face share one plane, cylinders "
+                   "share one axis line and spheres are centred on it, and cylinders and spheres "
+                   "share one radius (listed as \"relations\" in the JSON)");
   add_relation_options(command, options.relations);
 }
 

@@ -293,7 +293,8 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
 // parallel group and each side of an orthogonal pair share one direction up to sign, the two
 // sides' directions are orthogonal to round-off, a coaxial set holds cylinders of one direction
 // and spheres, every cylinder's axis and sphere's centre on its first cylinder's axis line to
-// round-off, and an equal-radius set cylinders and spheres of one radius, bit for bit.
+// round-off, an equal-radius set cylinders and spheres of one radius, bit for bit, and a
+// coplanar set planes through one plane to round-off.
 void check_relations(const std::vector<Primitive>& primitives,
                      const std::vector<ClusterRelation>& relations, const std::string& what) {
   auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest,
@@ -365,6 +366,23 @@ void check_relations(const std::vector<Primitive>& primitives,
                              std::abs(line.point[0]) + std::abs(line.point[1]) +
                              std::abs(line.point[2]) + line.radius;
         if (!(off <= 1e-9 * scale)) fail((what + ": coaxial member off the axis").c_str(), off);
+      }
+    }
+    if (relation.kind == ClusterRelation::Kind::Coplanar) {
+      // Planes of one direction (checked above) through one plane, to round-off.
+      const Primitive& first = primitives[relation.clusters[0]];
+      for (const std::uint32_t c : relation.clusters) {
+        const Vec3& p = primitives[c].point;
+        if (primitives[c].type != PrimitiveType::Plane)
+          fail((what + ": coplanar surface is not a plane").c_str(), c);
+        const Vec3& n = first.axis;
+        const double off =
+            std::abs(n[0] * (p[0] - first.point[0]) + n[1] * (p[1] - first.point[1]) +
+                     n[2] * (p[2] - first.point[2]));
+        const double scale = std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) +
+                             std::abs(first.point[0]) + std::abs(first.point[1]) +
+                             std::abs(first.point[2]);
+        if (!(off <= 1e-9 * scale)) fail((what + ": coplanar member off the plane").c_str(), off);
       }
     }
     if (equal_radius)

@@ -434,9 +434,13 @@ std::vector<ClusterRelation> Denoiser::regularize(const std::vector<std::vector<
   regularity.significance = options_.relation_significance;
   // Equal radii do not lower the error of a snap: fandisk (four noise draws), anchor_dense,
   // couplingdown and mech-holes-shark at the automatic level moved by -0.9% to +0.9% in RMS
-  // (docs/method.md), so the denoiser keeps each cylinder's own radius. Spheres centred on axes
-  // do (-0.1% to -1.2% on the same runs where one was found, none worse), and stay.
+  // (docs/method.md), so the denoiser keeps each cylinder's own radius. Nor do coplanar
+  // fragments: the automatic levels of NumPy draws of fandisk and couplingdown moved by -0.4% to
+  // 0%, but the C++ fandisk table's plain K = 40 by +1.6% and its Taubin K = 60 by +2.2%, so each
+  // plane keeps its own offset. Spheres centred on axes do lower it (-0.1% to -1.2% on the same
+  // runs where one was found, none worse), and stay.
   regularity.equal_radii = false;
+  regularity.coplanar = false;
   return detail::regularize_inliers(primitives, points, weights, options_.refit_outlier_threshold,
                                     1e-12 * bounding_box_diagonal(mesh_), regularity);
 }

@@ -782,6 +782,178 @@ double chi_square_bound(double significance, std::size_t freedom) {
   return k * std::pow(1 - spread + significance * std::sqrt(spread), 3);
 }
 
+// A plane aligned with a group's direction, by where it is along it.
+struct AlignedPlane {
+  std::size_t cluster = 0;
+  Eigen::Vector3d centroid;  // its inliers' weighted centroid: the aligned plane's point
+  double offset = 0;         // direction · centroid
+  double variance = 0;       // the offset's
+  double weight = 0;         // Σ w
+};
+
+// Its offset along `direction` (that of its inliers' weighted centroid, where align_plane()
+// puts it), and how well it is known: the weighted mean of the inliers' offsets has variance
+// σ̂² Σw² / (Σw)², σ̂² their weighted mean square about it with the plane's 3 degrees of freedom
+// taken (floored at the resolution of its extent, as its direction's is).
+std::optional<AlignedPlane> aligned_plane(std::size_t cluster, const Eigen::Vector3d& direction,
+                                          std::span<const Vec3> points,
+                                          std::span<const double> weights) {
+  const std::size_t n = points.size();
+  if (n < 6) return std::nullopt;
+  AlignedPlane plane{cluster, Eigen::Vector3d::Zero()};
+  for (std::size_t k = 0; k < n; ++k) {
+    plane.weight += weights[k];
+    plane.centroid += weights[k] * to_eigen(points[k]);
+  }
+  if (!(plane.weight > 0)) return std::nullopt;
+  plane.centroid /= plane.weight;
+  plane.offset = direction.dot(plane.centroid);
+  double weight2 = 0, squares = 0, extent2 = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d e = to_eigen(points[k]) - plane.centroid;
+    const double r = direction.dot(e);
+    weight2 += weights[k] * weights[k];
+    squares += weights[k] * r * r;
+    extent2 += weights[k] * (e.squaredNorm() - r * r);
+  }
+  const double residual_variance = std::max(squares / plane.weight * double(n) / double(n - 3),
+                                            kResolution * kResolution * extent2 / plane.weight);
+  plane.variance = residual_variance * weight2 / (plane.weight * plane.weight);
+  return plane;
+}
+
+// The planes of `set` (aligned with `direction` through their inliers' weighted centroids) made
+// one plane through all their inliers, each keeping its side: the least-squares offset with the
+// direction fixed is the weighted mean of theirs. Appends the Coplanar relation.
+void share_one_plane(const Eigen::Vector3d& direction, const std::vector<std::size_t>& set,
+                     std::vector<Primitive>& primitives,
+                     const std::vector<std::vector<double>>& weights,
+                     std::vector<Relation>& relations) {
+  double weight = 0, weighted = 0;
+  for (const std::size_t c : set) {
+    double own = 0;
+    for (const double w : weights[c]) own += w;
+    weight += own;
+    weighted += own * direction.dot(to_eigen(primitives[c].point));
+  }
+  const double shared = weighted / weight;
+  for (const std::size_t c : set) {
+    const Eigen::Vector3d point = to_eigen(primitives[c].point);
+    primitives[c].point = to_vec3(point - (direction.dot(point) - shared) * direction);
+  }
+  relations.push_back({Relation::Kind::Coplanar, set, {}});
+}
+
+// Sets of a direction group's planes (aligned with its direction, of covariance
+// `direction_covariance`) that are one plane within the significance: the fragments
+// of one face that a hole, a boss or the hierarchy cut apart. Best-located first, each joins the
+// first set whose pooled offset it is within the significance of, counting both offsets'
+// variances and the direction's tilt over the distance between its centroid and the set's first
+// member's; else it starts one. A set must then be explained by one plane of the direction
+// through all its inliers as each member was by its own: the guard of the coaxial sets (the
+// significance corrected for the number of members), the worst member leaving first. Returns the
+// sets of two or more, as clusters, increasing.
+std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direction_covariance,
+                                                    std::vector<AlignedPlane> planes,
+                                                    double significance) {
+  std::stable_sort(planes.begin(), planes.end(), [](const AlignedPlane& a, const AlignedPlane& b) {
+    return a.variance < b.variance;
+  });
+  struct Set {
+    std::vector<std::size_t> planes;       // indices into `planes`
+    double information = 0, weighted = 0;  // Σ 1/variance, Σ offset/variance
+  };
+  const double bound = chi_square_bound(significance, 1);
+  std::vector<Set> sets;
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    std::size_t joined = sets.size();
+    for (std::size_t s = 0; s < sets.size() && joined == sets.size(); ++s) {
+      const double offset = planes[i].offset - sets[s].weighted / sets[s].information;
+      const Eigen::Vector3d apart = planes[i].centroid - planes[sets[s].planes[0]].centroid;
+      const double variance =
+          planes[i].variance + 1 / sets[s].information + apart.dot(direction_covariance * apart);
+      if (offset * offset <= bound * variance) joined = s;
+    }
+    if (joined == sets.size()) sets.emplace_back();
+    sets[joined].planes.push_back(i);
+    sets[joined].information += 1 / planes[i].variance;
+    sets[joined].weighted += planes[i].offset / planes[i].variance;
+  }
+  std::vector<std::vector<std::size_t>> coplanar;
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    // Moved out: a member that leaves starts a set of its own, which may reallocate `sets`.
+    std::vector<std::size_t> set = std::move(sets[s].planes);
+    while (set.size() > 1) {
+      // One plane through all the members' inliers: the weighted mean of their offsets.
+      double weight = 0, weighted = 0;
+      Eigen::Vector3d middle = Eigen::Vector3d::Zero();  // where the shared plane pivots
+      for (const std::size_t i : set) {
+        weight += planes[i].weight;
+        weighted += planes[i].weight * planes[i].offset;
+        middle += planes[i].weight * planes[i].centroid;
+      }
+      const double shared = weighted / weight;
+      middle /= weight;
+      const double member_bound = family_significance(significance, set.size());
+      std::size_t worst = set.size();
+      double worst_excess = 1;
+      for (std::size_t j = 0; j < set.size(); ++j) {
+        // The member's residual sum rises by its weight times the move², against the bound
+        // times its residual variance: the move against its offset's standard deviation, with
+        // the direction's tilt over its distance from where the shared plane pivots.
+        const AlignedPlane& plane = planes[set[j]];
+        const double moved = plane.offset - shared;
+        const Eigen::Vector3d apart = plane.centroid - middle;
+        const double excess = moved * moved /
+                              (member_bound * member_bound *
+                               (plane.variance + apart.dot(direction_covariance * apart)));
+        if (excess > worst_excess) {
+          worst_excess = excess;
+          worst = j;
+        }
+      }
+      if (worst == set.size()) break;
+      sets.push_back({{set[worst]}});
+      set.erase(set.begin() + static_cast<std::ptrdiff_t>(worst));
+    }
+    if (set.size() < 2) continue;
+    std::vector<std::size_t>& clusters = coplanar.emplace_back();
+    for (const std::size_t i : set) clusters.push_back(planes[i].cluster);
+    std::sort(clusters.begin(), clusters.end());
+  }
+  return coplanar;
+}
+
+// Each coplanar set of a group counts as one plane in its direction: the sum of its members'
+// information (their scatters, each about its own centroid) gives way to the union's (about the
+// union's centroid), which also holds how far apart the fragments lie, so the direction is known
+// better, and the group's direction and covariance are formed again from its information.
+void count_coplanar_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
+                           const std::vector<std::vector<std::size_t>>& sets,
+                           const std::vector<std::vector<Vec3>>& points) {
+  auto term = [](const Oriented& item) -> Eigen::Matrix3d {
+    return item.frame * item.covariance.inverse() * item.frame.transpose();
+  };
+  for (const std::vector<std::size_t>& set : sets) {
+    std::vector<Vec3> union_points;
+    for (const std::size_t c : set)
+      union_points.insert(union_points.end(), points[c].begin(), points[c].end());
+    const std::optional<Oriented> joined = oriented_plane(set[0], union_points);
+    if (!joined || !(joined->variance > 0)) continue;
+    for (const std::size_t i : group.members)
+      if (std::binary_search(set.begin(), set.end(), items[i].cluster))
+        group.information -= term(items[i]);
+    group.information += term(*joined);
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(group.information);
+  const Eigen::Vector3d direction = eigen.eigenvectors().col(0);
+  group.direction = direction.dot(group.direction) < 0 ? -direction : direction;
+  group.covariance.setZero();
+  for (int k = 1; k < 3; ++k)
+    group.covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
+                        eigen.eigenvalues()(k);
+}
+
 // Refits line l with its cylinders and the spheres `spheres` (indices into settled.surfaces) on
 // it, each sphere one parameter along it: while any member's residual sum rises by more than the
 // significance, corrected for the number of members, allows, the sphere whose rise is largest
@@ -1400,6 +1572,23 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     if (item && std::isfinite(item->variance) && item->variance > 0) items.push_back(*item);
   }
   std::vector<DirectionGroup> groups = group_directions(items, options);
+  // Each group's coplanar sets, found before the directions are made orthogonal: each counts as
+  // one plane in its group's direction.
+  std::vector<std::vector<std::vector<std::size_t>>> coplanar(groups.size());
+  if (options.coplanar)
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      std::vector<AlignedPlane> planes;
+      for (const std::size_t i : groups[g].members) {
+        const std::size_t c = items[i].cluster;
+        if (primitives[c].type != PrimitiveType::Plane) continue;
+        if (const std::optional<AlignedPlane> plane =
+                aligned_plane(c, groups[g].direction, points[c], weights[c]))
+          planes.push_back(*plane);
+      }
+      if (planes.size() < 2) continue;
+      coplanar[g] = coplanar_sets(groups[g].covariance, std::move(planes), options.significance);
+      if (!coplanar[g].empty()) count_coplanar_as_one(groups[g], items, coplanar[g], points);
+    }
   std::vector<std::pair<std::size_t, std::size_t>> orthogonal;
   if (options.orthogonal) orthogonal = orthogonalize(groups, options);
   std::vector<bool> constrained(groups.size(), false);
@@ -1429,6 +1618,8 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     std::sort(parallel.members.begin(), parallel.members.end());
     refitted[g] = parallel.members;
     if (parallel.members.size() >= 2) relations.push_back(std::move(parallel));
+    for (const std::vector<std::size_t>& set : coplanar[g])
+      share_one_plane(group.direction, set, primitives, weights, relations);
     align_cylinders(group.direction, group.covariance, std::move(cylinders), options.significance,
                     primitives, points, weights, relations, settled);
   }

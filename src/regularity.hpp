@@ -2,9 +2,9 @@
 // Relations between the primitives of a segmentation, and the refit that makes them exact (after
 // GlobFit, Li et al. 2011): planes' normals and cylinders' axes that agree within their fits'
 // uncertainty share one direction, estimated from all of them, directions at right angles within
-// it are made orthogonal, cylinders of one direction whose axes agree share one axis line, spheres
-// centred on such a line within it are centred on it, and cylinders and spheres whose radii agree
-// share one radius.
+// it are made orthogonal, planes of one direction whose offsets agree are made one plane, cylinders
+// of one direction whose axes agree share one axis line, spheres centred on such a line within it
+// are centred on it, and cylinders and spheres whose radii agree share one radius.
 
 #include <cstddef>
 #include <span>
@@ -24,6 +24,9 @@ struct RegularityOptions {
   double max_angle_degrees = 20;
   /// Make directions at right angles within the significance exactly orthogonal.
   bool orthogonal = true;
+  /// Make planes of one direction whose offsets along it agree within the significance one
+  /// plane (the fragments of one face): one offset instead of one each.
+  bool coplanar = true;
   /// Centre a sphere whose centre is on a cylinder's axis line within the significance on it (a
   /// ball end, a hemispherical cap): one parameter along the line instead of three; and three
   /// spheres or more on one line of a direction made exact (a revolved profile's arcs).
@@ -50,7 +53,9 @@ struct Relation {
 /// they are), makes the groups' directions that are at right angles within the significance
 /// exactly orthogonal (RegularityOptions::orthogonal), and refits every member of a group of two
 /// or more, or of a group in a right angle, with the group's direction: a plane through its
-/// inliers' weighted centroid, a cylinder by geometric least squares of its inliers' circle,
+/// inliers' weighted centroid, or with the planes coplanar with it through all their inliers
+/// (RegularityOptions::coplanar: one offset; the set counts as one plane in the group's direction,
+/// before the right angles), a cylinder by geometric least squares of its inliers' circle,
 /// jointly with the cylinders coaxial with it (one axis line, one radius each). points[c] and
 /// weights[c] are cluster c's inlier vertices (input units) and their weights; a cluster with too
 /// few to estimate its direction's uncertainty is left alone. Deterministic: clusters are visited
@@ -60,16 +65,16 @@ struct Relation {
 /// made exact with no cylinder on it, and cylinders and spheres whose radii agree within the
 /// significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with the
 /// surfaces on their lines (each free sphere on its own centre). Returns the relations made
-/// exact: each direction group's members that were refitted with its direction, then each
-/// coaxial set of its cylinders (spheres added when they join it), in that order, then the
-/// coaxial sets a sphere started with one cylinder, then the lines of spheres alone, then the
-/// classes of equal radii, then the right angles by their members.
+/// exact: each direction group's members that were refitted with its direction, then its coplanar
+/// sets, then each coaxial set of its cylinders (spheres added when they join it), in that order,
+/// then the coaxial sets a sphere started with one cylinder, then the lines of spheres alone, then
+/// the classes of equal radii, then the right angles by their members.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,
                                  const RegularityOptions& options);
 
-/// Orders relations by kind (parallel, coaxial, orthogonal), then by their clusters.
+/// Orders relations by kind (ClusterRelation::Kind's order), then by their clusters.
 void sort_relations(std::vector<ClusterRelation>& relations);
 
 /// A cluster's inliers: its points within `threshold` robust deviations (1.4826 × the median

@@ -31,6 +31,8 @@ std::string_view to_string(ClusterRelation::Kind kind) {
       return "orthogonal";
     case ClusterRelation::Kind::EqualRadius:
       return "equal_radius";
+    case ClusterRelation::Kind::Coplanar:
+      return "coplanar";
   }
   return "unknown";
 }

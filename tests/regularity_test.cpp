@@ -141,6 +141,80 @@ TEST(Regularity, ParallelPlanesShareOneNormalNearerTheTruth) {
   }
 }
 
+// The fragments of one face (a plate's top cut in three by holes or by the hierarchy) become one
+// plane through all their points, each keeping its side; the face below it, and a step 2% of the
+// fragments' size above them (13 standard deviations of the offset, with the direction's tilt
+// over the distance), keep their own places.
+TEST(Regularity, FragmentsOfOneFaceBecomeOnePlane) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  double shared_error = 0, parallel_error = 0, own_error = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{
+        noisy_plane(z, {0, 0, 0}, 1, 0.01, rng), noisy_plane(z, {1.5, 0, 0}, 1, 0.01, rng),
+        noisy_plane(z, {0, 1.5, 0}, 0.5, 0.01, rng), noisy_plane(-z, {0.7, 0.7, -1}, 1, 0.01, rng),
+        noisy_plane(z, {1.5, 1.5, 0.02}, 1, 0.01, rng)};
+    std::vector<Primitive> planes;
+    for (const Cluster& cluster : clusters) planes.push_back(fitted_plane(cluster));
+    const std::vector<Primitive> own = planes;
+    std::vector<Primitive> parallel_only = planes;
+    {
+      std::vector<std::vector<Vec3>> points;
+      std::vector<std::vector<double>> weights;
+      for (const Cluster& c : clusters) {
+        points.push_back(c.points);
+        weights.push_back(c.weights);
+      }
+      detail::RegularityOptions options;
+      options.coplanar = false;
+      detail::regularize(parallel_only, points, weights, options);
+    }
+    const Relations relations = regularize(planes, clusters);
+    ASSERT_EQ(relations.size(), 2u);
+    EXPECT_EQ(relations[0], (Relations::value_type{Kind::Parallel, {0, 1, 2, 3, 4}}));
+    EXPECT_EQ(relations[1], (Relations::value_type{Kind::Coplanar, {0, 1, 2}}));
+    // One plane: each fragment's point on the first's plane, each keeping its side.
+    const Eigen::Vector3d normal = to_eigen(planes[0].axis);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(normal.dot(to_eigen(planes[c].point) - to_eigen(planes[0].point)), 0, 1e-14);
+      EXPECT_GT(to_eigen(planes[c].axis).dot(to_eigen(own[c].axis)), 0);
+    }
+    // Through all their points: the least-squares offset, which moving either way only raises.
+    auto squares = [&](double shift) {
+      double sum = 0;
+      for (int c = 0; c < 3; ++c)
+        for (const Vec3& p : clusters[c].points) {
+          const double d = normal.dot(to_eigen(p) - to_eigen(planes[0].point)) - shift;
+          sum += d * d;
+        }
+      return sum;
+    };
+    EXPECT_LT(squares(0), squares(1e-6));
+    EXPECT_LT(squares(0), squares(-1e-6));
+    // The others keep their offsets: each through its own points' centroid.
+    EXPECT_NEAR(planes[3].point[2], own[3].point[2], 1e-14);
+    EXPECT_NEAR(planes[4].point[2], own[4].point[2], 1e-14);
+    // Nearer the truth (z = 0) over the fragments than their own planes: RMS heights above it.
+    auto height = [](const Primitive& plane, const Vec3& at) {
+      const Eigen::Vector3d n = to_eigen(plane.axis), p = to_eigen(plane.point);
+      return p.z() - (n.x() * (at[0] - p.x()) + n.y() * (at[1] - p.y())) / n.z();
+    };
+    for (int c = 0; c < 3; ++c)
+      for (const Vec3& p : clusters[c].points) {
+        shared_error += std::pow(height(planes[c], p), 2) / 1200;
+        parallel_error += std::pow(height(parallel_only[c], p), 2) / 1200;
+        own_error += std::pow(height(own[c], p), 2) / 1200;
+      }
+  }
+  std::printf(
+      "fragments of one face: RMS height above the truth %.3g as one plane, %.3g parallel only, "
+      "%.3g own fits\n",
+      std::sqrt(shared_error / 20), std::sqrt(parallel_error / 20), std::sqrt(own_error / 20));
+  EXPECT_LT(shared_error, parallel_error);
+  EXPECT_LT(parallel_error, own_error);
+}
+
 TEST(Regularity, DirectionsFartherApartThanTheirUncertaintyStayApart) {
   // A 2 degree draft: with noise of 0.1% of the size the normals are known to about 0.01 degree.
   std::mt19937_64 rng(3);

@@ -557,6 +557,41 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
     EXPECT_GE(centred.size() + 1, on_axis.size());
     // couplingdown's seven spheres centred on one line along z, with no cylinder there: one set.
     EXPECT_EQ(spheres_alone, name == std::string("couplingdown.off") ? 1u : 0u);
+
+    // Coplanar: exactly the planes whose own fits are one plane (normals within 1e-6 radians up
+    // to their side, offsets within 1e-9 of the diagonal: couplingdown's faces cut apart by its
+    // holes, sets of 3 and 4), each set made one plane to round-off.
+    Groups one_plane;
+    std::vector<bool> grouped(before.size(), false);
+    for (std::uint32_t a = 0; a < before.size(); ++a) {
+      if (before[a].primitive.type != PrimitiveType::Plane || grouped[a]) continue;
+      std::vector<std::uint32_t> group{a};
+      for (std::uint32_t b = a + 1; b < before.size(); ++b)
+        if (before[b].primitive.type == PrimitiveType::Plane && !grouped[b] &&
+            angle_between_lines_degrees(before[a].primitive.axis, before[b].primitive.axis) <
+                1e-6 * 180 / std::numbers::pi &&
+            std::abs(dot(before[a].primitive.axis,
+                         {before[b].primitive.point[0] - before[a].primitive.point[0],
+                          before[b].primitive.point[1] - before[a].primitive.point[1],
+                          before[b].primitive.point[2] - before[a].primitive.point[2]})) <
+                1e-9 * diagonal) {
+          group.push_back(b);
+          grouped[b] = true;
+        }
+      if (group.size() > 1) one_plane.push_back(group);
+    }
+    const Groups coplanar = clusters_of(relations, ClusterRelation::Kind::Coplanar);
+    std::printf("%s: %zu coplanar sets, %zu sets of planes in one plane\n", name, coplanar.size(),
+                one_plane.size());
+    EXPECT_EQ(coplanar, one_plane);
+    for (const auto& set : coplanar)
+      for (const std::uint32_t c : set) {
+        const Primitive &first = after[set[0]].primitive, &plane = after[c].primitive;
+        EXPECT_LT(std::abs(dot(first.axis,
+                               {plane.point[0] - first.point[0], plane.point[1] - first.point[1],
+                                plane.point[2] - first.point[2]})),
+                  1e-12 * diagonal);
+      }
   }
 }
 

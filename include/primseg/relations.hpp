@@ -40,6 +40,10 @@ struct ClusterRelation {
     /// of a bolt circle, fillets of one radius, the spherical seats of a pattern, a cylinder and
     /// the hemisphere that closes it, the fragments of one cylinder (which are coaxial too).
     EqualRadius,
+    /// Planes of one direction made one plane, each keeping its side: the fragments of one face
+    /// cut apart by a hole, a boss, a slot or the hierarchy. They are also part of a Parallel
+    /// relation.
+    Coplanar,
   };
   Kind kind = Kind::Parallel;
   /// Cluster labels, increasing; two or more (Orthogonal: one or more, its lowest below the
@@ -49,7 +53,7 @@ struct ClusterRelation {
   std::vector<std::uint32_t> orthogonal_to;
 };
 
-/// "parallel", "coaxial", "orthogonal" or "equal_radius".
+/// "parallel", "coaxial", "orthogonal", "equal_radius" or "coplanar".
 std::string_view to_string(ClusterRelation::Kind kind);
 
 /// Options of regularize_clusters().
@@ -75,8 +79,8 @@ struct RelationOptions {
 /// Throws InvalidInputError when an option is out of its range.
 void validate(const RelationOptions& options);
 
-/// Finds the parallel, orthogonal, coaxial and equal-radius relations among the primitives of a
-/// level's clusters and makes them exact, in place.
+/// Finds the parallel, orthogonal, coplanar, coaxial and equal-radius relations among the
+/// primitives of a level's clusters and makes them exact, in place.
 ///
 /// `reports` are the level's clusters as describe_clusters() or refine_boundaries() report them
 /// (reports[c] is label c of `segmentation`; shape (K)). Planes and cylinders take part, and
@@ -84,14 +88,16 @@ void validate(const RelationOptions& options);
 /// come from its inlier vertices (each mesh vertex once, weighted by its corners' weights in the
 /// hierarchy); clusters with too few vertices to estimate it (6 for a plane, 12 for a cylinder)
 /// stay out. Every member of a relation is refitted: a plane through its inliers' weighted centroid
-/// with the group's normal, a cylinder by geometric least squares with the group's axis direction,
-/// jointly with the cylinders and spheres coaxial with it (one axis line; one radius each, and each
-/// sphere one position along the line) and the cylinders and spheres of equal radius (one radius,
-/// each on its own line or centre). Its report's `primitive`, `rms` and `max` are replaced (`rms`
-/// and `max` measured as describe_clusters() does, on all the cluster's vertices); every other
-/// report is left bit for bit. Deterministic, O(F log F).
+/// with the group's normal, or with its coplanar fragments through all their inliers (one offset;
+/// a coplanar set counts as one plane in the group's normal), a cylinder by geometric least squares
+/// with the group's axis direction, jointly with the cylinders and spheres coaxial with it (one
+/// axis line; one radius each, and each sphere one position along the line) and the cylinders and
+/// spheres of equal radius (one radius, each on its own line or centre). Its report's `primitive`,
+/// `rms` and `max` are replaced (`rms` and `max` measured as describe_clusters() does, on all the
+/// cluster's vertices); every other report is left bit for bit. Deterministic, O(F log F).
 ///
-/// Returns the relations made exact, ordered by kind (parallel first), then by their clusters.
+/// Returns the relations made exact, ordered by kind (parallel, coaxial, orthogonal,
+/// equal_radius, coplanar), then by their clusters.
 /// Throws InvalidInputError when the segmentation or the reports do not match the hierarchy.
 std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
                                                  const Segmentation& segmentation,

@@ -1,5 +1,5 @@
 // The relations of a page written by `primseg view --regularize`: for every level of up to a
-// number of clusters, the parallel, coaxial, orthogonal and equal-radius sets `primseg cut
+// number of clusters, the parallel, coaxial, orthogonal, equal-radius and coplanar sets `primseg cut
 // --clusters K --regularize` finds, and the fits they make exact (layout in data.js).
 
 import { lowerBound } from './hierarchy.js';
@@ -10,6 +10,7 @@ export const RELATION_MEANINGS = {
   coaxial: 'cylinders made one axis line, each keeping its radius, and spheres centred on it',
   orthogonal: 'two directions made exactly orthogonal (the clusters before | against those after)',
   equal_radius: 'cylinders and spheres made one radius, each keeping its axis line or centre',
+  coplanar: 'planes made one plane, each keeping its side: the fragments of one face',
 };
 
 export class LevelRelations {
