@@ -476,6 +476,35 @@ test('fandisk --regularize: each level lists primseg cut --regularize\'s relatio
   await page.close();
 });
 
+test('couplingdown --regularize: its faces cut apart by holes are listed as coplanar sets, as cut --regularize finds them', async () => {
+  execFileSync('tar', ['xzf', '/usr/share/doc/libcgal-dev/data.tar.gz', '-C', work, 'data/meshes/couplingdown.off']);
+  const mesh = join(work, 'data/meshes/couplingdown.off'), tree = join(work, 'couplingdown.tree');
+  const html = join(work, 'couplingdown-relations.html');
+  primseg('segment', mesh, '--tree', tree, '--quiet');
+  primseg('view', mesh, '--tree', tree, '--clusters', '30', '--regularize', '-o', html, '--quiet');
+  const labelsFile = join(work, 'c.labels'), jsonFile = join(work, 'c.json');
+  primseg('cut', tree, '--clusters', '30', '--regularize', '--labels', labelsFile, '--json', jsonFile, '--quiet');
+  const cliLabels = readLabels(labelsFile), cli = JSON.parse(readFileSync(jsonFile, 'utf8'));
+  const { page, errors } = await openViewer(browser, html);
+  const shown = await page.evaluate(async () => {
+    const viewer = await window.primseg.ready;
+    viewer.setClusters(30);
+    return { labels: viewer.labels(), relations: viewer.currentRelations(),
+      rows: Array.from(document.querySelectorAll('#relations .relation'), (row) => ({ text: row.textContent, title: row.title })) };
+  });
+  const cliOf = new Map();
+  shown.labels.forEach((p, f) => cliOf.set(p, cliLabels[f]));
+  const relations = shown.relations.map((r) => ({ ...r, clusters: r.clusters.map((id) => cliOf.get(id)).sort((a, b) => a - b),
+    ...(r.orthogonal_to ? { orthogonal_to: r.orthogonal_to.map((id) => cliOf.get(id)).sort((a, b) => a - b) } : {}) }));
+  assert.deepEqual(relations, cli.relations);
+  const coplanar = shown.rows.filter((row) => row.text.startsWith('coplanar: '));
+  assert.equal(coplanar.length, cli.relations.filter((r) => r.kind === 'coplanar').length);
+  assert.ok(coplanar.length >= 2, `${coplanar.length} coplanar sets listed`);
+  for (const row of coplanar) assert.match(row.title, /one plane/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('fandisk --regularize: a relation under the pointer, or clicked, leaves only its clusters in colour', async () => {
   const html = join(work, 'fandisk-relations.html');
   const { page, errors } = await openViewer(browser, html, { test: true, width: 640, height: 480 });
