@@ -96,6 +96,26 @@ def test_regularized_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path)
     assert fandisk_tree.clusters(30, refine=2) != clusters
 
 
+def test_coplanar_faces_of_a_part_share_one_plane(cgal_mesh):
+    # couplingdown's faces cut apart by its holes: at its automatic level each coplanar set is one
+    # plane (one normal up to its side, every member's point on it), and a plane's members are
+    # also members of one parallel relation.
+    tree = primseg.segment(primseg.read_mesh(str(cgal_mesh("couplingdown.off"))))
+    relations = tree.relations("auto", refine=2)
+    clusters = tree.clusters("auto", refine=2, regularize=True)
+    coplanar = [r["clusters"] for r in relations if r["kind"] == "coplanar"]
+    assert len(coplanar) == 2 and sorted(len(s) for s in coplanar) == [3, 4]
+    parallel = [set(r["clusters"]) for r in relations if r["kind"] == "parallel"]
+    for members in coplanar:
+        assert any(set(members) <= group for group in parallel)
+        normal = np.array(clusters[members[0]]["params"]["normal"])
+        point = np.array(clusters[members[0]]["params"]["point"])
+        for c in members:
+            assert clusters[c]["type"] == "plane"
+            assert abs(abs(np.array(clusters[c]["params"]["normal"]) @ normal) - 1) < 1e-15
+            assert abs((np.array(clusters[c]["params"]["point"]) - point) @ normal) < 1e-14
+
+
 def test_relation_options_are_the_clis(cli, fandisk, fandisk_tree, tmp_path):
     # The options of --regularize, as keywords: the same relations and fits as the CLI's, fewer
     # equal radii with a tighter radius bound, and out-of-range values refused.
