@@ -2,11 +2,12 @@
 /// @file relations.hpp
 /// Design intent between the fitted primitives of a segmentation: plane normals and cylinder axes
 /// that agree within their fits' uncertainty (opposite faces of a box, a shaft and its end faces),
-/// directions at right angles, cylinders that share an axis line and spheres centred on it (a
-/// stepped shaft, the fragments of one bore, a ball end, a hole's spherical seat) and cylinders and
-/// spheres of one radius (a bolt circle's holes). Making
-/// these relations exact is what reverse engineering wants of a scanned part's fits: a box with
-/// parallel faces, a shaft with one axis (after GlobFit, Li et al. 2011).
+/// directions at right angles, planes in one plane (the fragments of one face cut apart by holes),
+/// cylinders that share an axis line and spheres centred on it (a stepped shaft, the fragments of
+/// one bore, a ball end, a hole's spherical seat) and cylinders and spheres of one radius (a bolt
+/// circle's holes). Making these relations exact is what reverse engineering wants of a scanned
+/// part's fits: a box with parallel faces, a flange face in one plane, a shaft with one axis (after
+/// GlobFit, Li et al. 2011).
 
 #include <cstdint>
 #include <memory>
