@@ -1577,6 +1577,10 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
   std::vector<std::vector<std::vector<std::size_t>>> coplanar(groups.size());
   if (options.coplanar)
     for (std::size_t g = 0; g < groups.size(); ++g) {
+      if (std::count_if(groups[g].members.begin(), groups[g].members.end(), [&](std::size_t i) {
+            return primitives[items[i].cluster].type == PrimitiveType::Plane;
+          }) < 2)
+        continue;
       std::vector<AlignedPlane> planes;
       for (const std::size_t i : groups[g].members) {
         const std::size_t c = items[i].cluster;
