@@ -8,10 +8,10 @@
 #include <string>
 
 #include "cluster_numbering.hpp"
-#include "leaf_order.hpp"
 #include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
+#include "tree_nodes.hpp"
 #include "triangle_corners.hpp"
 #include "working_primitive.hpp"
 
@@ -68,25 +68,9 @@ std::vector<std::uint32_t> label_faces(const Hierarchy& hierarchy,
 }  // namespace
 
 Segmentation cut_by_count(const Hierarchy& hierarchy, std::uint32_t clusters) {
-  const std::uint32_t f = hierarchy.face_count();
-  if (clusters < 1 || clusters > f)
-    throw InvalidInputError("the number of clusters must be between 1 and " + std::to_string(f) +
-                            ", not " + std::to_string(clusters));
-  const std::uint32_t real = f - hierarchy.component_count();
-  const std::uint32_t applied = std::min(real, f - clusters);
-  // The kept nodes: applied merges' nodes whose parent is not applied, and leaves whose parent
-  // is not applied.
+  std::vector<std::uint32_t> nodes = detail::level_nodes(hierarchy, clusters);
   std::vector<std::uint32_t> kept(hierarchy.node_count(), kNone);
-  std::vector<std::uint32_t> nodes;
-  const auto& parents = hierarchy.parents();
-  auto is_applied = [&](std::uint32_t node) { return node >= f && node - f < applied; };
-  for (std::uint32_t node = 0; node < f + applied; ++node) {
-    const std::uint32_t parent = parents[node];
-    if (parent == kNone || !is_applied(parent)) {
-      kept[node] = static_cast<std::uint32_t>(nodes.size());
-      nodes.push_back(node);
-    }
-  }
+  for (std::uint32_t c = 0; c < nodes.size(); ++c) kept[nodes[c]] = c;
   auto labels = label_faces(hierarchy, kept);
   return number_clusters(hierarchy, std::move(labels), std::move(nodes));
 }
@@ -206,12 +190,8 @@ std::vector<ClusterReport> describe_nodes(const Hierarchy& hierarchy,
                                           std::span<const std::uint32_t> nodes,
                                           const DescribeOptions& options) {
   const DualGraph& graph = hierarchy.graph();
-  const std::uint32_t f = hierarchy.face_count();
-  const auto merges = hierarchy.merges();
-  for (std::uint32_t node : nodes)
-    if (node >= hierarchy.node_count() || (node >= f && merges[node - f].trailing))
-      throw InvalidInputError("describe_nodes: " + std::to_string(node) +
-                              " is not a node of the tree, or joins components");
+  for (const std::uint32_t node : nodes)
+    detail::check_cluster_node(hierarchy, node, "describe_nodes");
   const detail::LeafOrder leaves(hierarchy);
 
   std::vector<ClusterReport> reports(nodes.size());

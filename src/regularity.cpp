@@ -49,6 +49,21 @@ struct DirectionGroup {
   std::vector<std::size_t> members;                      // indices into the Oriented items
 };
 
+// An item's information about its group's direction: Fᵢ Cᵢ⁻¹ Fᵢᵀ.
+Eigen::Matrix3d direction_information(const Oriented& item) {
+  return item.frame * item.covariance.inverse() * item.frame.transpose();
+}
+
+// The group's direction and its covariance, from its information.
+void form_direction(DirectionGroup& group) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(group.information);
+  group.direction = eigen.eigenvectors().col(0);
+  group.covariance.setZero();
+  for (int k = 1; k < 3; ++k)
+    group.covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
+                        eigen.eigenvalues()(k);
+}
+
 double angle_between_lines(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), std::abs(a.dot(b)));
 }
@@ -544,30 +559,35 @@ std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
     if (best == groups.size()) groups.emplace_back().direction = item.direction;
     DirectionGroup& group = groups[best];
     group.members.push_back(i);
-    group.information += item.frame * item.covariance.inverse() * item.frame.transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(group.information);
-    group.direction = eigen.eigenvectors().col(0);
-    group.covariance.setZero();
-    for (int k = 1; k < 3; ++k)
-      group.covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
-                          eigen.eigenvalues()(k);
+    group.information += direction_information(item);
+    form_direction(group);
   }
   return groups;
+}
+
+// Σ w and the weighted centroid of `points` (not finite when Σ w is 0).
+struct WeightedCentroid {
+  Eigen::Vector3d centroid;
+  double weight = 0;
+};
+WeightedCentroid weighted_centroid(std::span<const Vec3> points, std::span<const double> weights) {
+  WeightedCentroid middle{Eigen::Vector3d::Zero()};
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    middle.weight += weights[k];
+    middle.centroid += weights[k] * to_eigen(points[k]);
+  }
+  middle.centroid /= middle.weight;
+  return middle;
 }
 
 // The plane with normal ±`direction` (its own side) through its inliers' weighted centroid;
 // false (the plane unchanged) when they weigh nothing.
 bool align_plane(Primitive& plane, const Eigen::Vector3d& direction, std::span<const Vec3> points,
                  std::span<const double> weights) {
-  double total = 0;
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    total += weights[k];
-    centroid += weights[k] * to_eigen(points[k]);
-  }
-  if (!(total > 0)) return false;
+  const WeightedCentroid middle = weighted_centroid(points, weights);
+  if (!(middle.weight > 0)) return false;
   plane.axis = to_vec3(direction.dot(to_eigen(plane.axis)) < 0 ? -direction : direction);
-  plane.point = to_vec3(centroid / total);
+  plane.point = to_vec3(middle.centroid);
   return true;
 }
 
@@ -800,13 +820,10 @@ std::optional<AlignedPlane> aligned_plane(std::size_t cluster, const Eigen::Vect
                                           std::span<const double> weights) {
   const std::size_t n = points.size();
   if (n < 6) return std::nullopt;
-  AlignedPlane plane{cluster, Eigen::Vector3d::Zero()};
-  for (std::size_t k = 0; k < n; ++k) {
-    plane.weight += weights[k];
-    plane.centroid += weights[k] * to_eigen(points[k]);
-  }
-  if (!(plane.weight > 0)) return std::nullopt;
-  plane.centroid /= plane.weight;
+  const WeightedCentroid middle = weighted_centroid(points, weights);
+  if (!(middle.weight > 0)) return std::nullopt;
+  AlignedPlane plane{cluster, middle.centroid};
+  plane.weight = middle.weight;
   plane.offset = direction.dot(plane.centroid);
   double weight2 = 0, squares = 0, extent2 = 0;
   for (std::size_t k = 0; k < n; ++k) {
@@ -931,9 +948,7 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
 void count_coplanar_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
                            const std::vector<std::vector<std::size_t>>& sets,
                            const std::vector<std::vector<Vec3>>& points) {
-  auto term = [](const Oriented& item) -> Eigen::Matrix3d {
-    return item.frame * item.covariance.inverse() * item.frame.transpose();
-  };
+  const Eigen::Vector3d before = group.direction;
   for (const std::vector<std::size_t>& set : sets) {
     std::vector<Vec3> union_points;
     for (const std::size_t c : set)
@@ -942,16 +957,11 @@ void count_coplanar_as_one(DirectionGroup& group, const std::vector<Oriented>& i
     if (!joined || !(joined->variance > 0)) continue;
     for (const std::size_t i : group.members)
       if (std::binary_search(set.begin(), set.end(), items[i].cluster))
-        group.information -= term(items[i]);
-    group.information += term(*joined);
+        group.information -= direction_information(items[i]);
+    group.information += direction_information(*joined);
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(group.information);
-  const Eigen::Vector3d direction = eigen.eigenvectors().col(0);
-  group.direction = direction.dot(group.direction) < 0 ? -direction : direction;
-  group.covariance.setZero();
-  for (int k = 1; k < 3; ++k)
-    group.covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
-                        eigen.eigenvalues()(k);
+  form_direction(group);
+  if (group.direction.dot(before) < 0) group.direction = -group.direction;
 }
 
 // Refits line l with its cylinders and the spheres `spheres` (indices into settled.surfaces) on

@@ -11,11 +11,11 @@
 #include <string>
 
 #include "cluster_numbering.hpp"
-#include "leaf_order.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "primseg/geometric_fit.hpp"
 #include "regularity.hpp"
+#include "tree_nodes.hpp"
 #include "triangle_corners.hpp"
 #include "working_primitive.hpp"
 
@@ -236,17 +236,12 @@ LevelRegularizer::LevelRegularizer(const Hierarchy& hierarchy, std::span<const s
                                    const RelationOptions& options, unsigned threads)
     : hierarchy_(&hierarchy), options_(options), nodes_(std::make_unique<Nodes>()) {
   validate(options);
-  const std::uint32_t f = hierarchy.face_count();
-  const auto merges = hierarchy.merges();
   if (reports.size() != nodes.size())
     throw InvalidInputError("LevelRegularizer: " + std::to_string(reports.size()) +
                             " reports for " + std::to_string(nodes.size()) + " nodes");
   for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const std::uint32_t node = nodes[i];
-    if (node >= hierarchy.node_count() || (node >= f && merges[node - f].trailing))
-      throw InvalidInputError("LevelRegularizer: " + std::to_string(node) +
-                              " is not a node of the tree, or joins components");
-    if (i > 0 && node <= nodes[i - 1])
+    detail::check_cluster_node(hierarchy, nodes[i], "LevelRegularizer");
+    if (i > 0 && nodes[i] <= nodes[i - 1])
       throw InvalidInputError("LevelRegularizer: the nodes are not strictly increasing");
   }
   Nodes& n = *nodes_;
@@ -310,29 +305,13 @@ LevelRegularizer& LevelRegularizer::operator=(LevelRegularizer&&) noexcept = def
 RegularizedLevel LevelRegularizer::level(std::uint32_t clusters) const {
   const Hierarchy& hierarchy = *hierarchy_;
   Nodes& n = *nodes_;
-  const std::uint32_t f = hierarchy.face_count();
-  if (clusters < 1 || clusters > f)
-    throw InvalidInputError("the number of clusters must be between 1 and " + std::to_string(f) +
-                            ", not " + std::to_string(clusters));
-  // cut_by_count()'s nodes: the applied merges' nodes and the leaves whose parent is not applied,
-  // that is the children of the merges not applied (the root alone when all are).
-  const auto merges = hierarchy.merges();
-  const std::uint32_t real = f - hierarchy.component_count();
-  const std::uint32_t applied = std::min(real, f - clusters);
   std::vector<std::size_t> members;  // indices into n.ids
-  auto add = [&](std::uint32_t node) {
+  for (const std::uint32_t node : detail::level_nodes(hierarchy, clusters)) {
     const auto at = std::lower_bound(n.ids.begin(), n.ids.end(), node);
     if (at == n.ids.end() || *at != node)
       throw InvalidInputError("LevelRegularizer: node " + std::to_string(node) + " of level " +
                               std::to_string(clusters) + " was not given");
     members.push_back(static_cast<std::size_t>(at - n.ids.begin()));
-  };
-  if (applied == merges.size()) {
-    add(hierarchy.node_count() - 1);
-  } else {
-    for (std::size_t i = applied; i < merges.size(); ++i)
-      for (const std::uint32_t child : {merges[i].first, merges[i].second})
-        if (child < f + applied) add(child);
   }
   // Numbered as cut_by_count() numbers them: by decreasing area, ties by lowest face.
   detail::sort_into_label_order(
