@@ -507,10 +507,24 @@ std::optional<CoaxialFit> fit_alone(const Primitive& cylinder, const Eigen::Vect
   return fit_coaxial(direction, centre, {&alone, 1});
 }
 
+// The weighted mean of direction · x over the points of `clusters`.
+double middle_along(const Eigen::Vector3d& direction, std::span<const std::size_t> clusters,
+                    const std::vector<std::vector<Vec3>>& points,
+                    const std::vector<std::vector<double>>& weights) {
+  double total = 0, sum = 0;
+  for (const std::size_t c : clusters)
+    for (std::size_t i = 0; i < points[c].size(); ++i) {
+      total += weights[c][i];
+      sum += weights[c][i] * direction.dot(to_eigen(points[c][i]));
+    }
+  return total > 0 ? sum / total : 0;
+}
+
 // A cylinder of a direction group, refitted alone with the group's direction.
 struct AlignedCylinder {
   std::size_t cluster = 0;
   CoaxialFit fit;
+  double middle = 0;  // where its inliers are along the direction: middle_along()
 };
 
 // The information-weighted mean of axis positions: where a coaxial set's axis is, and how well.
@@ -591,10 +605,22 @@ bool align_plane(Primitive& plane, const Eigen::Vector3d& direction, std::span<c
   return true;
 }
 
+// The covariance of a direction's tilt (radians², 3x3) in orthonormal_pair(direction)
+// coordinates.
+Eigen::Matrix2d tilt_in_frame(const Eigen::Vector3d& direction, const Eigen::Matrix3d& covariance) {
+  const auto [u, v] = orthonormal_pair(direction);
+  Eigen::Matrix<double, 3, 2> frame;
+  frame << u, v;
+  return frame.transpose() * covariance * frame;
+}
+
 // Sets of cylinders (indices into `cylinders`, sorted best-located first) whose axes are one line
-// within the significance: each joins the first set whose information-weighted axis it is near.
-// An axis known less well than the radius (a nearly flat cylinder) joins none.
+// within the significance: each joins the first set whose information-weighted axis it is near,
+// counting the direction's tilt (`tilt`, radians², orthonormal_pair(direction) coordinates) over
+// the distance along it from the set's first member, as the coplanar sets do. An axis known less
+// well than the radius (a nearly flat cylinder) joins none.
 std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCylinder>& cylinders,
+                                                   const Eigen::Matrix2d& tilt,
                                                    double significance2) {
   std::vector<std::vector<std::size_t>> sets;
   std::vector<PooledCentre> pooled;
@@ -605,7 +631,9 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
     for (std::size_t s = 0; located && s < sets.size(); ++s) {
       const Eigen::Matrix2d covariance = pooled[s].covariance();
       const Eigen::Vector2d delta = fit.centre - covariance * pooled[s].weighted;
-      if (delta.dot((fit.centre_covariance + covariance).ldlt().solve(delta)) <= significance2) {
+      const double apart = cylinders[k].middle - cylinders[sets[s][0]].middle;
+      const Eigen::Matrix2d combined = fit.centre_covariance + covariance + apart * apart * tilt;
+      if (delta.dot(combined.ldlt().solve(delta)) <= significance2) {
         joined = s;
         break;
       }
@@ -655,28 +683,6 @@ void place_cylinder(Primitive& cylinder, const Eigen::Vector3d& direction,
   cylinder.radius = radius;
 }
 
-// The weighted mean of direction · x over the points of `clusters`.
-double middle_along(const Eigen::Vector3d& direction, std::span<const std::size_t> clusters,
-                    const std::vector<std::vector<Vec3>>& points,
-                    const std::vector<std::vector<double>>& weights) {
-  double total = 0, sum = 0;
-  for (const std::size_t c : clusters)
-    for (std::size_t i = 0; i < points[c].size(); ++i) {
-      total += weights[c][i];
-      sum += weights[c][i] * direction.dot(to_eigen(points[c][i]));
-    }
-  return total > 0 ? sum / total : 0;
-}
-
-// The covariance of a direction's tilt (radians², 3x3) in orthonormal_pair(direction)
-// coordinates.
-Eigen::Matrix2d tilt_in_frame(const Eigen::Vector3d& direction, const Eigen::Matrix3d& covariance) {
-  const auto [u, v] = orthonormal_pair(direction);
-  Eigen::Matrix<double, 3, 2> frame;
-  frame << u, v;
-  return frame.transpose() * covariance * frame;
-}
-
 // Whether a 2D position of covariance `covariance` is known to within `bound` at the
 // significance, in its worst direction (the interval rule of the spheres' centres).
 bool known_within(const Eigen::Matrix2d& covariance, double significance, double bound) {
@@ -718,6 +724,177 @@ struct SettledSurfaces {
   std::vector<Surface> surfaces;
 };
 
+// The coaxial sets of a direction group's cylinders (each refitted alone with `direction`, of
+// tilt covariance `direction_covariance`; sorted here, best-located first), each with its joint
+// fit (none for a lone cylinder): coaxial_sets(), then the joint fit `fit_set(set)` (an optional
+// fit whose `rms` are its members', in the set's order) must explain each member as its own fit
+// did, within the significance corrected for the number of members: a member whose residual sum
+// rises by more than its square times its residual variance (it has 2 degrees of freedom fewer)
+// leaves the set, the worst first, and starts one of its own.
+template <class FitSet>
+auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& direction_covariance,
+                      std::vector<AlignedCylinder>& cylinders, double significance,
+                      const std::vector<std::vector<Vec3>>& points, const FitSet& fit_set) {
+  using Fit = std::invoke_result_t<FitSet, const std::vector<std::size_t>&>;  // optional
+  std::stable_sort(cylinders.begin(), cylinders.end(),
+                   [](const AlignedCylinder& a, const AlignedCylinder& b) {
+                     return a.fit.centre_covariance.trace() < b.fit.centre_covariance.trace();
+                   });
+  std::vector<std::vector<std::size_t>> sets = coaxial_sets(
+      cylinders, tilt_in_frame(direction, direction_covariance), significance * significance);
+  std::vector<std::pair<std::vector<std::size_t>, Fit>> fitted;
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    Fit joint;
+    while (sets[s].size() > 1) {
+      Fit fit = fit_set(sets[s]);
+      const double bound = family_significance(significance, sets[s].size());
+      std::size_t worst = sets[s].size();
+      double worst_excess = 1;
+      for (std::size_t j = 0; j < sets[s].size(); ++j) {
+        const AlignedCylinder& member = cylinders[sets[s][j]];
+        const double excess = fit ? residual_excess(member.fit.rms[0], fit->rms[j],
+                                                    points[member.cluster].size(), bound * bound, 3)
+                                  : std::numeric_limits<double>::infinity();
+        if (excess > worst_excess) {
+          worst_excess = excess;
+          worst = j;
+        }
+      }
+      if (worst == sets[s].size()) {
+        joint = std::move(fit);
+        break;
+      }
+      sets.push_back({sets[s][worst]});
+      sets[s].erase(sets[s].begin() + static_cast<std::ptrdiff_t>(worst));
+    }
+    fitted.emplace_back(sets[s], std::move(joint));
+  }
+  return fitted;
+}
+
+// The joint fit with `direction` of the cylinders `set` (indices into `cylinders`): one line
+// through them, each keeping its own radius, from the information-weighted mean of their own
+// lines.
+std::optional<CoaxialFit> fit_on_one_line(const Eigen::Vector3d& direction,
+                                          const std::vector<AlignedCylinder>& cylinders,
+                                          const std::vector<std::size_t>& set,
+                                          const std::vector<std::vector<Vec3>>& points,
+                                          const std::vector<std::vector<double>>& weights) {
+  std::vector<CoaxialMember> members;
+  PooledCentre pooled;
+  for (const std::size_t k : set) {
+    const std::size_t c = cylinders[k].cluster;
+    members.push_back({points[c], weights[c], cylinders[k].fit.radii[0]});
+    pooled.add(cylinders[k].fit);
+  }
+  return fit_coaxial(direction, pooled.centre(), members);
+}
+
+// A coaxial set fitted on one line of free direction: the set as one item of its direction group,
+// and the members' residuals.
+struct FreeLineFit {
+  Oriented item;
+  std::vector<double> rms;  // per member, unweighted, at least kResolution × its radius
+};
+
+// A coaxial set's members fitted with one axis line whose direction is free too (Gauss–Newton
+// from `direction` and the set's joint fit with it, weighted steps as the joint fits take them),
+// as one item of its direction group: its direction, and how well all its points determine it
+// together (from the unweighted residuals, as oriented_cylinder()'s). Sharing the line ties the
+// members: two short steps of a shaft far apart fix the axis better than each does alone. Nothing
+// when the iteration does not settle or a radius ends non-positive.
+std::optional<FreeLineFit> fit_free_line(Eigen::Vector3d direction, const CoaxialFit& start,
+                                         std::span<const std::size_t> clusters,
+                                         const std::vector<std::vector<Vec3>>& points,
+                                         const std::vector<std::vector<double>>& weights) {
+  const Eigen::Index members = static_cast<Eigen::Index>(clusters.size());
+  const Eigen::Index parameters = 4 + members;
+  std::vector<double> radii = start.radii;
+  const double scale = *std::max_element(radii.begin(), radii.end());
+  std::size_t count = 0;
+  for (const std::size_t c : clusters) count += points[c].size();
+  if (!(scale > 0) || count <= static_cast<std::size_t>(parameters)) return std::nullopt;
+  auto [u, v] = orthonormal_pair(direction);
+  Eigen::Vector3d pivot = start.centre.x() * u + start.centre.y() * v;
+  // The tilt pivots where the points are along the line, so that it hardly moves them on average.
+  pivot += direction * (middle_along(direction, clusters, points, weights) - direction.dot(pivot));
+  // Parameters: the tilt along u and v times `scale` (one unit in every column), the line's shift
+  // along u and v, the radii. Residuals e = |Q(x − pivot)| − r, Q = I − d dᵀ.
+  Eigen::MatrixXd weighted(parameters, parameters), information(parameters, parameters);
+  Eigen::VectorXd gradient(parameters);
+  std::vector<double> member_squares(clusters.size());
+  double squares = 0;
+  constexpr int kMaxSteps = 30;
+  for (int step = 0;; ++step) {
+    weighted.setZero();
+    information.setZero();
+    gradient.setZero();
+    squares = 0;
+    for (Eigen::Index k = 0; k < members; ++k) {
+      const std::size_t c = clusters[static_cast<std::size_t>(k)];
+      double& own_squares = member_squares[static_cast<std::size_t>(k)];
+      own_squares = 0;
+      for (std::size_t i = 0; i < points[c].size(); ++i) {
+        const Eigen::Vector3d d = to_eigen(points[c][i]) - pivot;
+        const double t = direction.dot(d);
+        const Eigen::Vector3d radial = d - t * direction;
+        const double length = radial.norm();
+        if (!(length > 0)) continue;
+        const Eigen::Vector3d normal = radial / length;
+        const double e = length - radii[static_cast<std::size_t>(k)];
+        // The residual's derivatives: `line` for the line's four parameters, −1 for its radius.
+        const Eigen::Vector4d line(-t / scale * normal.dot(u), -t / scale * normal.dot(v),
+                                   -normal.dot(u), -normal.dot(v));
+        const double w = weights[c][i];
+        for (const auto& [matrix, weight] :
+             {std::pair{&weighted, w}, std::pair{&information, 1.0}}) {
+          matrix->topLeftCorner<4, 4>() += weight * line * line.transpose();
+          matrix->block<4, 1>(0, 4 + k) -= weight * line;
+          (*matrix)(4 + k, 4 + k) += weight;
+        }
+        gradient.head<4>() += w * e * line;
+        gradient(4 + k) -= w * e;
+        own_squares += e * e;
+      }
+      squares += own_squares;
+    }
+    weighted.bottomLeftCorner(members, 4) = weighted.topRightCorner(4, members).transpose();
+    information.bottomLeftCorner(members, 4) = information.topRightCorner(4, members).transpose();
+    const Eigen::VectorXd delta = -weighted.ldlt().solve(gradient);
+    if (!delta.allFinite()) return std::nullopt;
+    const bool settled = delta.cwiseAbs().maxCoeff() <= 1e-12 * scale;
+    if (settled) break;
+    if (step == kMaxSteps) return std::nullopt;
+    direction = (direction + delta(0) / scale * u + delta(1) / scale * v).normalized();
+    pivot += delta(2) * u + delta(3) * v;
+    for (Eigen::Index k = 0; k < members; ++k) {
+      radii[static_cast<std::size_t>(k)] += delta(4 + k);
+      if (!(radii[static_cast<std::size_t>(k)] > 0)) return std::nullopt;
+    }
+    std::tie(u, v) = orthonormal_pair(direction);
+    pivot +=
+        direction * (middle_along(direction, clusters, points, weights) - direction.dot(pivot));
+  }
+  const double residual_variance =
+      std::max(squares / double(count - static_cast<std::size_t>(parameters)),
+               kResolution * kResolution * scale * scale);
+  const Eigen::MatrixXd covariance = information.inverse() * residual_variance;
+  if (!covariance.allFinite()) return std::nullopt;
+  FreeLineFit fit;
+  Oriented& item = fit.item;
+  item.cluster = clusters[0];
+  item.direction = direction;
+  item.frame.col(0) = u;
+  item.frame.col(1) = v;
+  item.covariance = covariance.topLeftCorner<2, 2>() / (scale * scale);
+  item.variance = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(item.covariance).eigenvalues()(1);
+  if (!std::isfinite(item.variance) || !(item.variance > 0)) return std::nullopt;
+  for (std::size_t k = 0; k < clusters.size(); ++k)
+    fit.rms.push_back(std::max(std::sqrt(member_squares[k] / double(points[clusters[k]].size())),
+                               kResolution * radii[k]));
+  return fit;
+}
+
 // Refits the cylinders of a direction group: each coaxial set around one axis line (each member
 // keeping its own radius), the others alone with the group's direction. Appends the coaxial sets
 // of two or more to `relations`, and every cylinder refitted to `settled`.
@@ -727,63 +904,29 @@ void align_cylinders(const Eigen::Vector3d& direction, const Eigen::Matrix3d& di
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights,
                      std::vector<Relation>& relations, SettledSurfaces& settled) {
-  std::stable_sort(cylinders.begin(), cylinders.end(),
-                   [](const AlignedCylinder& a, const AlignedCylinder& b) {
-                     return a.fit.centre_covariance.trace() < b.fit.centre_covariance.trace();
-                   });
-  std::vector<std::vector<std::size_t>> sets = coaxial_sets(cylinders, significance * significance);
-  for (std::size_t s = 0; s < sets.size(); ++s) {
-    CoaxialFit joint;
-    // The joint fit must explain each member as its own fit did, within the significance
-    // corrected for the number of members: a member whose residual sum rises by more than its
-    // square times its residual variance (it has 2 degrees of freedom fewer) leaves the set, the
-    // worst first.
-    while (sets[s].size() > 1) {
-      std::vector<CoaxialMember> members;
-      PooledCentre pooled;
-      for (const std::size_t k : sets[s]) {
-        const std::size_t c = cylinders[k].cluster;
-        members.push_back({points[c], weights[c], cylinders[k].fit.radii[0]});
-        pooled.add(cylinders[k].fit);
-      }
-      const std::optional<CoaxialFit> fit = fit_coaxial(direction, pooled.centre(), members);
-      const double bound = family_significance(significance, sets[s].size());
-      std::size_t worst = sets[s].size();
-      double worst_excess = 1;
-      for (std::size_t j = 0; j < sets[s].size(); ++j) {
-        const double excess = fit ? residual_excess(cylinders[sets[s][j]].fit.rms[0], fit->rms[j],
-                                                    members[j].points.size(), bound * bound, 3)
-                                  : std::numeric_limits<double>::infinity();
-        if (excess > worst_excess) {
-          worst_excess = excess;
-          worst = j;
-        }
-      }
-      if (worst == sets[s].size()) {
-        joint = *fit;
-        break;
-      }
-      sets.push_back({sets[s][worst]});
-      sets[s].erase(sets[s].begin() + static_cast<std::ptrdiff_t>(worst));
-    }
+  const auto sets =
+      fit_coaxial_sets(direction, direction_covariance, cylinders, significance, points,
+                       [&](const std::vector<std::size_t>& set) {
+                         return fit_on_one_line(direction, cylinders, set, points, weights);
+                       });
+  for (const auto& [members, fit] : sets) {
+    const CoaxialFit& joint = fit ? *fit : cylinders[members[0]].fit;
     std::size_t coaxial_index = kNoRelation;
-    if (sets[s].size() == 1) {
-      joint = cylinders[sets[s][0]].fit;
-    } else {
+    if (members.size() > 1) {
       coaxial_index = relations.size();
       Relation& coaxial = relations.emplace_back();
       coaxial.kind = Relation::Kind::Coaxial;
-      for (const std::size_t k : sets[s]) coaxial.members.push_back(cylinders[k].cluster);
+      for (const std::size_t k : members) coaxial.members.push_back(cylinders[k].cluster);
       std::sort(coaxial.members.begin(), coaxial.members.end());
     }
     const std::size_t line = settled.lines.size();
     std::vector<std::size_t> clusters;
-    for (const std::size_t k : sets[s]) clusters.push_back(cylinders[k].cluster);
+    for (const std::size_t k : members) clusters.push_back(cylinders[k].cluster);
     settled.lines.push_back({direction, joint.centre, joint.centre_covariance, coaxial_index,
                              middle_along(direction, clusters, points, weights),
                              tilt_in_frame(direction, direction_covariance)});
-    for (std::size_t j = 0; j < sets[s].size(); ++j) {
-      const std::size_t c = cylinders[sets[s][j]].cluster;
+    for (std::size_t j = 0; j < members.size(); ++j) {
+      const std::size_t c = clusters[j];
       place_cylinder(primitives[c], direction, joint.centre, joint.radii[j]);
       settled.surfaces.push_back(
           {c, false, line, 0, joint.radii[j], joint.radius_variances[j], joint.rms[j]});
@@ -941,27 +1084,78 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
   return coplanar;
 }
 
-// Each coplanar set of a group counts as one plane in its direction: the sum of its members'
-// information (their scatters, each about its own centroid) gives way to the union's (about the
-// union's centroid), which also holds how far apart the fragments lie, so the direction is known
-// better, and the group's direction and covariance are formed again from its information.
-void count_coplanar_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
+// `joined` counts as the members of `set` (clusters, increasing) in their group's direction: the
+// sum of the members' information gives way to its. The group's direction is formed again by the
+// caller.
+void count_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
+                  std::span<const std::size_t> set, const Oriented& joined) {
+  for (const std::size_t i : group.members)
+    if (std::binary_search(set.begin(), set.end(), items[i].cluster))
+      group.information -= direction_information(items[i]);
+  group.information += direction_information(joined);
+}
+
+// Each coplanar set of a group counts as one plane: the union's scatter (about the union's
+// centroid) also holds how far apart the fragments lie, so the direction is known better than
+// from the members' own scatters. Returns whether any did.
+bool count_coplanar_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
                            const std::vector<std::vector<std::size_t>>& sets,
                            const std::vector<std::vector<Vec3>>& points) {
-  const Eigen::Vector3d before = group.direction;
+  bool counted = false;
   for (const std::vector<std::size_t>& set : sets) {
     std::vector<Vec3> union_points;
     for (const std::size_t c : set)
       union_points.insert(union_points.end(), points[c].begin(), points[c].end());
     const std::optional<Oriented> joined = oriented_plane(set[0], union_points);
     if (!joined || !(joined->variance > 0)) continue;
-    for (const std::size_t i : group.members)
-      if (std::binary_search(set.begin(), set.end(), items[i].cluster))
-        group.information -= direction_information(items[i]);
-    group.information += direction_information(*joined);
+    count_as_one(group, items, set, *joined);
+    counted = true;
   }
-  form_direction(group);
-  if (group.direction.dot(before) < 0) group.direction = -group.direction;
+  return counted;
+}
+
+// Each coaxial set of a group's cylinders counts as one item: its members fitted on one line of
+// free direction. The sets are align_cylinders()'s, except that the joint fit a set must pass is
+// this one: the group's direction, still to be settled, need not suit all members at once (two
+// steps of a shaft far apart tell the axis better together than the group's direction gives it).
+// Returns whether any set counted.
+bool count_coaxial_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
+                          const std::vector<Primitive>& primitives,
+                          const std::vector<std::vector<Vec3>>& points,
+                          const std::vector<std::vector<double>>& weights, double significance) {
+  std::vector<AlignedCylinder> cylinders;
+  for (const std::size_t i : group.members) {
+    const std::size_t c = items[i].cluster;
+    if (primitives[c].type != PrimitiveType::Cylinder) continue;
+    if (std::optional<CoaxialFit> fit =
+            fit_alone(primitives[c], group.direction, points[c], weights[c]))
+      cylinders.push_back(
+          {c, std::move(*fit), middle_along(group.direction, {&c, 1}, points, weights)});
+  }
+  if (cylinders.size() < 2) return false;
+  // The clusters of `set`, in its order.
+  const auto clusters_of = [&](const std::vector<std::size_t>& set) {
+    std::vector<std::size_t> clusters;
+    for (const std::size_t k : set) clusters.push_back(cylinders[k].cluster);
+    return clusters;
+  };
+  const auto sets = fit_coaxial_sets(
+      group.direction, group.covariance, cylinders, significance, points,
+      [&](const std::vector<std::size_t>& set) -> std::optional<FreeLineFit> {
+        const std::optional<CoaxialFit> start =
+            fit_on_one_line(group.direction, cylinders, set, points, weights);
+        if (!start) return std::nullopt;
+        return fit_free_line(group.direction, *start, clusters_of(set), points, weights);
+      });
+  bool counted = false;
+  for (const auto& [set, fit] : sets) {
+    if (!fit) continue;
+    std::vector<std::size_t> clusters = clusters_of(set);
+    std::sort(clusters.begin(), clusters.end());
+    count_as_one(group, items, clusters, fit->item);
+    counted = true;
+  }
+  return counted;
 }
 
 // Refits line l with its cylinders and the spheres `spheres` (indices into settled.surfaces) on
@@ -1582,27 +1776,37 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     if (item && std::isfinite(item->variance) && item->variance > 0) items.push_back(*item);
   }
   std::vector<DirectionGroup> groups = group_directions(items, options);
-  // Each group's coplanar sets, found before the directions are made orthogonal: each counts as
-  // one plane in its group's direction.
+  // Each group's coplanar sets and coaxial sets, found before the directions are made orthogonal:
+  // each counts as one plane or one line in its group's direction.
   std::vector<std::vector<std::vector<std::size_t>>> coplanar(groups.size());
-  if (options.coplanar)
-    for (std::size_t g = 0; g < groups.size(); ++g) {
-      if (std::count_if(groups[g].members.begin(), groups[g].members.end(), [&](std::size_t i) {
-            return primitives[items[i].cluster].type == PrimitiveType::Plane;
-          }) < 2)
-        continue;
-      std::vector<AlignedPlane> planes;
-      for (const std::size_t i : groups[g].members) {
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    DirectionGroup& group = groups[g];
+    if (group.members.size() < 2) continue;
+    bool counted = false;
+    std::vector<AlignedPlane> planes;
+    const auto is_plane = [&](std::size_t i) {
+      return primitives[items[i].cluster].type == PrimitiveType::Plane;
+    };
+    if (options.coplanar &&
+        std::count_if(group.members.begin(), group.members.end(), is_plane) >= 2)
+      for (const std::size_t i : group.members) {
         const std::size_t c = items[i].cluster;
         if (primitives[c].type != PrimitiveType::Plane) continue;
         if (const std::optional<AlignedPlane> plane =
-                aligned_plane(c, groups[g].direction, points[c], weights[c]))
+                aligned_plane(c, group.direction, points[c], weights[c]))
           planes.push_back(*plane);
       }
-      if (planes.size() < 2) continue;
-      coplanar[g] = coplanar_sets(groups[g].covariance, std::move(planes), options.significance);
-      if (!coplanar[g].empty()) count_coplanar_as_one(groups[g], items, coplanar[g], points);
+    if (planes.size() >= 2) {
+      coplanar[g] = coplanar_sets(group.covariance, std::move(planes), options.significance);
+      counted = count_coplanar_as_one(group, items, coplanar[g], points);
     }
+    if (count_coaxial_as_one(group, items, primitives, points, weights, options.significance))
+      counted = true;
+    if (!counted) continue;
+    const Eigen::Vector3d before = group.direction;
+    form_direction(group);
+    if (group.direction.dot(before) < 0) group.direction = -group.direction;
+  }
   std::vector<std::pair<std::size_t, std::size_t>> orthogonal;
   if (options.orthogonal) orthogonal = orthogonalize(groups, options);
   std::vector<bool> constrained(groups.size(), false);
@@ -1625,7 +1829,8 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
       }
       if (std::optional<CoaxialFit> fit =
               fit_alone(primitive, group.direction, points[c], weights[c])) {
-        cylinders.push_back({c, std::move(*fit)});
+        cylinders.push_back(
+            {c, std::move(*fit), middle_along(group.direction, {&c, 1}, points, weights)});
         parallel.members.push_back(c);
       }
     }

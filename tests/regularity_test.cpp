@@ -366,6 +366,54 @@ TEST(Regularity, ASteppedShaftSharesOneAxisLine) {
   EXPECT_NEAR(primitives[1].point[2], 1, 0.1);
 }
 
+// The squared distances of the points of `clusters` to the surfaces of `cylinders` (one each)
+// once their shared axis is turned by `tilt` radians towards `towards` about cylinder 0's point.
+double squares_with_tilt(const std::vector<Primitive>& cylinders,
+                         const std::vector<Cluster>& clusters, const Eigen::Vector3d& towards,
+                         double tilt) {
+  const Eigen::Vector3d axis = to_eigen(cylinders[0].axis).normalized();
+  const Eigen::Vector3d turned = (std::cos(tilt) * axis + std::sin(tilt) * towards).normalized();
+  double sum = 0;
+  for (std::size_t c = 0; c < clusters.size(); ++c)
+    for (const Vec3& p : clusters[c].points) {
+      const Eigen::Vector3d d = to_eigen(p) - to_eigen(cylinders[0].point);
+      sum += std::pow((d - d.dot(turned) * turned).norm() - cylinders[c].radius, 2);
+    }
+  return sum;
+}
+
+TEST(Regularity, AShaftsStepsFarApartFixTheirAxisTogether) {
+  // Two short steps of a shaft (radii 0.5 and 0.3, 0.2 long) 2 apart: each alone knows the axis
+  // direction to about σ / length, together to about σ / their distance.
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ(), x = Eigen::Vector3d::UnitX(),
+                        y = Eigen::Vector3d::UnitY();
+  double shared_error = 0, own_error = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.5, 0.2, 0.005, rng, 6),
+                                        noisy_cylinder(z, {0, 0, 2}, 0.3, 0.2, 0.005, rng, 6)};
+    std::vector<Primitive> cylinders{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.5),
+                                     fitted_cylinder(clusters[1], z, {0, 0, 2}, 0.3)};
+    const std::vector<Primitive> own = cylinders;
+    ASSERT_EQ(regularize(cylinders, clusters),
+              (Relations{{Kind::Parallel, {0, 1}}, {Kind::Coaxial, {0, 1}}}));
+    // The least-squares axis of both steps: turning it either way, about either tangent, only
+    // adds to their squared distances (the members' own directions, combined, would not be it).
+    for (const Eigen::Vector3d& towards : {x, y}) {
+      const double at = squares_with_tilt(cylinders, clusters, towards, 0);
+      EXPECT_LT(at, squares_with_tilt(cylinders, clusters, towards, 1e-6));
+      EXPECT_LT(at, squares_with_tilt(cylinders, clusters, towards, -1e-6));
+    }
+    shared_error += std::pow(angle_between_lines(cylinders[0].axis, to_vec3(z)), 2) / 20;
+    for (const Primitive& cylinder : own)
+      own_error += std::pow(angle_between_lines(cylinder.axis, to_vec3(z)), 2) / 40;
+  }
+  std::printf("steps of a shaft 2 apart: axis %.3g rad from the truth (RMS), own fits %.3g\n",
+              std::sqrt(shared_error), std::sqrt(own_error));
+  EXPECT_LT(shared_error, own_error / 4);
+}
+
 TEST(Regularity, ParallelHolesApartStayOnTheirOwnAxes) {
   // Two holes of one plate 0.05 apart (ten times the noise): parallel, not coaxial, one radius.
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
