@@ -156,6 +156,25 @@ def test_file_errors(tmp_path, fandisk):
         primseg.segment(V_OK, F_OK).save(tmp_path / "no" / "such" / "dir" / "t.tree")
 
 
+def test_relations_of_levels_errors():
+    h = primseg.segment(V_OK, F_OK)
+    assert h.relations_of_levels([]) == []
+    for k in (0, -1, 3, 2**40):
+        with pytest.raises(primseg.InvalidInputError,
+                           match=rf"ks\[1\]: k must be between 1 and the number of faces \(2\), not {k}$"):
+            h.relations_of_levels([1, k])
+    for bad in ([1.5], [1, "auto"], "12", 2, [None], np.array([1.0])):
+        with pytest.raises(TypeError):
+            h.relations_of_levels(bad)
+    for bad in (dict(relation_significance=0.0), dict(max_relation_angle=90.0),
+                dict(max_radius_difference=1.0)):
+        (keyword,) = bad
+        with pytest.raises(ValueError, match=keyword):
+            h.relations_of_levels([1], **bad)
+    with pytest.raises(TypeError):
+        h.relations_of_levels([1], threads=-1)
+
+
 def test_denoise_argument_errors():
     mesh = primseg.Mesh(V_OK, F_OK)
     with pytest.raises(ValueError, match=r"denoise\(mesh\) takes no F \(give the level as k=...\)"):

@@ -137,6 +137,56 @@ def test_relation_options_are_the_clis(cli, fandisk, fandisk_tree, tmp_path):
             fandisk_tree.relations(60, **bad)
 
 
+def assert_levels_are_the_one_level_calls(tree, levels, ks, **keywords):
+    """relations_of_levels(ks, **keywords) against clusters(k, regularize=True) and relations(k)
+    for each k: equal, and bit for bit (repr tells -0.0 from 0.0)."""
+    assert [level["k"] for level in levels] == list(ks)
+    for level in levels:
+        expected = {"k": level["k"],
+                    "clusters": tree.clusters(level["k"], regularize=True, **keywords),
+                    "relations": tree.relations(level["k"], **keywords)}
+        assert level == expected
+        assert repr(level) == repr(expected)
+
+
+def test_relations_of_levels_are_the_one_level_calls(fandisk_tree):
+    # Levels in any order, repeated, below and above each other: each is what the one-level calls
+    # give, on any thread count.
+    ks = [60, 1, 30, 2, 30, 100, 7]
+    levels = fandisk_tree.relations_of_levels(ks)
+    assert_levels_are_the_one_level_calls(fandisk_tree, levels, ks)
+    assert levels[2] == levels[4] and levels[2] is not levels[4]  # a repeat: its own dicts
+    for threads in (1, 3):
+        assert fandisk_tree.relations_of_levels(ks, threads=threads) == levels
+    # Not vacuous: the levels have relations of several kinds, and fits they changed.
+    assert {r["kind"] for r in levels[0]["relations"]} >= {"parallel", "orthogonal", "coaxial"}
+    assert levels[0]["clusters"] != fandisk_tree.clusters(60)
+    # The relation options, as relations() and clusters() spell them.
+    keywords = dict(relation_significance=2.5, max_relation_angle=10.0, max_radius_difference=0.001)
+    tight = fandisk_tree.relations_of_levels([60, 30], **keywords)
+    assert_levels_are_the_one_level_calls(fandisk_tree, tight, [60, 30], **keywords)
+    assert tight[0]["relations"] != levels[0]["relations"]
+    # Any sequence of integers: a range, a numpy array; none gives none.
+    assert fandisk_tree.relations_of_levels(range(5, 8)) == fandisk_tree.relations_of_levels(
+        np.array([5, 6, 7], dtype=np.int32))
+    assert fandisk_tree.relations_of_levels([]) == []
+
+
+def test_relations_of_levels_find_the_coplanar_faces_of_each_level(cgal_mesh):
+    # couplingdown's faces cut apart by its holes, level by level from 1 to 60 clusters: the
+    # coplanar sets (and every other relation and fit) of each level as relations(k) finds them.
+    tree = primseg.segment(primseg.read_mesh(str(cgal_mesh("couplingdown.off"))))
+    ks = range(1, 61)
+    levels = tree.relations_of_levels(ks)
+    assert_levels_are_the_one_level_calls(tree, levels, ks)
+    coplanar = [[r for r in level["relations"] if r["kind"] == "coplanar"] for level in levels]
+    assert sum(map(bool, coplanar)) >= 40 and max(map(len, coplanar)) >= 2
+
+
+def test_relations_of_levels_releases_the_gil(fandisk_tree):
+    assert_releases_the_gil(lambda: fandisk_tree.relations_of_levels(range(1, 101), threads=1))
+
+
 def test_borders_of_a_capped_cylinder_are_two_circles_at_right_angles():
     V, F, regions = capped_cylinder()
     tree = primseg.segment(V, F)

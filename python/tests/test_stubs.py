@@ -143,6 +143,7 @@ def test_mypy_accepts_the_stub_and_a_typed_use_of_it(tmp_path, monkeypatch):
         "mesh: primseg.Mesh = primseg.read_mesh('part.off')\n"
         "tree: primseg.Hierarchy = primseg.segment(mesh, primitives=['plane'], progress=print)\n"
         "labels: NDArray[np.int32] = tree.cut('auto', refine=2)\n"
+        "levels: list[dict[str, object]] = tree.relations_of_levels(range(1, 11), threads=2)\n"
         "V: NDArray[np.float64] = primseg.denoise(tree, k=30)\n"
         "V2, rounds = primseg.denoise(mesh, k=30, return_rounds=True)\n"
         "first: dict[str, object] = rounds[0]\n"
