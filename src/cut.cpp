@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cluster_numbering.hpp"
+#include "cluster_triangles.hpp"
 #include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
@@ -148,15 +149,7 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
   for (std::uint32_t label : segmentation.labels)
     if (label >= k)
       throw InvalidInputError("describe_clusters: a label is not below the cluster count");
-  // Triangles of each cluster in ascending order (compressed rows).
-  std::vector<std::uint32_t> offset(k + 1, 0);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-    ++offset[segmentation.labels[mesh.face_of_triangle[t]] + 1];
-  for (std::uint32_t c = 0; c < k; ++c) offset[c + 1] += offset[c];
-  std::vector<std::uint32_t> triangles(offset[k]);
-  std::vector<std::uint32_t> next(offset.begin(), offset.end() - 1);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-    triangles[next[segmentation.labels[mesh.face_of_triangle[t]]]++] = t;
+  const detail::ClusterTriangles clusters(mesh, segmentation.labels, k);
   std::vector<ClusterReport> reports(k);
   for (std::uint32_t f = 0; f < mesh.face_count(); ++f)
     ++reports[segmentation.labels[f]].face_count;
@@ -170,9 +163,9 @@ std::vector<ClusterReport> describe_clusters(const Hierarchy& hierarchy,
     r.node = segmentation.nodes[c];
     points[thread].clear();
     weights[thread].clear();
-    for (std::uint32_t i = offset[c]; i < offset[c + 1]; ++i) {
-      detail::append_corners(graph, triangles[i], points[thread], weights[thread]);
-      r.area += graph.triangle_area(triangles[i]);
+    for (const std::uint32_t t : clusters.of(c)) {
+      detail::append_corners(graph, t, points[thread], weights[thread]);
+      r.area += graph.triangle_area(t);
     }
     fit_report(graph.frame(), start[c], points[thread], weights[thread], options, r);
   });

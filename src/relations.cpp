@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cluster_numbering.hpp"
+#include "cluster_triangles.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "primseg/geometric_fit.hpp"
@@ -167,21 +168,8 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
     if (label >= k)
       throw InvalidInputError("regularize_clusters: a label is not below the cluster count");
 
-  // The triangles grouped by cluster, increasing (counting sort).
-  std::vector<std::uint32_t> triangle_offsets(static_cast<std::size_t>(k) + 1, 0);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-    ++triangle_offsets[segmentation.labels[mesh.face_of_triangle[t]] + 1];
-  for (std::uint32_t c = 0; c < k; ++c) triangle_offsets[c + 1] += triangle_offsets[c];
-  std::vector<std::uint32_t> triangles_by_cluster(mesh.triangle_count());
-  {
-    std::vector<std::uint32_t> next(triangle_offsets.begin(), triangle_offsets.end() - 1);
-    for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-      triangles_by_cluster[next[segmentation.labels[mesh.face_of_triangle[t]]]++] = t;
-  }
-  auto triangles_of = [&](std::size_t c) {
-    return std::span<const std::uint32_t>(triangles_by_cluster)
-        .subspan(triangle_offsets[c], triangle_offsets[c + 1] - triangle_offsets[c]);
-  };
+  const detail::ClusterTriangles clusters(mesh, segmentation.labels, k);
+  const auto triangles_of = [&](std::size_t c) { return clusters.of(c); };
   VertexScratch scratch(mesh.vertex_count());
   std::vector<std::vector<Vec3>> points(k);
   std::vector<std::vector<double>> weights(k);
