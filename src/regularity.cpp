@@ -1135,8 +1135,8 @@ bool count_coaxial_as_one(DirectionGroup& group, const std::vector<Oriented>& it
   if (cylinders.size() < 2) return false;
   // The clusters of `set`, in its order.
   const auto clusters_of = [&](const std::vector<std::size_t>& set) {
-    std::vector<std::size_t> clusters;
-    for (const std::size_t k : set) clusters.push_back(cylinders[k].cluster);
+    std::vector<std::size_t> clusters(set.size());
+    for (std::size_t j = 0; j < set.size(); ++j) clusters[j] = cylinders[set[j]].cluster;
     return clusters;
   };
   const auto sets = fit_coaxial_sets(
