@@ -1123,6 +1123,10 @@ bool count_coaxial_as_one(DirectionGroup& group, const std::vector<Oriented>& it
                           const std::vector<Primitive>& primitives,
                           const std::vector<std::vector<Vec3>>& points,
                           const std::vector<std::vector<double>>& weights, double significance) {
+  const auto is_cylinder = [&](std::size_t i) {
+    return primitives[items[i].cluster].type == PrimitiveType::Cylinder;
+  };
+  if (std::count_if(group.members.begin(), group.members.end(), is_cylinder) < 2) return false;
   std::vector<AlignedCylinder> cylinders;
   for (const std::size_t i : group.members) {
     const std::size_t c = items[i].cluster;
