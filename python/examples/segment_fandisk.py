@@ -128,6 +128,25 @@ for same in (r["clusters"] for r in relations if r["kind"] == "equal_radius"):
     assert len(radii) == 1
 
 # %% [markdown]
+# ## The design intent of many levels at once
+# `relations_of_levels` gives the regularized clusters and the relations of many levels in one
+# call, as `clusters(k, regularize=True)` and `relations(k)` give them level by level, but
+# gathering each cluster's vertices once: to see at which level a relation appears or goes.
+
+# %%
+start = time.perf_counter()
+levels = tree.relations_of_levels(range(10, 61, 5))
+print(f"{len(levels)} levels in {time.perf_counter() - start:.2f} s")
+kinds = ("parallel", "coaxial", "orthogonal", "equal_radius", "coplanar")
+print("  k " + " ".join(f"{kind:>12}" for kind in kinds))
+for level in levels:
+    found = [r["kind"] for r in level["relations"]]
+    print(f"{level['k']:>3} " + " ".join(f"{found.count(kind):>12}" for kind in kinds))
+at_30 = next(level for level in levels if level["k"] == 30)
+assert at_30["relations"] == relations and at_30["clusters"] == exact
+assert all(any(r["kind"] == "coaxial" for r in level["relations"]) for level in levels[2:])
+
+# %% [markdown]
 # ## Per-face quantities with numpy
 # Labels index the cluster list, so per-face arrays are one fancy-indexing away: here the RMS
 # distance of each face's cluster, ready to colour a mesh viewer with.
