@@ -92,7 +92,8 @@ void validate(const RelationOptions& options);
 /// with the group's normal, or with its coplanar fragments through all their inliers (one offset;
 /// a coplanar set counts as one plane in the group's normal), a cylinder by geometric least squares
 /// with the group's axis direction, jointly with the cylinders and spheres coaxial with it (one
-/// axis line; one radius each, and each sphere one position along the line) and the cylinders and
+/// axis line; one radius each, and each sphere one position along the line; the cylinders of a
+/// coaxial set, fitted on one line, count as one in the group's direction) and the cylinders and
 /// spheres of equal radius (one radius, each on its own line or centre). Its report's `primitive`,
 /// `rms` and `max` are replaced (`rms` and `max` measured as describe_clusters() does, on all the
 /// cluster's vertices); every other report is left bit for bit. Deterministic, O(F log F).
