@@ -527,6 +527,16 @@ struct AlignedCylinder {
   double middle = 0;  // where its inliers are along the direction: middle_along()
 };
 
+// Cylinder `c` refitted alone with `direction` (fit_alone()), and where it is along it.
+std::optional<AlignedCylinder> aligned_cylinder(std::size_t c, const Primitive& cylinder,
+                                                const Eigen::Vector3d& direction,
+                                                const std::vector<std::vector<Vec3>>& points,
+                                                const std::vector<std::vector<double>>& weights) {
+  std::optional<CoaxialFit> fit = fit_alone(cylinder, direction, points[c], weights[c]);
+  if (!fit) return std::nullopt;
+  return AlignedCylinder{c, std::move(*fit), middle_along(direction, {&c, 1}, points, weights)};
+}
+
 // The information-weighted mean of axis positions: where a coaxial set's axis is, and how well.
 struct PooledCentre {
   Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
@@ -1131,10 +1141,9 @@ bool count_coaxial_as_one(DirectionGroup& group, const std::vector<Oriented>& it
   for (const std::size_t i : group.members) {
     const std::size_t c = items[i].cluster;
     if (primitives[c].type != PrimitiveType::Cylinder) continue;
-    if (std::optional<CoaxialFit> fit =
-            fit_alone(primitives[c], group.direction, points[c], weights[c]))
-      cylinders.push_back(
-          {c, std::move(*fit), middle_along(group.direction, {&c, 1}, points, weights)});
+    if (std::optional<AlignedCylinder> cylinder =
+            aligned_cylinder(c, primitives[c], group.direction, points, weights))
+      cylinders.push_back(std::move(*cylinder));
   }
   if (cylinders.size() < 2) return false;
   // The clusters of `set`, in its order.
@@ -1831,10 +1840,9 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
           parallel.members.push_back(c);
         continue;
       }
-      if (std::optional<CoaxialFit> fit =
-              fit_alone(primitive, group.direction, points[c], weights[c])) {
-        cylinders.push_back(
-            {c, std::move(*fit), middle_along(group.direction, {&c, 1}, points, weights)});
+      if (std::optional<AlignedCylinder> cylinder =
+              aligned_cylinder(c, primitive, group.direction, points, weights)) {
+        cylinders.push_back(std::move(*cylinder));
         parallel.members.push_back(c);
       }
     }
