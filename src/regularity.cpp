@@ -824,26 +824,18 @@ std::optional<FreeLineFit> fit_free_line(Eigen::Vector3d direction, const Coaxia
   std::size_t count = 0;
   for (const std::size_t c : clusters) count += points[c].size();
   if (!(scale > 0) || count <= static_cast<std::size_t>(parameters)) return std::nullopt;
-  auto [u, v] = orthonormal_pair(direction);
+  Eigen::Vector3d u, v;  // not a structured binding: the lambdas below capture them
+  std::tie(u, v) = orthonormal_pair(direction);
   Eigen::Vector3d pivot = start.centre.x() * u + start.centre.y() * v;
   // The tilt pivots where the points are along the line, so that it hardly moves them on average.
   pivot += direction * (middle_along(direction, clusters, points, weights) - direction.dot(pivot));
   // Parameters: the tilt along u and v times `scale` (one unit in every column), the line's shift
-  // along u and v, the radii. Residuals e = |Q(x − pivot)| − r, Q = I − d dᵀ.
-  Eigen::MatrixXd weighted(parameters, parameters), information(parameters, parameters);
-  Eigen::VectorXd gradient(parameters);
-  std::vector<double> member_squares(clusters.size());
-  double squares = 0;
-  constexpr int kMaxSteps = 30;
-  for (int step = 0;; ++step) {
-    weighted.setZero();
-    information.setZero();
-    gradient.setZero();
-    squares = 0;
+  // along u and v, the radii. Residuals e = |Q(x − pivot)| − r, Q = I − d dᵀ; `visit(k, i, e,
+  // line)` gets point i of member k, its residual and its derivatives: `line` for the line's four
+  // parameters, −1 for its radius.
+  const auto for_each_residual = [&](const auto& visit) {
     for (Eigen::Index k = 0; k < members; ++k) {
       const std::size_t c = clusters[static_cast<std::size_t>(k)];
-      double& own_squares = member_squares[static_cast<std::size_t>(k)];
-      own_squares = 0;
       for (std::size_t i = 0; i < points[c].size(); ++i) {
         const Eigen::Vector3d d = to_eigen(points[c][i]) - pivot;
         const double t = direction.dot(d);
@@ -851,29 +843,38 @@ std::optional<FreeLineFit> fit_free_line(Eigen::Vector3d direction, const Coaxia
         const double length = radial.norm();
         if (!(length > 0)) continue;
         const Eigen::Vector3d normal = radial / length;
-        const double e = length - radii[static_cast<std::size_t>(k)];
-        // The residual's derivatives: `line` for the line's four parameters, −1 for its radius.
-        const Eigen::Vector4d line(-t / scale * normal.dot(u), -t / scale * normal.dot(v),
-                                   -normal.dot(u), -normal.dot(v));
-        const double w = weights[c][i];
-        for (const auto& [matrix, weight] :
-             {std::pair{&weighted, w}, std::pair{&information, 1.0}}) {
-          matrix->topLeftCorner<4, 4>() += weight * line * line.transpose();
-          matrix->block<4, 1>(0, 4 + k) -= weight * line;
-          (*matrix)(4 + k, 4 + k) += weight;
-        }
-        gradient.head<4>() += w * e * line;
-        gradient(4 + k) -= w * e;
-        own_squares += e * e;
+        visit(k, weights[c][i], length - radii[static_cast<std::size_t>(k)],
+              Eigen::Vector4d(-t / scale * normal.dot(u), -t / scale * normal.dot(v),
+                              -normal.dot(u), -normal.dot(v)));
       }
-      squares += own_squares;
     }
-    weighted.bottomLeftCorner(members, 4) = weighted.topRightCorner(4, members).transpose();
-    information.bottomLeftCorner(members, 4) = information.topRightCorner(4, members).transpose();
+  };
+  // Adds a residual's Jacobian row, times `weight`, to the (symmetric) normal matrix `matrix`:
+  // its upper part only, the lower filled by symmetric().
+  const auto add_row = [](Eigen::MatrixXd& matrix, Eigen::Index k, double weight,
+                          const Eigen::Vector4d& line) {
+    matrix.topLeftCorner<4, 4>() += weight * line * line.transpose();
+    matrix.block<4, 1>(0, 4 + k) -= weight * line;
+    matrix(4 + k, 4 + k) += weight;
+  };
+  const auto symmetric = [members](Eigen::MatrixXd& matrix) {
+    matrix.bottomLeftCorner(members, 4) = matrix.topRightCorner(4, members).transpose();
+  };
+  Eigen::MatrixXd weighted(parameters, parameters);
+  Eigen::VectorXd gradient(parameters);
+  constexpr int kMaxSteps = 30;
+  for (int step = 0;; ++step) {
+    weighted.setZero();
+    gradient.setZero();
+    for_each_residual([&](Eigen::Index k, double w, double e, const Eigen::Vector4d& line) {
+      add_row(weighted, k, w, line);
+      gradient.head<4>() += w * e * line;
+      gradient(4 + k) -= w * e;
+    });
+    symmetric(weighted);
     const Eigen::VectorXd delta = -weighted.ldlt().solve(gradient);
     if (!delta.allFinite()) return std::nullopt;
-    const bool settled = delta.cwiseAbs().maxCoeff() <= 1e-12 * scale;
-    if (settled) break;
+    if (delta.cwiseAbs().maxCoeff() <= 1e-12 * scale) break;
     if (step == kMaxSteps) return std::nullopt;
     direction = (direction + delta(0) / scale * u + delta(1) / scale * v).normalized();
     pivot += delta(2) * u + delta(3) * v;
@@ -885,6 +886,16 @@ std::optional<FreeLineFit> fit_free_line(Eigen::Vector3d direction, const Coaxia
     pivot +=
         direction * (middle_along(direction, clusters, points, weights) - direction.dot(pivot));
   }
+  // At the solution: the unweighted information and each member's residual sum.
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(parameters, parameters);
+  std::vector<double> member_squares(clusters.size(), 0);
+  double squares = 0;
+  for_each_residual([&](Eigen::Index k, double, double e, const Eigen::Vector4d& line) {
+    add_row(information, k, 1, line);
+    member_squares[static_cast<std::size_t>(k)] += e * e;
+  });
+  symmetric(information);
+  for (const double own : member_squares) squares += own;
   const double residual_variance =
       std::max(squares / double(count - static_cast<std::size_t>(parameters)),
                kResolution * kResolution * scale * scale);

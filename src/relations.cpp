@@ -169,12 +169,11 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
       throw InvalidInputError("regularize_clusters: a label is not below the cluster count");
 
   const detail::ClusterTriangles clusters(mesh, segmentation.labels, k);
-  const auto triangles_of = [&](std::size_t c) { return clusters.of(c); };
   VertexScratch scratch(mesh.vertex_count());
   std::vector<std::vector<Vec3>> points(k);
   std::vector<std::vector<double>> weights(k);
   for (std::uint32_t c = 0; c < k; ++c)
-    gather_vertices(graph, triangles_of(c), scratch, points[c], weights[c]);
+    gather_vertices(graph, clusters.of(c), scratch, points[c], weights[c]);
 
   std::vector<Primitive> primitives;
   primitives.reserve(k);
@@ -186,7 +185,7 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
   report_refitted(
       graph.frame(), relations, primitives,
       [&](std::size_t c, const Primitive& working) {
-        return measure(graph, triangles_of(c), working);
+        return measure(graph, clusters.of(c), working);
       },
       reports);
   return relations;
