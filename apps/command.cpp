@@ -178,8 +178,9 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
                    "Make the fits' design intent exact: plane normals and cylinder axes that "
                    "agree within their uncertainty share one direction, directions at right "
                    "angles become orthogonal, fragments of one face share one plane, cylinders "
-                   "share one axis line and spheres are centred on it, and cylinders and spheres "
-                   "share one radius (listed as \"relations\" in the JSON)");
+                   "share one axis line and spheres are centred on it, cylinders and spheres "
+                   "share one radius, and fillets become tangent to the faces they border "
+                   "(listed as \"relations\" in the JSON)");
   add_relation_options(command, options.relations);
 }
 

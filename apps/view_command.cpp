@@ -264,7 +264,7 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
   nlohmann::json kind_names = nlohmann::json::array();
   for (const auto kind : {ClusterRelation::Kind::Parallel, ClusterRelation::Kind::Coaxial,
                           ClusterRelation::Kind::Orthogonal, ClusterRelation::Kind::EqualRadius,
-                          ClusterRelation::Kind::Coplanar})
+                          ClusterRelation::Kind::Coplanar, ClusterRelation::Kind::Tangent})
     kind_names.push_back(to_string(kind));
   return {{"firstClusters", first},
           {"levels", level_count},
@@ -429,11 +429,11 @@ Command add_view_command(CLI::App& app) {
                    "--skeleton: skinning blend half-width on each side of a boundary, in bone "
                    "radii")
       ->capture_default_str();
-  view->add_flag(
-      "--regularize", o->regularize,
-      "List the relations cut --regularize finds (parallel, orthogonal, coaxial, "
-      "equal radius, coplanar) at every level of up to --regularize-clusters clusters, highlight "
-      "their clusters, and show the fits they make exact");
+  view->add_flag("--regularize", o->regularize,
+                 "List the relations cut --regularize finds (parallel, orthogonal, coaxial, "
+                 "equal radius, coplanar, tangent) at every level of up to --regularize-clusters "
+                 "clusters, highlight "
+                 "their clusters, and show the fits they make exact");
   view->add_option("--regularize-clusters", o->regularize_clusters,
                    "The levels of --regularize: every level of up to this many clusters (at most " +
                        std::to_string(kMaxClustersWithParameters) + "; default " +

@@ -293,8 +293,9 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
 // parallel group and each side of an orthogonal pair share one direction up to sign, the two
 // sides' directions are orthogonal to round-off, a coaxial set holds cylinders of one direction
 // and spheres, every cylinder's axis and sphere's centre on its first cylinder's axis line to
-// round-off, an equal-radius set cylinders and spheres of one radius, bit for bit, and a
-// coplanar set planes through one plane to round-off.
+// round-off, an equal-radius set cylinders and spheres of one radius, bit for bit, a coplanar set
+// planes through one plane to round-off, and a tangent pair a cylinder whose axis is orthogonal to
+// the plane's normal and at its radius from the plane, to round-off.
 void check_relations(const std::vector<Primitive>& primitives,
                      const std::vector<ClusterRelation>& relations, const std::string& what) {
   auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest,
@@ -321,7 +322,27 @@ void check_relations(const std::vector<Primitive>& primitives,
   for (const ClusterRelation& relation : relations) {
     const bool orthogonal = relation.kind == ClusterRelation::Kind::Orthogonal;
     const bool equal_radius = relation.kind == ClusterRelation::Kind::EqualRadius;
-    check_members(relation.clusters, orthogonal ? 1 : 2, !equal_radius);
+    const bool tangent = relation.kind == ClusterRelation::Kind::Tangent;
+    check_members(relation.clusters, orthogonal ? 1 : 2, !equal_radius && !tangent);
+    if (tangent) {
+      if (relation.clusters.size() != 2) fail((what + ": tangent pair's size").c_str());
+      std::uint32_t c = relation.clusters[0], p = relation.clusters[1];
+      if (primitives[c].type != PrimitiveType::Cylinder) std::swap(c, p);
+      if (primitives[c].type != PrimitiveType::Cylinder ||
+          primitives[p].type != PrimitiveType::Plane)
+        fail((what + ": tangent pair is not a cylinder and a plane").c_str());
+      const Vec3 &n = primitives[p].axis, &a = primitives[c].axis;
+      const double cosine = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+      if (!(std::abs(cosine) <= 1e-12))
+        fail((what + ": tangent axis not along the plane").c_str(), cosine);
+      const Vec3 &q = primitives[c].point, &o = primitives[p].point;
+      const double distance =
+          std::abs(n[0] * (q[0] - o[0]) + n[1] * (q[1] - o[1]) + n[2] * (q[2] - o[2]));
+      const double scale = std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2]) + std::abs(o[0]) +
+                           std::abs(o[1]) + std::abs(o[2]) + primitives[c].radius;
+      if (!(std::abs(distance - primitives[c].radius) <= 1e-9 * scale))
+        fail((what + ": tangent axis not at the radius from the plane").c_str(), distance);
+    }
     for (const std::uint32_t c : relation.clusters) {
       const PrimitiveType type = primitives[c].type;
       if (relation.kind == ClusterRelation::Kind::Coaxial && type != PrimitiveType::Cylinder &&

@@ -1341,7 +1341,8 @@ The design intent among the level's fits, as the CLI's --regularize writes it in
 direction; "coaxial": cylinders of one axis line and spheres centred on it, or three spheres or
 more centred on one line with no cylinder; "orthogonal": two directions at right angles;
 "equal_radius": cylinders and spheres of one radius; "coplanar": planes of one plane, the
-fragments of one face) and clusters (their labels, increasing; for
+fragments of one face; "tangent": a cylinder and a plane it borders, the cylinder tangent to it,
+as a fillet and the face it rounds) and clusters (their labels, increasing; for
 "orthogonal", those of one direction, and orthogonal_to those of the other).
 clusters(..., regularize=True) gives the primitives with these relations made exact.)",
                kLevelArguments, kRefineArgument, kRelationArguments,

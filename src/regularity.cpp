@@ -1783,6 +1783,230 @@ std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<Direc
   return kept;
 }
 
+// A linear condition on a cylinder of fixed direction, on y = (c, r): its axis line's position c
+// in orthonormal_pair(direction) coordinates and its radius r: row · y = target. Tangent to a
+// plane of unit normal n (orthogonal to the axis; (n·u, n·v) in those coordinates) and offset
+// n · x = o, with the axis on `side` (±1) of it: row = (n·u, n·v, −side), target = o. Of a given
+// radius (shared with others of equal radius): row = (0, 0, 1), target = r.
+struct CylinderHold {
+  Eigen::Vector3d row;
+  double target = 0;
+};
+
+struct HeldCylinderFit {
+  Eigen::Vector3d y;     // (c, r)
+  double rms = 0;        // unweighted, at least kResolution × the radius
+  std::size_t free = 0;  // 3 − the number of holds
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of y, from the unweighted residuals
+};
+
+// The cylinder of axis direction `direction` fitted to `points` by geometric least squares
+// (weighted residuals |Q(x − c)| − r) subject to `holds` (at most 3): Gauss–Newton over the 3 − k
+// coordinates z of y = y₀ + N z, y₀ the start (`centre`, `radius`) projected onto the holds and N
+// an orthonormal basis of their rows' null space. Nothing when the holds are (nearly) dependent
+// (one plane twice, parallel planes on one side of the axis), the iteration does not converge in
+// 50 steps, the radius ends non-positive or the points do not outnumber the free parameters.
+std::optional<HeldCylinderFit> fit_held_cylinder(const Eigen::Vector3d& direction,
+                                                 const Eigen::Vector2d& centre, double radius,
+                                                 std::span<const CylinderHold> holds,
+                                                 std::span<const Vec3> points,
+                                                 std::span<const double> weights) {
+  const std::size_t k = holds.size();
+  if (k > 3 || points.size() <= 3 - k) return std::nullopt;
+  // The rows' Gram determinant, normalised: 1 for orthogonal rows, 0 for dependent ones.
+  Eigen::MatrixXd gram(k, k);
+  Eigen::VectorXd excess(k);
+  Eigen::Vector3d y(centre.x(), centre.y(), radius);
+  double norms = 1;
+  for (std::size_t i = 0; i < k; ++i) {
+    for (std::size_t j = 0; j < k; ++j)
+      gram(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
+          holds[i].row.dot(holds[j].row);
+    excess(static_cast<Eigen::Index>(i)) = holds[i].row.dot(y) - holds[i].target;
+    norms *= holds[i].row.squaredNorm();
+  }
+  if (k > 0) {
+    if (!(gram.determinant() > 1e-12 * norms)) return std::nullopt;
+    const Eigen::VectorXd multipliers = gram.ldlt().solve(excess);
+    for (std::size_t i = 0; i < k; ++i)
+      y -= multipliers(static_cast<Eigen::Index>(i)) * holds[i].row;
+  }
+  const Eigen::Index free = static_cast<Eigen::Index>(3 - k);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, free);
+  if (k == 0) {
+    basis = Eigen::Matrix3d::Identity();
+  } else if (k == 1) {
+    const auto [a, b] = orthonormal_pair(holds[0].row.normalized());
+    basis << a, b;
+  } else if (k == 2) {
+    basis.col(0) = holds[0].row.cross(holds[1].row).normalized();
+  }
+  const auto [u, v] = orthonormal_pair(direction);
+  std::vector<Eigen::Vector2d> projected;
+  projected.reserve(points.size());
+  for (const Vec3& p : points) projected.emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
+  // Σ w e² and its Gauss–Newton system in z (weighted or not); returns the unweighted Σ e².
+  Eigen::MatrixXd normal(free, free);
+  Eigen::VectorXd gradient(free);
+  auto linearise = [&](bool weighted) {
+    normal.setZero();
+    gradient.setZero();
+    double squares = 0;
+    for (std::size_t i = 0; i < projected.size(); ++i) {
+      const Eigen::Vector2d d = projected[i] - y.head<2>();
+      const double length = d.norm();
+      if (!(length > 0)) continue;
+      const double e = length - y(2), w = weighted ? weights[i] : 1.0;
+      const Eigen::VectorXd row =
+          basis.transpose() * Eigen::Vector3d(-d.x() / length, -d.y() / length, -1);
+      normal.noalias() += w * row * row.transpose();
+      gradient += w * e * row;
+      squares += e * e;
+    }
+    return squares;
+  };
+  bool converged = free == 0;
+  for (int step = 0; step < 50 && !converged; ++step) {
+    linearise(true);
+    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
+    if (!delta.allFinite()) return std::nullopt;
+    const Eigen::Vector3d move = basis * delta;
+    y += move;
+    converged = !(move.norm() > 1e-14 * y.norm());
+  }
+  if (!converged || !y.allFinite() || !(y(2) > 0)) return std::nullopt;
+  const double squares = linearise(false);
+  HeldCylinderFit fit{y, 0, static_cast<std::size_t>(free)};
+  const double count = static_cast<double>(projected.size());
+  fit.rms = std::max(std::sqrt(squares / count), kResolution * y(2));
+  if (free > 0) {
+    const double variance = std::max(squares / (count - static_cast<double>(free)),
+                                     kResolution * kResolution * y(2) * y(2));
+    fit.covariance = basis * normal.inverse() * basis.transpose() * variance;
+    if (!fit.covariance.allFinite()) return std::nullopt;
+  }
+  return fit;
+}
+
+// Whether a point of `points` is also one of `sorted` (sorted): whether two clusters border each
+// other (a vertex on their border is an inlier of both).
+bool share_a_point(std::span<const Vec3> points, std::span<const Vec3> sorted) {
+  return std::any_of(points.begin(), points.end(), [&](const Vec3& p) {
+    return std::binary_search(sorted.begin(), sorted.end(), p);
+  });
+}
+
+// Cylinders held tangent to the planes they border: a fillet, a slot's round end. A cylinder
+// whose direction group a right angle made exactly orthogonal to a plane's (`orthogonal`, indices
+// into `groups`), and that does not share its axis line (a Coaxial relation of `relations`), is
+// tested against each plane of the other group that it borders (they share an inlier point) and
+// whose distance from its axis line, refitted with its direction (and its radius, if an
+// EqualRadius relation shares it), is its radius within the significance (the gap's standard
+// deviation from that fit's covariance), within max_radius_difference of the radius and known to
+// better than that (the interval rule of the spheres' centres). Candidates are tried from the
+// nearest in standard deviations, each kept when the cylinder refitted tangent to it and to those
+// kept before (fit_held_cylinder(): 2 parameters for one plane, 1 for two) raises its residual sum
+// by at most the χ² bound of that many conditions times its residual variance: a likelihood-ratio
+// test. The planes are held as they are: their fits are known far better than a fillet's narrow
+// arc. The cylinders kept are written back, and each pair is a Tangent relation of `tangents`.
+void make_tangent(const std::vector<DirectionGroup>& groups,
+                  const std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
+                  const std::vector<std::vector<std::size_t>>& refitted,
+                  const RegularityOptions& options, std::vector<Primitive>& primitives,
+                  const std::vector<std::vector<Vec3>>& points,
+                  const std::vector<std::vector<double>>& weights,
+                  const std::vector<Relation>& relations, std::vector<Relation>& tangents) {
+  std::vector<bool> shares_line(primitives.size(), false), shares_radius(primitives.size(), false);
+  for (const Relation& relation : relations) {
+    if (relation.kind == Relation::Kind::Coaxial)
+      for (const std::size_t c : relation.members) shares_line[c] = true;
+    if (relation.kind == Relation::Kind::EqualRadius)
+      for (const std::size_t c : relation.members) shares_radius[c] = true;
+  }
+  // Each candidate cylinder's direction group and the planes it may be tangent to.
+  std::map<std::size_t, std::pair<std::size_t, std::vector<std::size_t>>> candidates;
+  const auto pair_up = [&](std::size_t cylinder_group, std::size_t plane_group) {
+    for (const std::size_t c : refitted[cylinder_group]) {
+      if (primitives[c].type != PrimitiveType::Cylinder || shares_line[c]) continue;
+      auto& candidate = candidates[c];
+      candidate.first = cylinder_group;
+      for (const std::size_t p : refitted[plane_group])
+        if (primitives[p].type == PrimitiveType::Plane) candidate.second.push_back(p);
+    }
+  };
+  for (const auto& [i, j] : orthogonal) {
+    pair_up(i, j);
+    pair_up(j, i);
+  }
+  std::map<std::size_t, std::vector<Vec3>> sorted_points;  // of the candidate planes, on demand
+  const double significance2 = options.significance * options.significance;
+  for (auto& [c, candidate] : candidates) {
+    const Eigen::Vector3d& direction = groups[candidate.first].direction;
+    std::vector<std::size_t>& planes = candidate.second;
+    std::sort(planes.begin(), planes.end());
+    planes.erase(std::unique(planes.begin(), planes.end()), planes.end());
+    Primitive& cylinder = primitives[c];
+    const auto [u, v] = orthonormal_pair(direction);
+    const Eigen::Vector2d start(u.dot(to_eigen(cylinder.point)), v.dot(to_eigen(cylinder.point)));
+    std::vector<CylinderHold> holds;
+    if (shares_radius[c]) holds.push_back({Eigen::Vector3d::UnitZ(), cylinder.radius});
+    const std::optional<HeldCylinderFit> own =
+        fit_held_cylinder(direction, start, cylinder.radius, holds, points[c], weights[c]);
+    if (!own || own->free == 0) continue;
+    const double r = own->y(2);
+    // (score, plane, its hold) of the planes that pass the tests.
+    std::vector<std::tuple<double, std::size_t, CylinderHold>> tested;
+    for (const std::size_t p : planes) {
+      const Eigen::Vector3d normal = to_eigen(primitives[p].axis);
+      const double offset = normal.dot(to_eigen(primitives[p].point));
+      const Eigen::Vector2d in_frame(u.dot(normal), v.dot(normal));
+      const double distance = in_frame.dot(own->y.head<2>()) - offset;
+      const CylinderHold hold{Eigen::Vector3d(in_frame.x(), in_frame.y(), distance < 0 ? 1 : -1),
+                              offset};
+      const double gap = std::abs(distance) - r;
+      const double variance = hold.row.dot(own->covariance * hold.row);
+      const double bound = options.max_radius_difference * r;
+      if (!(std::abs(gap) <= bound && significance2 * variance <= bound * bound &&
+            gap * gap <= significance2 * variance))
+        continue;
+      std::vector<Vec3>& sorted = sorted_points[p];
+      if (sorted.empty()) {
+        sorted = points[p];
+        std::sort(sorted.begin(), sorted.end());
+      }
+      if (share_a_point(points[c], sorted)) tested.emplace_back(gap * gap / variance, p, hold);
+    }
+    std::sort(tested.begin(), tested.end(), [](const auto& a, const auto& b) {
+      return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
+    });
+    const std::size_t own_holds = holds.size();
+    std::vector<std::size_t> kept_planes;
+    std::optional<HeldCylinderFit> fit;
+    for (const auto& [score, p, hold] : tested) {
+      if (holds.size() == 3) break;
+      holds.push_back(hold);
+      std::optional<HeldCylinderFit> trial =
+          fit_held_cylinder(direction, own->y.head<2>(), r, holds, points[c], weights[c]);
+      const std::size_t conditions = holds.size() - own_holds;
+      if (trial && residual_excess(own->rms, trial->rms, points[c].size(),
+                                   chi_square_bound(options.significance, conditions),
+                                   static_cast<int>(own->free)) <= 1) {
+        fit = trial;
+        kept_planes.push_back(p);
+      } else {
+        holds.pop_back();
+      }
+    }
+    if (!fit) continue;
+    place_cylinder(cylinder, direction, fit->y.head<2>(), fit->y(2));
+    for (const std::size_t p : kept_planes) {
+      Relation& relation = tangents.emplace_back();
+      relation.kind = Relation::Kind::Tangent;
+      relation.members = {std::min(c, p), std::max(c, p)};
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
@@ -1903,6 +2127,10 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     if (options.equal_radii)
       equalize_radii(settled, options, primitives, points, weights, relations);
   }
+  std::vector<Relation> tangents;
+  if (options.tangency)
+    make_tangent(groups, orthogonal, refitted, options, primitives, points, weights, relations,
+                 tangents);
   std::vector<Relation> right_angles;
   for (const auto& [i, j] : orthogonal) {
     if (refitted[i].empty() || refitted[j].empty()) continue;
@@ -1917,6 +2145,7 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     return std::tie(a.members, a.others) < std::tie(b.members, b.others);
   });
   relations.insert(relations.end(), right_angles.begin(), right_angles.end());
+  relations.insert(relations.end(), tangents.begin(), tangents.end());
   return relations;
 }
 

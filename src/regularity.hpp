@@ -33,6 +33,10 @@ struct RegularityOptions {
   bool spheres_on_axes = true;
   /// Give cylinders and spheres whose radii agree within the significance one radius.
   bool equal_radii = true;
+  /// Hold a cylinder tangent to the planes it borders whose distance from its axis is its radius
+  /// within the significance, its direction made exactly orthogonal to theirs (a fillet, a slot's
+  /// round end): 2 parameters for one plane, 1 for two.
+  bool tangency = true;
   /// ... never when the radii differ by more than this fraction of the larger, nor a radius
   /// whose significance interval is wider than this fraction of it; likewise a sphere's centre's
   /// distance from an axis line, as a fraction of the sphere's radius.
@@ -68,7 +72,11 @@ struct Relation {
 /// exact: each direction group's members that were refitted with its direction, then its coplanar
 /// sets, then each coaxial set of its cylinders (spheres added when they join it), in that order,
 /// then the coaxial sets a sphere started with one cylinder, then the lines of spheres alone, then
-/// the classes of equal radii, then the right angles by their members.
+/// the classes of equal radii, then the right angles by their members. Last, cylinders whose
+/// direction a right angle made exactly orthogonal to a plane's, that border the plane and whose
+/// axis is at their radius from it within the significance are refitted tangent to it
+/// (RegularityOptions::tangency; not a cylinder on a shared axis line; one of a class of equal
+/// radii keeps that radius): each pair is a Tangent relation, by cylinder.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,

@@ -34,6 +34,8 @@ std::string_view to_string(ClusterRelation::Kind kind) {
       return "equal_radius";
     case ClusterRelation::Kind::Coplanar:
       return "coplanar";
+    case ClusterRelation::Kind::Tangent:
+      return "tangent";
   }
   return "unknown";
 }

@@ -695,5 +695,164 @@ TEST(Regularity, ANearlyFlatCylinderJoinsNoAxis) {
   EXPECT_GT(primitives[1].radius, 10);
 }
 
+// A profile in the xz-plane swept along y over [-0.5, 0.5] (21 rows): segment s's points are
+// cluster s, each moved along its normal by Gaussian noise of deviation `sigma`; consecutive
+// segments share their junction, a border vertex of both (one noisy point).
+struct ProfilePoint {
+  Eigen::Vector2d position, normal;  // (x, z)
+};
+using ProfileSegment = std::vector<ProfilePoint>;
+
+ProfileSegment profile_line(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+                            const Eigen::Vector2d& normal, int intervals) {
+  ProfileSegment segment;
+  for (int i = 0; i <= intervals; ++i)
+    segment.push_back({from + (to - from) * (i / double(intervals)), normal});
+  return segment;
+}
+
+ProfileSegment profile_arc(const Eigen::Vector2d& centre, double radius, double from_degrees,
+                           double to_degrees, int intervals) {
+  ProfileSegment segment;
+  for (int i = 0; i <= intervals; ++i) {
+    const double angle =
+        (from_degrees + (to_degrees - from_degrees) * i / intervals) * std::numbers::pi / 180;
+    const Eigen::Vector2d radial(std::cos(angle), std::sin(angle));
+    segment.push_back({centre + radius * radial, radial});
+  }
+  return segment;
+}
+
+std::vector<Cluster> swept_profile(const std::vector<ProfileSegment>& segments, double sigma,
+                                   std::mt19937_64& rng) {
+  std::normal_distribution<double> noise(0, sigma);
+  std::vector<Cluster> clusters(segments.size());
+  for (int row = 0; row <= 20; ++row) {
+    const double y = row / 20.0 - 0.5;
+    for (std::size_t s = 0; s < segments.size(); ++s)
+      for (std::size_t i = 0; i < segments[s].size(); ++i) {
+        Vec3 point;
+        if (s > 0 && i == 0) {
+          point = clusters[s - 1].points.back();
+        } else {
+          const ProfilePoint& p = segments[s][i];
+          const Eigen::Vector2d moved = p.position + noise(rng) * p.normal;
+          point = {moved.x(), y, moved.y()};
+        }
+        clusters[s].points.push_back(point);
+        clusters[s].weights.push_back(1);
+      }
+  }
+  return clusters;
+}
+
+// The distance of a cylinder's axis line from a plane (the axis parallel to the plane).
+double axis_to_plane(const Primitive& cylinder, const Primitive& plane) {
+  return std::abs(to_eigen(plane.axis).dot(to_eigen(cylinder.point) - to_eigen(plane.point)));
+}
+
+TEST(Regularity, AFilletIsHeldTangentToBothFacesItRounds) {
+  // A box's edge along y rounded by a quarter cylinder of radius 0.2 (axis through x = z = -0.2)
+  // between its side x = 0 and its top z = 0: side, fillet, top.
+  constexpr double kRadius = 0.2, kSigma = 0.002;
+  const Eigen::Vector2d centre(-kRadius, -kRadius);
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  double own_squares = 0, tangent_squares = 0;
+  int tangent_draws = 0;
+  constexpr int kDraws = 20;
+  for (std::uint64_t seed = 1; seed <= kDraws; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters =
+        swept_profile({profile_line({0, -1.2}, {0, -kRadius}, {1, 0}, 20),
+                       profile_arc(centre, kRadius, 0, 90, 12),
+                       profile_line({-kRadius, 0}, {-1.2, 0}, {0, 1}, 20)},
+                      kSigma, rng);
+    std::vector<Primitive> primitives{
+        fitted_plane(clusters[0]),
+        fitted_cylinder(clusters[1], y, {centre.x(), 0, centre.y()}, kRadius),
+        fitted_plane(clusters[2])};
+    own_squares += std::pow(primitives[1].radius - kRadius, 2);
+    const Relations relations = regularize(primitives, clusters);
+    const bool tangent_to_both =
+        std::count(relations.begin(), relations.end(),
+                   std::pair<Kind, std::vector<std::size_t>>{Kind::Tangent, {0, 1}}) == 1 &&
+        std::count(relations.begin(), relations.end(),
+                   std::pair<Kind, std::vector<std::size_t>>{Kind::Tangent, {1, 2}}) == 1;
+    if (!tangent_to_both) continue;
+    ++tangent_draws;
+    tangent_squares += std::pow(primitives[1].radius - kRadius, 2);
+    // Exactly tangent: the axis along both faces, at the radius from each.
+    for (const std::size_t plane : {0, 2}) {
+      EXPECT_NEAR(to_eigen(primitives[1].axis).dot(to_eigen(primitives[plane].axis)), 0, 1e-14);
+      EXPECT_NEAR(axis_to_plane(primitives[1], primitives[plane]), primitives[1].radius, 1e-14);
+    }
+  }
+  // Each of the two tests fails as rarely as a 3-sigma deviation: both pass in nearly every draw.
+  EXPECT_GE(tangent_draws, kDraws - 1);
+  // Held by its faces, the fillet's narrow arc is known far better.
+  const double own = std::sqrt(own_squares / kDraws);
+  const double tangent = std::sqrt(tangent_squares / tangent_draws);
+  std::printf("fillet radius RMS error: own %.3g, tangent %.3g\n", own, tangent);
+  EXPECT_LT(tangent, own / 2);
+}
+
+TEST(Regularity, ASlotsRoundEndIsTangentToBothSides) {
+  // A slot's end: its sides x = ±0.15 joined by a half cylinder of radius 0.15 about the y axis.
+  constexpr double kRadius = 0.15, kSigma = 0.002;
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters =
+        swept_profile({profile_line({kRadius, -1}, {kRadius, 0}, {-1, 0}, 20),
+                       profile_arc({0, 0}, kRadius, 0, 180, 18),
+                       profile_line({-kRadius, 0}, {-kRadius, -1}, {1, 0}, 20)},
+                      kSigma, rng);
+    std::vector<Primitive> primitives{fitted_plane(clusters[0]),
+                                      fitted_cylinder(clusters[1], y, {0, 0, 0}, kRadius),
+                                      fitted_plane(clusters[2])};
+    const Relations relations = regularize(primitives, clusters);
+    EXPECT_EQ(std::count(relations.begin(), relations.end(),
+                         std::pair<Kind, std::vector<std::size_t>>{Kind::Tangent, {0, 1}}),
+              1);
+    EXPECT_EQ(std::count(relations.begin(), relations.end(),
+                         std::pair<Kind, std::vector<std::size_t>>{Kind::Tangent, {1, 2}}),
+              1);
+    // Its radius is half the sides' distance, its axis midway between them.
+    EXPECT_NEAR(axis_to_plane(primitives[1], primitives[0]), primitives[1].radius, 1e-14);
+    EXPECT_NEAR(axis_to_plane(primitives[1], primitives[2]), primitives[1].radius, 1e-14);
+    EXPECT_NEAR(primitives[1].radius, kRadius, 0.002);
+  }
+}
+
+TEST(Regularity, ARoundMeetingItsFacesAtAKinkIsNotTangentToThem) {
+  // As the fillet above, but its arc spans 10 to 80 degrees and the faces go on from its ends:
+  // each face is r cos 10° from the axis, 1.5% of the radius (0.003, within max_radius_difference)
+  // short of it, with a kink of 10 degrees at each border.
+  constexpr double kRadius = 0.2, kSigma = 0.002;
+  const Eigen::Vector2d centre(-kRadius, -kRadius);
+  const double degree = std::numbers::pi / 180;
+  const Eigen::Vector2d start =
+      centre + kRadius * Eigen::Vector2d(std::cos(10 * degree), std::sin(10 * degree));
+  const Eigen::Vector2d end =
+      centre + kRadius * Eigen::Vector2d(std::cos(80 * degree), std::sin(80 * degree));
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters = swept_profile(
+        {profile_line({start.x(), -1.2}, start, {1, 0}, 20),
+         profile_arc(centre, kRadius, 10, 80, 12), profile_line(end, {-1.2, end.y()}, {0, 1}, 20)},
+        kSigma, rng);
+    std::vector<Primitive> primitives{
+        fitted_plane(clusters[0]),
+        fitted_cylinder(clusters[1], y, {centre.x(), 0, centre.y()}, kRadius),
+        fitted_plane(clusters[2])};
+    for (const auto& [kind, members] : regularize(primitives, clusters))
+      EXPECT_NE(kind, Kind::Tangent);
+  }
+}
+
 }  // namespace
 }  // namespace primseg

@@ -5,9 +5,10 @@
 /// directions at right angles, planes in one plane (the fragments of one face cut apart by holes),
 /// cylinders that share an axis line and spheres centred on it (a stepped shaft, the fragments of
 /// one bore, a ball end, a hole's spherical seat) and cylinders and spheres of one radius (a bolt
-/// circle's holes). Making these relations exact is what reverse engineering wants of a scanned
-/// part's fits: a box with parallel faces, a flange face in one plane, a shaft with one axis (after
-/// GlobFit, Li et al. 2011).
+/// circle's holes), and cylinders tangent to the planes they border (a fillet, a slot's round end).
+/// Making these relations exact is what reverse engineering wants of a scanned part's fits: a box
+/// with parallel faces, a flange face in one plane, a shaft with one axis, a fillet tangent to its
+/// faces (after GlobFit, Li et al. 2011).
 
 #include <cstdint>
 #include <memory>
@@ -45,6 +46,13 @@ struct ClusterRelation {
     /// cut apart by a hole, a boss, a slot or the hierarchy. They are also part of a Parallel
     /// relation.
     Coplanar,
+    /// A cylinder held tangent to a plane it borders, its axis orthogonal to the plane's normal
+    /// and at its radius from the plane: a fillet and each face it rounds, a slot's round end and
+    /// its sides. `clusters` are the two (one cylinder, one plane); a cylinder tangent to two
+    /// planes has two such relations. Its direction is also in an Orthogonal relation with the
+    /// plane's. Not for a cylinder that shares its axis line (Coaxial); one of an EqualRadius set
+    /// keeps that radius.
+    Tangent,
   };
   Kind kind = Kind::Parallel;
   /// Cluster labels, increasing; two or more (Orthogonal: one or more, its lowest below the
@@ -54,7 +62,7 @@ struct ClusterRelation {
   std::vector<std::uint32_t> orthogonal_to;
 };
 
-/// "parallel", "coaxial", "orthogonal", "equal_radius" or "coplanar".
+/// "parallel", "coaxial", "orthogonal", "equal_radius", "coplanar" or "tangent".
 std::string_view to_string(ClusterRelation::Kind kind);
 
 /// Options of regularize_clusters().
@@ -80,7 +88,7 @@ struct RelationOptions {
 /// Throws InvalidInputError when an option is out of its range.
 void validate(const RelationOptions& options);
 
-/// Finds the parallel, orthogonal, coplanar, coaxial and equal-radius relations among the
+/// Finds the parallel, orthogonal, coplanar, coaxial, equal-radius and tangent relations among the
 /// primitives of a level's clusters and makes them exact, in place.
 ///
 /// `reports` are the level's clusters as describe_clusters() or refine_boundaries() report them
@@ -94,12 +102,17 @@ void validate(const RelationOptions& options);
 /// with the group's axis direction, jointly with the cylinders and spheres coaxial with it (one
 /// axis line; one radius each, and each sphere one position along the line; the cylinders of a
 /// coaxial set, fitted on one line, count as one in the group's direction) and the cylinders and
-/// spheres of equal radius (one radius, each on its own line or centre). Its report's `primitive`,
-/// `rms` and `max` are replaced (`rms` and `max` measured as describe_clusters() does, on all the
-/// cluster's vertices); every other report is left bit for bit. Deterministic, O(F log F).
+/// spheres of equal radius (one radius, each on its own line or centre); last, a cylinder on its
+/// own line whose direction a right angle made orthogonal to a plane's normal, that shares a vertex
+/// with the plane and whose axis is at its radius from it within the significance (and within
+/// `max_radius_difference` of the radius, known to better than that) is refitted tangent to it,
+/// the plane held as it is (a likelihood-ratio test of the refit decides). Its report's
+/// `primitive`, `rms` and `max` are replaced (`rms` and `max` measured as describe_clusters() does,
+/// on all the cluster's vertices); every other report is left bit for bit. Deterministic, O(F log
+/// F).
 ///
 /// Returns the relations made exact, ordered by kind (parallel, coaxial, orthogonal,
-/// equal_radius, coplanar), then by their clusters.
+/// equal_radius, coplanar, tangent), then by their clusters.
 /// Throws InvalidInputError when the segmentation or the reports do not match the hierarchy.
 std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
                                                  const Segmentation& segmentation,

@@ -98,13 +98,14 @@ assert np.sum(angles < 7) >= 5 and np.sum(angles > 80) >= 5
 
 # %% [markdown]
 # ## The design intent
-# Which fits are parallel, coaxial, at right angles or of one radius within their uncertainty; with
+# Which fits are parallel, coaxial, at right angles, of one radius or tangent (a cylinder and a face
+# it borders) within their uncertainty; with
 # `regularize=True` the clusters' primitives have these relations made exact (the CLI's
 # `--regularize`), as a CAD model would have them.
 
 # %%
 relations = tree.relations(30)
-for kind in ("parallel", "coaxial", "orthogonal", "equal_radius"):
+for kind in ("parallel", "coaxial", "orthogonal", "equal_radius", "tangent"):
     print(f"{kind}: {sum(r['kind'] == kind for r in relations)}")
 exact = tree.clusters(30, regularize=True)
 # The cylinders of a coaxial set (which may also hold spheres centred on their axis).
@@ -126,6 +127,17 @@ for same in (r["clusters"] for r in relations if r["kind"] == "equal_radius"):
     radii = {exact[c]["params"]["radius"] for c in same}
     print("one radius for the clusters", same, ":", radii)
     assert len(radii) == 1
+# A tangent cylinder's axis lies along its plane, at its radius from it.
+tangent = [r["clusters"] for r in relations if r["kind"] == "tangent"]
+assert tangent
+for pair in tangent:
+    cylinder, plane = sorted(pair, key=lambda c: exact[c]["type"] != "cylinder")
+    normal = direction(plane)
+    gap = abs(normal @ (np.array(exact[cylinder]["params"]["point"]) - exact[plane]["params"]["point"]))
+    print(f"cylinder {cylinder} of radius {exact[cylinder]['params']['radius']:.4f} tangent to plane"
+          f" {plane}: its axis {gap:.4f} from it")
+    assert abs(normal @ direction(cylinder)) < 1e-14
+    assert abs(gap - exact[cylinder]["params"]["radius"]) < 1e-12
 
 # %% [markdown]
 # ## The design intent of many levels at once
@@ -137,7 +149,7 @@ for same in (r["clusters"] for r in relations if r["kind"] == "equal_radius"):
 start = time.perf_counter()
 levels = tree.relations_of_levels(range(10, 61, 5))
 print(f"{len(levels)} levels in {time.perf_counter() - start:.2f} s")
-kinds = ("parallel", "coaxial", "orthogonal", "equal_radius", "coplanar")
+kinds = ("parallel", "coaxial", "orthogonal", "equal_radius", "coplanar", "tangent")
 print("  k " + " ".join(f"{kind:>12}" for kind in kinds))
 for level in levels:
     found = [r["kind"] for r in level["relations"]]

@@ -61,9 +61,10 @@ def test_regularized_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path)
     borders = fandisk_tree.borders(30, refine=2, regularize=True)
     assert json.loads(json.dumps(borders)) == expected["borders"]
     # The relations are exact: one direction per parallel group (and per side of a right angle),
-    # one axis line per coaxial set, right angles to round-off, one radius per equal-radius set.
+    # one axis line per coaxial set, right angles to round-off, one radius per equal-radius set,
+    # a tangent cylinder's axis at its radius from its plane.
     kinds = {r["kind"] for r in relations}
-    assert kinds == {"parallel", "coaxial", "orthogonal", "equal_radius"}
+    assert kinds == {"parallel", "coaxial", "orthogonal", "equal_radius", "tangent"}
 
     def direction(c):
         params = clusters[c]["params"]
@@ -72,6 +73,14 @@ def test_regularized_level_matches_the_cli(cli, fandisk, fandisk_tree, tmp_path)
     for relation in relations:
         if relation["kind"] == "equal_radius":
             assert len({clusters[c]["params"]["radius"] for c in relation["clusters"]}) == 1
+            continue
+        if relation["kind"] == "tangent":
+            types = {clusters[c]["type"]: clusters[c]["params"] for c in relation["clusters"]}
+            cylinder, plane = types["cylinder"], types["plane"]
+            normal, axis = np.array(plane["normal"]), np.array(cylinder["axis"])
+            assert abs(normal @ axis) < 1e-14
+            gap = abs(normal @ (np.array(cylinder["point"]) - np.array(plane["point"])))
+            assert abs(gap - cylinder["radius"]) < 1e-12 * cylinder["radius"]
             continue
         sides = [relation["clusters"]] + ([relation["orthogonal_to"]] if "orthogonal_to" in relation else [])
         for side in sides:

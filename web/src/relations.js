@@ -1,6 +1,6 @@
 // The relations of a page written by `primseg view --regularize`: for every level of up to a
-// number of clusters, the parallel, coaxial, orthogonal, equal-radius and coplanar sets `primseg cut
-// --clusters K --regularize` finds, and the fits they make exact (layout in data.js).
+// number of clusters, the parallel, coaxial, orthogonal, equal-radius, coplanar and tangent sets
+// `primseg cut --clusters K --regularize` finds, and the fits they make exact (layout in data.js).
 
 import { lowerBound } from './hierarchy.js';
 
@@ -11,6 +11,7 @@ export const RELATION_MEANINGS = {
   orthogonal: 'two directions made exactly orthogonal (the clusters before | against those after)',
   equal_radius: 'cylinders and spheres made one radius, each keeping its axis line or centre',
   coplanar: 'planes made one plane, each keeping its side: the fragments of one face',
+  tangent: 'a cylinder made tangent to a plane it borders: a fillet and a face it rounds',
 };
 
 export class LevelRelations {
