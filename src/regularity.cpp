@@ -1899,16 +1899,31 @@ bool share_a_point(std::span<const Vec3> points, std::span<const Vec3> sorted) {
 // Cylinders held tangent to the planes they border: a fillet, a slot's round end. A cylinder
 // whose direction group a right angle made exactly orthogonal to a plane's (`orthogonal`, indices
 // into `groups`), and that does not share its axis line (a Coaxial relation of `relations`), is
-// tested against each plane of the other group that it borders (they share an inlier point) and
-// whose distance from its axis line, refitted with its direction (and its radius, if an
-// EqualRadius relation shares it), is its radius within the significance (the gap's standard
+// tested against each plane of the other group that it borders (they share an inlier point).
+//
+// A tangent join is a band about the contact line (the foot of the cylinder's axis on the plane,
+// from its fit as it comes) where the two surfaces are within the noise of each other, and the
+// hierarchy's border through it follows the noise: a point there joins the surface its noise
+// moves it towards. A row of the plane's side counted in the cylinder (√(r² + t²) from its axis,
+// t along the plane from the contact line) also pulls its radius up. On a noisy fillet cut by the
+// hierarchy the gap between the axis's distance from a face and the radius came out up to 4
+// deviations too small, and one of its two tangencies was refused in 4 draws of 30. So each side
+// keeps only its points beyond the band on its own side: a choice by where points are along the
+// plane, across the noise, which does not bias the fits (1 of 30). A plane's offset is
+// refitted with its normal from its points beyond every candidate cylinder's band (not a coplanar
+// set's shared offset). The band is as narrow as it can be, so that the points next to the
+// contact line still tell a kink of a few degrees from a tangency.
+//
+// The gap to each plane, from the cylinder refitted on its points with its direction (and its
+// radius, if an EqualRadius relation shares it), must be within the significance (its standard
 // deviation from that fit's covariance), within max_radius_difference of the radius and known to
 // better than that (the interval rule of the spheres' centres). Candidates are tried from the
 // nearest in standard deviations, each kept when the cylinder refitted tangent to it and to those
 // kept before (fit_held_cylinder(): 2 parameters for one plane, 1 for two) raises its residual sum
 // by at most the χ² bound of that many conditions times its residual variance: a likelihood-ratio
-// test. The planes are held as they are: their fits are known far better than a fillet's narrow
-// arc. The cylinders kept are written back, and each pair is a Tangent relation of `tangents`.
+// test. The planes are held at their offsets: a face has far more points than a fillet's narrow
+// arc. The cylinders kept are written back, and the planes they are tangent to with their
+// refitted offsets; each pair is a Tangent relation of `tangents`.
 void make_tangent(const std::vector<DirectionGroup>& groups,
                   const std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
                   const std::vector<std::vector<std::size_t>>& refitted,
@@ -1916,13 +1931,14 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
                   const std::vector<std::vector<Vec3>>& points,
                   const std::vector<std::vector<double>>& weights,
                   const std::vector<Relation>& relations, std::vector<Relation>& tangents) {
-  std::vector<bool> shares_line(primitives.size(), false), shares_radius(primitives.size(), false);
-  for (const Relation& relation : relations) {
-    if (relation.kind == Relation::Kind::Coaxial)
-      for (const std::size_t c : relation.members) shares_line[c] = true;
-    if (relation.kind == Relation::Kind::EqualRadius)
-      for (const std::size_t c : relation.members) shares_radius[c] = true;
-  }
+  std::vector<bool> shares_line(primitives.size(), false), shares_radius(primitives.size(), false),
+      shares_offset(primitives.size(), false);
+  for (const Relation& relation : relations)
+    for (const std::size_t c : relation.members) {
+      if (relation.kind == Relation::Kind::Coaxial) shares_line[c] = true;
+      if (relation.kind == Relation::Kind::EqualRadius) shares_radius[c] = true;
+      if (relation.kind == Relation::Kind::Coplanar) shares_offset[c] = true;
+    }
   // Each candidate cylinder's direction group and the planes it may be tangent to.
   std::map<std::size_t, std::pair<std::size_t, std::vector<std::size_t>>> candidates;
   const auto pair_up = [&](std::size_t cylinder_group, std::size_t plane_group) {
@@ -1938,27 +1954,106 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
     pair_up(i, j);
     pair_up(j, i);
   }
-  std::map<std::size_t, std::vector<Vec3>> sorted_points;  // of the candidate planes, on demand
-  const double significance2 = options.significance * options.significance;
+  // A contact line of a cylinder and a plane it borders: across the axis along the plane
+  // (direction × normal), where the axis is, the sign of the cylinder's side, and the half-width
+  // of the band about it where the two surfaces are within the noise of each other.
+  struct Contact {
+    std::size_t cylinder = 0, plane = 0;
+    Eigen::Vector3d across;
+    double at = 0, side = 1, band = 0;
+  };
+  // Where x is across a contact line: above 0 on the cylinder's side, below on the plane's.
+  const auto across_contact = [](const Contact& contact, const Vec3& x) {
+    return (contact.across.dot(to_eigen(x)) - contact.at) * contact.side;
+  };
+  std::vector<Contact> contacts;
+  std::map<std::size_t, std::vector<Vec3>> sorted_points;  // of the candidate planes
   for (auto& [c, candidate] : candidates) {
-    const Eigen::Vector3d& direction = groups[candidate.first].direction;
     std::vector<std::size_t>& planes = candidate.second;
     std::sort(planes.begin(), planes.end());
     planes.erase(std::unique(planes.begin(), planes.end()), planes.end());
+    const Eigen::Vector3d& direction = groups[candidate.first].direction;
+    // At a distance t along the plane from the contact line the cylinder is t²/2r from it: the
+    // surfaces are within the cylinder's residual deviation σ of each other for t < √(2 r σ).
+    const Primitive& cylinder = primitives[c];
+    double squares = 0;
+    for (const Vec3& x : points[c]) {
+      const Eigen::Vector3d offset = to_eigen(x) - to_eigen(cylinder.point);
+      squares += std::pow((offset - offset.dot(direction) * direction).norm() - cylinder.radius, 2);
+    }
+    const double deviation = std::max(std::sqrt(squares / static_cast<double>(points[c].size())),
+                                      kResolution * cylinder.radius);
+    const double band = std::sqrt(2 * cylinder.radius * deviation);
+    for (const std::size_t p : planes) {
+      std::vector<Vec3>& sorted = sorted_points[p];
+      if (sorted.empty()) {
+        sorted = points[p];
+        std::sort(sorted.begin(), sorted.end());
+      }
+      if (!share_a_point(points[c], sorted)) continue;
+      Contact contact{c, p, direction.cross(to_eigen(primitives[p].axis)).normalized()};
+      contact.band = band;
+      contact.at = contact.across.dot(to_eigen(primitives[c].point));
+      double side = 0;
+      for (std::size_t i = 0; i < points[c].size(); ++i)
+        side += weights[c][i] * (contact.across.dot(to_eigen(points[c][i])) - contact.at);
+      contact.side = side < 0 ? -1 : 1;
+      contacts.push_back(contact);
+    }
+  }
+  // Each bordered plane's offset from its points beyond every candidate cylinder's band.
+  std::map<std::size_t, std::vector<const Contact*>> contacts_of_plane;
+  for (const Contact& contact : contacts) contacts_of_plane[contact.plane].push_back(&contact);
+  std::map<std::size_t, double> offsets;
+  for (const auto& [p, bordering] : contacts_of_plane) {
+    const Eigen::Vector3d normal = to_eigen(primitives[p].axis);
+    double& offset = offsets[p] = normal.dot(to_eigen(primitives[p].point));
+    if (shares_offset[p]) continue;
+    double total = 0, sum = 0;
+    for (std::size_t i = 0; i < points[p].size(); ++i) {
+      const Vec3& x = points[p][i];  // not the binding p: clang 14 refuses it in a lambda
+      if (std::any_of(bordering.begin(), bordering.end(), [&](const Contact* contact) {
+            return across_contact(*contact, x) > -contact->band;
+          }))
+        continue;
+      total += weights[p][i];
+      sum += weights[p][i] * normal.dot(to_eigen(x));
+    }
+    if (total > 0) offset = sum / total;
+  }
+  std::vector<bool> moved(primitives.size(), false);  // planes to write their offset back to
+  const double significance2 = options.significance * options.significance;
+  for (std::size_t first = 0; first < contacts.size();) {
+    const std::size_t c = contacts[first].cylinder;
+    std::size_t last = first;
+    while (last < contacts.size() && contacts[last].cylinder == c) ++last;
+    const std::span<const Contact> bordered(contacts.data() + first, last - first);
+    first = last;
+    // The cylinder's points on its own side of every contact line.
+    std::vector<Vec3> own_points;
+    std::vector<double> own_weights;
+    for (std::size_t i = 0; i < points[c].size(); ++i)
+      if (std::none_of(bordered.begin(), bordered.end(), [&](const Contact& contact) {
+            return across_contact(contact, points[c][i]) < contact.band;
+          })) {
+        own_points.push_back(points[c][i]);
+        own_weights.push_back(weights[c][i]);
+      }
     Primitive& cylinder = primitives[c];
+    const Eigen::Vector3d& direction = groups[candidates[c].first].direction;
     const auto [u, v] = orthonormal_pair(direction);
     const Eigen::Vector2d start(u.dot(to_eigen(cylinder.point)), v.dot(to_eigen(cylinder.point)));
     std::vector<CylinderHold> holds;
     if (shares_radius[c]) holds.push_back({Eigen::Vector3d::UnitZ(), cylinder.radius});
     const std::optional<HeldCylinderFit> own =
-        fit_held_cylinder(direction, start, cylinder.radius, holds, points[c], weights[c]);
+        fit_held_cylinder(direction, start, cylinder.radius, holds, own_points, own_weights);
     if (!own || own->free == 0) continue;
     const double r = own->y(2);
     // (score, plane, its hold) of the planes that pass the tests.
     std::vector<std::tuple<double, std::size_t, CylinderHold>> tested;
-    for (const std::size_t p : planes) {
-      const Eigen::Vector3d normal = to_eigen(primitives[p].axis);
-      const double offset = normal.dot(to_eigen(primitives[p].point));
+    for (const Contact& contact : bordered) {
+      const Eigen::Vector3d normal = to_eigen(primitives[contact.plane].axis);
+      const double offset = offsets[contact.plane];
       const Eigen::Vector2d in_frame(u.dot(normal), v.dot(normal));
       const double distance = in_frame.dot(own->y.head<2>()) - offset;
       const CylinderHold hold{Eigen::Vector3d(in_frame.x(), in_frame.y(), distance < 0 ? 1 : -1),
@@ -1966,15 +2061,9 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       const double gap = std::abs(distance) - r;
       const double variance = hold.row.dot(own->covariance * hold.row);
       const double bound = options.max_radius_difference * r;
-      if (!(std::abs(gap) <= bound && significance2 * variance <= bound * bound &&
-            gap * gap <= significance2 * variance))
-        continue;
-      std::vector<Vec3>& sorted = sorted_points[p];
-      if (sorted.empty()) {
-        sorted = points[p];
-        std::sort(sorted.begin(), sorted.end());
-      }
-      if (share_a_point(points[c], sorted)) tested.emplace_back(gap * gap / variance, p, hold);
+      if (std::abs(gap) <= bound && significance2 * variance <= bound * bound &&
+          gap * gap <= significance2 * variance)
+        tested.emplace_back(gap * gap / variance, contact.plane, hold);
     }
     std::sort(tested.begin(), tested.end(), [](const auto& a, const auto& b) {
       return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
@@ -1986,9 +2075,9 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       if (holds.size() == 3) break;
       holds.push_back(hold);
       std::optional<HeldCylinderFit> trial =
-          fit_held_cylinder(direction, own->y.head<2>(), r, holds, points[c], weights[c]);
+          fit_held_cylinder(direction, own->y.head<2>(), r, holds, own_points, own_weights);
       const std::size_t conditions = holds.size() - own_holds;
-      if (trial && residual_excess(own->rms, trial->rms, points[c].size(),
+      if (trial && residual_excess(own->rms, trial->rms, own_points.size(),
                                    chi_square_bound(options.significance, conditions),
                                    static_cast<int>(own->free)) <= 1) {
         fit = trial;
@@ -2000,10 +2089,17 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
     if (!fit) continue;
     place_cylinder(cylinder, direction, fit->y.head<2>(), fit->y(2));
     for (const std::size_t p : kept_planes) {
+      moved[p] = true;
       Relation& relation = tangents.emplace_back();
       relation.kind = Relation::Kind::Tangent;
       relation.members = {std::min(c, p), std::max(c, p)};
     }
+  }
+  for (const auto& [p, offset] : offsets) {
+    if (!moved[p]) continue;
+    const Eigen::Vector3d normal = to_eigen(primitives[p].axis);
+    const Eigen::Vector3d point = to_eigen(primitives[p].point);
+    primitives[p].point = to_vec3(point + (offset - normal.dot(point)) * normal);
   }
 }
 

@@ -754,8 +754,8 @@ double axis_to_plane(const Primitive& cylinder, const Primitive& plane) {
 TEST(Regularity, AFilletIsHeldTangentToBothFacesItRounds) {
   // A box's edge along y rounded by a quarter cylinder of radius 0.2 (axis through x = z = -0.2)
   // between its side x = 0 and its top z = 0: side, fillet, top.
-  constexpr double kRadius = 0.2, kSigma = 0.002;
-  const Eigen::Vector2d centre(-kRadius, -kRadius);
+  constexpr double kRoundRadius = 0.2, kSigma = 0.002;
+  const Eigen::Vector2d centre(-kRoundRadius, -kRoundRadius);
   const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
   double own_squares = 0, tangent_squares = 0;
   int tangent_draws = 0;
@@ -764,15 +764,15 @@ TEST(Regularity, AFilletIsHeldTangentToBothFacesItRounds) {
     SCOPED_TRACE(seed);
     std::mt19937_64 rng(seed);
     const std::vector<Cluster> clusters =
-        swept_profile({profile_line({0, -1.2}, {0, -kRadius}, {1, 0}, 20),
-                       profile_arc(centre, kRadius, 0, 90, 12),
-                       profile_line({-kRadius, 0}, {-1.2, 0}, {0, 1}, 20)},
+        swept_profile({profile_line({0, -1.2}, {0, -kRoundRadius}, {1, 0}, 20),
+                       profile_arc(centre, kRoundRadius, 0, 90, 12),
+                       profile_line({-kRoundRadius, 0}, {-1.2, 0}, {0, 1}, 20)},
                       kSigma, rng);
     std::vector<Primitive> primitives{
         fitted_plane(clusters[0]),
-        fitted_cylinder(clusters[1], y, {centre.x(), 0, centre.y()}, kRadius),
+        fitted_cylinder(clusters[1], y, {centre.x(), 0, centre.y()}, kRoundRadius),
         fitted_plane(clusters[2])};
-    own_squares += std::pow(primitives[1].radius - kRadius, 2);
+    own_squares += std::pow(primitives[1].radius - kRoundRadius, 2);
     const Relations relations = regularize(primitives, clusters);
     const bool tangent_to_both =
         std::count(relations.begin(), relations.end(),
@@ -781,7 +781,7 @@ TEST(Regularity, AFilletIsHeldTangentToBothFacesItRounds) {
                    std::pair<Kind, std::vector<std::size_t>>{Kind::Tangent, {1, 2}}) == 1;
     if (!tangent_to_both) continue;
     ++tangent_draws;
-    tangent_squares += std::pow(primitives[1].radius - kRadius, 2);
+    tangent_squares += std::pow(primitives[1].radius - kRoundRadius, 2);
     // Exactly tangent: the axis along both faces, at the radius from each.
     for (const std::size_t plane : {0, 2}) {
       EXPECT_NEAR(to_eigen(primitives[1].axis).dot(to_eigen(primitives[plane].axis)), 0, 1e-14);
@@ -799,18 +799,18 @@ TEST(Regularity, AFilletIsHeldTangentToBothFacesItRounds) {
 
 TEST(Regularity, ASlotsRoundEndIsTangentToBothSides) {
   // A slot's end: its sides x = ±0.15 joined by a half cylinder of radius 0.15 about the y axis.
-  constexpr double kRadius = 0.15, kSigma = 0.002;
+  constexpr double kRoundRadius = 0.15, kSigma = 0.002;
   const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
     SCOPED_TRACE(seed);
     std::mt19937_64 rng(seed);
     const std::vector<Cluster> clusters =
-        swept_profile({profile_line({kRadius, -1}, {kRadius, 0}, {-1, 0}, 20),
-                       profile_arc({0, 0}, kRadius, 0, 180, 18),
-                       profile_line({-kRadius, 0}, {-kRadius, -1}, {1, 0}, 20)},
+        swept_profile({profile_line({kRoundRadius, -1}, {kRoundRadius, 0}, {-1, 0}, 20),
+                       profile_arc({0, 0}, kRoundRadius, 0, 180, 18),
+                       profile_line({-kRoundRadius, 0}, {-kRoundRadius, -1}, {1, 0}, 20)},
                       kSigma, rng);
     std::vector<Primitive> primitives{fitted_plane(clusters[0]),
-                                      fitted_cylinder(clusters[1], y, {0, 0, 0}, kRadius),
+                                      fitted_cylinder(clusters[1], y, {0, 0, 0}, kRoundRadius),
                                       fitted_plane(clusters[2])};
     const Relations relations = regularize(primitives, clusters);
     EXPECT_EQ(std::count(relations.begin(), relations.end(),
@@ -822,7 +822,7 @@ TEST(Regularity, ASlotsRoundEndIsTangentToBothSides) {
     // Its radius is half the sides' distance, its axis midway between them.
     EXPECT_NEAR(axis_to_plane(primitives[1], primitives[0]), primitives[1].radius, 1e-14);
     EXPECT_NEAR(axis_to_plane(primitives[1], primitives[2]), primitives[1].radius, 1e-14);
-    EXPECT_NEAR(primitives[1].radius, kRadius, 0.002);
+    EXPECT_NEAR(primitives[1].radius, kRoundRadius, 0.002);
   }
 }
 
@@ -830,24 +830,25 @@ TEST(Regularity, ARoundMeetingItsFacesAtAKinkIsNotTangentToThem) {
   // As the fillet above, but its arc spans 10 to 80 degrees and the faces go on from its ends:
   // each face is r cos 10° from the axis, 1.5% of the radius (0.003, within max_radius_difference)
   // short of it, with a kink of 10 degrees at each border.
-  constexpr double kRadius = 0.2, kSigma = 0.002;
-  const Eigen::Vector2d centre(-kRadius, -kRadius);
+  constexpr double kRoundRadius = 0.2, kSigma = 0.002;
+  const Eigen::Vector2d centre(-kRoundRadius, -kRoundRadius);
   const double degree = std::numbers::pi / 180;
   const Eigen::Vector2d start =
-      centre + kRadius * Eigen::Vector2d(std::cos(10 * degree), std::sin(10 * degree));
+      centre + kRoundRadius * Eigen::Vector2d(std::cos(10 * degree), std::sin(10 * degree));
   const Eigen::Vector2d end =
-      centre + kRadius * Eigen::Vector2d(std::cos(80 * degree), std::sin(80 * degree));
+      centre + kRoundRadius * Eigen::Vector2d(std::cos(80 * degree), std::sin(80 * degree));
   const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     SCOPED_TRACE(seed);
     std::mt19937_64 rng(seed);
-    const std::vector<Cluster> clusters = swept_profile(
-        {profile_line({start.x(), -1.2}, start, {1, 0}, 20),
-         profile_arc(centre, kRadius, 10, 80, 12), profile_line(end, {-1.2, end.y()}, {0, 1}, 20)},
-        kSigma, rng);
+    const std::vector<Cluster> clusters =
+        swept_profile({profile_line({start.x(), -1.2}, start, {1, 0}, 20),
+                       profile_arc(centre, kRoundRadius, 10, 80, 12),
+                       profile_line(end, {-1.2, end.y()}, {0, 1}, 20)},
+                      kSigma, rng);
     std::vector<Primitive> primitives{
         fitted_plane(clusters[0]),
-        fitted_cylinder(clusters[1], y, {centre.x(), 0, centre.y()}, kRadius),
+        fitted_cylinder(clusters[1], y, {centre.x(), 0, centre.y()}, kRoundRadius),
         fitted_plane(clusters[2])};
     for (const auto& [kind, members] : regularize(primitives, clusters))
       EXPECT_NE(kind, Kind::Tangent);

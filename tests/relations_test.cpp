@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <random>
 #include <span>
 #include <string>
 #include <thread>
@@ -426,6 +428,89 @@ TEST(Relations, TwoBearingSeatsFarApartShareTheirAxis) {
       "two bearing seats 12 apart: shared axis %.3g degrees from the truth (RMS), own %.3g\n",
       std::sqrt(shared_error), std::sqrt(own_error));
   EXPECT_LT(shared_error, own_error / 9);
+}
+
+// A box's edge rounded by a fillet, swept along y over [0, 1]: in the xz profile its side x = 0
+// from z = -1 up to -r, a quarter circle of radius r = 0.2 about (-r, -r) and its top z = 0 from
+// x = -r to -1; edges about 0.025 long, each vertex moved along the profile's normal by Gaussian
+// noise of deviation `noise`. An open sheet of three surfaces.
+Mesh rounded_edge(double noise, std::uint64_t seed) {
+  constexpr double kFilletRadius = 0.2;
+  std::vector<std::array<double, 4>> profile;  // x, z, normal x, normal z
+  constexpr int kLine = 32, kArc = 13, kRows = 41;
+  for (int i = 0; i < kLine; ++i)
+    profile.push_back({0, -1 + (1 - kFilletRadius) * i / kLine, 1, 0});
+  for (int i = 0; i < kArc; ++i) {
+    const double angle = std::numbers::pi / 2 * i / kArc;
+    profile.push_back({-kFilletRadius + kFilletRadius * std::cos(angle),
+                       -kFilletRadius + kFilletRadius * std::sin(angle), std::cos(angle),
+                       std::sin(angle)});
+  }
+  for (int i = 0; i <= kLine; ++i)
+    profile.push_back({-kFilletRadius - (1 - kFilletRadius) * i / kLine, 0, 0, 1});
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gaussian(0, noise);
+  const int rows = kRows - 1, columns = static_cast<int>(profile.size()) - 1;
+  return testing::grid_mesh(rows, columns, [&](double y, double along) {
+    const auto& [x, z, nx, nz] = profile[static_cast<std::size_t>(std::lround(along * columns))];
+    const double move = gaussian(rng);  // the grid visits each vertex once, in order
+    return Vec3{x + move * nx, y, z + move * nz};
+  });
+}
+
+// Through the whole pipeline (hierarchy, refined cut, regularize_clusters): the fillet is held
+// tangent to both faces it rounds, exactly, and its radius is nearer the truth than its own fit's.
+// Each of the two tests fails as rarely as a 3-sigma deviation if the fits are unbiased: at most
+// one draw of 30 misses one. (Without the bands about the contact lines, the hierarchy's noisy
+// borders biased the fits: 4 and 2 draws of 30 missed one.)
+TEST(Relations, AFilletIsTangentToTheFacesItRounds) {
+  constexpr int kSeeds = 30;
+  for (const double noise : {0.001, 0.002}) {
+    SCOPED_TRACE(noise);
+    double own_squares = 0, tangent_squares = 0;
+    int tangent_draws = 0;
+    for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+      SCOPED_TRACE(seed);
+      const Hierarchy hierarchy = build_hierarchy(rounded_edge(noise, seed));
+      BoundaryRefinementOptions refine;
+      refine.max_passes = 2;
+      const RefinedLevel level = refine_boundaries(hierarchy, cut_by_count(hierarchy, 3), refine);
+      const std::vector<ClusterReport>& own = level.reports;
+      std::vector<ClusterReport> reports = own;
+      const std::vector<ClusterRelation> relations =
+          regularize_clusters(hierarchy, level.segmentation, reports);
+      std::uint32_t fillet = 3;
+      for (std::uint32_t c = 0; c < 3; ++c)
+        if (reports[c].primitive.type == PrimitiveType::Cylinder) fillet = c;
+      ASSERT_LT(fillet, 3u);
+      Groups both;
+      for (std::uint32_t c = 0; c < 3; ++c)
+        if (c != fillet) both.push_back({std::min(c, fillet), std::max(c, fillet)});
+      const Groups tangent = clusters_of(relations, ClusterRelation::Kind::Tangent);
+      const Primitive& cylinder = reports[fillet].primitive;
+      for (const auto& pair : tangent) {
+        // Exact: the axis along the face, at the radius from it.
+        const Primitive& plane = reports[pair[0] == fillet ? pair[1] : pair[0]].primitive;
+        EXPECT_LT(std::abs(dot(plane.axis, cylinder.axis)), 1e-14);
+        const Vec3 offset{cylinder.point[0] - plane.point[0], cylinder.point[1] - plane.point[1],
+                          cylinder.point[2] - plane.point[2]};
+        EXPECT_NEAR(std::abs(dot(plane.axis, offset)), cylinder.radius, 1e-14);
+        EXPECT_LE(reports[fillet].rms, 1.1 * own[fillet].rms);
+      }
+      if (tangent != both) continue;
+      ++tangent_draws;
+      own_squares += std::pow(own[fillet].primitive.radius - 0.2, 2);
+      tangent_squares += std::pow(cylinder.radius - 0.2, 2);
+    }
+    const double own = std::sqrt(own_squares / tangent_draws);
+    const double tangent = std::sqrt(tangent_squares / tangent_draws);
+    std::printf(
+        "rounded edge, noise %g: tangent to both faces in %d of %d draws, fillet radius "
+        "error %.3g RMS against %.3g for its own fit\n",
+        noise, tangent_draws, kSeeds, tangent, own);
+    EXPECT_GE(tangent_draws, kSeeds - 1);
+    EXPECT_LT(tangent, own / 3);
+  }
 }
 
 // Fandisk's fits: its concentric front cylinders are found coaxial, its right angles exact, and no

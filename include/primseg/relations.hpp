@@ -105,8 +105,10 @@ void validate(const RelationOptions& options);
 /// spheres of equal radius (one radius, each on its own line or centre); last, a cylinder on its
 /// own line whose direction a right angle made orthogonal to a plane's normal, that shares a vertex
 /// with the plane and whose axis is at its radius from it within the significance (and within
-/// `max_radius_difference` of the radius, known to better than that) is refitted tangent to it,
-/// the plane held as it is (a likelihood-ratio test of the refit decides). Its report's
+/// `max_radius_difference` of the radius, known to better than that) is refitted tangent to it (a
+/// likelihood-ratio test of the refit decides), each fitted on its points away from the band
+/// about their contact line where the two surfaces are within the noise of each other (the plane
+/// keeps its normal, and its offset unless a coplanar set shares it). Its report's
 /// `primitive`, `rms` and `max` are replaced (`rms` and `max` measured as describe_clusters() does,
 /// on all the cluster's vertices); every other report is left bit for bit. Deterministic, O(F log
 /// F).
