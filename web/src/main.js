@@ -541,6 +541,10 @@ class Viewer {
       row.dataset.index = String(i);
       let text = this.relationText(relation);
       if (relation.kind === 'equal_radius') text += `, r = ${format(this.primitiveOf(this.levelRelations[i].members[0]).radius)}`;
+      if (relation.kind === 'tangent') {
+        const cylinder = this.levelRelations[i].members.map((c) => this.primitiveOf(c)).find((p) => TYPE_NAMES[p.type] === 'cylinder');
+        if (cylinder) text += `, r = ${format(cylinder.radius)}`;
+      }
       row.textContent = text;
       row.title = RELATION_MEANINGS[relation.kind] ?? relation.kind;
       row.addEventListener('pointerenter', () => this.emphasize(i));

@@ -438,6 +438,13 @@ test('fandisk --regularize: each level lists primseg cut --regularize\'s relatio
       ...(r.orthogonal_to ? { orthogonal_to: asCli(r.orthogonal_to) } : {}) }));
     assert.deepEqual(relations, cli.relations, `K = ${K}: the relations`);
     assert.equal(shown.rows.length, cli.relations.length, `K = ${K}: one row per relation`);
+    // A tangent pair's row names its cylinder's radius, as primseg reports it.
+    cli.relations.forEach((r, i) => {
+      if (r.kind !== 'tangent') return;
+      const cylinder = r.clusters.map((c) => cli.clusters[c]).find((c) => c.type === 'cylinder');
+      const radius = Number(/r = ([-0-9.e+]+)/.exec(shown.rows[i])?.[1]);
+      assert.ok(Math.abs(radius - cylinder.params.radius) <= 1e-3 * cylinder.params.radius, `K = ${K}: ${shown.rows[i]}`);
+    });
     for (const r of cli.relations) kinds.add(r.kind);
     // Every cluster's panel: the fit as cut --regularize reports it (the members' made exact),
     // and the relations it is in.
@@ -449,7 +456,7 @@ test('fandisk --regularize: each level lists primseg cut --regularize\'s relatio
       if (member.length) ++refitted;
     }
   }
-  for (const kind of ['parallel', 'coaxial', 'orthogonal', 'equal_radius']) assert.ok(kinds.has(kind), `a ${kind} relation is compared`);
+  for (const kind of ['parallel', 'coaxial', 'orthogonal', 'equal_radius', 'tangent']) assert.ok(kinds.has(kind), `a ${kind} relation is compared`);
   assert.ok(refitted > 50, `${refitted} exact fits compared`);
   // Beyond the page's levels, and on a cut by tolerance no count gives, none is listed; a cut by
   // tolerance that is a level by count lists that level's.
