@@ -568,6 +568,24 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
       EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
     }
   }
+  // A tangent pair: a cylinder whose axis lies along the plane at its radius from it, neither
+  // fit much worse for it.
+  const Groups tangent = clusters_of(relations, ClusterRelation::Kind::Tangent);
+  std::printf("fandisk: %zu tangent pairs\n", tangent.size());
+  EXPECT_GE(tangent.size(), 1u);
+  for (const auto& pair : tangent) {
+    const bool cylinder_first = after[pair[0]].primitive.type == PrimitiveType::Cylinder;
+    const Primitive& cylinder = after[pair[cylinder_first ? 0 : 1]].primitive;
+    const Primitive& plane = after[pair[cylinder_first ? 1 : 0]].primitive;
+    ASSERT_EQ(cylinder.type, PrimitiveType::Cylinder);
+    ASSERT_EQ(plane.type, PrimitiveType::Plane);
+    EXPECT_LT(std::abs(dot(cylinder.axis, plane.axis)), 1e-14);
+    const Vec3 offset{cylinder.point[0] - plane.point[0], cylinder.point[1] - plane.point[1],
+                      cylinder.point[2] - plane.point[2]};
+    EXPECT_NEAR(std::abs(dot(plane.axis, offset)), cylinder.radius, 1e-12 * diagonal);
+    for (const std::uint32_t c : pair)
+      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal);
+  }
   // fandisk's large sphere is centred on the axis of the cylinder beside it, to 0.07% of its
   // radius: one surface of revolution.
   EXPECT_TRUE(std::any_of(coaxial.begin(), coaxial.end(), [&](const auto& set) {
