@@ -2087,7 +2087,9 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       }
     }
     if (!fit) continue;
-    place_cylinder(cylinder, direction, fit->y.head<2>(), fit->y(2));
+    // A held radius is met to round-off; its class's radius stays the same bits.
+    place_cylinder(cylinder, direction, fit->y.head<2>(),
+                   shares_radius[c] ? cylinder.radius : fit->y(2));
     for (const std::size_t p : kept_planes) {
       moved[p] = true;
       Relation& relation = tangents.emplace_back();
