@@ -223,8 +223,10 @@ void add_relation_options(CLI::App& command, RelationOptions& options) {
       .add_option("--max-radius-difference", options.max_radius_difference,
                   "--regularize: radii never agree when they differ by more than this fraction "
                   "of the larger, nor does a radius known less well; nor is a sphere centred on "
-                  "an axis farther than this fraction of its radius from it, or known less well "
-                  "(in (0, 1); lower it for fewer chance relations on freeform parts)")
+                  "an axis farther than this fraction of its radius from it, or known less well, "
+                  "nor a cylinder made tangent to a plane when its axis's distance from it "
+                  "differs from its radius by more (in (0, 1); lower it for fewer chance "
+                  "relations on freeform parts)")
       ->check(open_range(0, 1, "a fraction in (0, 1) of the larger radius"))
       ->capture_default_str();
 }

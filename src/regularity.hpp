@@ -33,14 +33,15 @@ struct RegularityOptions {
   bool spheres_on_axes = true;
   /// Give cylinders and spheres whose radii agree within the significance one radius.
   bool equal_radii = true;
+  /// ... never when the radii differ by more than this fraction of the larger, nor a radius
+  /// whose significance interval is wider than this fraction of it; likewise a sphere's centre's
+  /// distance from an axis line, as a fraction of the sphere's radius, and the gap between a
+  /// cylinder's radius and its axis's distance from a plane it is to be tangent to.
+  double max_radius_difference = 0.05;
   /// Hold a cylinder tangent to the planes it borders whose distance from its axis is its radius
   /// within the significance, its direction made exactly orthogonal to theirs (a fillet, a slot's
   /// round end): 2 parameters for one plane, 1 for two.
   bool tangency = true;
-  /// ... never when the radii differ by more than this fraction of the larger, nor a radius
-  /// whose significance interval is wider than this fraction of it; likewise a sphere's centre's
-  /// distance from an axis line, as a fraction of the sphere's radius.
-  double max_radius_difference = 0.05;
 };
 
 /// Primitives that regularize() made share a direction, an axis line or a radius, or made

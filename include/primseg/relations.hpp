@@ -78,7 +78,8 @@ struct RelationOptions {
   /// less well than that (significance × its standard deviation above this fraction of it: a
   /// cylinder patch of a freeform surface) takes part in none. The same fraction of a sphere's
   /// radius bounds its centre's distance from a cylinder's axis, and how well that distance must
-  /// be known, for the sphere to be centred on the axis.
+  /// be known, for the sphere to be centred on the axis; and of a cylinder's radius, the gap
+  /// between it and its axis's distance from a plane, for the cylinder to be made tangent to it.
   double max_radius_difference = 0.05;
   /// The directions and the refits use each cluster's inlier vertices: those within this many
   /// robust deviations (1.4826 × the median distance) of its primitive. > 0.
