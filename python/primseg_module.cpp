@@ -414,7 +414,8 @@ const char* kRelationArguments =
   same names (RelationOptions significance, max_angle_degrees, max_radius_difference): fits agree
   within relation_significance standard deviations (> 0), never beyond max_relation_angle degrees
   (in (0, 90)) or radii more than max_radius_difference apart (in (0, 1); a sphere's centre is
-  put on an axis no farther than that fraction of its radius from it). Raise
+  put on an axis no farther than that fraction of its radius from it, and a cylinder made tangent
+  to a plane no farther than that fraction of its radius from tangent). Raise
   InvalidInputError (a ValueError) outside these ranges.)";
 
 // The RelationOptions of relation_significance, max_relation_angle and max_radius_difference;
