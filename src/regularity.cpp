@@ -1968,23 +1968,18 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
   };
   std::vector<Contact> contacts;
   std::map<std::size_t, std::vector<Vec3>> sorted_points;  // of the candidate planes
-  for (auto& [c, candidate] : candidates) {
-    std::vector<std::size_t>& planes = candidate.second;
-    std::sort(planes.begin(), planes.end());
-    planes.erase(std::unique(planes.begin(), planes.end()), planes.end());
+  for (const auto& [c, candidate] : candidates) {
+    // No plane twice: each is in one direction group, and each pair of groups is one right angle.
     const Eigen::Vector3d& direction = groups[candidate.first].direction;
     // At a distance t along the plane from the contact line the cylinder is t²/2r from it: the
     // surfaces are within the cylinder's residual deviation σ of each other for t < √(2 r σ).
     const Primitive& cylinder = primitives[c];
     double squares = 0;
-    for (const Vec3& x : points[c]) {
-      const Eigen::Vector3d offset = to_eigen(x) - to_eigen(cylinder.point);
-      squares += std::pow((offset - offset.dot(direction) * direction).norm() - cylinder.radius, 2);
-    }
+    for (const Vec3& x : points[c]) squares += std::pow(cylinder.distance(x), 2);
     const double deviation = std::max(std::sqrt(squares / static_cast<double>(points[c].size())),
                                       kResolution * cylinder.radius);
     const double band = std::sqrt(2 * cylinder.radius * deviation);
-    for (const std::size_t p : planes) {
+    for (const std::size_t p : candidate.second) {
       std::vector<Vec3>& sorted = sorted_points[p];
       if (sorted.empty()) {
         sorted = points[p];
