@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -1783,86 +1784,99 @@ std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<Direc
   return kept;
 }
 
-// A linear condition on a cylinder of fixed direction, on y = (c, r): its axis line's position c
-// in orthonormal_pair(direction) coordinates and its radius r: row · y = target. Tangent to a
-// plane of unit normal n (orthogonal to the axis; (n·u, n·v) in those coordinates) and offset
-// n · x = o, with the axis on `side` (±1) of it: row = (n·u, n·v, −side), target = o. Of a given
-// radius (shared with others of equal radius): row = (0, 0, 1), target = r.
-struct CylinderHold {
-  Eigen::Vector3d row;
+// A linear condition on cylinders of fixed direction on one axis line, on y = (c, r₀, r₁, …): the
+// line's position c in orthonormal_pair(direction) coordinates and each member's radius:
+// row · y = target. Member i tangent to a plane of unit normal n (orthogonal to the axis; (n·u,
+// n·v) in those coordinates) and offset n · x = o, with the axis on `side` (±1) of it: row = (n·u,
+// n·v, 0, …, −side at rᵢ, …), target = o. Member i of a given radius (shared with others of equal
+// radius): row = e(rᵢ), target = r. The line through a given position (a sphere centred on it):
+// rows e(c₀) and e(c₁).
+struct LineHold {
+  Eigen::VectorXd row;
   double target = 0;
 };
 
-struct HeldCylinderFit {
-  Eigen::Vector3d y;     // (c, r)
-  double rms = 0;        // unweighted, at least kResolution × the radius
-  std::size_t free = 0;  // 3 − the number of holds
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of y, from the unweighted residuals
+// Round-off of a condition its holds imply, relative to the row or the radius.
+constexpr double kImplied = 1e-9;
+
+struct HeldLineFit {
+  Eigen::VectorXd y;     // (c, r₀, r₁, …)
+  double rms = 0;        // unweighted, over every member's points, at least kResolution × a radius
+  std::size_t free = 0;  // the parameters − the number of holds
+  std::size_t count = 0;       // points
+  Eigen::MatrixXd covariance;  // of y, from the unweighted residuals
 };
 
-// The cylinder of axis direction `direction` fitted to `points` by geometric least squares
-// (weighted residuals |Q(x − c)| − r) subject to `holds` (at most 3): Gauss–Newton over the 3 − k
-// coordinates z of y = y₀ + N z, y₀ the start (`centre`, `radius`) projected onto the holds and N
-// an orthonormal basis of their rows' null space. Nothing when the holds are (nearly) dependent
-// (one plane twice, parallel planes on one side of the axis), the iteration does not converge in
-// 50 steps, the radius ends non-positive or the points do not outnumber the free parameters.
-std::optional<HeldCylinderFit> fit_held_cylinder(const Eigen::Vector3d& direction,
-                                                 const Eigen::Vector2d& centre, double radius,
-                                                 std::span<const CylinderHold> holds,
-                                                 std::span<const Vec3> points,
-                                                 std::span<const double> weights) {
-  const std::size_t k = holds.size();
-  if (k > 3 || points.size() <= 3 - k) return std::nullopt;
+// The cylinders `members` of axis direction `direction`, on one line, fitted to their points by
+// geometric least squares (weighted residuals |Q(x − c)| − rᵢ) subject to `holds` (at most as
+// many as the parameters, 2 + the members): Gauss–Newton over the free coordinates z of y = y₀ +
+// N z, y₀ the start (`centre` and the members' radii) projected onto the holds and N an
+// orthonormal basis of their rows' null space. Nothing when the holds are (nearly) dependent (one
+// plane twice, parallel planes on one side of the axis), the iteration does not converge in 50
+// steps, a radius ends non-positive or the points do not outnumber the free parameters.
+std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
+                                         const Eigen::Vector2d& centre,
+                                         std::span<const CoaxialMember> members,
+                                         std::span<const LineHold> holds) {
+  const Eigen::Index size = 2 + static_cast<Eigen::Index>(members.size());
+  const Eigen::Index k = static_cast<Eigen::Index>(holds.size());
+  std::size_t count = 0;
+  double largest_radius = 0;
+  for (const CoaxialMember& member : members) {
+    count += member.points.size();
+    largest_radius = std::max(largest_radius, member.radius);
+  }
+  if (k > size || count <= static_cast<std::size_t>(size - k)) return std::nullopt;
+  Eigen::VectorXd y(size);
+  y.head<2>() = centre;
+  for (Eigen::Index i = 2; i < size; ++i) y(i) = members[static_cast<std::size_t>(i - 2)].radius;
   // The rows' Gram determinant, normalised: 1 for orthogonal rows, 0 for dependent ones.
-  Eigen::MatrixXd gram(k, k);
+  Eigen::MatrixXd rows(size, k);
   Eigen::VectorXd excess(k);
-  Eigen::Vector3d y(centre.x(), centre.y(), radius);
   double norms = 1;
-  for (std::size_t i = 0; i < k; ++i) {
-    for (std::size_t j = 0; j < k; ++j)
-      gram(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
-          holds[i].row.dot(holds[j].row);
-    excess(static_cast<Eigen::Index>(i)) = holds[i].row.dot(y) - holds[i].target;
-    norms *= holds[i].row.squaredNorm();
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const LineHold& hold = holds[static_cast<std::size_t>(i)];
+    rows.col(i) = hold.row;
+    excess(i) = hold.row.dot(y) - hold.target;
+    norms *= hold.row.squaredNorm();
   }
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Identity(size, size);
   if (k > 0) {
+    const Eigen::MatrixXd gram = rows.transpose() * rows;
     if (!(gram.determinant() > 1e-12 * norms)) return std::nullopt;
-    const Eigen::VectorXd multipliers = gram.ldlt().solve(excess);
-    for (std::size_t i = 0; i < k; ++i)
-      y -= multipliers(static_cast<Eigen::Index>(i)) * holds[i].row;
+    y -= rows * gram.ldlt().solve(excess);
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(rows);
+    basis = (qr.householderQ() * Eigen::MatrixXd::Identity(size, size)).rightCols(size - k);
   }
-  const Eigen::Index free = static_cast<Eigen::Index>(3 - k);
-  Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, free);
-  if (k == 0) {
-    basis = Eigen::Matrix3d::Identity();
-  } else if (k == 1) {
-    const auto [a, b] = orthonormal_pair(holds[0].row.normalized());
-    basis << a, b;
-  } else if (k == 2) {
-    basis.col(0) = holds[0].row.cross(holds[1].row).normalized();
-  }
+  const Eigen::Index free = size - k;
   const auto [u, v] = orthonormal_pair(direction);
-  std::vector<Eigen::Vector2d> projected;
-  projected.reserve(points.size());
-  for (const Vec3& p : points) projected.emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
+  std::vector<std::vector<Eigen::Vector2d>> projected(members.size());
+  for (std::size_t m = 0; m < members.size(); ++m)
+    for (const Vec3& p : members[m].points)
+      projected[m].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
   // Σ w e² and its Gauss–Newton system in z (weighted or not); returns the unweighted Σ e².
   Eigen::MatrixXd normal(free, free);
   Eigen::VectorXd gradient(free);
+  Eigen::VectorXd jacobian(size);
   auto linearise = [&](bool weighted) {
     normal.setZero();
     gradient.setZero();
     double squares = 0;
-    for (std::size_t i = 0; i < projected.size(); ++i) {
-      const Eigen::Vector2d d = projected[i] - y.head<2>();
-      const double length = d.norm();
-      if (!(length > 0)) continue;
-      const double e = length - y(2), w = weighted ? weights[i] : 1.0;
-      const Eigen::VectorXd row =
-          basis.transpose() * Eigen::Vector3d(-d.x() / length, -d.y() / length, -1);
-      normal.noalias() += w * row * row.transpose();
-      gradient += w * e * row;
-      squares += e * e;
-    }
+    for (std::size_t m = 0; m < members.size(); ++m)
+      for (std::size_t i = 0; i < projected[m].size(); ++i) {
+        const Eigen::Vector2d d = projected[m][i] - y.head<2>();
+        const double length = d.norm();
+        if (!(length > 0)) continue;
+        const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
+        const double e = length - y(radius), w = weighted ? members[m].weights[i] : 1.0;
+        jacobian.setZero();
+        jacobian.head<2>() = -d / length;
+        jacobian(radius) = -1;
+        const Eigen::VectorXd row = basis.transpose() * jacobian;
+        normal.noalias() += w * row * row.transpose();
+        gradient += w * e * row;
+        squares += e * e;
+      }
     return squares;
   };
   bool converged = free == 0;
@@ -1870,22 +1884,32 @@ std::optional<HeldCylinderFit> fit_held_cylinder(const Eigen::Vector3d& directio
     linearise(true);
     const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
     if (!delta.allFinite()) return std::nullopt;
-    const Eigen::Vector3d move = basis * delta;
+    const Eigen::VectorXd move = basis * delta;
     y += move;
     converged = !(move.norm() > 1e-14 * y.norm());
   }
-  if (!converged || !y.allFinite() || !(y(2) > 0)) return std::nullopt;
+  if (!converged || !y.allFinite() || !(y.tail(size - 2).minCoeff() > 0)) return std::nullopt;
   const double squares = linearise(false);
-  HeldCylinderFit fit{y, 0, static_cast<std::size_t>(free)};
-  const double count = static_cast<double>(projected.size());
-  fit.rms = std::max(std::sqrt(squares / count), kResolution * y(2));
+  HeldLineFit fit{y, 0, static_cast<std::size_t>(free), count, Eigen::MatrixXd::Zero(size, size)};
+  const double n = static_cast<double>(count);
+  fit.rms = std::max(std::sqrt(squares / n), kResolution * largest_radius);
   if (free > 0) {
-    const double variance = std::max(squares / (count - static_cast<double>(free)),
-                                     kResolution * kResolution * y(2) * y(2));
+    const double variance = std::max(squares / (n - static_cast<double>(free)),
+                                     kResolution * kResolution * largest_radius * largest_radius);
     fit.covariance = basis * normal.inverse() * basis.transpose() * variance;
     if (!fit.covariance.allFinite()) return std::nullopt;
   }
   return fit;
+}
+
+// Whether `row` is a combination of the holds' rows, to round-off.
+bool implied_by(std::span<const LineHold> holds, const Eigen::VectorXd& row) {
+  if (holds.empty()) return false;
+  Eigen::MatrixXd rows(row.size(), static_cast<Eigen::Index>(holds.size()));
+  for (std::size_t i = 0; i < holds.size(); ++i)
+    rows.col(static_cast<Eigen::Index>(i)) = holds[i].row;
+  const Eigen::VectorXd combination = rows.colPivHouseholderQr().solve(row);
+  return (rows * combination - row).norm() <= kImplied * row.norm();
 }
 
 // Whether a point of `points` is also one of `sorted` (sorted): whether two clusters border each
@@ -1898,8 +1922,11 @@ bool share_a_point(std::span<const Vec3> points, std::span<const Vec3> sorted) {
 
 // Cylinders held tangent to the planes they border: a fillet, a slot's round end. A cylinder
 // whose direction group a right angle made exactly orthogonal to a plane's (`orthogonal`, indices
-// into `groups`), and that does not share its axis line (a Coaxial relation of `relations`), is
-// tested against each plane of the other group that it borders (they share an inlier point).
+// into `groups`) is tested against each plane of the other group that it borders (they share an
+// inlier point). The cylinders of a Coaxial relation of `relations` (the fragments of one fillet
+// the hierarchy cut apart, a counterbore's steps) are tested on their one line, together: its
+// position and their radii are fitted at once, and a tangency of one moves them all. A line with
+// spheres centred on it is left out.
 //
 // A tangent join is a band about the contact line (the foot of the cylinder's axis on the plane,
 // from its fit as it comes) where the two surfaces are within the noise of each other, and the
@@ -1914,16 +1941,19 @@ bool share_a_point(std::span<const Vec3> points, std::span<const Vec3> sorted) {
 // set's shared offset). The band is as narrow as it can be, so that the points next to the
 // contact line still tell a kink of a few degrees from a tangency.
 //
-// The gap to each plane, from the cylinder refitted on its points with its direction (and its
-// radius, if an EqualRadius relation shares it), must be within the significance (its standard
-// deviation from that fit's covariance), within max_radius_difference of the radius and known to
-// better than that (the interval rule of the spheres' centres). Candidates are tried from the
-// nearest in standard deviations, each kept when the cylinder refitted tangent to it and to those
-// kept before (fit_held_cylinder(): 2 parameters for one plane, 1 for two) raises its residual sum
-// by at most the χ² bound of that many conditions times its residual variance: a likelihood-ratio
-// test. The planes are held at their offsets: a face has far more points than a fillet's narrow
-// arc. The cylinders kept are written back, and the planes they are tangent to with their
-// refitted offsets; each pair is a Tangent relation of `tangents`.
+// The gap to each plane, from the line's cylinders refitted on their points with its direction
+// (a radius an EqualRadius relation shares with clusters off the line held, one shared only on
+// the line one parameter), must be within the significance (its standard deviation from that
+// fit's covariance), within max_radius_difference of the radius and known to better than that
+// (the interval rule of the spheres' centres). Candidates are tried from the nearest in standard
+// deviations, each kept when the line refitted tangent to it and to those kept before
+// (fit_held_line(): a lone cylinder keeps 2 parameters for one plane, 1 for two) raises its
+// residual sum by at most the χ² bound of that many conditions times its residual variance: a
+// likelihood-ratio test. A condition the kept ones imply (a fragment's face once another fragment
+// of the same radius is tangent to it) is kept when it holds to round-off. The planes are held at
+// their offsets: a face has far more points than a fillet's narrow arc. The cylinders are written
+// back, and the planes they are tangent to with their refitted offsets; each pair is a Tangent
+// relation of `tangents`.
 void make_tangent(const std::vector<DirectionGroup>& groups,
                   const std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
                   const std::vector<std::vector<std::size_t>>& refitted,
@@ -1931,19 +1961,21 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
                   const std::vector<std::vector<Vec3>>& points,
                   const std::vector<std::vector<double>>& weights,
                   const std::vector<Relation>& relations, std::vector<Relation>& tangents) {
-  std::vector<bool> shares_line(primitives.size(), false), shares_radius(primitives.size(), false),
-      shares_offset(primitives.size(), false);
-  for (const Relation& relation : relations)
-    for (const std::size_t c : relation.members) {
-      if (relation.kind == Relation::Kind::Coaxial) shares_line[c] = true;
-      if (relation.kind == Relation::Kind::EqualRadius) shares_radius[c] = true;
-      if (relation.kind == Relation::Kind::Coplanar) shares_offset[c] = true;
+  std::vector<bool> shares_offset(primitives.size(), false);
+  // Each cluster's Coaxial and EqualRadius relations.
+  std::vector<std::size_t> line_of(primitives.size(), kNoRelation),
+      radius_of(primitives.size(), kNoRelation);
+  for (std::size_t r = 0; r < relations.size(); ++r)
+    for (const std::size_t c : relations[r].members) {
+      if (relations[r].kind == Relation::Kind::Coaxial) line_of[c] = r;
+      if (relations[r].kind == Relation::Kind::EqualRadius) radius_of[c] = r;
+      if (relations[r].kind == Relation::Kind::Coplanar) shares_offset[c] = true;
     }
   // Each candidate cylinder's direction group and the planes it may be tangent to.
   std::map<std::size_t, std::pair<std::size_t, std::vector<std::size_t>>> candidates;
   const auto pair_up = [&](std::size_t cylinder_group, std::size_t plane_group) {
     for (const std::size_t c : refitted[cylinder_group]) {
-      if (primitives[c].type != PrimitiveType::Cylinder || shares_line[c]) continue;
+      if (primitives[c].type != PrimitiveType::Cylinder) continue;
       auto& candidate = candidates[c];
       candidate.first = cylinder_group;
       for (const std::size_t p : refitted[plane_group])
@@ -2018,74 +2050,135 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
   }
   std::vector<bool> moved(primitives.size(), false);  // planes to write their offset back to
   const double significance2 = options.significance * options.significance;
-  for (std::size_t first = 0; first < contacts.size();) {
-    const std::size_t c = contacts[first].cylinder;
-    std::size_t last = first;
-    while (last < contacts.size() && contacts[last].cylinder == c) ++last;
-    const std::span<const Contact> bordered(contacts.data() + first, last - first);
-    first = last;
-    // The cylinder's points on its own side of every contact line.
-    std::vector<Vec3> own_points;
-    std::vector<double> own_weights;
-    for (std::size_t i = 0; i < points[c].size(); ++i)
-      if (std::none_of(bordered.begin(), bordered.end(), [&](const Contact& contact) {
-            return across_contact(contact, points[c][i]) < contact.band;
-          })) {
-        own_points.push_back(points[c][i]);
-        own_weights.push_back(weights[c][i]);
-      }
-    Primitive& cylinder = primitives[c];
-    const Eigen::Vector3d& direction = groups[candidates[c].first].direction;
+  // Each line: a candidate cylinder alone, or the cylinders of a Coaxial relation (all in one
+  // direction group). A line with spheres centred on it is left as it is (a sphere is no
+  // candidate): moving the line would move them, and a joint held fit of spheres on a line is not
+  // modelled.
+  std::vector<bool> done(primitives.size(), false);
+  for (const auto& [first, candidate] : candidates) {
+    if (done[first]) continue;
+    const std::vector<std::size_t> cylinders = line_of[first] == kNoRelation
+                                                   ? std::vector<std::size_t>{first}
+                                                   : relations[line_of[first]].members;
+    for (const std::size_t c : cylinders) done[c] = true;
+    if (std::any_of(cylinders.begin(), cylinders.end(),
+                    [&](std::size_t c) { return !candidates.contains(c); }))
+      continue;
+    std::vector<const Contact*> bordered;
+    for (const Contact& contact : contacts)
+      if (std::find(cylinders.begin(), cylinders.end(), contact.cylinder) != cylinders.end())
+        bordered.push_back(&contact);
+    if (bordered.empty()) continue;
+    // Each cylinder's points on its own side of every contact line of its own.
+    const std::size_t count = cylinders.size();
+    std::vector<std::vector<Vec3>> own_points(count);
+    std::vector<std::vector<double>> own_weights(count);
+    std::vector<CoaxialMember> members;
+    for (std::size_t m = 0; m < count; ++m) {
+      const std::size_t c = cylinders[m];
+      for (std::size_t i = 0; i < points[c].size(); ++i)
+        if (std::none_of(bordered.begin(), bordered.end(), [&](const Contact* contact) {
+              return contact->cylinder == c &&
+                     across_contact(*contact, points[c][i]) < contact->band;
+            })) {
+          own_points[m].push_back(points[c][i]);
+          own_weights[m].push_back(weights[c][i]);
+        }
+      members.push_back({own_points[m], own_weights[m], primitives[c].radius});
+    }
+    const Eigen::Vector3d& direction = groups[candidate.first].direction;
     const auto [u, v] = orthonormal_pair(direction);
-    const Eigen::Vector2d start(u.dot(to_eigen(cylinder.point)), v.dot(to_eigen(cylinder.point)));
-    std::vector<CylinderHold> holds;
-    if (shares_radius[c]) holds.push_back({Eigen::Vector3d::UnitZ(), cylinder.radius});
-    const std::optional<HeldCylinderFit> own =
-        fit_held_cylinder(direction, start, cylinder.radius, holds, own_points, own_weights);
+    const Eigen::Vector3d on_line = to_eigen(primitives[first].point);
+    const Eigen::Vector2d start(u.dot(on_line), v.dot(on_line));
+    const Eigen::Index size = 2 + static_cast<Eigen::Index>(count);
+    const auto unit = [size](Eigen::Index i) {
+      return Eigen::VectorXd(Eigen::VectorXd::Unit(size, i));
+    };
+    // A radius shared with clusters off the line is held; one shared only by cylinders on the
+    // line (fragments of one fillet) is one parameter of the fit: holding it at the value fitted
+    // to the same points would make the tests overconfident. `tied[m]`: the first member of m's
+    // class on the line, itself for a radius of its own, kNoRelation for a held one.
+    std::vector<LineHold> holds;
+    std::vector<std::size_t> tied(count);
+    for (std::size_t m = 0; m < count; ++m) {
+      const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
+      tied[m] = m;
+      if (radius_of[cylinders[m]] == kNoRelation) continue;
+      const std::vector<std::size_t>& shared = relations[radius_of[cylinders[m]]].members;
+      if (std::any_of(shared.begin(), shared.end(), [&](std::size_t c) {
+            return std::find(cylinders.begin(), cylinders.end(), c) == cylinders.end();
+          })) {
+        tied[m] = kNoRelation;
+        holds.push_back({unit(radius), primitives[cylinders[m]].radius});
+        continue;
+      }
+      for (std::size_t j = 0; j < m && tied[m] == m; ++j)
+        if (radius_of[cylinders[j]] == radius_of[cylinders[m]]) tied[m] = j;
+      if (tied[m] != m)
+        holds.push_back({unit(radius) - unit(2 + static_cast<Eigen::Index>(tied[m])), 0});
+    }
+    const std::optional<HeldLineFit> own = fit_held_line(direction, start, members, holds);
     if (!own || own->free == 0) continue;
-    const double r = own->y(2);
-    // (score, plane, its hold) of the planes that pass the tests.
-    std::vector<std::tuple<double, std::size_t, CylinderHold>> tested;
-    for (const Contact& contact : bordered) {
-      const Eigen::Vector3d normal = to_eigen(primitives[contact.plane].axis);
-      const double offset = offsets[contact.plane];
+    // (score, plane, its cylinder's index in `cylinders`, its hold) of the planes that pass.
+    std::vector<std::tuple<double, std::size_t, std::size_t, LineHold>> tested;
+    for (const Contact* contact : bordered) {
+      const std::size_t m = static_cast<std::size_t>(
+          std::find(cylinders.begin(), cylinders.end(), contact->cylinder) - cylinders.begin());
+      const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
+      const Eigen::Vector3d normal = to_eigen(primitives[contact->plane].axis);
+      const double offset = offsets[contact->plane];
       const Eigen::Vector2d in_frame(u.dot(normal), v.dot(normal));
       const double distance = in_frame.dot(own->y.head<2>()) - offset;
-      const CylinderHold hold{Eigen::Vector3d(in_frame.x(), in_frame.y(), distance < 0 ? 1 : -1),
-                              offset};
+      LineHold hold{Eigen::VectorXd::Zero(size), offset};
+      hold.row.head<2>() = in_frame;
+      hold.row(radius) = distance < 0 ? 1 : -1;
+      const double r = own->y(radius);
       const double gap = std::abs(distance) - r;
       const double variance = hold.row.dot(own->covariance * hold.row);
       const double bound = options.max_radius_difference * r;
       if (std::abs(gap) <= bound && significance2 * variance <= bound * bound &&
           gap * gap <= significance2 * variance)
-        tested.emplace_back(gap * gap / variance, contact.plane, hold);
+        tested.emplace_back(gap * gap / variance, contact->plane, m, hold);
     }
     std::sort(tested.begin(), tested.end(), [](const auto& a, const auto& b) {
-      return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
+      return std::tie(std::get<0>(a), std::get<1>(a), std::get<2>(a)) <
+             std::tie(std::get<0>(b), std::get<1>(b), std::get<2>(b));
     });
     const std::size_t own_holds = holds.size();
-    std::vector<std::size_t> kept_planes;
-    std::optional<HeldCylinderFit> fit;
-    for (const auto& [score, p, hold] : tested) {
-      if (holds.size() == 3) break;
+    std::vector<std::pair<std::size_t, std::size_t>> kept;  // (cylinder, plane)
+    std::optional<HeldLineFit> fit;
+    for (const auto& [score, p, m, hold] : tested) {
+      // A condition the kept ones imply (a fragment's second face, once the line and the other
+      // fragments are held) holds to round-off or not at all: it adds no freedom to test.
+      if (implied_by(holds, hold.row)) {
+        const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
+        if (fit && std::abs(hold.row.dot(fit->y) - hold.target) <= kImplied * fit->y(radius))
+          kept.emplace_back(cylinders[m], p);
+        continue;
+      }
       holds.push_back(hold);
-      std::optional<HeldCylinderFit> trial =
-          fit_held_cylinder(direction, own->y.head<2>(), r, holds, own_points, own_weights);
+      for (std::size_t j = 0; j < count; ++j)
+        members[j].radius = own->y(2 + static_cast<Eigen::Index>(j));
+      std::optional<HeldLineFit> trial = fit_held_line(direction, own->y.head<2>(), members, holds);
       const std::size_t conditions = holds.size() - own_holds;
-      if (trial && residual_excess(own->rms, trial->rms, own_points.size(),
+      if (trial && residual_excess(own->rms, trial->rms, own->count,
                                    chi_square_bound(options.significance, conditions),
                                    static_cast<int>(own->free)) <= 1) {
         fit = trial;
-        kept_planes.push_back(p);
+        kept.emplace_back(cylinders[m], p);
       } else {
         holds.pop_back();
       }
     }
     if (!fit) continue;
-    // A held radius is met to round-off; its class's radius stays the same bits.
-    place_cylinder(cylinder, direction, fit->y.head<2>(),
-                   shares_radius[c] ? cylinder.radius : fit->y(2));
-    for (const std::size_t p : kept_planes) {
+    for (std::size_t m = 0; m < count; ++m) {
+      Primitive& cylinder = primitives[cylinders[m]];
+      // A held or tied radius is met to round-off: its class's radius stays one set of bits.
+      place_cylinder(cylinder, direction, fit->y.head<2>(),
+                     tied[m] == kNoRelation ? cylinder.radius
+                                            : fit->y(2 + static_cast<Eigen::Index>(tied[m])));
+    }
+    for (const auto& [c, p] : kept) {
       moved[p] = true;
       Relation& relation = tangents.emplace_back();
       relation.kind = Relation::Kind::Tangent;

@@ -515,6 +515,26 @@ TEST(Relations, AFilletIsTangentToTheFacesItRounds) {
 
 // Fandisk's fits: its concentric front cylinders are found coaxial, its right angles exact, and no
 // relation costs a fit much of its quality.
+// Each tangent pair: a cylinder whose axis lies along the plane at its radius from it, neither
+// fit much worse for it.
+void expect_exactly_tangent(const std::vector<ClusterReport>& before,
+                            const std::vector<ClusterReport>& after, const Groups& tangent,
+                            double diagonal) {
+  for (const auto& pair : tangent) {
+    const bool cylinder_first = after[pair[0]].primitive.type == PrimitiveType::Cylinder;
+    const Primitive& cylinder = after[pair[cylinder_first ? 0 : 1]].primitive;
+    const Primitive& plane = after[pair[cylinder_first ? 1 : 0]].primitive;
+    ASSERT_EQ(cylinder.type, PrimitiveType::Cylinder);
+    ASSERT_EQ(plane.type, PrimitiveType::Plane);
+    EXPECT_LT(std::abs(dot(cylinder.axis, plane.axis)), 1e-14);
+    const Vec3 offset{cylinder.point[0] - plane.point[0], cylinder.point[1] - plane.point[1],
+                      cylinder.point[2] - plane.point[2]};
+    EXPECT_NEAR(std::abs(dot(plane.axis, offset)), cylinder.radius, 1e-12 * diagonal);
+    for (const std::uint32_t c : pair)
+      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal);
+  }
+}
+
 TEST(Relations, FandiskRelationsAreExactAndCheap) {
   const Mesh mesh = read_mesh(testing::cgal_mesh("fandisk.off"));
   const Hierarchy hierarchy = build_hierarchy(mesh);
@@ -568,24 +588,10 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
       EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
     }
   }
-  // A tangent pair: a cylinder whose axis lies along the plane at its radius from it, neither
-  // fit much worse for it.
   const Groups tangent = clusters_of(relations, ClusterRelation::Kind::Tangent);
   std::printf("fandisk: %zu tangent pairs\n", tangent.size());
   EXPECT_GE(tangent.size(), 1u);
-  for (const auto& pair : tangent) {
-    const bool cylinder_first = after[pair[0]].primitive.type == PrimitiveType::Cylinder;
-    const Primitive& cylinder = after[pair[cylinder_first ? 0 : 1]].primitive;
-    const Primitive& plane = after[pair[cylinder_first ? 1 : 0]].primitive;
-    ASSERT_EQ(cylinder.type, PrimitiveType::Cylinder);
-    ASSERT_EQ(plane.type, PrimitiveType::Plane);
-    EXPECT_LT(std::abs(dot(cylinder.axis, plane.axis)), 1e-14);
-    const Vec3 offset{cylinder.point[0] - plane.point[0], cylinder.point[1] - plane.point[1],
-                      cylinder.point[2] - plane.point[2]};
-    EXPECT_NEAR(std::abs(dot(plane.axis, offset)), cylinder.radius, 1e-12 * diagonal);
-    for (const std::uint32_t c : pair)
-      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal);
-  }
+  expect_exactly_tangent(before, after, tangent, diagonal);
   // fandisk's large sphere is centred on the axis of the cylinder beside it, to 0.07% of its
   // radius: one surface of revolution.
   EXPECT_TRUE(std::any_of(coaxial.begin(), coaxial.end(), [&](const auto& set) {
@@ -593,6 +599,64 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
       return after[c].primitive.type == PrimitiveType::Sphere;
     });
   }));
+}
+
+// A libcgal-demo part at its automatic level with the borders refined and regularized, as
+// `segment --clusters auto --refine 2 --regularize`: the level's reports before and after, and
+// the relations.
+struct RegularizedPart {
+  Hierarchy hierarchy;  // and the mesh
+  RefinedLevel level;
+  std::vector<ClusterReport> after;
+  std::vector<ClusterRelation> relations;
+};
+
+RegularizedPart regularized_part(const char* name) {
+  Hierarchy hierarchy = build_hierarchy(read_mesh(testing::cgal_mesh(name)));
+  BoundaryRefinementOptions refine;
+  refine.max_passes = 2;
+  RefinedLevel level = refine_boundaries(
+      hierarchy, cut_by_count(hierarchy, choose_level(hierarchy).clusters), refine);
+  std::vector<ClusterReport> after = level.reports;
+  std::vector<ClusterRelation> relations =
+      regularize_clusters(hierarchy, level.segmentation, after);
+  return {std::move(hierarchy), std::move(level), std::move(after), std::move(relations)};
+}
+
+TEST(Relations, ALugsRoundEndIsTangentToItsSideOnItsHolesLine) {
+  // anchor (libcgal-demo) at its automatic level with the borders refined (as `segment --refine
+  // 2`): lugs whose round ends (radius 0.125) are concentric with the holes through them (radius
+  // 0.06), each hole and its lug's end one coaxial set, and the end tangent to the lug's flat side.
+  const RegularizedPart part = regularized_part("anchor.off");
+  const std::vector<ClusterReport>& before = part.level.reports;
+  const std::vector<ClusterReport>& after = part.after;
+  const std::vector<ClusterRelation>& relations = part.relations;
+  const Mesh& mesh = part.hierarchy.mesh();
+  const Groups coaxial = clusters_of(relations, ClusterRelation::Kind::Coaxial);
+  const Groups tangent = clusters_of(relations, ClusterRelation::Kind::Tangent);
+  const double diagonal = bounding_box_diagonal(mesh);
+  expect_exactly_tangent(before, after, tangent, diagonal);
+  // The tangent cylinders on a shared line, and that line still one.
+  std::size_t on_shared_lines = 0;
+  for (const auto& pair : tangent)
+    for (const auto& set : coaxial) {
+      const std::uint32_t cylinder =
+          after[pair[0]].primitive.type == PrimitiveType::Cylinder ? pair[0] : pair[1];
+      if (!std::binary_search(set.begin(), set.end(), cylinder)) continue;
+      ++on_shared_lines;
+      for (const std::uint32_t c : set) {
+        ASSERT_EQ(after[c].primitive.type, PrimitiveType::Cylinder);
+        EXPECT_LT(
+            angle_between_lines_degrees(after[c].primitive.axis, after[set[0]].primitive.axis),
+            1e-12);
+        EXPECT_LT(distance_from_axis(after[c].primitive.point, after[set[0]].primitive),
+                  1e-12 * diagonal);
+        EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
+      }
+    }
+  std::printf("anchor at %u clusters: %zu tangent pairs, %zu of them on a coaxial set's line\n",
+              part.level.segmentation.cluster_count(), tangent.size(), on_shared_lines);
+  EXPECT_GE(on_shared_lines, 2u);
 }
 
 // Cylinders and spheres of a CAD part whose fitted radii agree within `tolerance` (relative),
@@ -629,16 +693,12 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
   for (const auto& [name, tolerance] :
        {std::pair{"couplingdown.off", 1e-5}, std::pair{"anchor_dense.off", 1e-2}}) {
     SCOPED_TRACE(name);
-    const Mesh mesh = read_mesh(testing::cgal_mesh(name));
-    const Hierarchy hierarchy = build_hierarchy(mesh);
-    BoundaryRefinementOptions refine;
-    refine.max_passes = 2;
-    const RefinedLevel level = refine_boundaries(
-        hierarchy, cut_by_count(hierarchy, choose_level(hierarchy).clusters), refine);
-    const std::vector<ClusterReport>& before = level.reports;
-    std::vector<ClusterReport> after = before;
-    const std::vector<ClusterRelation> relations =
-        regularize_clusters(hierarchy, level.segmentation, after);
+    const RegularizedPart part = regularized_part(name);
+    const std::vector<ClusterReport>& before = part.level.reports;
+    const std::vector<ClusterReport>& after = part.after;
+    const std::vector<ClusterRelation>& relations = part.relations;
+    const Mesh& mesh = part.hierarchy.mesh();
+    const RefinedLevel& level = part.level;
     const Groups truth = equal_radii(before, tolerance);
     const Groups found = clusters_of(relations, ClusterRelation::Kind::EqualRadius);
     std::printf("%s at %u clusters: %zu equal-radius sets of", name,

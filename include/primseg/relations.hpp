@@ -50,8 +50,9 @@ struct ClusterRelation {
     /// and at its radius from the plane: a fillet and each face it rounds, a slot's round end and
     /// its sides. `clusters` are the two (one cylinder, one plane); a cylinder tangent to two
     /// planes has two such relations. Its direction is also in an Orthogonal relation with the
-    /// plane's. Not for a cylinder that shares its axis line (Coaxial); one of an EqualRadius set
-    /// keeps that radius.
+    /// plane's. The cylinders of a Coaxial set (fragments of one fillet, a lug's round end and
+    /// the hole through it) stay on their one line; one whose radius an EqualRadius set shares
+    /// with clusters off that line keeps that radius. Not for a line with spheres centred on it.
     Tangent,
   };
   Kind kind = Kind::Parallel;
@@ -103,11 +104,12 @@ void validate(const RelationOptions& options);
 /// with the group's axis direction, jointly with the cylinders and spheres coaxial with it (one
 /// axis line; one radius each, and each sphere one position along the line; the cylinders of a
 /// coaxial set, fitted on one line, count as one in the group's direction) and the cylinders and
-/// spheres of equal radius (one radius, each on its own line or centre); last, a cylinder on its
-/// own line whose direction a right angle made orthogonal to a plane's normal, that shares a vertex
-/// with the plane and whose axis is at its radius from it within the significance (and within
-/// `max_radius_difference` of the radius, known to better than that) is refitted tangent to it (a
-/// likelihood-ratio test of the refit decides), each fitted on its points away from the band
+/// spheres of equal radius (one radius, each on its own line or centre); last, a cylinder whose
+/// direction a right angle made orthogonal to a plane's normal, that shares a vertex with the
+/// plane and whose axis is at its radius from it within the significance (and within
+/// `max_radius_difference` of the radius, known to better than that) is refitted tangent to it,
+/// with the cylinders coaxial with it on their one line (a likelihood-ratio test of the refit
+/// decides; a line with spheres on it stays as it is), each fitted on its points away from the band
 /// about their contact line where the two surfaces are within the noise of each other (the plane
 /// keeps its normal, and its offset unless a coplanar set shares it). Its report's
 /// `primitive`, `rms` and `max` are replaced (`rms` and `max` measured as describe_clusters() does,
