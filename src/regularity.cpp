@@ -28,6 +28,8 @@ namespace {
 // would make every direction and axis certain beyond its own rounding and no two of them equal;
 // any measured surface has residuals far above it.
 constexpr double kResolution = 1e-9;
+// Two directions the right angles made one, to round-off (radians).
+constexpr double kSameDirection = 1e-12;
 
 // A primitive with a direction (a plane's normal, a cylinder's axis) and how well its inliers
 // determine it.
@@ -1784,6 +1786,53 @@ std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<Direc
   return kept;
 }
 
+// Groups the right angles made one direction. On an exact CAD mesh directions are known to a
+// tiny fraction of a degree, and two groups of faces the part means to be parallel can differ by
+// more than that before the right angles; each then made orthogonal to the same two others, they
+// end with one direction to round-off. They are one group: the first keeps its direction and
+// takes the other's members, information, coplanar sets and right angles (`orthogonal`, indices
+// into `groups`, renumbered; the emptied group keeps none).
+void merge_parallel_groups(std::vector<DirectionGroup>& groups,
+                           std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
+                           std::vector<std::vector<std::vector<std::size_t>>>& coplanar) {
+  std::vector<std::size_t> merged_into(groups.size());
+  std::iota(merged_into.begin(), merged_into.end(), std::size_t{0});
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (merged_into[g] != g) continue;
+    DirectionGroup& kept = groups[g];
+    bool merged = false;
+    for (std::size_t h = g + 1; h < groups.size(); ++h) {
+      if (merged_into[h] != h ||
+          !(kept.direction.cross(groups[h].direction).norm() <= kSameDirection))
+        continue;
+      merged_into[h] = g;
+      merged = true;
+      kept.members.insert(kept.members.end(), groups[h].members.begin(), groups[h].members.end());
+      groups[h].members.clear();
+      kept.information += groups[h].information;
+      coplanar[g].insert(coplanar[g].end(), coplanar[h].begin(), coplanar[h].end());
+      coplanar[h].clear();
+    }
+    if (!merged) continue;
+    std::sort(kept.members.begin(), kept.members.end());
+    // The tilt's covariance from the joint information across the kept direction.
+    const Eigen::Matrix3d across =
+        Eigen::Matrix3d::Identity() - kept.direction * kept.direction.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(across * kept.information * across);
+    kept.covariance.setZero();
+    for (int k = 1; k < 3; ++k)
+      kept.covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
+                         eigen.eigenvalues()(k);
+  }
+  for (auto& [i, j] : orthogonal) {
+    i = merged_into[i];
+    j = merged_into[j];
+    if (i > j) std::swap(i, j);
+  }
+  std::sort(orthogonal.begin(), orthogonal.end());
+  orthogonal.erase(std::unique(orthogonal.begin(), orthogonal.end()), orthogonal.end());
+}
+
 // A linear condition on cylinders of fixed direction on one axis line, on y = (c, r₀, r₁, …): the
 // line's position c in orthonormal_pair(direction) coordinates and each member's radius:
 // row · y = target. Member i tangent to a plane of unit normal n (orthogonal to the axis; (n·u,
@@ -2242,7 +2291,10 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     if (group.direction.dot(before) < 0) group.direction = -group.direction;
   }
   std::vector<std::pair<std::size_t, std::size_t>> orthogonal;
-  if (options.orthogonal) orthogonal = orthogonalize(groups, options);
+  if (options.orthogonal) {
+    orthogonal = orthogonalize(groups, options);
+    merge_parallel_groups(groups, orthogonal, coplanar);
+  }
   std::vector<bool> constrained(groups.size(), false);
   for (const auto& [i, j] : orthogonal) constrained[i] = constrained[j] = true;
   // The clusters each group refitted, for the orthogonal relations.

@@ -272,6 +272,48 @@ TEST(Regularity, PlanesAtRightAnglesBecomeExactlyOrthogonal) {
   }
 }
 
+// A square plane of side 1 with normal `normal` through `centre`, 20 x 20 points moved along the
+// normal by ±sigma in a checkerboard: residuals of deviation sigma that do not tilt its fit.
+Cluster checkered_plane(const Eigen::Vector3d& normal, const Eigen::Vector3d& centre,
+                        double sigma) {
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  Cluster cluster;
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j) {
+      const double s = i / 19.0 - 0.5, t = j / 19.0 - 0.5, height = (i + j) % 2 ? sigma : -sigma;
+      cluster.points.push_back(to_vec3(centre + s * u + t * v + height * normal));
+      cluster.weights.push_back(1);
+    }
+  return cluster;
+}
+
+TEST(Regularity, FacesTheRightAnglesMakeParallelAreOneParallelGroup) {
+  // Two faces A and B tilted ±0.0042 rad about y from x, each known to 0.00165 rad: farther apart
+  // (0.0084) than the significance lets two such directions agree (3 √2 × 0.00165 = 0.0070), so
+  // they are not grouped, yet each is at right angles to the faces C (normal z) and D (normal y),
+  // known far better, within the significance (0.0042 against 3 × 0.00165). The right angles
+  // make A and B both C × D: parallel to round-off, and one parallel group with one right angle
+  // to each of C and D.
+  const double tilt = 0.0042;
+  const Eigen::Vector3d a(std::cos(tilt), 0, std::sin(tilt)), b(std::cos(tilt), 0, -std::sin(tilt));
+  const std::vector<Cluster> clusters{
+      checkered_plane(a, {0.6, 0, 0}, 0.01), checkered_plane(b, {-0.6, 0, 0}, 0.01),
+      checkered_plane(Eigen::Vector3d::UnitZ(), {0, 0, 0.6}, 0.001),
+      checkered_plane(Eigen::Vector3d::UnitY(), {0, 0.6, 0}, 0.001)};
+  std::vector<Primitive> planes;
+  for (const Cluster& cluster : clusters) planes.push_back(fitted_plane(cluster));
+  EXPECT_NEAR(angle_between_lines(planes[0].axis, to_vec3(a)), 0, 1e-12);
+  const Relations relations = regularize(planes, clusters);
+  EXPECT_EQ(std::count(relations.begin(), relations.end(),
+                       std::pair<Kind, std::vector<std::size_t>>{Kind::Parallel, {0, 1}}),
+            1);
+  EXPECT_LE(angle_between_lines(planes[0].axis, planes[1].axis), 1e-12);
+  using Pairs = std::vector<std::pair<std::vector<std::size_t>, std::vector<std::size_t>>>;
+  planes.clear();
+  for (const Cluster& cluster : clusters) planes.push_back(fitted_plane(cluster));
+  EXPECT_EQ(right_angles(planes, clusters), (Pairs{{{0, 1}, {2}}, {{0, 1}, {3}}, {{2}, {3}}}));
+}
+
 TEST(Regularity, An88DegreeAngleStaysAsItIs) {
   // Normals known to about 0.01 degree, 2 degrees from a right angle.
   std::mt19937_64 rng(5);
