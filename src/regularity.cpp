@@ -1906,7 +1906,8 @@ std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
   // Σ w e² and its Gauss–Newton system in z (weighted or not); returns the unweighted Σ e².
   Eigen::MatrixXd normal(free, free);
   Eigen::VectorXd gradient(free);
-  Eigen::VectorXd jacobian(size);
+  Eigen::VectorXd row(free);  // a residual's derivative in z
+  const Eigen::MatrixXd basis_rows = basis.transpose();
   auto linearise = [&](bool weighted) {
     normal.setZero();
     gradient.setZero();
@@ -1918,12 +1919,10 @@ std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
         if (!(length > 0)) continue;
         const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
         const double e = length - y(radius), w = weighted ? members[m].weights[i] : 1.0;
-        jacobian.setZero();
-        jacobian.head<2>() = -d / length;
-        jacobian(radius) = -1;
-        const Eigen::VectorXd row = basis.transpose() * jacobian;
+        row.noalias() = -(d.x() / length) * basis_rows.col(0) -
+                        (d.y() / length) * basis_rows.col(1) - basis_rows.col(radius);
         normal.noalias() += w * row * row.transpose();
-        gradient += w * e * row;
+        gradient.noalias() += (w * e) * row;
         squares += e * e;
       }
     return squares;
