@@ -76,10 +76,12 @@ struct Relation {
 /// the classes of equal radii, then the right angles by their members. Last, cylinders whose
 /// direction a right angle made exactly orthogonal to a plane's, that border the plane and whose
 /// axis is at their radius from it within the significance are refitted tangent to it
-/// (RegularityOptions::tangency; not a cylinder on a shared axis line; one of a class of equal
-/// radii keeps that radius), each on its points away from the band about the contact line where
-/// the two surfaces are within the noise (the plane's offset refitted so, unless it is a coplanar
-/// set's): each pair is a Tangent relation, by cylinder.
+/// (RegularityOptions::tangency; the cylinders of a coaxial set together, on their one line, not
+/// a line with spheres on it; one of a class of equal radii with members off its line keeps that
+/// radius), each on its points away from the band about the contact line where the two surfaces
+/// are within the noise (the plane's offset refitted so, unless it is a coplanar set's): each
+/// pair is a Tangent relation, by line. Direction groups the right angles made one direction are
+/// merged first.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,
