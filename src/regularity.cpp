@@ -57,14 +57,21 @@ Eigen::Matrix3d direction_information(const Oriented& item) {
   return item.frame * item.covariance.inverse() * item.frame.transpose();
 }
 
+// The covariance of a direction's tilt from the eigen-decomposition of its information: the
+// inverse across it, over the two largest eigenvalues (the direction is the smallest's).
+Eigen::Matrix3d tilt_covariance(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eigen) {
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (int k = 1; k < 3; ++k)
+    covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
+                  eigen.eigenvalues()(k);
+  return covariance;
+}
+
 // The group's direction and its covariance, from its information.
 void form_direction(DirectionGroup& group) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(group.information);
   group.direction = eigen.eigenvectors().col(0);
-  group.covariance.setZero();
-  for (int k = 1; k < 3; ++k)
-    group.covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
-                        eigen.eigenvalues()(k);
+  group.covariance = tilt_covariance(eigen);
 }
 
 double angle_between_lines(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -1818,11 +1825,8 @@ void merge_parallel_groups(std::vector<DirectionGroup>& groups,
     // The tilt's covariance from the joint information across the kept direction.
     const Eigen::Matrix3d across =
         Eigen::Matrix3d::Identity() - kept.direction * kept.direction.transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(across * kept.information * across);
-    kept.covariance.setZero();
-    for (int k = 1; k < 3; ++k)
-      kept.covariance += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() /
-                         eigen.eigenvalues()(k);
+    kept.covariance = tilt_covariance(
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(across * kept.information * across));
   }
   for (auto& [i, j] : orthogonal) {
     i = merged_into[i];
@@ -1838,8 +1842,8 @@ void merge_parallel_groups(std::vector<DirectionGroup>& groups,
 // row · y = target. Member i tangent to a plane of unit normal n (orthogonal to the axis; (n·u,
 // n·v) in those coordinates) and offset n · x = o, with the axis on `side` (±1) of it: row = (n·u,
 // n·v, 0, …, −side at rᵢ, …), target = o. Member i of a given radius (shared with others of equal
-// radius): row = e(rᵢ), target = r. The line through a given position (a sphere centred on it):
-// rows e(c₀) and e(c₁).
+// radius off the line): row = e(rᵢ), target = r. Members i and j of one radius: row = e(rᵢ) −
+// e(rⱼ), target = 0.
 struct LineHold {
   Eigen::VectorXd row;
   double target = 0;
@@ -2193,6 +2197,8 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
              std::tie(std::get<0>(b), std::get<1>(b), std::get<2>(b));
     });
     const std::size_t own_holds = holds.size();
+    for (std::size_t m = 0; m < count; ++m)  // each trial starts from the own fit
+      members[m].radius = own->y(2 + static_cast<Eigen::Index>(m));
     std::vector<std::pair<std::size_t, std::size_t>> kept;  // (cylinder, plane)
     std::optional<HeldLineFit> fit;
     for (const auto& [score, p, m, hold] : tested) {
@@ -2205,8 +2211,6 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
         continue;
       }
       holds.push_back(hold);
-      for (std::size_t j = 0; j < count; ++j)
-        members[j].radius = own->y(2 + static_cast<Eigen::Index>(j));
       std::optional<HeldLineFit> trial = fit_held_line(direction, own->y.head<2>(), members, holds);
       const std::size_t conditions = holds.size() - own_holds;
       if (trial && residual_excess(own->rms, trial->rms, own->count,
