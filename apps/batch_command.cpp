@@ -252,7 +252,7 @@ void run_batch(const BatchOptions& o) {
   options.exact_costs = o.exact_costs;
   options.threads = 1;  // The workers are the parallelism: one file each.
   validate(options);
-  validate(o.fit.relations);
+  validate_relation_options(o.fit.relations);
   validate_level(o.level, UINT32_MAX);
   const auto [shard, shards] = parse_shard(o.shard);
 

@@ -186,19 +186,22 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
 
 namespace {
 
-// Accepts a finite number above `low` and, when given, below `high`; otherwise the error names
-// the range (CLI11 prefixes the option's name), as `range` says it. The help shows the interval.
-CLI::Validator open_range(double low, std::optional<double> high, const std::string& range) {
-  const std::string interval =
-      high ? "in (" + CLI::detail::to_string(low) + ", " + CLI::detail::to_string(*high) + ")"
-           : "> " + CLI::detail::to_string(low);
+// Accepts a finite number above `low` (or equal to it, when `with_low`) and, when given, below
+// `high`; otherwise the error names the range (CLI11 prefixes the option's name), as `range` says
+// it. The help shows the interval.
+CLI::Validator number_range(double low, std::optional<double> high, const std::string& range,
+                            bool with_low = false) {
+  const std::string from = (with_low ? "[" : "(") + CLI::detail::to_string(low);
+  const std::string interval = high ? "in " + from + ", " + CLI::detail::to_string(*high) + ")"
+                                    : (with_low ? ">= " : "> ") + CLI::detail::to_string(low);
   return CLI::Validator(
       [=](const std::string& text) -> std::string {
         double value = 0;
         const char* end = text.data() + text.size();
         const auto [stop, error] = std::from_chars(text.data(), end, value);
         const bool number = error == std::errc() && stop == end && std::isfinite(value);
-        if (number && value > low && (!high || value < *high)) return {};
+        if (number && (value > low || (with_low && value == low)) && (!high || value < *high))
+          return {};
         return "the value " + text + " must be " + range;
       },
       interval);
@@ -211,13 +214,29 @@ void add_relation_options(CLI::App& command, RelationOptions& options) {
       .add_option("--relation-significance", options.significance,
                   "--regularize: directions, axis lines and radii agree when they are within "
                   "this many standard deviations of their fits (> 0; larger finds more)")
-      ->check(open_range(0, std::nullopt, "a positive number of standard deviations"))
+      ->check(number_range(0, std::nullopt, "a positive number of standard deviations"))
       ->capture_default_str();
   command
       .add_option("--max-relation-angle", options.max_angle_degrees,
                   "--regularize: directions never agree, nor are made orthogonal, beyond this "
                   "angle, whatever their uncertainty (degrees, in (0, 90))")
-      ->check(open_range(0, 90, "an angle in (0, 90) degrees"))
+      ->check(number_range(0, 90, "an angle in (0, 90) degrees"))
+      ->capture_default_str();
+  command
+      .add_option("--relation-angle-tolerance", options.angle_tolerance_degrees,
+                  "--regularize: directions within this angle of one another are parallel, and "
+                  "within it of a right angle orthogonal, whatever their uncertainty (degrees, "
+                  "at least 0 and below --max-relation-angle; 0: the significance alone). For "
+                  "CAD parts, whose tessellation errs by more than its fits' statistics allow")
+      ->check(number_range(0, 90, "an angle in [0, 90) degrees", true))
+      ->capture_default_str();
+  command
+      .add_option("--relation-length-tolerance", options.length_tolerance,
+                  "--regularize: axis lines, plane offsets, sphere centres on lines, radii and "
+                  "tangency gaps within this distance agree whatever their uncertainty, and a "
+                  "joint fit that raises a member's RMS residual by at most this much (in "
+                  "quadrature) keeps it (input units, >= 0; 0: the significance alone)")
+      ->check(number_range(0, std::nullopt, "a distance >= 0", true))
       ->capture_default_str();
   command
       .add_option("--max-radius-difference", options.max_radius_difference,
@@ -227,8 +246,17 @@ void add_relation_options(CLI::App& command, RelationOptions& options) {
                   "nor a cylinder made tangent to a plane when its axis's distance from it "
                   "differs from its radius by more (in (0, 1); lower it for fewer chance "
                   "relations on freeform parts)")
-      ->check(open_range(0, 1, "a fraction in (0, 1) of the larger radius"))
+      ->check(number_range(0, 1, "a fraction in (0, 1) of the larger radius"))
       ->capture_default_str();
+}
+
+void validate_relation_options(const RelationOptions& options) {
+  if (!(options.angle_tolerance_degrees < options.max_angle_degrees))
+    throw InvalidInputError("--relation-angle-tolerance " +
+                            CLI::detail::to_string(options.angle_tolerance_degrees) +
+                            " must be below --max-relation-angle (" +
+                            CLI::detail::to_string(options.max_angle_degrees) + ")");
+  validate(options);
 }
 
 std::string relation_options_signature(const RelationOptions& options) {
@@ -241,12 +269,15 @@ std::string relation_options_signature(const RelationOptions& options) {
   };
   add("relation_significance", options.significance, defaults.significance);
   add("max_relation_angle", options.max_angle_degrees, defaults.max_angle_degrees);
+  add("relation_angle_tolerance", options.angle_tolerance_degrees,
+      defaults.angle_tolerance_degrees);
+  add("relation_length_tolerance", options.length_tolerance, defaults.length_tolerance);
   add("max_radius_difference", options.max_radius_difference, defaults.max_radius_difference);
   return signature;
 }
 
 void validate_level_outputs(LevelOptions& options) {
-  validate(options.relations);
+  validate_relation_options(options.relations);
   validate_output_files(options.files);
   if (writes_to_standard_output(options.files)) options.quiet = true;
 }

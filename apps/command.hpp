@@ -111,9 +111,13 @@ void add_level_options(CLI::App& command, LevelOptions& options,
 /// Adds --refine and --regularize (LevelOptions::refine and ::regularize) to a command that
 /// reports a hierarchy's level, and the options of --regularize (add_relation_options).
 void add_fit_options(CLI::App& command, LevelOptions& options);
-/// Adds --relation-significance, --max-relation-angle and --max-radius-difference (the
-/// RelationOptions of --regularize), checked by validate(RelationOptions) when the command runs.
+/// Adds --relation-significance, --max-relation-angle, --relation-angle-tolerance,
+/// --relation-length-tolerance and --max-radius-difference (the RelationOptions of --regularize),
+/// checked by validate_relation_options() when the command runs.
 void add_relation_options(CLI::App& command, RelationOptions& options);
+/// validate(RelationOptions), with the bound between two options named by their flags: throws
+/// InvalidInputError.
+void validate_relation_options(const RelationOptions& options);
 /// The options of `relations` that differ from the defaults, as " name=value" pairs (a resumed
 /// batch redoes outputs made with others): empty for the defaults.
 std::string relation_options_signature(const RelationOptions& options);

@@ -463,7 +463,7 @@ Command add_view_command(CLI::App& app) {
         options.primitives = parse_primitives(o->primitives);
         options.threads = o->threads;
         validate(options);
-        validate(o->relations);
+        validate_relation_options(o->relations);
         if (o->tree_path == kStandardInput && o->mesh_path == kStandardInput)
           throw InvalidInputError("view: only one of MESH and --tree can be standard input ('-')");
         auto mesh = std::make_shared<const Mesh>(

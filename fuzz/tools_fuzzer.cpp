@@ -497,17 +497,28 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
       fail("regularized level: a cluster outside every relation changed", double(c));
   }
 
+  // With tolerances as wide as a user may set them, which relate far more, the same holds.
+  RelationOptions tolerant;
+  tolerant.angle_tolerance_degrees = 10;
+  tolerant.length_tolerance = 0.01 * bounding_box_diagonal(*mesh);
+  std::vector<ClusterReport> tolerated = results.refined.reports;
+  const std::vector<ClusterRelation> tolerated_relations =
+      regularize_clusters(hierarchy, results.refined.segmentation, tolerated, tolerant);
+  check_reports(hierarchy, results.refined.segmentation, tolerated);
+  check_relations(cluster_primitives(tolerated), tolerated_relations,
+                  "regularized level with tolerances");
+
   // The level as `primseg view --regularize` regularizes it, from its nodes' reports: the same
-  // clusters, relations and reports as the cut's, bit for bit.
-  {
+  // clusters, relations and reports as the cut's, bit for bit, with either options.
+  for (const RelationOptions& options : {RelationOptions{}, tolerant}) {
     std::vector<std::uint32_t> nodes = results.level.nodes;
     std::sort(nodes.begin(), nodes.end());
     const LevelRegularizer regularizer(hierarchy, nodes, describe_nodes(hierarchy, nodes, describe),
-                                       {}, 1);
+                                       options, 1);
     const RegularizedLevel viewed = regularizer.level(clusters);
     std::vector<ClusterReport> cut_reports = results.reports;
     const std::vector<ClusterRelation> cut_relations =
-        regularize_clusters(hierarchy, results.level, cut_reports);
+        regularize_clusters(hierarchy, results.level, cut_reports, options);
     if (viewed.nodes != results.level.nodes) fail("level regularizer: nodes");
     if (viewed.relations.size() != cut_relations.size())
       fail("level regularizer: relations", double(viewed.relations.size()),

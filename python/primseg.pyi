@@ -70,6 +70,8 @@ class Hierarchy:
         regularize: bool = False,
         relation_significance: float = 3.0,
         max_relation_angle: float = 20.0,
+        relation_angle_tolerance: float = 0.0,
+        relation_length_tolerance: float = 0.0,
         max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def borders(
@@ -82,6 +84,8 @@ class Hierarchy:
         regularize: bool = False,
         relation_significance: float = 3.0,
         max_relation_angle: float = 20.0,
+        relation_angle_tolerance: float = 0.0,
+        relation_length_tolerance: float = 0.0,
         max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def relations(
@@ -93,6 +97,8 @@ class Hierarchy:
         refine: int = 0,
         relation_significance: float = 3.0,
         max_relation_angle: float = 20.0,
+        relation_angle_tolerance: float = 0.0,
+        relation_length_tolerance: float = 0.0,
         max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def relations_of_levels(
@@ -101,6 +107,8 @@ class Hierarchy:
         *,
         relation_significance: float = 3.0,
         max_relation_angle: float = 20.0,
+        relation_angle_tolerance: float = 0.0,
+        relation_length_tolerance: float = 0.0,
         max_radius_difference: float = 0.05,
         threads: int = 0,
     ) -> list[dict[str, Any]]: ...

@@ -415,12 +415,19 @@ const char* kRelationArguments =
   within relation_significance standard deviations (> 0), never beyond max_relation_angle degrees
   (in (0, 90)) or radii more than max_radius_difference apart (in (0, 1); a sphere's centre is
   put on an axis no farther than that fraction of its radius from it, and a cylinder made tangent
-  to a plane no farther than that fraction of its radius from tangent). Raise
+  to a plane no farther than that fraction of its radius from tangent).
+  relation_angle_tolerance (degrees, at least 0 and below max_relation_angle) and
+  relation_length_tolerance (input units, >= 0; RelationOptions angle_tolerance_degrees,
+  length_tolerance): directions, and axis lines, offsets, centres, radii and tangency gaps, that
+  agree within them are related whatever their uncertainty (for CAD parts, whose tessellation errs
+  by more than the fits' statistics allow); 0, the default, leaves the significance alone. Raise
   InvalidInputError (a ValueError) outside these ranges.)";
 
-// The RelationOptions of relation_significance, max_relation_angle and max_radius_difference;
-// InvalidInputError, naming the keyword, outside their ranges.
-RelationOptions relation_arguments(double significance, double max_angle, double max_difference) {
+// The RelationOptions of relation_significance, max_relation_angle, relation_angle_tolerance,
+// relation_length_tolerance and max_radius_difference; InvalidInputError, naming the keyword,
+// outside their ranges.
+RelationOptions relation_arguments(double significance, double max_angle, double angle_tolerance,
+                                   double length_tolerance, double max_difference) {
   auto refuse = [](const char* keyword, double value, const char* range) {
     throw InvalidInputError(std::string(keyword) + " is " + std::to_string(value) + ", must be " +
                             range);
@@ -428,11 +435,17 @@ RelationOptions relation_arguments(double significance, double max_angle, double
   if (!(significance > 0 && std::isfinite(significance)))
     refuse("relation_significance", significance, "a positive number");
   if (!(max_angle > 0 && max_angle < 90)) refuse("max_relation_angle", max_angle, "in (0, 90)");
+  if (!(angle_tolerance >= 0 && angle_tolerance < max_angle))
+    refuse("relation_angle_tolerance", angle_tolerance, "at least 0 and below max_relation_angle");
+  if (!(length_tolerance >= 0 && std::isfinite(length_tolerance)))
+    refuse("relation_length_tolerance", length_tolerance, "a finite number at least 0");
   if (!(max_difference > 0 && max_difference < 1))
     refuse("max_radius_difference", max_difference, "in (0, 1)");
   RelationOptions options;
   options.significance = significance;
   options.max_angle_degrees = max_angle;
+  options.angle_tolerance_degrees = angle_tolerance;
+  options.length_tolerance = length_tolerance;
   options.max_radius_difference = max_difference;
   return options;
 }
@@ -1241,7 +1254,8 @@ labels as the CLI's --labels.)",
           "clusters",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
              std::optional<double> relative_tolerance, std::int64_t refine, bool regularize,
-             double significance, double max_angle, double max_difference) {
+             double significance, double max_angle, double angle_tolerance, double length_tolerance,
+             double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterReport> reports;
             {
@@ -1249,7 +1263,8 @@ labels as the CLI's --labels.)",
               std::vector<ClusterRelation> relations;
               refined_level(*self.hierarchy, level, refine, &reports,
                             regularize ? &relations : nullptr,
-                            relation_arguments(significance, max_angle, max_difference));
+                            relation_arguments(significance, max_angle, angle_tolerance,
+                                               length_tolerance, max_difference));
             }
             py::list clusters;
             for (const ClusterReport& report : reports) clusters.append(cluster_dict(report));
@@ -1260,9 +1275,11 @@ labels as the CLI's --labels.)",
           py::arg("regularize") = false,
           py::arg("relation_significance") = RelationOptions{}.significance,
           py::arg("max_relation_angle") = RelationOptions{}.max_angle_degrees,
+          py::arg("relation_angle_tolerance") = RelationOptions{}.angle_tolerance_degrees,
+          py::arg("relation_length_tolerance") = RelationOptions{}.length_tolerance,
           py::arg("max_radius_difference") = RelationOptions{}.max_radius_difference,
           join_docs(
-              {R"(clusters(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False, relation_significance=3.0, max_relation_angle=20.0, max_radius_difference=0.05) -> list of dict
+              {R"(clusters(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False, relation_significance=3.0, max_relation_angle=20.0, relation_angle_tolerance=0.0, relation_length_tolerance=0.0, max_radius_difference=0.05) -> list of dict
 
 One dict per cluster, in label order, with the keys and values of the CLI's --json "clusters":
 id, type ("plane", "cylinder", "sphere"), faces (count), area, rms, max, and params (input
@@ -1278,7 +1295,8 @@ as lists). json.dumps() takes it as it is.)",
           "borders",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
              std::optional<double> relative_tolerance, std::int64_t refine, bool regularize,
-             double significance, double max_angle, double max_difference) {
+             double significance, double max_angle, double angle_tolerance, double length_tolerance,
+             double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterBorder> borders;
             {
@@ -1287,7 +1305,8 @@ as lists). json.dumps() takes it as it is.)",
               std::vector<ClusterRelation> relations;
               const Segmentation segmentation = refined_level(
                   *self.hierarchy, level, refine, &reports, regularize ? &relations : nullptr,
-                  relation_arguments(significance, max_angle, max_difference));
+                  relation_arguments(significance, max_angle, angle_tolerance, length_tolerance,
+                                     max_difference));
               borders = cluster_borders(self.hierarchy->mesh(), segmentation.labels,
                                         cluster_primitives(reports));
             }
@@ -1300,9 +1319,11 @@ as lists). json.dumps() takes it as it is.)",
           py::arg("regularize") = false,
           py::arg("relation_significance") = RelationOptions{}.significance,
           py::arg("max_relation_angle") = RelationOptions{}.max_angle_degrees,
+          py::arg("relation_angle_tolerance") = RelationOptions{}.angle_tolerance_degrees,
+          py::arg("relation_length_tolerance") = RelationOptions{}.length_tolerance,
           py::arg("max_radius_difference") = RelationOptions{}.max_radius_difference,
           join_docs(
-              {R"(borders(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False, relation_significance=3.0, max_relation_angle=20.0, max_radius_difference=0.05) -> list of dict
+              {R"(borders(k=None, *, tolerance=None, relative_tolerance=None, refine=0, regularize=False, relation_significance=3.0, max_relation_angle=20.0, relation_angle_tolerance=0.0, relation_length_tolerance=0.0, max_radius_difference=0.05) -> list of dict
 
 Where the clusters of the level meet, as the CLI's --json "borders": one dict per border with
 clusters (a, b), b None along the mesh's open boundary; edges (count); length (input units);
@@ -1318,14 +1339,16 @@ order along each curve. json.dumps() takes it as it is.)",
           "relations",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
              std::optional<double> relative_tolerance, std::int64_t refine, double significance,
-             double max_angle, double max_difference) {
+             double max_angle, double angle_tolerance, double length_tolerance,
+             double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterRelation> relations;
             {
               py::gil_scoped_release release;
               std::vector<ClusterReport> reports;
               refined_level(*self.hierarchy, level, refine, &reports, &relations,
-                            relation_arguments(significance, max_angle, max_difference));
+                            relation_arguments(significance, max_angle, angle_tolerance,
+                                               length_tolerance, max_difference));
             }
             return relations_list(relations);
           },
@@ -1333,9 +1356,11 @@ order along each curve. json.dumps() takes it as it is.)",
           py::arg("relative_tolerance") = py::none(), py::arg("refine") = 0,
           py::arg("relation_significance") = RelationOptions{}.significance,
           py::arg("max_relation_angle") = RelationOptions{}.max_angle_degrees,
+          py::arg("relation_angle_tolerance") = RelationOptions{}.angle_tolerance_degrees,
+          py::arg("relation_length_tolerance") = RelationOptions{}.length_tolerance,
           py::arg("max_radius_difference") = RelationOptions{}.max_radius_difference,
           join_docs(
-              {R"(relations(k=None, *, tolerance=None, relative_tolerance=None, refine=0, relation_significance=3.0, max_relation_angle=20.0, max_radius_difference=0.05) -> list of dict
+              {R"(relations(k=None, *, tolerance=None, relative_tolerance=None, refine=0, relation_significance=3.0, max_relation_angle=20.0, relation_angle_tolerance=0.0, relation_length_tolerance=0.0, max_radius_difference=0.05) -> list of dict
 
 The design intent among the level's fits, as the CLI's --regularize writes it in the JSON's
 "relations": one dict per relation with kind ("parallel": plane normals and cylinder axes of one
@@ -1353,9 +1378,10 @@ clusters(..., regularize=True) gives the primitives with these relations made ex
       .def(
           "relations_of_levels",
           [](const PyHierarchy& self, const std::vector<std::int64_t>& ks, double significance,
-             double max_angle, double max_difference, unsigned threads) {
-            const RelationOptions options =
-                relation_arguments(significance, max_angle, max_difference);
+             double max_angle, double angle_tolerance, double length_tolerance,
+             double max_difference, unsigned threads) {
+            const RelationOptions options = relation_arguments(
+                significance, max_angle, angle_tolerance, length_tolerance, max_difference);
             std::vector<std::uint32_t> counts;
             counts.reserve(ks.size());
             for (std::size_t i = 0; i < ks.size(); ++i) {
@@ -1387,10 +1413,12 @@ clusters(..., regularize=True) gives the primitives with these relations made ex
           py::arg("ks"), py::kw_only(),
           py::arg("relation_significance") = RelationOptions{}.significance,
           py::arg("max_relation_angle") = RelationOptions{}.max_angle_degrees,
+          py::arg("relation_angle_tolerance") = RelationOptions{}.angle_tolerance_degrees,
+          py::arg("relation_length_tolerance") = RelationOptions{}.length_tolerance,
           py::arg("max_radius_difference") = RelationOptions{}.max_radius_difference,
           py::arg("threads") = 0u,
           join_docs(
-              {R"(relations_of_levels(ks, *, relation_significance=3.0, max_relation_angle=20.0, max_radius_difference=0.05, threads=0) -> list of dict
+              {R"(relations_of_levels(ks, *, relation_significance=3.0, max_relation_angle=20.0, relation_angle_tolerance=0.0, relation_length_tolerance=0.0, max_radius_difference=0.05, threads=0) -> list of dict
 
 The relations and the regularized fits of many levels at once: one dict per entry of ks (numbers
 of clusters, in their order; repeats allowed) with k (the entry), clusters (the list

@@ -562,8 +562,18 @@ struct PooledCentre {
   Eigen::Matrix2d covariance() const { return information.inverse(); }
 };
 
+// A test's score with a tolerance (RegularityOptions::angle_tolerance, length_tolerance): passed at
+// or below `bound`, it also passes when the difference it judges, of size `size`, is within
+// `tolerance`, and such a difference then ranks by its size against the tolerance. A tolerance of
+// 0 leaves the score as it is.
+double tolerated(double score, double bound, double size, double tolerance) {
+  if (!(tolerance > 0)) return score;
+  const double scaled = size / tolerance;
+  return std::min(score, bound * scaled * scaled);
+}
+
 // Visited from the best-determined direction, each joins the group it is within the significance
-// of (the best score), else starts one.
+// (or the angle tolerance) of (the best score), else starts one.
 std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
                                              const RegularityOptions& options) {
   std::vector<std::size_t> order(items.size());
@@ -578,13 +588,16 @@ std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
     std::size_t best = groups.size();
     double best_score = options.significance * options.significance;
     for (std::size_t g = 0; g < groups.size(); ++g) {
-      if (angle_between_lines(item.direction, groups[g].direction) > max_angle) continue;
+      const double angle = angle_between_lines(item.direction, groups[g].direction);
+      if (angle > max_angle) continue;
       Eigen::Vector3d direction = groups[g].direction;
       if (direction.dot(item.direction) < 0) direction = -direction;
       const Eigen::Vector2d delta = item.frame.transpose() * direction;
       const Eigen::Matrix2d combined =
           item.covariance + item.frame.transpose() * groups[g].covariance * item.frame;
-      const double score = delta.dot(combined.ldlt().solve(delta));
+      const double score =
+          tolerated(delta.dot(combined.ldlt().solve(delta)),
+                    options.significance * options.significance, angle, options.angle_tolerance);
       if (score <= best_score) {
         best_score = score;
         best = g;
@@ -637,11 +650,11 @@ Eigen::Matrix2d tilt_in_frame(const Eigen::Vector3d& direction, const Eigen::Mat
 // Sets of cylinders (indices into `cylinders`, sorted best-located first) whose axes are one line
 // within the significance: each joins the first set whose information-weighted axis it is near,
 // counting the direction's tilt (`tilt`, radians², orthonormal_pair(direction) coordinates) over
-// the distance along it from the set's first member, as the coplanar sets do. An axis known less
-// well than the radius (a nearly flat cylinder) joins none.
+// the distance along it from the set's first member, as the coplanar sets do; or within the length
+// tolerance of it. An axis known less well than the radius (a nearly flat cylinder) joins none.
 std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCylinder>& cylinders,
                                                    const Eigen::Matrix2d& tilt,
-                                                   double significance2) {
+                                                   double significance2, double length_tolerance) {
   std::vector<std::vector<std::size_t>> sets;
   std::vector<PooledCentre> pooled;
   for (std::size_t k = 0; k < cylinders.size(); ++k) {
@@ -653,7 +666,8 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
       const Eigen::Vector2d delta = fit.centre - covariance * pooled[s].weighted;
       const double apart = cylinders[k].middle - cylinders[sets[s][0]].middle;
       const Eigen::Matrix2d combined = fit.centre_covariance + covariance + apart * apart * tilt;
-      if (delta.dot(combined.ldlt().solve(delta)) <= significance2) {
+      if (tolerated(delta.dot(combined.ldlt().solve(delta)), significance2, delta.norm(),
+                    length_tolerance) <= significance2) {
         joined = s;
         break;
       }
@@ -683,12 +697,14 @@ double family_significance(double significance, std::size_t tests) {
 
 // How far a joint fit explains a member worse than its own fit did: the rise of its residual sum
 // over significance² times its residual variance (estimated with the degrees of freedom of the
-// member's own fit, of `parameters` parameters). Above 1, it does not belong.
+// member's own fit, of `parameters` parameters), or, when lower, the rise of its mean square
+// against the square of the length tolerance. Above 1, it does not belong.
 double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2,
-                       int parameters) {
+                       int parameters, double length_tolerance) {
   const double n = static_cast<double>(count);
   const double rise = n * (joint_rms * joint_rms - own_rms * own_rms);
-  return rise / (significance2 * own_rms * own_rms * n / (n - parameters));
+  return tolerated(rise / (significance2 * own_rms * own_rms * n / (n - parameters)), 1,
+                   std::sqrt(std::max(rise / n, 0.0)), length_tolerance);
 }
 
 // `cylinder` on the line of `direction` through `centre` (orthonormal_pair(direction)
@@ -753,15 +769,17 @@ struct SettledSurfaces {
 // leaves the set, the worst first, and starts one of its own.
 template <class FitSet>
 auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& direction_covariance,
-                      std::vector<AlignedCylinder>& cylinders, double significance,
+                      std::vector<AlignedCylinder>& cylinders, const RegularityOptions& options,
                       const std::vector<std::vector<Vec3>>& points, const FitSet& fit_set) {
+  const double significance = options.significance;
   using Fit = std::invoke_result_t<FitSet, const std::vector<std::size_t>&>;  // optional
   std::stable_sort(cylinders.begin(), cylinders.end(),
                    [](const AlignedCylinder& a, const AlignedCylinder& b) {
                      return a.fit.centre_covariance.trace() < b.fit.centre_covariance.trace();
                    });
-  std::vector<std::vector<std::size_t>> sets = coaxial_sets(
-      cylinders, tilt_in_frame(direction, direction_covariance), significance * significance);
+  std::vector<std::vector<std::size_t>> sets =
+      coaxial_sets(cylinders, tilt_in_frame(direction, direction_covariance),
+                   significance * significance, options.length_tolerance);
   std::vector<std::pair<std::vector<std::size_t>, Fit>> fitted;
   for (std::size_t s = 0; s < sets.size(); ++s) {
     Fit joint;
@@ -772,9 +790,10 @@ auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& d
       double worst_excess = 1;
       for (std::size_t j = 0; j < sets[s].size(); ++j) {
         const AlignedCylinder& member = cylinders[sets[s][j]];
-        const double excess = fit ? residual_excess(member.fit.rms[0], fit->rms[j],
-                                                    points[member.cluster].size(), bound * bound, 3)
-                                  : std::numeric_limits<double>::infinity();
+        const double excess =
+            fit ? residual_excess(member.fit.rms[0], fit->rms[j], points[member.cluster].size(),
+                                  bound * bound, 3, options.length_tolerance)
+                : std::numeric_limits<double>::infinity();
         if (excess > worst_excess) {
           worst_excess = excess;
           worst = j;
@@ -930,13 +949,13 @@ std::optional<FreeLineFit> fit_free_line(Eigen::Vector3d direction, const Coaxia
 // keeping its own radius), the others alone with the group's direction. Appends the coaxial sets
 // of two or more to `relations`, and every cylinder refitted to `settled`.
 void align_cylinders(const Eigen::Vector3d& direction, const Eigen::Matrix3d& direction_covariance,
-                     std::vector<AlignedCylinder> cylinders, double significance,
+                     std::vector<AlignedCylinder> cylinders, const RegularityOptions& options,
                      std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights,
                      std::vector<Relation>& relations, SettledSurfaces& settled) {
   const auto sets =
-      fit_coaxial_sets(direction, direction_covariance, cylinders, significance, points,
+      fit_coaxial_sets(direction, direction_covariance, cylinders, options, points,
                        [&](const std::vector<std::size_t>& set) {
                          return fit_on_one_line(direction, cylinders, set, points, weights);
                        });
@@ -1046,7 +1065,8 @@ void share_one_plane(const Eigen::Vector3d& direction, const std::vector<std::si
 // sets of two or more, as clusters, increasing.
 std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direction_covariance,
                                                     std::vector<AlignedPlane> planes,
-                                                    double significance) {
+                                                    const RegularityOptions& options) {
+  const double significance = options.significance;
   std::stable_sort(planes.begin(), planes.end(), [](const AlignedPlane& a, const AlignedPlane& b) {
     return a.variance < b.variance;
   });
@@ -1063,7 +1083,9 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
       const Eigen::Vector3d apart = planes[i].centroid - planes[sets[s].planes[0]].centroid;
       const double variance =
           planes[i].variance + 1 / sets[s].information + apart.dot(direction_covariance * apart);
-      if (offset * offset <= bound * variance) joined = s;
+      if (tolerated(offset * offset / variance, bound, std::abs(offset),
+                    options.length_tolerance) <= bound)
+        joined = s;
     }
     if (joined == sets.size()) sets.emplace_back();
     sets[joined].planes.push_back(i);
@@ -1095,9 +1117,11 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
         const AlignedPlane& plane = planes[set[j]];
         const double moved = plane.offset - shared;
         const Eigen::Vector3d apart = plane.centroid - middle;
-        const double excess = moved * moved /
-                              (member_bound * member_bound *
-                               (plane.variance + apart.dot(direction_covariance * apart)));
+        const double excess =
+            tolerated(moved * moved /
+                          (member_bound * member_bound *
+                           (plane.variance + apart.dot(direction_covariance * apart))),
+                      1, std::abs(moved), options.length_tolerance);
         if (excess > worst_excess) {
           worst_excess = excess;
           worst = j;
@@ -1153,7 +1177,8 @@ bool count_coplanar_as_one(DirectionGroup& group, const std::vector<Oriented>& i
 bool count_coaxial_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
                           const std::vector<Primitive>& primitives,
                           const std::vector<std::vector<Vec3>>& points,
-                          const std::vector<std::vector<double>>& weights, double significance) {
+                          const std::vector<std::vector<double>>& weights,
+                          const RegularityOptions& options) {
   const auto is_cylinder = [&](std::size_t i) {
     return primitives[items[i].cluster].type == PrimitiveType::Cylinder;
   };
@@ -1174,7 +1199,7 @@ bool count_coaxial_as_one(DirectionGroup& group, const std::vector<Oriented>& it
     return clusters;
   };
   const auto sets = fit_coaxial_sets(
-      group.direction, group.covariance, cylinders, significance, points,
+      group.direction, group.covariance, cylinders, options, points,
       [&](const std::vector<std::size_t>& set) -> std::optional<FreeLineFit> {
         const std::optional<CoaxialFit> start =
             fit_on_one_line(group.direction, cylinders, set, points, weights);
@@ -1200,7 +1225,7 @@ bool count_coaxial_as_one(DirectionGroup& group, const std::vector<Oriented>& it
 // Returns whether it did.
 bool settle_on_line(SettledSurfaces& settled, std::size_t l,
                     const std::vector<std::size_t>& cylinders, std::vector<std::size_t> spheres,
-                    double significance, std::vector<Primitive>& primitives,
+                    const RegularityOptions& options, std::vector<Primitive>& primitives,
                     const std::vector<std::vector<Vec3>>& points,
                     const std::vector<std::vector<double>>& weights,
                     std::vector<Relation>& relations, std::size_t fewest = 1) {
@@ -1228,7 +1253,7 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
     fit = fit_cylinders_and_spheres({&line.direction, 1}, {&line.centre, 1}, centres, radii, terms,
                                     sphere_terms, true);
     const std::size_t members = cylinders.size() + spheres.size();
-    const double bound = family_significance(significance, members);
+    const double bound = family_significance(options.significance, members);
     double worst_excess = 1, worst_sphere_excess = -std::numeric_limits<double>::infinity();
     std::size_t worst_sphere = 0;
     for (std::size_t j = 0; j < members; ++j) {
@@ -1238,7 +1263,7 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
       // A sphere's own fit has 4 parameters, a cylinder's (on its direction) 3.
       const double excess =
           fit ? residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(),
-                                bound * bound, is_sphere ? 4 : 3)
+                                bound * bound, is_sphere ? 4 : 3, options.length_tolerance)
               : std::numeric_limits<double>::infinity();
       worst_excess = std::max(worst_excess, excess);
       if (is_sphere && excess > worst_sphere_excess) {
@@ -1347,7 +1372,8 @@ void centre_spheres_on_axes(SettledSurfaces& settled, const RegularityOptions& o
       const Eigen::Matrix2d combined =
           frame * covariance * frame.transpose() + line.covariance + height * height * line.tilt;
       if (!known_within(combined, significance, largest_offset)) continue;
-      const double score = offset.dot(combined.ldlt().solve(offset));
+      const double score = tolerated(offset.dot(combined.ldlt().solve(offset)), offset_bound,
+                                     offset.norm(), options.length_tolerance);
       if (score <= nearest_score) {
         nearest_score = score;
         nearest = l;
@@ -1357,7 +1383,7 @@ void centre_spheres_on_axes(SettledSurfaces& settled, const RegularityOptions& o
   }
   for (std::size_t l = 0; l < line_count; ++l)
     if (!spheres_on[l].empty())
-      settle_on_line(settled, l, cylinders_on[l], spheres_on[l], significance, primitives, points,
+      settle_on_line(settled, l, cylinders_on[l], spheres_on[l], options, primitives, points,
                      weights, relations);
 }
 
@@ -1426,7 +1452,9 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
         const double height = sphere.height - sets[s].height;
         const Eigen::Matrix2d combined =
             sphere.covariance + sets[s].pooled.covariance() + height * height * tilt;
-        if (offset.dot(combined.ldlt().solve(offset)) <= bound) joined = s;
+        if (tolerated(offset.dot(combined.ldlt().solve(offset)), bound, offset.norm(),
+                      options.length_tolerance) <= bound)
+          joined = s;
       }
       if (joined == sets.size()) sets.emplace_back().height = sphere.height;
       sets[joined].surfaces.push_back(sphere.surface);
@@ -1438,8 +1466,8 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
       for (const std::size_t k : set.surfaces) clusters.push_back(settled.surfaces[k].cluster);
       settled.lines.push_back({direction, set.pooled.centre(), set.pooled.covariance(), kNoRelation,
                                middle_along(direction, clusters, points, weights), tilt});
-      if (!settle_on_line(settled, settled.lines.size() - 1, {}, set.surfaces, options.significance,
-                          primitives, points, weights, relations, kFewestSpheresOnALine))
+      if (!settle_on_line(settled, settled.lines.size() - 1, {}, set.surfaces, options, primitives,
+                          points, weights, relations, kFewestSpheresOnALine))
         settled.lines.pop_back();
     }
   }
@@ -1477,8 +1505,9 @@ std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surfa
     const double joined_information = information + 1 / variance,
                  joined_moment = moment + d / variance, joined_square = square + d * d / variance;
     const double spread = joined_square - joined_moment * joined_moment / joined_information;
+    const double bound = members == 0 ? 0 : chi_square_bound(options.significance, members);
     if (members == 0 || r - first > options.max_radius_difference * r ||
-        spread > chi_square_bound(options.significance, members)) {
+        tolerated(spread, bound, r - first, options.length_tolerance) > bound) {
       first = r;
       information = 1 / variance;
       moment = square = 0;
@@ -1604,7 +1633,7 @@ void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& opt
         // A sphere's own fit has 4 parameters (2 on a line), a cylinder's (on its direction) 3.
         const int parameters = !surface.sphere ? 3 : surface.line == kNoLine ? 4 : 2;
         const double excess = residual_excess(surface.rms, rms, points[surface.cluster].size(),
-                                              bound * bound, parameters);
+                                              bound * bound, parameters, options.length_tolerance);
         if (excess > worst_excess) {
           worst_excess = excess;
           worst = j;
@@ -1669,7 +1698,8 @@ bool make_orthogonal(Eigen::Vector3d& a, const Eigen::Matrix3d& covariance_a, Ei
 // The most groups a frame (a component closing a triangle of right angles) is solved over.
 constexpr std::size_t kLargestFrame = 16;
 
-// Pairs of direction groups at right angles within the significance, made exactly so.
+// Pairs of direction groups at right angles within the significance (or the angle tolerance),
+// made exactly so.
 //
 // Pairs are taken by increasing score, each scored again when it comes up on the directions the
 // pairs kept before it left (a kept pair moves its component's directions), so pairs up to twice
@@ -1682,8 +1712,8 @@ constexpr std::size_t kLargestFrame = 16;
 // of chance right angles between a freeform surface's many planes (bunny00: 486 pairs among 488
 // groups): a pair joining two of them is met by its own two directions, each side turning
 // rigidly with its own, so it costs O(G), not sweeps over every constraint. Either way the pair
-// is kept only when no direction ends beyond the significance of its measurement.
-// Returns the kept pairs (indices into `groups`, first < second), in increasing order.
+// is kept only when no direction ends beyond the significance (or the angle tolerance) of its
+// measurement. Returns the kept pairs (indices into `groups`, first < second), in increasing order.
 std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<DirectionGroup>& groups,
                                                                const RegularityOptions& options) {
   using Pair = std::pair<std::size_t, std::size_t>;
@@ -1697,9 +1727,11 @@ std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<Direc
   auto score = [&](std::size_t i, std::size_t j) {
     const Eigen::Vector3d &a = solved[i], &b = solved[j];
     const double cosine = a.dot(b);
-    if (std::abs(std::asin(std::clamp(cosine, -1.0, 1.0))) > max_tilt)
-      return std::numeric_limits<double>::infinity();
-    return cosine * cosine / (b.dot(groups[i].covariance * b) + a.dot(groups[j].covariance * a));
+    const double from_right_angle = std::abs(std::asin(std::clamp(cosine, -1.0, 1.0)));
+    if (from_right_angle > max_tilt) return std::numeric_limits<double>::infinity();
+    return tolerated(
+        cosine * cosine / (b.dot(groups[i].covariance * b) + a.dot(groups[j].covariance * a)),
+        significance2, from_right_angle, options.angle_tolerance);
   };
   // Min-queue of (score, i, j); a score is that of the directions when it was computed.
   using Entry = std::tuple<double, std::size_t, std::size_t>;
@@ -1775,7 +1807,9 @@ std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<Direc
     bool within = true;
     for (std::size_t k = 0; within && k < component.size(); ++k) {
       const Eigen::Vector3d tilt = moved[k] - measured[component[k]];
-      within = tilt.dot(groups[component[k]].information * tilt) <= significance2;
+      const double angle = 2 * std::asin(std::min(tilt.norm() / 2, 1.0));
+      within = tolerated(tilt.dot(groups[component[k]].information * tilt), significance2, angle,
+                         options.angle_tolerance) <= significance2;
     }
     if (!within) continue;
     for (std::size_t k = 0; k < component.size(); ++k) solved[component[k]] = moved[k];
@@ -1996,16 +2030,16 @@ bool share_a_point(std::span<const Vec3> points, std::span<const Vec3> sorted) {
 // The gap to each plane, from the line's cylinders refitted on their points with its direction
 // (a radius an EqualRadius relation shares with clusters off the line held, one shared only on
 // the line one parameter), must be within the significance (its standard deviation from that
-// fit's covariance), within max_radius_difference of the radius and known to better than that
-// (the interval rule of the spheres' centres). Candidates are tried from the nearest in standard
-// deviations, each kept when the line refitted tangent to it and to those kept before
-// (fit_held_line(): a lone cylinder keeps 2 parameters for one plane, 1 for two) raises its
-// residual sum by at most the χ² bound of that many conditions times its residual variance: a
-// likelihood-ratio test. A condition the kept ones imply (a fragment's face once another fragment
-// of the same radius is tangent to it) is kept when it holds to round-off. The planes are held at
-// their offsets: a face has far more points than a fillet's narrow arc. The cylinders are written
-// back, and the planes they are tangent to with their refitted offsets; each pair is a Tangent
-// relation of `tangents`.
+// fit's covariance) or the length tolerance, within max_radius_difference of the radius and known
+// to better than that (the interval rule of the spheres' centres). Candidates are tried from the
+// nearest in standard deviations, each kept when the line refitted tangent to it and to those kept
+// before (fit_held_line(): a lone cylinder keeps 2 parameters for one plane, 1 for two) raises its
+// residual sum by at most the χ² bound of that many conditions times its residual variance (a
+// likelihood-ratio test), or its mean square by at most the length tolerance's square. A condition
+// the kept ones imply (a fragment's face once another fragment of the same radius is tangent to it)
+// is kept when it holds to round-off. The planes are held at their offsets: a face has far more
+// points than a fillet's narrow arc. The cylinders are written back, and the planes they are
+// tangent to with their refitted offsets; each pair is a Tangent relation of `tangents`.
 void make_tangent(const std::vector<DirectionGroup>& groups,
                   const std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
                   const std::vector<std::vector<std::size_t>>& refitted,
@@ -2188,9 +2222,11 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       const double gap = std::abs(distance) - r;
       const double variance = hold.row.dot(own->covariance * hold.row);
       const double bound = options.max_radius_difference * r;
+      const double score =
+          tolerated(gap * gap / variance, significance2, std::abs(gap), options.length_tolerance);
       if (std::abs(gap) <= bound && significance2 * variance <= bound * bound &&
-          gap * gap <= significance2 * variance)
-        tested.emplace_back(gap * gap / variance, contact->plane, m, hold);
+          score <= significance2)
+        tested.emplace_back(score, contact->plane, m, hold);
     }
     std::sort(tested.begin(), tested.end(), [](const auto& a, const auto& b) {
       return std::tie(std::get<0>(a), std::get<1>(a), std::get<2>(a)) <
@@ -2215,7 +2251,7 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       const std::size_t conditions = holds.size() - own_holds;
       if (trial && residual_excess(own->rms, trial->rms, own->count,
                                    chi_square_bound(options.significance, conditions),
-                                   static_cast<int>(own->free)) <= 1) {
+                                   static_cast<int>(own->free), options.length_tolerance) <= 1) {
         fit = trial;
         kept.emplace_back(cylinders[m], p);
       } else {
@@ -2283,11 +2319,10 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
           planes.push_back(*plane);
       }
     if (planes.size() >= 2) {
-      coplanar[g] = coplanar_sets(group.covariance, std::move(planes), options.significance);
+      coplanar[g] = coplanar_sets(group.covariance, std::move(planes), options);
       counted = count_coplanar_as_one(group, items, coplanar[g], points);
     }
-    if (count_coaxial_as_one(group, items, primitives, points, weights, options.significance))
-      counted = true;
+    if (count_coaxial_as_one(group, items, primitives, points, weights, options)) counted = true;
     if (!counted) continue;
     const Eigen::Vector3d before = group.direction;
     form_direction(group);
@@ -2327,8 +2362,8 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     if (parallel.members.size() >= 2) relations.push_back(std::move(parallel));
     for (const std::vector<std::size_t>& set : coplanar[g])
       share_one_plane(group.direction, set, primitives, weights, relations);
-    align_cylinders(group.direction, group.covariance, std::move(cylinders), options.significance,
-                    primitives, points, weights, relations, settled);
+    align_cylinders(group.direction, group.covariance, std::move(cylinders), options, primitives,
+                    points, weights, relations, settled);
   }
   if (options.equal_radii || options.spheres_on_axes) {
     // The cylinders no direction relation refitted take part too, each on its own axis (fitted

@@ -22,6 +22,14 @@ struct RegularityOptions {
   /// ... and never farther than this, whatever the uncertainty (degrees); the same bounds make
   /// two directions orthogonal.
   double max_angle_degrees = 20;
+  /// Directions within this angle of one another are parallel, and within it of a right angle
+  /// orthogonal, whatever their uncertainty (radians, >= 0): a CAD tessellation's directions err
+  /// systematically, by more than their fits' statistics allow. 0: the statistics alone.
+  double angle_tolerance = 0;
+  /// Likewise for lengths (input units, >= 0): axis lines, sphere centres on lines, plane offsets,
+  /// radii and tangency gaps this close agree, and a joint fit that raises a member's mean square
+  /// residual by at most its square keeps the member. 0: the statistics alone.
+  double length_tolerance = 0;
   /// Make directions at right angles within the significance exactly orthogonal.
   bool orthogonal = true;
   /// Make planes of one direction whose offsets along it agree within the significance one
@@ -81,7 +89,10 @@ struct Relation {
 /// radius), each on its points away from the band about the contact line where the two surfaces
 /// are within the noise (the plane's offset refitted so, unless it is a coplanar set's): each
 /// pair is a Tangent relation, by line. Direction groups the right angles made one direction are
-/// merged first.
+/// merged first. Every test "within the significance" also passes a difference within the angle or
+/// length tolerance (RegularityOptions::angle_tolerance, length_tolerance), and every check that a
+/// joint fit explains a member as its own did also passes a rise of its mean square residual within
+/// the length tolerance's square.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,

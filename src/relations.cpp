@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <numbers>
 #include <span>
 #include <string>
 
@@ -49,6 +50,12 @@ void validate(const RelationOptions& options) {
     refuse("significance", options.significance, "a positive number");
   if (!(options.max_angle_degrees > 0 && options.max_angle_degrees < 90))
     refuse("max_angle_degrees", options.max_angle_degrees, "in (0, 90) degrees");
+  if (!(options.angle_tolerance_degrees >= 0 &&
+        options.angle_tolerance_degrees < options.max_angle_degrees))
+    refuse("angle_tolerance_degrees", options.angle_tolerance_degrees,
+           "at least 0 and below max_angle_degrees");
+  if (!(options.length_tolerance >= 0) || !std::isfinite(options.length_tolerance))
+    refuse("length_tolerance", options.length_tolerance, "a finite number at least 0");
   if (!(options.max_radius_difference > 0 && options.max_radius_difference < 1))
     refuse("max_radius_difference", options.max_radius_difference, "in (0, 1)");
   if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
@@ -102,10 +109,14 @@ void gather_vertices(const DualGraph& graph, std::span<const std::uint32_t> tria
   }
 }
 
-detail::RegularityOptions regularity_options(const RelationOptions& options) {
+// `options` for regularize(), which works in `hierarchy`'s working frame.
+detail::RegularityOptions regularity_options(const RelationOptions& options,
+                                             const Hierarchy& hierarchy) {
   detail::RegularityOptions regularity;
   regularity.significance = options.significance;
   regularity.max_angle_degrees = options.max_angle_degrees;
+  regularity.angle_tolerance = options.angle_tolerance_degrees * std::numbers::pi / 180;
+  regularity.length_tolerance = options.length_tolerance / hierarchy.graph().frame().scale();
   regularity.max_radius_difference = options.max_radius_difference;
   return regularity;
 }
@@ -183,7 +194,7 @@ std::vector<ClusterRelation> regularize_clusters(const Hierarchy& hierarchy,
     primitives.push_back(detail::to_working(graph.frame(), report.primitive));
   std::vector<ClusterRelation> relations =
       detail::regularize_inliers(primitives, points, weights, options.outlier_threshold,
-                                 inlier_floor(hierarchy), regularity_options(options));
+                                 inlier_floor(hierarchy), regularity_options(options, hierarchy));
   report_refitted(
       graph.frame(), relations, primitives,
       [&](std::size_t c, const Primitive& working) {
@@ -326,8 +337,8 @@ RegularizedLevel LevelRegularizer::level(std::uint32_t clusters) const {
     points[c].assign(n.inlier_points.begin() + first, n.inlier_points.begin() + last);
     weights[c].assign(n.inlier_weights.begin() + first, n.inlier_weights.begin() + last);
   }
-  result.relations =
-      detail::regularize_kept(primitives, points, weights, regularity_options(options_));
+  result.relations = detail::regularize_kept(primitives, points, weights,
+                                             regularity_options(options_, *hierarchy_));
   report_refitted(
       hierarchy.graph().frame(), result.relations, primitives,
       [&](std::size_t c, const Primitive& working) {

@@ -45,11 +45,12 @@ Cluster noisy_plane(const Eigen::Vector3d& normal, const Eigen::Vector3d& centre
 }
 
 // A cylinder of radius `radius` around the axis through `centre`, `rings` rings of 24 points over
-// `length`, moved radially by Gaussian noise of deviation `sigma`.
+// `length`, moved radially by Gaussian noise of deviation `sigma` (0: exact).
 Cluster noisy_cylinder(const Eigen::Vector3d& axis, const Eigen::Vector3d& centre, double radius,
                        double length, double sigma, std::mt19937_64& rng, int rings = 20) {
   const Eigen::Vector3d u = axis.unitOrthogonal(), v = axis.cross(u);
-  std::normal_distribution<double> noise(0, sigma);
+  std::normal_distribution<double> standard;
+  const auto noise = [&](std::mt19937_64& engine) { return sigma * standard(engine); };
   Cluster cluster;
   for (int i = 0; i < rings; ++i)
     for (int k = 0; k < 24; ++k) {
@@ -63,11 +64,13 @@ Cluster noisy_cylinder(const Eigen::Vector3d& axis, const Eigen::Vector3d& centr
 }
 
 // A spherical cap of radius `radius` about `centre`, facing `pole`: 10 rings of 24 points from
-// the pole down to `polar_angle` (radians), moved radially by Gaussian noise of deviation `sigma`.
+// the pole down to `polar_angle` (radians), moved radially by Gaussian noise of deviation `sigma`
+// (0: exact).
 Cluster noisy_sphere_cap(const Eigen::Vector3d& centre, double radius, const Eigen::Vector3d& pole,
                          double polar_angle, double sigma, std::mt19937_64& rng) {
   const Eigen::Vector3d u = pole.unitOrthogonal(), v = pole.cross(u);
-  std::normal_distribution<double> noise(0, sigma);
+  std::normal_distribution<double> standard;
+  const auto noise = [&](std::mt19937_64& engine) { return sigma * standard(engine); };
   Cluster cluster;
   for (int i = 1; i <= 10; ++i)
     for (int k = 0; k < 24; ++k) {
@@ -106,7 +109,8 @@ using Kind = detail::Relation::Kind;
 // The relations regularize() made, as (kind, members) pairs in its order.
 using Relations = std::vector<std::pair<Kind, std::vector<std::size_t>>>;
 
-Relations regularize(std::vector<Primitive>& primitives, const std::vector<Cluster>& clusters) {
+Relations regularize(std::vector<Primitive>& primitives, const std::vector<Cluster>& clusters,
+                     const detail::RegularityOptions& options = {}) {
   std::vector<std::vector<Vec3>> points;
   std::vector<std::vector<double>> weights;
   for (const Cluster& c : clusters) {
@@ -114,7 +118,7 @@ Relations regularize(std::vector<Primitive>& primitives, const std::vector<Clust
     weights.push_back(c.weights);
   }
   Relations relations;
-  for (const detail::Relation& relation : detail::regularize(primitives, points, weights, {}))
+  for (const detail::Relation& relation : detail::regularize(primitives, points, weights, options))
     relations.emplace_back(relation.kind, relation.members);
   return relations;
 }
@@ -767,7 +771,8 @@ ProfileSegment profile_arc(const Eigen::Vector2d& centre, double radius, double 
 
 std::vector<Cluster> swept_profile(const std::vector<ProfileSegment>& segments, double sigma,
                                    std::mt19937_64& rng) {
-  std::normal_distribution<double> noise(0, sigma);
+  std::normal_distribution<double> standard;  // sigma 0: exact
+  const auto noise = [&](std::mt19937_64& engine) { return sigma * standard(engine); };
   std::vector<Cluster> clusters(segments.size());
   for (int row = 0; row <= 20; ++row) {
     const double y = row / 20.0 - 0.5;
@@ -938,6 +943,135 @@ TEST(Regularity, ARoundMeetingItsFacesAtAKinkIsNotTangentToThem) {
     for (const auto& [kind, members] : regularize(primitives, clusters))
       EXPECT_NE(kind, Kind::Tangent);
   }
+}
+
+// Whether `relations` holds the relation (kind, members) once.
+bool has_relation(const Relations& relations, Kind kind, const std::vector<std::size_t>& members) {
+  return std::count(relations.begin(), relations.end(), std::pair{kind, members}) == 1;
+}
+
+// Options with an angle tolerance (radians) and a length tolerance.
+detail::RegularityOptions with_tolerances(double angle, double length) {
+  detail::RegularityOptions options;
+  options.angle_tolerance = angle;
+  options.length_tolerance = length;
+  return options;
+}
+
+TEST(Regularity, AnAngleToleranceRelatesExactFacesOffByLessThanIt) {
+  // Three faces of a CAD part, exact but off by 0.02 degree (a tessellation's systematic error):
+  // the bottom tilted from the top's opposite, the side from a right angle to both. Each normal is
+  // known to its round-off, so no two agree within the significance, and 0.02 degree is within an
+  // angle tolerance of 0.05 degree but not of 0.01.
+  const double off = 0.02 * std::numbers::pi / 180;
+  const Eigen::Vector3d top = Eigen::Vector3d::UnitZ(), bottom(0, std::sin(off), -std::cos(off)),
+                        side(std::cos(off), 0, std::sin(off));
+  const std::vector<Cluster> clusters{checkered_plane(top, {0, 0, 0.5}, 0),
+                                      checkered_plane(bottom, {0, 0, -0.5}, 0),
+                                      checkered_plane(side, {0.5, 0, 0}, 0)};
+  std::vector<Primitive> fitted;
+  for (const Cluster& cluster : clusters) fitted.push_back(fitted_plane(cluster));
+  for (const double tolerance : {0.0, 0.01 * std::numbers::pi / 180}) {
+    SCOPED_TRACE(tolerance);
+    std::vector<Primitive> planes = fitted;
+    EXPECT_TRUE(regularize(planes, clusters, with_tolerances(tolerance, 0)).empty());
+    for (std::size_t c = 0; c < planes.size(); ++c) EXPECT_EQ(planes[c].axis, fitted[c].axis);
+  }
+  std::vector<Primitive> planes = fitted;
+  const Relations relations =
+      regularize(planes, clusters, with_tolerances(0.05 * std::numbers::pi / 180, 0));
+  EXPECT_EQ(relations, (Relations{{Kind::Parallel, {0, 1}}, {Kind::Orthogonal, {0, 1}}}));
+  EXPECT_LE(angle_between_lines(planes[0].axis, planes[1].axis), 1e-12);
+  EXPECT_LE(std::abs(to_eigen(planes[0].axis).dot(to_eigen(planes[2].axis))), 1e-15);
+  // Each keeps its side, within the tolerance of its own normal.
+  for (std::size_t c = 0; c < planes.size(); ++c) {
+    EXPECT_GT(to_eigen(planes[c].axis).dot(to_eigen(fitted[c].axis)), 0);
+    EXPECT_LE(angle_between_lines(planes[c].axis, fitted[c].axis), off);
+  }
+}
+
+TEST(Regularity, ALengthToleranceRelatesExactSurfacesOffByLessThanIt) {
+  // An exact part along z whose intended relations are off by 1e-4 (a CAD export's rounding):
+  // 0 and 1, steps of a shaft (radii 0.3 and 0.5) whose axes are 1e-4 apart; 2, a hole of radius
+  // 0.3 + 1e-4 beside them; 3 and 4, fragments of one face 1e-4 apart along z; 5, a ball end of
+  // radius 0.4 centred 1e-4 off the shaft's axis. Known to round-off, none agrees within the
+  // significance; within a length tolerance of 1e-3 all do, within 1e-5 none.
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  constexpr double kOff = 1e-4;
+  std::mt19937_64 rng(1);
+  const std::vector<Cluster> clusters{
+      noisy_cylinder(z, {0, 0, 0}, 0.3, 1, 0, rng),
+      noisy_cylinder(z, {kOff, 0, 1.5}, 0.5, 1, 0, rng),
+      noisy_cylinder(z, {2, 0, 0}, 0.3 + kOff, 1, 0, rng),
+      checkered_plane(z, {3.5, 0, -0.6}, 0),
+      checkered_plane(z, {5.5, 0, -0.6 + kOff}, 0),
+      noisy_sphere_cap({0, kOff, 3}, 0.4, z, std::numbers::pi / 2, 0, rng)};
+  const std::vector<Primitive> fitted{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.3),
+                                      fitted_cylinder(clusters[1], z, {kOff, 0, 1.5}, 0.5),
+                                      fitted_cylinder(clusters[2], z, {2, 0, 0}, 0.3 + kOff),
+                                      fitted_plane(clusters[3]),
+                                      fitted_plane(clusters[4]),
+                                      fitted_sphere(clusters[5], {0, kOff, 3}, 0.4)};
+  for (const double tolerance : {0.0, 1e-5}) {
+    SCOPED_TRACE(tolerance);
+    std::vector<Primitive> primitives = fitted;
+    EXPECT_EQ(regularize(primitives, clusters, with_tolerances(0, tolerance)),
+              (Relations{{Kind::Parallel, {0, 1, 2, 3, 4}}}));
+  }
+  std::vector<Primitive> primitives = fitted;
+  const Relations relations = regularize(primitives, clusters, with_tolerances(0, 1e-3));
+  EXPECT_TRUE(has_relation(relations, Kind::Coaxial, {0, 1, 5}));
+  EXPECT_TRUE(has_relation(relations, Kind::EqualRadius, {0, 2}));
+  EXPECT_TRUE(has_relation(relations, Kind::Coplanar, {3, 4}));
+  // Exact, each within the tolerance of its own fit.
+  EXPECT_LE(axis_offset(primitives[0], primitives[1]), 1e-12);
+  Primitive sphere_centre = primitives[0];
+  sphere_centre.point = primitives[5].point;
+  EXPECT_LE(axis_offset(primitives[0], sphere_centre), 1e-12);
+  EXPECT_EQ(primitives[0].radius, primitives[2].radius);
+  EXPECT_NEAR(primitives[3].point[2], primitives[4].point[2], 1e-12);
+  for (std::size_t c = 0; c < primitives.size(); ++c) {
+    SCOPED_TRACE(c);
+    EXPECT_NEAR(primitives[c].radius, fitted[c].radius, kOff);
+    EXPECT_LE((to_eigen(primitives[c].point) - to_eigen(fitted[c].point))
+                  .cross(to_eigen(fitted[c].axis))
+                  .norm(),
+              kOff);
+  }
+}
+
+TEST(Regularity, ALengthToleranceMakesAnExactFilletOffByLessThanItTangent) {
+  // The rounded edge, exact, with its fillet's axis 1e-4 farther from the side than its radius
+  // (a kink of 1e-4 at that border) and exactly its radius from the top: tangent to the top
+  // within the significance, and to the side too only within a length tolerance above 1e-4.
+  constexpr double r = kRoundedEdgeRadius, kGap = 1e-4;
+  std::mt19937_64 rng(1);
+  const std::vector<Cluster> clusters = swept_profile(
+      {profile_line({0, -1.2}, {0, -r}, {1, 0}, 20), profile_arc({-r - kGap, -r}, r, 0, 90, 12),
+       profile_line({-r - kGap, 0}, {-1.2, 0}, {0, 1}, 20)},
+      0, rng);
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  const std::vector<Primitive> fitted{fitted_plane(clusters[0]),
+                                      fitted_cylinder(clusters[1], y, {-r - kGap, 0, -r}, r),
+                                      fitted_plane(clusters[2])};
+  for (const double tolerance : {0.0, 1e-5}) {
+    SCOPED_TRACE(tolerance);
+    std::vector<Primitive> primitives = fitted;
+    const Relations relations = regularize(primitives, clusters, with_tolerances(0, tolerance));
+    EXPECT_TRUE(has_relation(relations, Kind::Tangent, {1, 2}));
+    EXPECT_FALSE(has_relation(relations, Kind::Tangent, {0, 1}));
+  }
+  std::vector<Primitive> primitives = fitted;
+  constexpr double kTolerance = 2 * kGap;
+  const Relations relations = regularize(primitives, clusters, with_tolerances(0, kTolerance));
+  EXPECT_TRUE(has_relation(relations, Kind::Tangent, {0, 1}));
+  EXPECT_TRUE(has_relation(relations, Kind::Tangent, {1, 2}));
+  for (const std::size_t plane : {std::size_t{0}, std::size_t{2}})
+    EXPECT_NEAR(axis_to_plane(primitives[1], primitives[plane]), primitives[1].radius, 1e-14);
+  // The tangent fillet is within the tolerance of its points (RMS).
+  double squares = 0;
+  for (const Vec3& x : clusters[1].points) squares += std::pow(primitives[1].distance(x), 2);
+  EXPECT_LE(std::sqrt(squares / static_cast<double>(clusters[1].points.size())), kTolerance);
 }
 
 }  // namespace

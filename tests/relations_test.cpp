@@ -611,7 +611,7 @@ struct RegularizedPart {
   std::vector<ClusterRelation> relations;
 };
 
-RegularizedPart regularized_part(const char* name) {
+RegularizedPart regularized_part(const char* name, const RelationOptions& options = {}) {
   Hierarchy hierarchy = build_hierarchy(read_mesh(testing::cgal_mesh(name)));
   BoundaryRefinementOptions refine;
   refine.max_passes = 2;
@@ -619,8 +619,67 @@ RegularizedPart regularized_part(const char* name) {
       hierarchy, cut_by_count(hierarchy, choose_level(hierarchy).clusters), refine);
   std::vector<ClusterReport> after = level.reports;
   std::vector<ClusterRelation> relations =
-      regularize_clusters(hierarchy, level.segmentation, after);
+      regularize_clusters(hierarchy, level.segmentation, after, options);
   return {std::move(hierarchy), std::move(level), std::move(after), std::move(relations)};
+}
+
+RelationOptions with_length_tolerance(double tolerance) {
+  RelationOptions options;
+  options.length_tolerance = tolerance;
+  return options;
+}
+
+TEST(Relations, ALengthToleranceGivesTheHolesACadExportSplitOneRadius) {
+  // cheese (libcgal-demo, an exact CAD tessellation) at its automatic level with the borders
+  // refined: its many holes of one design radius (1/160) come out as two equal-radius classes,
+  // 0.00624994 and 0.00625007, each radius known far better than their difference. Within a
+  // length tolerance of 1e-6 they are one class, of that radius, and no member moves by more.
+  const auto classes = [](const RegularizedPart& part) {
+    Groups large;
+    for (const auto& members : clusters_of(part.relations, ClusterRelation::Kind::EqualRadius))
+      if (members.size() >= 50) large.push_back(members);
+    return large;
+  };
+  const RegularizedPart statistical = regularized_part("cheese.off");
+  const Groups apart = classes(statistical);
+  ASSERT_EQ(apart.size(), 2u);
+  const double radii[2] = {statistical.after[apart[0][0]].primitive.radius,
+                           statistical.after[apart[1][0]].primitive.radius};
+  EXPECT_GT(std::abs(radii[0] - radii[1]), 1e-7);
+  EXPECT_LT(std::abs(radii[0] - radii[1]), 1e-6);
+
+  constexpr double kTolerance = 1e-6;
+  const RegularizedPart part = regularized_part("cheese.off", with_length_tolerance(kTolerance));
+  const Groups joined = classes(part);
+  ASSERT_EQ(joined.size(), 1u);
+  for (const auto& members : apart)
+    for (const std::uint32_t c : members)
+      EXPECT_TRUE(std::binary_search(joined[0].begin(), joined[0].end(), c)) << c;
+  for (const std::uint32_t c : joined[0]) {
+    SCOPED_TRACE(c);
+    EXPECT_EQ(part.after[c].primitive.radius, part.after[joined[0][0]].primitive.radius);
+    // Its mean square residual rises by at most the tolerance's square.
+    EXPECT_LE(std::pow(part.after[c].rms, 2),
+              std::pow(part.level.reports[c].rms, 2) + kTolerance * kTolerance * (1 + 1e-9));
+  }
+  EXPECT_NEAR(part.after[joined[0][0]].primitive.radius, 1.0 / 160, 1e-7);
+}
+
+TEST(Relations, ALengthToleranceMakesFandisksFilletTangentToItsFace) {
+  // fandisk's fillet of radius 0.143 (cluster 7 of its automatic level, borders refined) is
+  // 1.7e-5 farther from the face it rounds (cluster 4) than tangent: 4.2 standard deviations of
+  // its gap on this exact tessellation, so refused. Within a length tolerance of 2e-5 it is
+  // tangent, exactly.
+  const Groups statistical =
+      clusters_of(regularized_part("fandisk.off").relations, ClusterRelation::Kind::Tangent);
+  EXPECT_EQ(std::count(statistical.begin(), statistical.end(), std::vector<std::uint32_t>{4, 7}),
+            0);
+  const RegularizedPart part = regularized_part("fandisk.off", with_length_tolerance(2e-5));
+  const Groups tangent = clusters_of(part.relations, ClusterRelation::Kind::Tangent);
+  EXPECT_EQ(tangent.size(), statistical.size() + 1);
+  EXPECT_EQ(std::count(tangent.begin(), tangent.end(), std::vector<std::uint32_t>{4, 7}), 1);
+  expect_exactly_tangent(part.level.reports, part.after, tangent,
+                         bounding_box_diagonal(part.hierarchy.mesh()));
 }
 
 TEST(Relations, ALugsRoundEndIsTangentToItsSideOnItsHolesLine) {
@@ -952,6 +1011,14 @@ TEST(Relations, RefusesMismatchedReportsAndBadOptions) {
            {"significance", [](RelationOptions& o) { o.significance = std::nan(""); }},
            {"max_angle_degrees", [](RelationOptions& o) { o.max_angle_degrees = 90; }},
            {"max_angle_degrees", [](RelationOptions& o) { o.max_angle_degrees = 0; }},
+           {"angle_tolerance_degrees", [](RelationOptions& o) { o.angle_tolerance_degrees = -1; }},
+           {"angle_tolerance_degrees",
+            [](RelationOptions& o) { o.angle_tolerance_degrees = o.max_angle_degrees; }},
+           {"angle_tolerance_degrees",
+            [](RelationOptions& o) { o.angle_tolerance_degrees = std::nan(""); }},
+           {"length_tolerance", [](RelationOptions& o) { o.length_tolerance = -1e-9; }},
+           {"length_tolerance", [](RelationOptions& o) { o.length_tolerance = INFINITY; }},
+           {"length_tolerance", [](RelationOptions& o) { o.length_tolerance = std::nan(""); }},
            {"max_radius_difference", [](RelationOptions& o) { o.max_radius_difference = 0; }},
            {"max_radius_difference", [](RelationOptions& o) { o.max_radius_difference = 1; }},
            {"max_radius_difference",

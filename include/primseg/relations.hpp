@@ -74,6 +74,19 @@ struct RelationOptions {
   /// ... and never when the tilt is larger than this, whatever the uncertainty (degrees, in
   /// (0, 90)).
   double max_angle_degrees = 20.0;
+  /// Directions within this angle of one another join one group, and two within it of a right
+  /// angle are made orthogonal, whatever the significance says (degrees, in [0,
+  /// max_angle_degrees)). A CAD tessellation's directions are known so precisely that its
+  /// systematic error, which more points do not average out, is many deviations: set this to the
+  /// part's angular tolerance to make such directions exact. 0: the significance alone.
+  double angle_tolerance_degrees = 0.0;
+  /// Likewise for lengths (input units, finite, >= 0): axis lines whose positions, planes whose
+  /// offsets, spheres whose centres (from a line) and radii that agree within this much, and a
+  /// cylinder whose gap to a plane it borders is within it, are related whatever the significance
+  /// says, and a member whose mean square residual a joint fit raises by at most its square stays
+  /// in its set. The other bounds (max_angle_degrees, max_radius_difference) still apply. 0: the
+  /// significance alone.
+  double length_tolerance = 0.0;
   /// Cylinders' and spheres' radii are made equal when they agree within the significance, and
   /// never when they differ by more than this fraction of the larger (in (0, 1)). A radius known
   /// less well than that (significance × its standard deviation above this fraction of it: a

@@ -167,6 +167,7 @@ def test_relations_of_levels_errors():
         with pytest.raises(TypeError):
             h.relations_of_levels(bad)
     for bad in (dict(relation_significance=0.0), dict(max_relation_angle=90.0),
+                dict(relation_angle_tolerance=float("nan")), dict(relation_length_tolerance=-1.0),
                 dict(max_radius_difference=1.0)):
         (keyword,) = bad
         with pytest.raises(ValueError, match=keyword):

@@ -125,22 +125,34 @@ def test_coplanar_faces_of_a_part_share_one_plane(cgal_mesh):
             assert abs((np.array(clusters[c]["params"]["point"]) - point) @ normal) < 1e-14
 
 
-def test_relation_options_are_the_clis(cli, fandisk, fandisk_tree, tmp_path):
-    # The options of --regularize, as keywords: the same relations and fits as the CLI's, fewer
-    # equal radii with a tighter radius bound, and out-of-range values refused.
-    options = ["--relation-significance", "2.5", "--max-relation-angle", "10", "--max-radius-difference", "0.001"]
-    run_cli(cli, "segment", fandisk, "--clusters", "60", "--regularize", *options,
+TIGHT_RELATIONS = dict(relation_significance=2.5, max_relation_angle=10.0, max_radius_difference=0.001)
+# A CAD part's tolerances: fandisk's exact tessellation errs by more than its fits' statistics.
+CAD_TOLERANCES = dict(relation_angle_tolerance=0.05, relation_length_tolerance=2e-5)
+
+
+def cli_options(keywords):
+    return [text for name, value in keywords.items()
+            for text in ("--" + name.replace("_", "-"), repr(value))]
+
+
+@pytest.mark.parametrize("keywords", [TIGHT_RELATIONS, CAD_TOLERANCES], ids=["tight", "cad"])
+def test_relation_options_are_the_clis(cli, fandisk, fandisk_tree, tmp_path, keywords):
+    # The options of --regularize, as keywords: the same relations and fits as the CLI's, other
+    # relations than the defaults (fewer equal radii with a tighter radius bound, more with
+    # tolerances), and out-of-range values refused.
+    run_cli(cli, "segment", fandisk, "--clusters", "60", "--regularize", *cli_options(keywords),
             "--json", tmp_path / "c.json", "--quiet")
     expected = json.loads((tmp_path / "c.json").read_text())
-    keywords = dict(relation_significance=2.5, max_relation_angle=10.0, max_radius_difference=0.001)
     relations = fandisk_tree.relations(60, **keywords)
     assert relations == expected["relations"]
     assert fandisk_tree.clusters(60, regularize=True, **keywords) == expected["clusters"]
     borders = fandisk_tree.borders(60, regularize=True, **keywords)
     assert json.loads(json.dumps(borders)) == expected["borders"]
-    equal = [r for r in fandisk_tree.relations(60) if r["kind"] == "equal_radius"]
-    assert len([r for r in relations if r["kind"] == "equal_radius"]) < len(equal)
-    for bad in (dict(relation_significance=0.0), dict(max_relation_angle=90.0), dict(max_radius_difference=1.0)):
+    assert relations != fandisk_tree.relations(60)
+    for bad in (dict(relation_significance=0.0), dict(max_relation_angle=90.0),
+                dict(relation_angle_tolerance=-1.0), dict(relation_angle_tolerance=20.0),
+                dict(relation_length_tolerance=-1e-9), dict(relation_length_tolerance=float("inf")),
+                dict(max_radius_difference=1.0)):
         (keyword,) = bad
         with pytest.raises(ValueError, match=keyword):  # named as the caller spells it
             fandisk_tree.relations(60, **bad)
@@ -171,10 +183,10 @@ def test_relations_of_levels_are_the_one_level_calls(fandisk_tree):
     assert {r["kind"] for r in levels[0]["relations"]} >= {"parallel", "orthogonal", "coaxial"}
     assert levels[0]["clusters"] != fandisk_tree.clusters(60)
     # The relation options, as relations() and clusters() spell them.
-    keywords = dict(relation_significance=2.5, max_relation_angle=10.0, max_radius_difference=0.001)
-    tight = fandisk_tree.relations_of_levels([60, 30], **keywords)
-    assert_levels_are_the_one_level_calls(fandisk_tree, tight, [60, 30], **keywords)
-    assert tight[0]["relations"] != levels[0]["relations"]
+    for keywords in (TIGHT_RELATIONS, CAD_TOLERANCES):
+        other = fandisk_tree.relations_of_levels([60, 30], **keywords)
+        assert_levels_are_the_one_level_calls(fandisk_tree, other, [60, 30], **keywords)
+        assert other[0]["relations"] != levels[0]["relations"]
     # Any sequence of integers: a range, a numpy array; none gives none.
     assert fandisk_tree.relations_of_levels(range(5, 8)) == fandisk_tree.relations_of_levels(
         np.array([5, 6, 7], dtype=np.int32))

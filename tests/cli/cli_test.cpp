@@ -1043,35 +1043,55 @@ TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
 }
 
 // The options of --regularize reach the library: the relations and fits are those of
-// regularize_clusters() with them, and a bound tighter than the noise's tilts leaves no direction
-// relation.
+// regularize_clusters() with them. A bound tighter than the noise's tilts leaves no direction
+// relation; a significance too strict for the noise relates less, and tolerances wider than the
+// noise then relate more.
 TEST(Cli, RegularizeOptionsAreTheLibrarys) {
   TempDir dir("regularize-options");
   write_noisy_box_with_hole(dir / "in.off");
   const Hierarchy hierarchy = build_hierarchy(read_mesh(dir / "in.off"));
   const Segmentation cut = cut_by_count(hierarchy, 7);
-  RelationOptions relation_options;
-  relation_options.significance = 2.5;
-  relation_options.max_angle_degrees = 1e-4;
-  relation_options.max_radius_difference = 0.01;
-  std::vector<ClusterReport> reports = describe_clusters(hierarchy, cut);
-  const std::vector<ClusterRelation> relations =
-      regularize_clusters(hierarchy, cut, reports, relation_options);
-  for (const ClusterRelation& relation : relations)
-    EXPECT_EQ(relation.kind, ClusterRelation::Kind::EqualRadius);  // none of directions
+  RelationOptions tight;
+  tight.significance = 2.5;
+  tight.max_angle_degrees = 1e-4;
+  tight.max_radius_difference = 0.01;
+  RelationOptions strict;
+  strict.significance = 0.01;
+  RelationOptions tolerant = strict;
+  tolerant.angle_tolerance_degrees = 5;
+  tolerant.length_tolerance = 0.05;
+  const std::vector<ClusterReport> described = describe_clusters(hierarchy, cut);
+  std::vector<ClusterReport> strict_reports = described;
+  const std::size_t strictly = regularize_clusters(hierarchy, cut, strict_reports, strict).size();
+  for (const auto& [relation_options, flags] :
+       {std::pair{tight,
+                  " --relation-significance 2.5 --max-relation-angle 1e-4 "
+                  "--max-radius-difference 0.01"},
+        std::pair{tolerant,
+                  " --relation-significance 0.01 --relation-angle-tolerance 5 "
+                  "--relation-length-tolerance 0.05"}}) {
+    SCOPED_TRACE(flags);
+    std::vector<ClusterReport> reports = described;
+    const std::vector<ClusterRelation> relations =
+        regularize_clusters(hierarchy, cut, reports, relation_options);
+    if (relation_options.max_angle_degrees < 1) {
+      for (const ClusterRelation& relation : relations)
+        EXPECT_EQ(relation.kind, ClusterRelation::Kind::EqualRadius);  // none of directions
+    } else {
+      EXPECT_GT(relations.size(), strictly);
+    }
 
-  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") +
-                     " --clusters 7 --regularize --relation-significance 2.5 "
-                     "--max-relation-angle 1e-4 --max-radius-difference 0.01 --quiet --json " +
-                     dir.q("s.json")));
-  const json j = read_json(dir / "s.json");
-  ASSERT_EQ(j["relations"].size(), relations.size());
-  for (std::size_t i = 0; i < relations.size(); ++i)
-    EXPECT_EQ(j["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
-              relations[i].clusters);
-  ASSERT_EQ(j["clusters"].size(), reports.size());
-  for (std::size_t c = 0; c < reports.size(); ++c)
-    EXPECT_EQ(j["clusters"][c]["rms"].get<double>(), reports[c].rms) << c;
+    ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --clusters 7 --regularize" + flags +
+                       " --quiet --json " + dir.q("s.json")));
+    const json j = read_json(dir / "s.json");
+    ASSERT_EQ(j["relations"].size(), relations.size());
+    for (std::size_t i = 0; i < relations.size(); ++i)
+      EXPECT_EQ(j["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
+                relations[i].clusters);
+    ASSERT_EQ(j["clusters"].size(), reports.size());
+    for (std::size_t c = 0; c < reports.size(); ++c)
+      EXPECT_EQ(j["clusters"][c]["rms"].get<double>(), reports[c].rms) << c;
+  }
 }
 
 TEST(Cli, EvalScoresTheGeneratedShapes) {
@@ -1120,6 +1140,17 @@ TEST(Cli, BadOptionsAreRejectedWithAMessage) {
       {"--max-relation-angle nan",
        "view " + mesh + " --regularize --max-relation-angle nan",
        {"--max-relation-angle", "nan", "(0, 90)"},
+       false},
+      {"--relation-angle-tolerance -1",
+       "segment " + mesh + " --regularize --relation-angle-tolerance -1",
+       {"--relation-angle-tolerance", "[0, 90)"},
+       false},
+      {"--relation-angle-tolerance above --max-relation-angle",
+       "segment " + mesh + " --regularize --relation-angle-tolerance 30",
+       {"--relation-angle-tolerance", "below --max-relation-angle"}},
+      {"--relation-length-tolerance inf",
+       "view " + mesh + " --regularize --relation-length-tolerance inf",
+       {"--relation-length-tolerance", ">= 0"},
        false},
       {"--max-radius-difference 1",
        "segment " + mesh + " --regularize --max-radius-difference 1",
