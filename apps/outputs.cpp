@@ -240,6 +240,7 @@ nlohmann::json relations_json(const std::vector<ClusterRelation>& relations) {
     nlohmann::json entry = {{"kind", to_string(relation.kind)}, {"clusters", relation.clusters}};
     if (relation.kind == ClusterRelation::Kind::Orthogonal)
       entry["orthogonal_to"] = relation.orthogonal_to;
+    entry["deviation"] = relation.deviation;
     list.push_back(std::move(entry));
   }
   return list;

@@ -236,7 +236,7 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
   std::vector<std::uint32_t> level_offsets{0}, member_offsets{0}, members, first_side;
   std::vector<std::uint8_t> kinds;
   std::vector<std::uint32_t> fit_offsets{0}, fit_nodes;
-  std::vector<double> parameters, errors;
+  std::vector<double> deviations, parameters, errors;
   for (const LevelRelations& level : levels) {
     for (const ClusterRelation& relation : level.relations) {
       kinds.push_back(static_cast<std::uint8_t>(relation.kind));
@@ -244,6 +244,7 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
       for (const std::uint32_t c : relation.orthogonal_to) members.push_back(level.nodes[c]);
       first_side.push_back(static_cast<std::uint32_t>(relation.clusters.size()));
       member_offsets.push_back(static_cast<std::uint32_t>(members.size()));
+      deviations.push_back(relation.deviation);
     }
     level_offsets.push_back(static_cast<std::uint32_t>(kinds.size()));
     for (const auto& [node, report] : level.fits) {
@@ -257,6 +258,7 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
   append_array(html, "relations-member-offsets", member_offsets);
   append_array(html, "relations-members", members);
   append_array(html, "relations-first-side", first_side);
+  append_array(html, "relations-deviations", deviations);
   append_array(html, "relations-fit-offsets", fit_offsets);
   append_array(html, "relations-fit-nodes", fit_nodes);
   append_array(html, "relations-fit-parameters", parameters);

@@ -295,7 +295,8 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
 // and spheres, every cylinder's axis and sphere's centre on its first cylinder's axis line to
 // round-off, an equal-radius set cylinders and spheres of one radius, bit for bit, a coplanar set
 // planes through one plane to round-off, and a tangent pair a cylinder whose axis is orthogonal to
-// the plane's normal and at its radius from the plane, to round-off.
+// the plane's normal and at its radius from the plane, to round-off; every deviation finite and
+// not negative.
 void check_relations(const std::vector<Primitive>& primitives,
                      const std::vector<ClusterRelation>& relations, const std::string& what) {
   auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest,
@@ -324,6 +325,7 @@ void check_relations(const std::vector<Primitive>& primitives,
     const bool equal_radius = relation.kind == ClusterRelation::Kind::EqualRadius;
     const bool tangent = relation.kind == ClusterRelation::Kind::Tangent;
     check_members(relation.clusters, orthogonal ? 1 : 2, !equal_radius && !tangent);
+    check_length(relation.deviation, (what + ": relation deviation").c_str());
     if (tangent) {
       if (relation.clusters.size() != 2) fail((what + ": tangent pair's size").c_str());
       std::uint32_t c = relation.clusters[0], p = relation.clusters[1];
@@ -526,7 +528,9 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
     for (std::size_t r = 0; r < cut_relations.size(); ++r)
       if (viewed.relations[r].kind != cut_relations[r].kind ||
           viewed.relations[r].clusters != cut_relations[r].clusters ||
-          viewed.relations[r].orthogonal_to != cut_relations[r].orthogonal_to)
+          viewed.relations[r].orthogonal_to != cut_relations[r].orthogonal_to ||
+          std::bit_cast<std::uint64_t>(viewed.relations[r].deviation) !=
+              std::bit_cast<std::uint64_t>(cut_relations[r].deviation))
         fail("level regularizer: relation", double(r));
     for (std::size_t c = 0; c < cut_reports.size(); ++c) {
       const ClusterReport &a = viewed.reports[c], &b = cut_reports[c];

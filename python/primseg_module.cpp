@@ -568,7 +568,7 @@ py::dict cluster_dict(const ClusterReport& report) {
 }
 
 // A border as the CLI's --json "borders" writes it.
-// The CLI's JSON "relations": one dict {kind, clusters} per relation.
+// The CLI's JSON "relations": one dict {kind, clusters, deviation} per relation.
 py::list relations_list(const std::vector<ClusterRelation>& relations) {
   py::list list;
   for (const ClusterRelation& relation : relations) {
@@ -577,6 +577,7 @@ py::list relations_list(const std::vector<ClusterRelation>& relations) {
     related["clusters"] = py::cast(relation.clusters);
     if (relation.kind == ClusterRelation::Kind::Orthogonal)
       related["orthogonal_to"] = py::cast(relation.orthogonal_to);
+    related["deviation"] = relation.deviation;
     list.append(related);
   }
   return list;
@@ -1369,7 +1370,9 @@ more centred on one line with no cylinder; "orthogonal": two directions at right
 "equal_radius": cylinders and spheres of one radius; "coplanar": planes of one plane, the
 fragments of one face; "tangent": a cylinder and a plane it borders, the cylinder tangent to it,
 as a fillet and the face it rounds) and clusters (their labels, increasing; for
-"orthogonal", those of one direction, and orthogonal_to those of the other).
+"orthogonal", those of one direction, and orthogonal_to those of the other), and deviation: how
+far the clusters' own fits were from the relation (degrees for "parallel" and "orthogonal", input
+units otherwise), what a tolerance must reach for it to hold whatever the statistics.
 clusters(..., regularize=True) gives the primitives with these relations made exact.)",
                kLevelArguments, kRefineArgument, kRelationArguments,
                cpp_doc("regularize_clusters", doc::relations__regularize_clusters),

@@ -2281,6 +2281,74 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
   }
 }
 
+// ClusterRelation::deviation of `related`: how far the clusters' own fits (`own`) were from it;
+// `shared` holds the fits that make it exact. Degrees for directions, the points' units for
+// lengths.
+double deviation(const ClusterRelation& related, std::span<const Primitive> own,
+                 std::span<const Primitive> shared) {
+  using Kind = ClusterRelation::Kind;
+  const std::vector<std::uint32_t>& members = related.clusters;
+  const auto axis = [&](std::uint32_t c) { return to_eigen(own[c].axis); };
+  const auto point = [&](std::uint32_t c) { return to_eigen(own[c].point); };
+  constexpr double kDegrees = 180 / std::numbers::pi;
+  double largest = 0;
+  switch (related.kind) {
+    case Kind::Parallel:
+      for (const std::uint32_t c : members)
+        largest = std::max(largest, angle_between_lines(axis(c), to_eigen(shared[c].axis)));
+      return largest * kDegrees;
+    case Kind::Orthogonal:
+      for (const std::uint32_t a : members)
+        for (const std::uint32_t b : related.orthogonal_to)
+          largest = std::max(largest, std::numbers::pi / 2 - angle_between_lines(axis(a), axis(b)));
+      return largest * kDegrees;
+    case Kind::Coaxial: {
+      // The shared line: a cylinder's, else (spheres alone) through the two centres farthest apart.
+      Eigen::Vector3d on_line = Eigen::Vector3d::Zero(), along = Eigen::Vector3d::Zero();
+      const auto cylinder = std::find_if(members.begin(), members.end(), [&](std::uint32_t c) {
+        return shared[c].type == PrimitiveType::Cylinder;
+      });
+      if (cylinder != members.end()) {
+        on_line = to_eigen(shared[*cylinder].point);
+        along = to_eigen(shared[*cylinder].axis).normalized();
+      } else {
+        for (const std::uint32_t a : members)
+          for (const std::uint32_t b : members) {
+            const Eigen::Vector3d apart = to_eigen(shared[b].point) - to_eigen(shared[a].point);
+            if (apart.norm() > along.norm()) {
+              on_line = to_eigen(shared[a].point);
+              along = apart;
+            }
+          }
+        if (!(along.norm() > 0)) return 0;
+        along.normalize();
+      }
+      for (const std::uint32_t c : members)
+        largest = std::max(largest, (point(c) - on_line).cross(along).norm());
+      return largest;
+    }
+    case Kind::EqualRadius: {
+      const auto [smallest, biggest] = std::minmax_element(
+          members.begin(), members.end(),
+          [&](std::uint32_t a, std::uint32_t b) { return own[a].radius < own[b].radius; });
+      return own[*biggest].radius - own[*smallest].radius;
+    }
+    case Kind::Coplanar: {
+      const Eigen::Vector3d normal = to_eigen(shared[members[0]].axis);
+      const Eigen::Vector3d on_plane = to_eigen(shared[members[0]].point);
+      for (const std::uint32_t c : members)
+        largest = std::max(largest, std::abs(normal.dot(point(c) - on_plane)));
+      return largest;
+    }
+    case Kind::Tangent: {
+      std::uint32_t c = members[0], p = members[1];
+      if (own[c].type != PrimitiveType::Cylinder) std::swap(c, p);
+      return std::abs(std::abs(axis(p).dot(point(c) - point(p))) - own[c].radius);
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
@@ -2455,6 +2523,7 @@ std::vector<ClusterRelation> regularize_kept(std::vector<Primitive>& primitives,
                                              const std::vector<std::vector<Vec3>>& inlier_points,
                                              const std::vector<std::vector<double>>& inlier_weights,
                                              const RegularityOptions& options) {
+  const std::vector<Primitive> own = primitives;
   std::vector<ClusterRelation> relations;
   for (const Relation& relation : regularize(primitives, inlier_points, inlier_weights, options)) {
     ClusterRelation& related = relations.emplace_back();
@@ -2463,6 +2532,7 @@ std::vector<ClusterRelation> regularize_kept(std::vector<Primitive>& primitives,
       related.clusters.push_back(static_cast<std::uint32_t>(c));
     for (const std::size_t c : relation.others)
       related.orthogonal_to.push_back(static_cast<std::uint32_t>(c));
+    related.deviation = deviation(related, own, primitives);
   }
   sort_relations(relations);
   return relations;

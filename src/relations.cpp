@@ -144,15 +144,19 @@ std::pair<double, double> measure(const DualGraph& graph, std::span<const std::u
 }
 
 // The relations' members' new primitives (working frame, `primitives`) into their reports, with
-// rms and max from `measure_cluster(c, the reported primitive in the working frame)`.
+// rms and max from `measure_cluster(c, the reported primitive in the working frame)`, and the
+// relations' deviations into input units.
 template <typename MeasureCluster>
-void report_refitted(const WorkingFrame& frame, const std::vector<ClusterRelation>& relations,
+void report_refitted(const WorkingFrame& frame, std::vector<ClusterRelation>& relations,
                      const std::vector<Primitive>& primitives,
                      const MeasureCluster& measure_cluster, std::vector<ClusterReport>& reports) {
   std::vector<bool> refitted(reports.size(), false);
-  for (const ClusterRelation& relation : relations) {
+  for (ClusterRelation& relation : relations) {
     for (const std::uint32_t c : relation.clusters) refitted[c] = true;
     for (const std::uint32_t c : relation.orthogonal_to) refitted[c] = true;
+    if (relation.kind != ClusterRelation::Kind::Parallel &&
+        relation.kind != ClusterRelation::Kind::Orthogonal)
+      relation.deviation = std::ldexp(relation.deviation, frame.exponent);  // a length
   }
   for (std::size_t c = 0; c < reports.size(); ++c) {
     if (!refitted[c]) continue;

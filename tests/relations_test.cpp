@@ -188,6 +188,16 @@ TEST(Relations, PartsShowTheirDesignIntentExactAndNoisy) {
       EXPECT_TRUE(clusters_of(relations, ClusterRelation::Kind::EqualRadius).empty());
       for (const auto& group : parallel) expect_one_direction(reports, group);
       expect_orthogonal(reports, relations);
+      // How far the own fits were from each relation: round-off on the exact part; on the noisy
+      // one, the noise's tilts (degrees), within the bound on directions.
+      for (const ClusterRelation& relation : relations) {
+        if (noise == 0) {
+          EXPECT_LT(relation.deviation, 1e-9);
+        } else {
+          EXPECT_GT(relation.deviation, 1e-3);
+          EXPECT_LT(relation.deviation, RelationOptions{}.max_angle_degrees);
+        }
+      }
     }
 }
 
@@ -663,23 +673,56 @@ TEST(Relations, ALengthToleranceGivesTheHolesACadExportSplitOneRadius) {
               std::pow(part.level.reports[c].rms, 2) + kTolerance * kTolerance * (1 + 1e-9));
   }
   EXPECT_NEAR(part.after[joined[0][0]].primitive.radius, 1.0 / 160, 1e-7);
+  // Its deviation, the spread of its members' own radii, spans both classes' radii.
+  const auto joined_class = std::find_if(
+      part.relations.begin(), part.relations.end(), [&](const ClusterRelation& relation) {
+        return relation.kind == ClusterRelation::Kind::EqualRadius &&
+               relation.clusters == joined[0];
+      });
+  ASSERT_NE(joined_class, part.relations.end());
+  EXPECT_GE(joined_class->deviation, std::abs(radii[0] - radii[1]));
+  EXPECT_LT(joined_class->deviation, 1e-3 / 160);
+}
+
+// The Tangent relation of `relations` between `a` and `b`, or null.
+const ClusterRelation* tangent_pair(const std::vector<ClusterRelation>& relations, std::uint32_t a,
+                                    std::uint32_t b) {
+  const auto found = std::find_if(relations.begin(), relations.end(), [&](const auto& relation) {
+    return relation.kind == ClusterRelation::Kind::Tangent &&
+           relation.clusters == std::vector<std::uint32_t>{a, b};
+  });
+  return found == relations.end() ? nullptr : &*found;
 }
 
 TEST(Relations, ALengthToleranceMakesFandisksFilletTangentToItsFace) {
   // fandisk's fillet of radius 0.143 (cluster 7 of its automatic level, borders refined) is
   // 1.7e-5 farther from the face it rounds (cluster 4) than tangent: 4.2 standard deviations of
   // its gap on this exact tessellation, so refused. Within a length tolerance of 2e-5 it is
-  // tangent, exactly.
-  const Groups statistical =
-      clusters_of(regularized_part("fandisk.off").relations, ClusterRelation::Kind::Tangent);
-  EXPECT_EQ(std::count(statistical.begin(), statistical.end(), std::vector<std::uint32_t>{4, 7}),
-            0);
+  // tangent, exactly, and its deviation says how far it was: its own gap.
+  const RegularizedPart statistical = regularized_part("fandisk.off");
+  EXPECT_EQ(tangent_pair(statistical.relations, 4, 7), nullptr);
   const RegularizedPart part = regularized_part("fandisk.off", with_length_tolerance(2e-5));
   const Groups tangent = clusters_of(part.relations, ClusterRelation::Kind::Tangent);
-  EXPECT_EQ(tangent.size(), statistical.size() + 1);
-  EXPECT_EQ(std::count(tangent.begin(), tangent.end(), std::vector<std::uint32_t>{4, 7}), 1);
+  EXPECT_EQ(tangent.size(),
+            clusters_of(statistical.relations, ClusterRelation::Kind::Tangent).size() + 1);
+  const ClusterRelation* fillet = tangent_pair(part.relations, 4, 7);
+  ASSERT_NE(fillet, nullptr);
   expect_exactly_tangent(part.level.reports, part.after, tangent,
                          bounding_box_diagonal(part.hierarchy.mesh()));
+  const Primitive& own_fillet = part.level.reports[7].primitive;
+  const Primitive& own_face = part.level.reports[4].primitive;
+  const Vec3 offset{own_fillet.point[0] - own_face.point[0],
+                    own_fillet.point[1] - own_face.point[1],
+                    own_fillet.point[2] - own_face.point[2]};
+  EXPECT_EQ(fillet->deviation, std::abs(std::abs(dot(own_face.axis, offset)) - own_fillet.radius));
+  EXPECT_GT(fillet->deviation, 1.6e-5);
+  EXPECT_LT(fillet->deviation, 2e-5);
+  // A tolerance well below the deviation does not make it tangent.
+  EXPECT_EQ(
+      tangent_pair(
+          regularized_part("fandisk.off", with_length_tolerance(0.8 * fillet->deviation)).relations,
+          4, 7),
+      nullptr);
 }
 
 TEST(Relations, ALugsRoundEndIsTangentToItsSideOnItsHolesLine) {

@@ -61,6 +61,17 @@ struct ClusterRelation {
   std::vector<std::uint32_t> clusters;
   /// Orthogonal: the clusters of the other direction, increasing; empty otherwise.
   std::vector<std::uint32_t> orthogonal_to;
+  /// How far the clusters' own fits were from the relation before it was made exact: about what
+  /// a tolerance (RelationOptions::angle_tolerance_degrees, length_tolerance) must reach for the
+  /// relation to hold whatever the statistics (the tests judge refits on the clusters' inliers,
+  /// so the two differ a little). Degrees for Parallel (the largest angle of a member's own
+  /// direction from the shared one) and Orthogonal (the largest departure from a right angle
+  /// between a member of each side); input units for Coaxial (the largest distance of a member's
+  /// own axis, at its point, or centre from the shared line), EqualRadius (the largest difference
+  /// of two members' radii), Coplanar (the largest distance of a member's own centroid from the
+  /// shared plane) and Tangent (the cylinder's own gap: its axis's distance from the plane, at
+  /// its point, minus its radius, in absolute value).
+  double deviation = 0;
 };
 
 /// "parallel", "coaxial", "orthogonal", "equal_radius", "coplanar" or "tangent".
@@ -127,7 +138,9 @@ void validate(const RelationOptions& options);
 /// keeps its normal, and its offset unless a coplanar set shares it). Its report's
 /// `primitive`, `rms` and `max` are replaced (`rms` and `max` measured as describe_clusters() does,
 /// on all the cluster's vertices); every other report is left bit for bit. Deterministic, O(F log
-/// F).
+/// F). Every test "within the significance" also passes a difference within
+/// `angle_tolerance_degrees` or `length_tolerance` (RelationOptions), and the refit's test too
+/// when it raises a member's RMS by at most `length_tolerance` in quadrature.
 ///
 /// Returns the relations made exact, ordered by kind (parallel, coaxial, orthogonal,
 /// equal_radius, coplanar, tangent), then by their clusters.

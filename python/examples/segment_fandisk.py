@@ -140,6 +140,21 @@ for pair in tangent:
     assert abs(gap - exact[cylinder]["params"]["radius"]) < 1e-12
 
 # %% [markdown]
+# ## A CAD part's tolerances
+# fandisk is an exact tessellation: its fits are known so precisely that the export's own small
+# errors are many standard deviations, and some relations the part was drawn with are refused. A
+# reverse engineer who knows the part's tolerances gives them (degrees, input units): relations
+# within them hold whatever the statistics say.
+
+# %%
+tolerances = dict(relation_angle_tolerance=0.05, relation_length_tolerance=2e-5)
+tolerant = tree.relations(30, **tolerances)
+tangent_within = [r["clusters"] for r in tolerant if r["kind"] == "tangent"]
+print(f"tangent pairs: {len(tangent)} by the statistics, {len(tangent_within)} within the"
+      f" tolerances: {tangent_within}")
+assert len(tangent_within) > len(tangent)
+
+# %% [markdown]
 # ## The design intent of many levels at once
 # `relations_of_levels` gives the regularized clusters and the relations of many levels in one
 # call, as `clusters(k, regularize=True)` and `relations(k)` give them level by level, but

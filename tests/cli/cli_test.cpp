@@ -1085,9 +1085,11 @@ TEST(Cli, RegularizeOptionsAreTheLibrarys) {
                        " --quiet --json " + dir.q("s.json")));
     const json j = read_json(dir / "s.json");
     ASSERT_EQ(j["relations"].size(), relations.size());
-    for (std::size_t i = 0; i < relations.size(); ++i)
+    for (std::size_t i = 0; i < relations.size(); ++i) {
       EXPECT_EQ(j["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
                 relations[i].clusters);
+      EXPECT_EQ(j["relations"][i]["deviation"].get<double>(), relations[i].deviation);
+    }
     ASSERT_EQ(j["clusters"].size(), reports.size());
     for (std::size_t c = 0; c < reports.size(); ++c)
       EXPECT_EQ(j["clusters"][c]["rms"].get<double>(), reports[c].rms) << c;

@@ -53,7 +53,8 @@ async function readArray(document, name, ArrayType, required = true) {
  * levelOffsets Uint32Array (L+1: level K's relations are [levelOffsets[K - K0],
  * levelOffsets[K - K0 + 1])), kinds Uint8Array (R), memberOffsets Uint32Array (R+1) and members
  * Uint32Array (tree nodes: a relation's clusters, then for an orthogonal one the clusters of the
- * other direction), firstSide Uint32Array (R: how many members are its clusters), fitOffsets
+ * other direction), firstSide Uint32Array (R: how many members are its clusters), deviations
+ * Float64Array (R: ClusterRelation::deviation, degrees or input units), fitOffsets
  * Uint32Array (L+1: level K's fits, as levelOffsets), fitNodes Uint32Array (M: the nodes the
  * relations refitted, increasing within a level), fitParameters Float64Array (9 per fit, as
  * parameters) and fitErrors Float64Array (2 per fit, as errors).
@@ -97,8 +98,8 @@ export async function readPageData(document) {
 
 const RELATION_ARRAYS = {
   levelOffsets: Uint32Array, kinds: Uint8Array, memberOffsets: Uint32Array, members: Uint32Array,
-  firstSide: Uint32Array, fitOffsets: Uint32Array, fitNodes: Uint32Array, fitParameters: Float64Array,
-  fitErrors: Float64Array,
+  firstSide: Uint32Array, deviations: Float64Array, fitOffsets: Uint32Array, fitNodes: Uint32Array,
+  fitParameters: Float64Array, fitErrors: Float64Array,
 };
 
 /** Reads the named arrays 'PREFIX-kebab-case-key' of `types` ({key: ArrayType}). */
@@ -119,6 +120,7 @@ async function readRelations(document, header, check) {
   check(offsets(r.levelOffsets, L, R) && offsets(r.fitOffsets, L, M), 'relation levels');
   check(r.kinds.length === R && r.kinds.every((k) => k < header.relations.kinds.length) &&
     r.firstSide.length === R && offsets(r.memberOffsets, R, r.members.length) &&
+    r.deviations.length === R && r.deviations.every((d) => d >= 0 && Number.isFinite(d)) &&
     r.members.every((node) => node < nodes), 'relations');
   check(r.fitNodes.length === M && r.fitParameters.length === 9 * M && r.fitErrors.length === 2 * M &&
     r.fitNodes.every((node) => node < nodes), 'relation fits');

@@ -504,16 +504,16 @@ class Viewer {
 
   /**
    * The current level's relations with cluster ids as primseg numbers them, as `primseg cut
-   * --regularize --json` lists them: [{kind, clusters, orthogonal_to?}], or null. `ids`: the
+   * --regularize --json` lists them: [{kind, clusters, orthogonal_to?, deviation}], or null. `ids`: the
    * cut's cluster ids (Tree.clusterIds), when the caller has them.
    */
   currentRelations(ids = null) {
     if (!this.levelRelations) return null;
     ids ??= this.tree.clusterIds(this.cut);
     const sorted = (list) => list.map((c) => ids[c]).sort((a, b) => a - b);
-    return this.levelRelations.map(({ kind, members, others }) =>
-      (kind === 'orthogonal' ? { kind, clusters: sorted(members), orthogonal_to: sorted(others) }
-        : { kind, clusters: sorted(members) }));
+    return this.levelRelations.map(({ kind, members, others, deviation }) =>
+      (kind === 'orthogonal' ? { kind, clusters: sorted(members), orthogonal_to: sorted(others), deviation }
+        : { kind, clusters: sorted(members), deviation }));
   }
 
   /** A relation as the CLI's summary writes it: "parallel: 2 7 24", "orthogonal: 0 | 8 9". */
@@ -545,8 +545,11 @@ class Viewer {
         const cylinder = this.levelRelations[i].members.map((c) => this.primitiveOf(c)).find((p) => TYPE_NAMES[p.type] === 'cylinder');
         if (cylinder) text += `, r = ${format(cylinder.radius)}`;
       }
+      const angular = relation.kind === 'parallel' || relation.kind === 'orthogonal';
+      text += `, off by ${format(relation.deviation)}${angular ? '°' : ''}`;
       row.textContent = text;
-      row.title = RELATION_MEANINGS[relation.kind] ?? relation.kind;
+      row.title = `${RELATION_MEANINGS[relation.kind] ?? relation.kind}; the own fits were off by ` +
+        `${format(relation.deviation)}${angular ? ' degrees' : ' (input units)'} before`;
       row.addEventListener('pointerenter', () => this.emphasize(i));
       row.addEventListener('pointerleave', () => this.emphasize(this.pinned));
       row.addEventListener('click', () => {

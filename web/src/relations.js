@@ -32,16 +32,17 @@ export class LevelRelations {
   /**
    * Level K's relations in primseg's order (by kind, then clusters): [{kind (its name), nodes
    * (tree nodes of its clusters), otherNodes (orthogonal: those of the other direction; else
-   * empty)}], or null when the page does not cover K.
+   * empty), deviation (how far the clusters' own fits were from it: degrees for parallel and
+   * orthogonal, input units otherwise)}], or null when the page does not cover K.
    */
   at(K) {
     if (!this.covers(K)) return null;
-    const { levelOffsets, kinds, memberOffsets, members, firstSide } = this.r;
+    const { levelOffsets, kinds, memberOffsets, members, firstSide, deviations } = this.r;
     const list = [];
     for (let i = levelOffsets[K - this.first]; i < levelOffsets[K - this.first + 1]; ++i) {
       const from = memberOffsets[i], split = from + firstSide[i], to = memberOffsets[i + 1];
       list.push({ kind: this.info.kinds[kinds[i]], nodes: Array.from(members.subarray(from, split)),
-        otherNodes: Array.from(members.subarray(split, to)) });
+        otherNodes: Array.from(members.subarray(split, to)), deviation: deviations[i] });
     }
     return list;
   }

@@ -438,6 +438,11 @@ test('fandisk --regularize: each level lists primseg cut --regularize\'s relatio
       ...(r.orthogonal_to ? { orthogonal_to: asCli(r.orthogonal_to) } : {}) }));
     assert.deepEqual(relations, cli.relations, `K = ${K}: the relations`);
     assert.equal(shown.rows.length, cli.relations.length, `K = ${K}: one row per relation`);
+    // Each row says how far the own fits were from its relation, as primseg reports it.
+    cli.relations.forEach((r, i) => {
+      const deviation = Number(/off by ([-0-9.e+]+)/.exec(shown.rows[i])?.[1]);
+      assert.ok(Math.abs(deviation - r.deviation) <= 1e-4 * r.deviation, `K = ${K}: ${shown.rows[i]}`);
+    });
     // A tangent pair's row names its cylinder's radius, as primseg reports it.
     cli.relations.forEach((r, i) => {
       if (r.kind !== 'tangent') return;
