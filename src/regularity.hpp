@@ -108,7 +108,8 @@ void keep_inliers(const Primitive& primitive, std::span<const Vec3> points,
                   std::vector<Vec3>& kept_points, std::vector<double>& kept_weights);
 
 /// regularize() on clusters' inliers (keep_inliers()), as relations between the indices of
-/// `primitives` in sort_relations() order.
+/// `primitives` in sort_relations() order, each with its deviation (ClusterRelation::deviation;
+/// lengths in the points' units).
 std::vector<ClusterRelation> regularize_kept(std::vector<Primitive>& primitives,
                                              const std::vector<std::vector<Vec3>>& inlier_points,
                                              const std::vector<std::vector<double>>& inlier_weights,
