@@ -562,10 +562,15 @@ struct PooledCentre {
   Eigen::Matrix2d covariance() const { return information.inverse(); }
 };
 
-// A test's score with a tolerance (RegularityOptions::angle_tolerance, length_tolerance): passed at
-// or below `bound`, it also passes when the difference it judges, of size `size`, is within
-// `tolerance`, and such a difference then ranks by its size against the tolerance. A tolerance of
-// 0 leaves the score as it is.
+// Whether a difference of size `size` is within a tolerance (RegularityOptions::angle_tolerance,
+// length_tolerance), which then passes a test whatever its statistic; never for a tolerance of 0.
+bool within_tolerance(double size, double tolerance) {
+  return tolerance > 0 && size <= tolerance;
+}
+
+// A test's score with a tolerance, where candidates rank by their scores: passed at or below
+// `bound`, it also passes when within_tolerance(size, tolerance), and such a difference then ranks
+// by its size against the tolerance. A tolerance of 0 leaves the score as it is.
 double tolerated(double score, double bound, double size, double tolerance) {
   if (!(tolerance > 0)) return score;
   const double scaled = size / tolerance;
@@ -666,8 +671,8 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
       const Eigen::Vector2d delta = fit.centre - covariance * pooled[s].weighted;
       const double apart = cylinders[k].middle - cylinders[sets[s][0]].middle;
       const Eigen::Matrix2d combined = fit.centre_covariance + covariance + apart * apart * tilt;
-      if (tolerated(delta.dot(combined.ldlt().solve(delta)), significance2, delta.norm(),
-                    length_tolerance) <= significance2) {
+      if (delta.dot(combined.ldlt().solve(delta)) <= significance2 ||
+          within_tolerance(delta.norm(), length_tolerance)) {
         joined = s;
         break;
       }
@@ -1083,8 +1088,8 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
       const Eigen::Vector3d apart = planes[i].centroid - planes[sets[s].planes[0]].centroid;
       const double variance =
           planes[i].variance + 1 / sets[s].information + apart.dot(direction_covariance * apart);
-      if (tolerated(offset * offset / variance, bound, std::abs(offset),
-                    options.length_tolerance) <= bound)
+      if (offset * offset <= bound * variance ||
+          within_tolerance(std::abs(offset), options.length_tolerance))
         joined = s;
     }
     if (joined == sets.size()) sets.emplace_back();
@@ -1452,8 +1457,8 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
         const double height = sphere.height - sets[s].height;
         const Eigen::Matrix2d combined =
             sphere.covariance + sets[s].pooled.covariance() + height * height * tilt;
-        if (tolerated(offset.dot(combined.ldlt().solve(offset)), bound, offset.norm(),
-                      options.length_tolerance) <= bound)
+        if (offset.dot(combined.ldlt().solve(offset)) <= bound ||
+            within_tolerance(offset.norm(), options.length_tolerance))
           joined = s;
       }
       if (joined == sets.size()) sets.emplace_back().height = sphere.height;
@@ -1505,9 +1510,9 @@ std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surfa
     const double joined_information = information + 1 / variance,
                  joined_moment = moment + d / variance, joined_square = square + d * d / variance;
     const double spread = joined_square - joined_moment * joined_moment / joined_information;
-    const double bound = members == 0 ? 0 : chi_square_bound(options.significance, members);
     if (members == 0 || r - first > options.max_radius_difference * r ||
-        tolerated(spread, bound, r - first, options.length_tolerance) > bound) {
+        (spread > chi_square_bound(options.significance, members) &&
+         !within_tolerance(r - first, options.length_tolerance))) {
       first = r;
       information = 1 / variance;
       moment = square = 0;
@@ -1807,9 +1812,9 @@ std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<Direc
     bool within = true;
     for (std::size_t k = 0; within && k < component.size(); ++k) {
       const Eigen::Vector3d tilt = moved[k] - measured[component[k]];
-      const double angle = 2 * std::asin(std::min(tilt.norm() / 2, 1.0));
-      within = tolerated(tilt.dot(groups[component[k]].information * tilt), significance2, angle,
-                         options.angle_tolerance) <= significance2;
+      within = tilt.dot(groups[component[k]].information * tilt) <= significance2 ||
+               within_tolerance(angle_between_lines(moved[k], measured[component[k]]),
+                                options.angle_tolerance);
     }
     if (!within) continue;
     for (std::size_t k = 0; k < component.size(); ++k) solved[component[k]] = moved[k];
@@ -2222,11 +2227,12 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       const double gap = std::abs(distance) - r;
       const double variance = hold.row.dot(own->covariance * hold.row);
       const double bound = options.max_radius_difference * r;
-      const double score =
-          tolerated(gap * gap / variance, significance2, std::abs(gap), options.length_tolerance);
       if (std::abs(gap) <= bound && significance2 * variance <= bound * bound &&
-          score <= significance2)
-        tested.emplace_back(score, contact->plane, m, hold);
+          (gap * gap <= significance2 * variance ||
+           within_tolerance(std::abs(gap), options.length_tolerance)))
+        tested.emplace_back(
+            tolerated(gap * gap / variance, significance2, std::abs(gap), options.length_tolerance),
+            contact->plane, m, hold);
     }
     std::sort(tested.begin(), tested.end(), [](const auto& a, const auto& b) {
       return std::tie(std::get<0>(a), std::get<1>(a), std::get<2>(a)) <

@@ -26,9 +26,9 @@ struct RegularityOptions {
   /// orthogonal, whatever their uncertainty (radians, >= 0): a CAD tessellation's directions err
   /// systematically, by more than their fits' statistics allow. 0: the statistics alone.
   double angle_tolerance = 0;
-  /// Likewise for lengths (input units, >= 0): axis lines, sphere centres on lines, plane offsets,
-  /// radii and tangency gaps this close agree, and a joint fit that raises a member's mean square
-  /// residual by at most its square keeps the member. 0: the statistics alone.
+  /// Likewise for lengths (the points' units, >= 0): axis lines, sphere centres on lines, plane
+  /// offsets, radii and tangency gaps this close agree, and a joint fit that raises a member's mean
+  /// square residual by at most its square keeps the member. 0: the statistics alone.
   double length_tolerance = 0;
   /// Make directions at right angles within the significance exactly orthogonal.
   bool orthogonal = true;

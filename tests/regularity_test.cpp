@@ -28,12 +28,19 @@ struct Cluster {
   std::vector<double> weights;
 };
 
+// Gaussian noise of deviation `sigma`; none at all for sigma 0 (an exact part).
+struct Noise {
+  double sigma;
+  std::normal_distribution<double> standard{};
+  double operator()(std::mt19937_64& rng) { return sigma * standard(rng); }
+};
+
 // An n × n grid of side `size` on the plane through `centre` with normal `normal`, each point
 // moved along the normal by Gaussian noise of deviation `sigma`.
 Cluster noisy_plane(const Eigen::Vector3d& normal, const Eigen::Vector3d& centre, double size,
                     double sigma, std::mt19937_64& rng, int n = 20) {
   const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
-  std::normal_distribution<double> noise(0, sigma);
+  Noise noise{sigma};
   Cluster cluster;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
@@ -49,8 +56,7 @@ Cluster noisy_plane(const Eigen::Vector3d& normal, const Eigen::Vector3d& centre
 Cluster noisy_cylinder(const Eigen::Vector3d& axis, const Eigen::Vector3d& centre, double radius,
                        double length, double sigma, std::mt19937_64& rng, int rings = 20) {
   const Eigen::Vector3d u = axis.unitOrthogonal(), v = axis.cross(u);
-  std::normal_distribution<double> standard;
-  const auto noise = [&](std::mt19937_64& engine) { return sigma * standard(engine); };
+  Noise noise{sigma};
   Cluster cluster;
   for (int i = 0; i < rings; ++i)
     for (int k = 0; k < 24; ++k) {
@@ -69,8 +75,7 @@ Cluster noisy_cylinder(const Eigen::Vector3d& axis, const Eigen::Vector3d& centr
 Cluster noisy_sphere_cap(const Eigen::Vector3d& centre, double radius, const Eigen::Vector3d& pole,
                          double polar_angle, double sigma, std::mt19937_64& rng) {
   const Eigen::Vector3d u = pole.unitOrthogonal(), v = pole.cross(u);
-  std::normal_distribution<double> standard;
-  const auto noise = [&](std::mt19937_64& engine) { return sigma * standard(engine); };
+  Noise noise{sigma};
   Cluster cluster;
   for (int i = 1; i <= 10; ++i)
     for (int k = 0; k < 24; ++k) {
@@ -771,8 +776,7 @@ ProfileSegment profile_arc(const Eigen::Vector2d& centre, double radius, double 
 
 std::vector<Cluster> swept_profile(const std::vector<ProfileSegment>& segments, double sigma,
                                    std::mt19937_64& rng) {
-  std::normal_distribution<double> standard;  // sigma 0: exact
-  const auto noise = [&](std::mt19937_64& engine) { return sigma * standard(engine); };
+  Noise noise{sigma};
   std::vector<Cluster> clusters(segments.size());
   for (int row = 0; row <= 20; ++row) {
     const double y = row / 20.0 - 0.5;
