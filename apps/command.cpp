@@ -174,13 +174,15 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
                   "cluster whose primitive fits them better (0: none)")
       ->check(CLI::Range(0u, 1000u))
       ->capture_default_str();
-  command.add_flag("--regularize", options.regularize,
-                   "Make the fits' design intent exact: plane normals and cylinder axes that "
-                   "agree within their uncertainty share one direction, directions at right "
-                   "angles become orthogonal, fragments of one face share one plane, cylinders "
-                   "share one axis line and spheres are centred on it, cylinders and spheres "
-                   "share one radius, and fillets become tangent to the faces they border "
-                   "(listed as \"relations\" in the JSON)");
+  command.add_flag(
+      "--regularize", options.regularize,
+      "Make the fits' design intent exact: plane normals and cylinder axes that "
+      "agree within their uncertainty share one direction, directions at right "
+      "angles become orthogonal, fragments of one face share one plane, cylinders "
+      "share one axis line and spheres are centred on it, cylinders and spheres "
+      "share one radius, and fillets become tangent to the faces and parallel cylinders "
+      "they border "
+      "(listed as \"relations\" in the JSON)");
   add_relation_options(command, options.relations);
 }
 
@@ -243,8 +245,9 @@ void add_relation_options(CLI::App& command, RelationOptions& options) {
                   "--regularize: radii never agree when they differ by more than this fraction "
                   "of the larger, nor does a radius known less well; nor is a sphere centred on "
                   "an axis farther than this fraction of its radius from it, or known less well, "
-                  "nor a cylinder made tangent to a plane when its axis's distance from it "
-                  "differs from its radius by more (in (0, 1); lower it for fewer chance "
+                  "nor a cylinder made tangent to a plane (a parallel cylinder) when its axis's "
+                  "distance from it differs from its radius (their radii's sum or difference) by "
+                  "more (in (0, 1); lower it for fewer chance "
                   "relations on freeform parts)")
       ->check(number_range(0, 1, "a fraction in (0, 1) of the larger radius"))
       ->capture_default_str();

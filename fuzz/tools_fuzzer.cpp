@@ -295,8 +295,9 @@ void check_denoised(const Mesh& input, const Mesh& denoised, const SnapReport& r
 // and spheres, every cylinder's axis and sphere's centre on its first cylinder's axis line to
 // round-off, an equal-radius set cylinders and spheres of one radius, bit for bit, a coplanar set
 // planes through one plane to round-off, and a tangent pair a cylinder whose axis is orthogonal to
-// the plane's normal and at its radius from the plane, to round-off; every deviation finite and
-// not negative.
+// the plane's normal and at its radius from the plane, or two cylinders of one direction whose
+// axes are the sum or the difference of their radii apart, to round-off; every deviation finite
+// and not negative.
 void check_relations(const std::vector<Primitive>& primitives,
                      const std::vector<ClusterRelation>& relations, const std::string& what) {
   auto check_members = [&](const std::vector<std::uint32_t>& members, std::size_t fewest,
@@ -324,15 +325,35 @@ void check_relations(const std::vector<Primitive>& primitives,
     const bool orthogonal = relation.kind == ClusterRelation::Kind::Orthogonal;
     const bool equal_radius = relation.kind == ClusterRelation::Kind::EqualRadius;
     const bool tangent = relation.kind == ClusterRelation::Kind::Tangent;
-    check_members(relation.clusters, orthogonal ? 1 : 2, !equal_radius && !tangent);
+    const bool two_cylinders =
+        tangent &&
+        std::all_of(relation.clusters.begin(), relation.clusters.end(), [&](std::uint32_t c) {
+          return c < primitives.size() && primitives[c].type == PrimitiveType::Cylinder;
+        });
+    check_members(relation.clusters, orthogonal ? 1 : 2,
+                  (!equal_radius && !tangent) || two_cylinders);
     check_length(relation.deviation, (what + ": relation deviation").c_str());
-    if (tangent) {
+    if (two_cylinders) {
+      if (relation.clusters.size() != 2) fail((what + ": tangent pair's size").c_str());
+      const Primitive &a = primitives[relation.clusters[0]], &b = primitives[relation.clusters[1]];
+      const Vec3 apart{a.point[0] - b.point[0], a.point[1] - b.point[1], a.point[2] - b.point[2]};
+      const Vec3& axis = b.axis;  // unit: one direction, checked above
+      const double along = apart[0] * axis[0] + apart[1] * axis[1] + apart[2] * axis[2];
+      const double distance = std::hypot(apart[0] - along * axis[0], apart[1] - along * axis[1],
+                                         apart[2] - along * axis[2]);
+      const double scale = std::abs(a.point[0]) + std::abs(a.point[1]) + std::abs(a.point[2]) +
+                           std::abs(b.point[0]) + std::abs(b.point[1]) + std::abs(b.point[2]) +
+                           a.radius + b.radius;
+      if (!(std::min(std::abs(distance - (a.radius + b.radius)),
+                     std::abs(distance - std::abs(a.radius - b.radius))) <= 1e-9 * scale))
+        fail((what + ": tangent cylinders' axes not their radii apart").c_str(), distance);
+    } else if (tangent) {
       if (relation.clusters.size() != 2) fail((what + ": tangent pair's size").c_str());
       std::uint32_t c = relation.clusters[0], p = relation.clusters[1];
       if (primitives[c].type != PrimitiveType::Cylinder) std::swap(c, p);
       if (primitives[c].type != PrimitiveType::Cylinder ||
           primitives[p].type != PrimitiveType::Plane)
-        fail((what + ": tangent pair is not a cylinder and a plane").c_str());
+        fail((what + ": tangent pair is not a cylinder and a plane, nor two cylinders").c_str());
       const Vec3 &n = primitives[p].axis, &a = primitives[c].axis;
       const double cosine = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
       if (!(std::abs(cosine) <= 1e-12))

@@ -415,7 +415,7 @@ const char* kRelationArguments =
   within relation_significance standard deviations (> 0), never beyond max_relation_angle degrees
   (in (0, 90)) or radii more than max_radius_difference apart (in (0, 1); a sphere's centre is
   put on an axis no farther than that fraction of its radius from it, and a cylinder made tangent
-  to a plane no farther than that fraction of its radius from tangent).
+  to a plane or a parallel cylinder no farther than that fraction of its radius from tangent).
   relation_angle_tolerance (degrees, at least 0 and below max_relation_angle) and
   relation_length_tolerance (input units, >= 0; RelationOptions angle_tolerance_degrees,
   length_tolerance): directions, and axis lines, offsets, centres, radii and tangency gaps, that
@@ -1369,7 +1369,8 @@ direction; "coaxial": cylinders of one axis line and spheres centred on it, or t
 more centred on one line with no cylinder; "orthogonal": two directions at right angles;
 "equal_radius": cylinders and spheres of one radius; "coplanar": planes of one plane, the
 fragments of one face; "tangent": a cylinder and a plane it borders, the cylinder tangent to it,
-as a fillet and the face it rounds) and clusters (their labels, increasing; for
+as a fillet and the face it rounds, or two parallel cylinders that border each other, as a fillet
+and the boss it rounds) and clusters (their labels, increasing; for
 "orthogonal", those of one direction, and orthogonal_to those of the other), and deviation: how
 far the clusters' own fits were from the relation (degrees for "parallel" and "orthogonal", input
 units otherwise), what a tolerance must reach for it to hold whatever the statistics.

@@ -1876,17 +1876,45 @@ void merge_parallel_groups(std::vector<DirectionGroup>& groups,
   orthogonal.erase(std::unique(orthogonal.begin(), orthogonal.end()), orthogonal.end());
 }
 
-// A linear condition on cylinders of fixed direction on one axis line, on y = (c, r₀, r₁, …): the
-// line's position c in orthonormal_pair(direction) coordinates and each member's radius:
+// Member i of a line tangent to a held cylinder of the same direction, whose axis is at `centre`
+// (orthonormal_pair(direction) coordinates) and whose radius is R: |c − centre| = partner_sign · R
+// + own_sign · rᵢ. (+1, +1): each outside the other (a fillet around a boss); (+1, −1): inside the
+// held one (a fillet in a bore); (−1, +1): around it.
+struct CircleHold {
+  Eigen::Vector2d centre;
+  double radius = 0, partner_sign = 1, own_sign = 1;
+  Eigen::Index member = 2;  // rᵢ's index in y
+};
+
+// A condition on cylinders of fixed direction on one axis line, on y = (c, r₀, r₁, …): the line's
+// position c in orthonormal_pair(direction) coordinates and each member's radius. Linear ones are
 // row · y = target. Member i tangent to a plane of unit normal n (orthogonal to the axis; (n·u,
 // n·v) in those coordinates) and offset n · x = o, with the axis on `side` (±1) of it: row = (n·u,
 // n·v, 0, …, −side at rᵢ, …), target = o. Member i of a given radius (shared with others of equal
 // radius off the line): row = e(rᵢ), target = r. Members i and j of one radius: row = e(rᵢ) −
-// e(rⱼ), target = 0.
+// e(rⱼ), target = 0. Member i tangent to a parallel cylinder: `circle`, and `row` and `target` its
+// linearisation at the y it was tested at (linearised()).
 struct LineHold {
   Eigen::VectorXd row;
   double target = 0;
+  std::optional<CircleHold> circle;
 };
+
+// `hold` as a linear condition at y: itself, or a circle's tangent plane there (row · y − target
+// is the circle's own excess |c − centre| − partner_sign · R − own_sign · rᵢ at y).
+LineHold linearised(const LineHold& hold, const Eigen::VectorXd& y) {
+  if (!hold.circle) return hold;
+  const CircleHold& circle = *hold.circle;
+  const Eigen::Vector2d apart = y.head<2>() - circle.centre;
+  const double distance = apart.norm();
+  LineHold linear{Eigen::VectorXd::Zero(y.size()), 0, circle};
+  linear.row.head<2>() = apart / distance;
+  linear.row(circle.member) = -circle.own_sign;
+  const double excess =
+      distance - circle.partner_sign * circle.radius - circle.own_sign * y(circle.member);
+  linear.target = linear.row.dot(y) - excess;
+  return linear;
+}
 
 // Round-off of a condition its holds imply, relative to the row or the radius.
 constexpr double kImplied = 1e-9;
@@ -1903,9 +1931,12 @@ struct HeldLineFit {
 // geometric least squares (weighted residuals |Q(x − c)| − rᵢ) subject to `holds` (at most as
 // many as the parameters, 2 + the members): Gauss–Newton over the free coordinates z of y = y₀ +
 // N z, y₀ the start (`centre` and the members' radii) projected onto the holds and N an
-// orthonormal basis of their rows' null space. Nothing when the holds are (nearly) dependent (one
-// plane twice, parallel planes on one side of the axis), the iteration does not converge in 50
-// steps, a radius ends non-positive or the points do not outnumber the free parameters.
+// orthonormal basis of their rows' null space. A circle's hold is linearised again at every step,
+// y projected onto it again and N formed again (a Newton step on the condition, then one of
+// Gauss–Newton along it: a fixed point meets the condition and is stationary along it). Nothing
+// when the holds are (nearly) dependent (one plane twice, parallel planes on one side of the
+// axis), the iteration does not converge in 50 steps, a radius ends non-positive or the points do
+// not outnumber the free parameters.
 std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
                                          const Eigen::Vector2d& centre,
                                          std::span<const CoaxialMember> members,
@@ -1922,24 +1953,34 @@ std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
   Eigen::VectorXd y(size);
   y.head<2>() = centre;
   for (Eigen::Index i = 2; i < size; ++i) y(i) = members[static_cast<std::size_t>(i - 2)].radius;
-  // The rows' Gram determinant, normalised: 1 for orthogonal rows, 0 for dependent ones.
-  Eigen::MatrixXd rows(size, k);
-  Eigen::VectorXd excess(k);
-  double norms = 1;
-  for (Eigen::Index i = 0; i < k; ++i) {
-    const LineHold& hold = holds[static_cast<std::size_t>(i)];
-    rows.col(i) = hold.row;
-    excess(i) = hold.row.dot(y) - hold.target;
-    norms *= hold.row.squaredNorm();
-  }
-  Eigen::MatrixXd basis = Eigen::MatrixXd::Identity(size, size);
-  if (k > 0) {
+  const bool curved = std::any_of(holds.begin(), holds.end(),
+                                  [](const LineHold& hold) { return hold.circle.has_value(); });
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Identity(size, size), basis_rows = basis;
+  double violation = 0;  // how far y was from the holds, linearised, before their last projection
+  // Projects y onto the holds (linearised at y) and forms the basis of their null space; false
+  // when they are (nearly) dependent: their rows' Gram determinant, normalised (1 for orthogonal
+  // rows, 0 for dependent ones), at most 1e-12.
+  const auto constrain = [&] {
+    if (k == 0) return true;
+    Eigen::MatrixXd rows(size, k);
+    Eigen::VectorXd excess(k);
+    double norms = 1;
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const LineHold hold = linearised(holds[static_cast<std::size_t>(i)], y);
+      rows.col(i) = hold.row;
+      excess(i) = hold.row.dot(y) - hold.target;
+      norms *= hold.row.squaredNorm();
+    }
     const Eigen::MatrixXd gram = rows.transpose() * rows;
-    if (!(gram.determinant() > 1e-12 * norms)) return std::nullopt;
+    if (!(gram.determinant() > 1e-12 * norms)) return false;
+    violation = excess.norm();
     y -= rows * gram.ldlt().solve(excess);
     const Eigen::HouseholderQR<Eigen::MatrixXd> qr(rows);
     basis = (qr.householderQ() * Eigen::MatrixXd::Identity(size, size)).rightCols(size - k);
-  }
+    basis_rows = basis.transpose();
+    return true;
+  };
+  if (!constrain()) return std::nullopt;
   const Eigen::Index free = size - k;
   const auto [u, v] = orthonormal_pair(direction);
   std::vector<std::vector<Eigen::Vector2d>> projected(members.size());
@@ -1950,7 +1991,6 @@ std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
   Eigen::MatrixXd normal(free, free);
   Eigen::VectorXd gradient(free);
   Eigen::VectorXd row(free);  // a residual's derivative in z
-  const Eigen::MatrixXd basis_rows = basis.transpose();
   auto linearise = [&](bool weighted) {
     normal.setZero();
     gradient.setZero();
@@ -1970,14 +2010,22 @@ std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
       }
     return squares;
   };
-  bool converged = free == 0;
+  bool converged = free == 0 && !curved;
   for (int step = 0; step < 50 && !converged; ++step) {
+    // A circle's hold linearised again, and y projected onto it: settled once y was on it.
+    const bool projected_again = curved && step > 0;
+    if (projected_again && !constrain()) return std::nullopt;
+    const bool on_holds = !projected_again || !(violation > 1e-14 * y.norm());
+    if (free == 0) {
+      converged = projected_again && on_holds;
+      continue;
+    }
     linearise(true);
     const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
     if (!delta.allFinite()) return std::nullopt;
     const Eigen::VectorXd move = basis * delta;
     y += move;
-    converged = !(move.norm() > 1e-14 * y.norm());
+    converged = !(move.norm() > 1e-14 * y.norm()) && on_holds;
   }
   if (!converged || !y.allFinite() || !(y.tail(size - 2).minCoeff() > 0)) return std::nullopt;
   const double squares = linearise(false);
@@ -1993,12 +2041,13 @@ std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
   return fit;
 }
 
-// Whether `row` is a combination of the holds' rows, to round-off.
-bool implied_by(std::span<const LineHold> holds, const Eigen::VectorXd& row) {
+// Whether `row` is a combination of the holds' rows (linearised at y), to round-off.
+bool implied_by(std::span<const LineHold> holds, const Eigen::VectorXd& row,
+                const Eigen::VectorXd& y) {
   if (holds.empty()) return false;
   Eigen::MatrixXd rows(row.size(), static_cast<Eigen::Index>(holds.size()));
   for (std::size_t i = 0; i < holds.size(); ++i)
-    rows.col(static_cast<Eigen::Index>(i)) = holds[i].row;
+    rows.col(static_cast<Eigen::Index>(i)) = linearised(holds[i], y).row;
   const Eigen::VectorXd combination = rows.colPivHouseholderQr().solve(row);
   return (rows * combination - row).norm() <= kImplied * row.norm();
 }
@@ -2018,6 +2067,15 @@ bool share_a_point(std::span<const Vec3> points, std::span<const Vec3> sorted) {
 // the hierarchy cut apart, a counterbore's steps) are tested on their one line, together: its
 // position and their radii are fitted at once, and a tangency of one moves them all. A line with
 // spheres centred on it is left out.
+//
+// Likewise a cylinder tangent to a cylinder of its direction group that it borders, on another
+// line: a fillet around a boss or inside a bore, the arcs of an extruded profile. The one with
+// fewer points is refitted, the other held (as a plane is): |c − c'| = R ± r, a CircleHold,
+// nonlinear in the line's position c, which fit_held_line() linearises at every step. Its band is
+// where the circles part by less than the noise, √(2σ / |1/r ± 1/R|); circles of nearly one
+// curvature, one inside the other, are left out. A held cylinder must be where it ends, so lines
+// with such partners come after the others, the largest first, and a partner still to move is not
+// held.
 //
 // A tangent join is a band about the contact line (the foot of the cylinder's axis on the plane,
 // from its fit as it comes) where the two surfaces are within the noise of each other, and the
@@ -2077,21 +2135,58 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
     pair_up(i, j);
     pair_up(j, i);
   }
-  // A contact line of a cylinder and a plane it borders: across the axis along the plane
-  // (direction × normal), where the axis is, the sign of the cylinder's side, and the half-width
-  // of the band about it where the two surfaces are within the noise of each other.
+  std::map<std::size_t, std::vector<Vec3>> sorted_points;  // of the candidate planes and partners
+  const auto sorted = [&](std::size_t c) -> const std::vector<Vec3>& {
+    std::vector<Vec3>& list = sorted_points[c];
+    if (list.empty()) {
+      list = points[c];
+      std::sort(list.begin(), list.end());
+    }
+    return list;
+  };
+  // Cylinders of one direction group on different axis lines that border each other: the one of
+  // fewer points (a fillet) may be held tangent to the other, which is held as it is. Its axis
+  // must be about the sum or the difference of their radii from the other's (within
+  // max_radius_difference of its radius) before their points are compared.
+  std::map<std::size_t, std::vector<std::size_t>> partners;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (const std::size_t a : refitted[g])
+      for (const std::size_t b : refitted[g]) {
+        if (primitives[a].type != PrimitiveType::Cylinder ||
+            primitives[b].type != PrimitiveType::Cylinder || a == b ||
+            (line_of[a] != kNoRelation && line_of[a] == line_of[b]) ||
+            std::pair(points[a].size(), b) > std::pair(points[b].size(), a))
+          continue;
+        // a is the smaller; b the held partner.
+        const Eigen::Vector3d& direction = groups[g].direction;
+        const Eigen::Vector3d apart = to_eigen(primitives[a].point) - to_eigen(primitives[b].point);
+        const double distance = (apart - apart.dot(direction) * direction).norm();
+        const double r = primitives[a].radius, big = primitives[b].radius;
+        if (!(std::min(std::abs(distance - (big + r)), std::abs(distance - std::abs(big - r))) <=
+              options.max_radius_difference * r) ||
+            !share_a_point(points[a], sorted(b)))
+          continue;
+        partners[a].push_back(b);
+        candidates[a].first = g;
+      }
+  // A contact line of a cylinder and a plane or a held cylinder it borders: across the axis along
+  // the plane (direction × normal; for a cylinder, the normal at the contact: along the line
+  // joining the axes), where the axis is, the sign of the cylinder's side, and the half-width of
+  // the band about it where the two surfaces are within the noise of each other. A held
+  // cylinder's contact also has the signs of its CircleHold.
   struct Contact {
     std::size_t cylinder = 0, plane = 0;
     Eigen::Vector3d across;
     double at = 0, side = 1, band = 0;
+    double partner_sign = 0, own_sign = 0;  // 0 for a plane
   };
   // Where x is across a contact line: above 0 on the cylinder's side, below on the plane's.
   const auto across_contact = [](const Contact& contact, const Vec3& x) {
     return (contact.across.dot(to_eigen(x)) - contact.at) * contact.side;
   };
   std::vector<Contact> contacts;
-  std::map<std::size_t, std::vector<Vec3>> sorted_points;  // of the candidate planes
-  for (const auto& [c, candidate] : candidates) {
+  for (const auto& [key, candidate] : candidates) {
+    const std::size_t c = key;  // not the binding: clang 14 refuses it in a lambda
     // No plane twice: each is in one direction group, and each pair of groups is one right angle.
     const Eigen::Vector3d& direction = groups[candidate.first].direction;
     // At a distance t along the plane from the contact line the cylinder is t²/2r from it: the
@@ -2102,26 +2197,50 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
     const double deviation = std::max(std::sqrt(squares / static_cast<double>(points[c].size())),
                                       kResolution * cylinder.radius);
     const double band = std::sqrt(2 * cylinder.radius * deviation);
-    for (const std::size_t p : candidate.second) {
-      std::vector<Vec3>& sorted = sorted_points[p];
-      if (sorted.empty()) {
-        sorted = points[p];
-        std::sort(sorted.begin(), sorted.end());
-      }
-      if (!share_a_point(points[c], sorted)) continue;
-      Contact contact{c, p, direction.cross(to_eigen(primitives[p].axis)).normalized()};
-      contact.band = band;
+    const auto add_contact = [&](Contact contact) {
       contact.at = contact.across.dot(to_eigen(primitives[c].point));
       double side = 0;
       for (std::size_t i = 0; i < points[c].size(); ++i)
         side += weights[c][i] * (contact.across.dot(to_eigen(points[c][i])) - contact.at);
       contact.side = side < 0 ? -1 : 1;
       contacts.push_back(contact);
+    };
+    for (const std::size_t p : candidate.second) {
+      if (!share_a_point(points[c], sorted(p))) continue;
+      Contact contact{c, p, direction.cross(to_eigen(primitives[p].axis)).normalized()};
+      contact.band = band;
+      add_contact(contact);
+    }
+    const auto held = partners.find(c);
+    if (held == partners.end()) continue;
+    for (const std::size_t p : held->second) {
+      // The condition nearest to the fits as they are; two circles of curvatures 1/r and ±1/R
+      // part by t²/2 |1/r ± 1/R| at t from their contact, so the band is √(2σ / |1/r ± 1/R|).
+      // Circles of nearly one curvature, one inside the other, stay within the noise of each
+      // other too far from their contact to tell a tangency: none below a quarter of 1/r.
+      const Eigen::Vector3d apart = to_eigen(cylinder.point) - to_eigen(primitives[p].point);
+      const Eigen::Vector3d normal = apart - apart.dot(direction) * direction;
+      const double distance = normal.norm(), r = cylinder.radius, big = primitives[p].radius;
+      Contact contact{c, p, direction.cross(normal / distance).normalized()};
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& [partner_sign, own_sign] : {std::pair{1.0, 1.0}, {1.0, -1.0}, {-1.0, 1.0}}) {
+        const double target = partner_sign * big + own_sign * r;
+        if (target > 0 && std::abs(distance - target) < best) {
+          best = std::abs(distance - target);
+          contact.partner_sign = partner_sign;
+          contact.own_sign = own_sign;
+        }
+      }
+      const double curvature = std::abs(1 / r + contact.partner_sign * contact.own_sign / big);
+      if (!(curvature * r >= 0.25) || !(distance > 0)) continue;
+      contact.band = std::sqrt(2 * deviation / curvature);
+      add_contact(contact);
     }
   }
   // Each bordered plane's offset from its points beyond every candidate cylinder's band.
   std::map<std::size_t, std::vector<const Contact*>> contacts_of_plane;
-  for (const Contact& contact : contacts) contacts_of_plane[contact.plane].push_back(&contact);
+  for (const Contact& contact : contacts)
+    if (contact.own_sign == 0) contacts_of_plane[contact.plane].push_back(&contact);
   std::map<std::size_t, double> offsets;
   for (const auto& [p, bordering] : contacts_of_plane) {
     const Eigen::Vector3d normal = to_eigen(primitives[p].axis);
@@ -2145,21 +2264,50 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
   // direction group). A line with spheres centred on it is left as it is (a sphere is no
   // candidate): moving the line would move them, and a joint held fit of spheres on a line is not
   // modelled.
-  std::vector<bool> done(primitives.size(), false);
+  // (the candidate that found it, its cylinders)
+  std::vector<std::pair<std::size_t, std::vector<std::size_t>>> lines;
+  std::vector<bool> done(primitives.size(), false), on_a_line(primitives.size(), false);
   for (const auto& [first, candidate] : candidates) {
     if (done[first]) continue;
-    const std::vector<std::size_t> cylinders = line_of[first] == kNoRelation
-                                                   ? std::vector<std::size_t>{first}
-                                                   : relations[line_of[first]].members;
+    std::vector<std::size_t> cylinders = line_of[first] == kNoRelation
+                                             ? std::vector<std::size_t>{first}
+                                             : relations[line_of[first]].members;
     for (const std::size_t c : cylinders) done[c] = true;
-    if (std::any_of(cylinders.begin(), cylinders.end(),
-                    [&](std::size_t c) { return !candidates.contains(c); }))
-      continue;
+    if (std::all_of(cylinders.begin(), cylinders.end(),
+                    [&](std::size_t c) { return candidates.contains(c); })) {
+      for (const std::size_t c : cylinders) on_a_line[c] = true;
+      lines.emplace_back(first, std::move(cylinders));
+    }
+  }
+  // A line tangent to a held cylinder must come after that cylinder's own line, which may move
+  // it: lines with partners go last, the largest first (by their largest member's points); a
+  // partner whose line comes later is not held.
+  const auto has_partner = [&](const auto& line) {
+    return std::any_of(line.second.begin(), line.second.end(),
+                       [&](std::size_t c) { return partners.contains(c); });
+  };
+  const auto largest = [&](const auto& line) {
+    std::pair<std::size_t, std::size_t> key{0, 0};  // (points, the lowest cluster first)
+    for (const std::size_t c : line.second) key = std::max(key, {points[c].size(), ~c});
+    return key;
+  };
+  const auto first_held = std::stable_partition(
+      lines.begin(), lines.end(), [&](const auto& line) { return !has_partner(line); });
+  std::stable_sort(first_held, lines.end(),
+                   [&](const auto& a, const auto& b) { return largest(a) > largest(b); });
+  std::vector<bool> settled(primitives.size(), false);  // where it ends: its line was processed
+  for (const auto& line : lines) {
+    const std::size_t first = line.first;
+    const std::vector<std::size_t>& cylinders = line.second;
+    for (const std::size_t c : cylinders) settled[c] = true;
+    // Contacts with a cylinder that is still to move are left out.
     std::vector<const Contact*> bordered;
     for (const Contact& contact : contacts)
-      if (std::find(cylinders.begin(), cylinders.end(), contact.cylinder) != cylinders.end())
+      if (std::find(cylinders.begin(), cylinders.end(), contact.cylinder) != cylinders.end() &&
+          (contact.own_sign == 0 || !on_a_line[contact.plane] || settled[contact.plane]))
         bordered.push_back(&contact);
     if (bordered.empty()) continue;
+    const auto& candidate = candidates.at(first);
     // Each cylinder's points on its own side of every contact line of its own.
     const std::size_t count = cylinders.size();
     std::vector<std::vector<Vec3>> own_points(count);
@@ -2178,9 +2326,11 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       members.push_back({own_points[m], own_weights[m], primitives[c].radius});
     }
     const Eigen::Vector3d& direction = groups[candidate.first].direction;
-    const auto [u, v] = orthonormal_pair(direction);
-    const Eigen::Vector3d on_line = to_eigen(primitives[first].point);
-    const Eigen::Vector2d start(u.dot(on_line), v.dot(on_line));
+    const auto frame = orthonormal_pair(direction);
+    const auto in_frame = [&frame](const Eigen::Vector3d& x) {
+      return Eigen::Vector2d(frame.first.dot(x), frame.second.dot(x));
+    };
+    const Eigen::Vector2d start = in_frame(to_eigen(primitives[first].point));
     const Eigen::Index size = 2 + static_cast<Eigen::Index>(count);
     const auto unit = [size](Eigen::Index i) {
       return Eigen::VectorXd(Eigen::VectorXd::Unit(size, i));
@@ -2200,32 +2350,55 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
             return std::find(cylinders.begin(), cylinders.end(), c) == cylinders.end();
           })) {
         tied[m] = kNoRelation;
-        holds.push_back({unit(radius), primitives[cylinders[m]].radius});
+        holds.push_back({unit(radius), primitives[cylinders[m]].radius, std::nullopt});
         continue;
       }
       for (std::size_t j = 0; j < m && tied[m] == m; ++j)
         if (radius_of[cylinders[j]] == radius_of[cylinders[m]]) tied[m] = j;
       if (tied[m] != m)
-        holds.push_back({unit(radius) - unit(2 + static_cast<Eigen::Index>(tied[m])), 0});
+        holds.push_back(
+            {unit(radius) - unit(2 + static_cast<Eigen::Index>(tied[m])), 0, std::nullopt});
     }
     const std::optional<HeldLineFit> own = fit_held_line(direction, start, members, holds);
     if (!own || own->free == 0) continue;
-    // (score, plane, its cylinder's index in `cylinders`, its hold) of the planes that pass.
+    // (score, plane or held cylinder, its cylinder's index in `cylinders`, its hold) of the
+    // contacts that pass.
     std::vector<std::tuple<double, std::size_t, std::size_t, LineHold>> tested;
     for (const Contact* contact : bordered) {
       const std::size_t m = static_cast<std::size_t>(
           std::find(cylinders.begin(), cylinders.end(), contact->cylinder) - cylinders.begin());
       const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-      const Eigen::Vector3d normal = to_eigen(primitives[contact->plane].axis);
-      const double offset = offsets[contact->plane];
-      const Eigen::Vector2d in_frame(u.dot(normal), v.dot(normal));
-      const double distance = in_frame.dot(own->y.head<2>()) - offset;
-      LineHold hold{Eigen::VectorXd::Zero(size), offset};
-      hold.row.head<2>() = in_frame;
-      hold.row(radius) = distance < 0 ? 1 : -1;
       const double r = own->y(radius);
-      const double gap = std::abs(distance) - r;
-      const double variance = hold.row.dot(own->covariance * hold.row);
+      LineHold hold{Eigen::VectorXd::Zero(size), 0, std::nullopt};
+      double gap = 0, variance = 0;
+      const Primitive& other = primitives[contact->plane];
+      if (contact->own_sign == 0) {
+        const Eigen::Vector3d normal = to_eigen(other.axis);
+        const double offset = offsets[contact->plane];
+        const Eigen::Vector2d normal_in_frame = in_frame(normal);
+        const double distance = normal_in_frame.dot(own->y.head<2>()) - offset;
+        hold.target = offset;
+        hold.row.head<2>() = normal_in_frame;
+        hold.row(radius) = distance < 0 ? 1 : -1;
+        gap = std::abs(distance) - r;
+        variance = hold.row.dot(own->covariance * hold.row);
+      } else {
+        // The held cylinder's axis and radius are uncertain too: its own fit's covariance counts.
+        const Eigen::Vector2d centre = in_frame(to_eigen(other.point));
+        hold = linearised(
+            {Eigen::VectorXd(), 0,
+             CircleHold{centre, other.radius, contact->partner_sign, contact->own_sign, radius}},
+            own->y);
+        gap = hold.row.dot(own->y) - hold.target;
+        const CoaxialMember alone{points[contact->plane], weights[contact->plane], other.radius};
+        const std::optional<HeldLineFit> partner =
+            fit_held_line(direction, centre, {&alone, 1}, {});
+        if (!partner) continue;
+        Eigen::Vector3d partner_row;
+        partner_row << -hold.row.head<2>(), -contact->partner_sign;
+        variance = hold.row.dot(own->covariance * hold.row) +
+                   partner_row.dot(partner->covariance * partner_row);
+      }
       const double bound = options.max_radius_difference * r;
       if (std::abs(gap) <= bound && significance2 * variance <= bound * bound &&
           (gap * gap <= significance2 * variance ||
@@ -2246,9 +2419,11 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
     for (const auto& [score, p, m, hold] : tested) {
       // A condition the kept ones imply (a fragment's second face, once the line and the other
       // fragments are held) holds to round-off or not at all: it adds no freedom to test.
-      if (implied_by(holds, hold.row)) {
+      const Eigen::VectorXd& at = fit ? fit->y : own->y;
+      if (implied_by(holds, linearised(hold, at).row, at)) {
         const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-        if (fit && std::abs(hold.row.dot(fit->y) - hold.target) <= kImplied * fit->y(radius))
+        const LineHold there = fit ? linearised(hold, fit->y) : hold;
+        if (fit && std::abs(there.row.dot(fit->y) - there.target) <= kImplied * fit->y(radius))
           kept.emplace_back(cylinders[m], p);
         continue;
       }
@@ -2349,7 +2524,14 @@ double deviation(const ClusterRelation& related, std::span<const Primitive> own,
     case Kind::Tangent: {
       std::uint32_t c = members[0], p = members[1];
       if (own[c].type != PrimitiveType::Cylinder) std::swap(c, p);
-      return std::abs(std::abs(axis(p).dot(point(c) - point(p))) - own[c].radius);
+      if (own[p].type == PrimitiveType::Plane)
+        return std::abs(std::abs(axis(p).dot(point(c) - point(p))) - own[c].radius);
+      // Two cylinders: the distance of the smaller one's axis, at its point, from the larger's
+      // line, against the sum or the difference of their radii, whichever is nearer.
+      if (own[c].radius > own[p].radius) std::swap(c, p);
+      const double distance = (point(c) - point(p)).cross(axis(p).normalized()).norm();
+      return std::min(std::abs(distance - (own[c].radius + own[p].radius)),
+                      std::abs(distance - std::abs(own[c].radius - own[p].radius)));
     }
   }
   return 0;

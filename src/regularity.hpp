@@ -48,7 +48,8 @@ struct RegularityOptions {
   double max_radius_difference = 0.05;
   /// Hold a cylinder tangent to the planes it borders whose distance from its axis is its radius
   /// within the significance, its direction made exactly orthogonal to theirs (a fillet, a slot's
-  /// round end): 2 parameters for one plane, 1 for two.
+  /// round end): 2 parameters for one plane, 1 for two; and tangent to a cylinder of its
+  /// direction group with more points that it borders (a fillet around a boss or in a bore).
   bool tangency = true;
 };
 

@@ -525,12 +525,24 @@ TEST(Relations, AFilletIsTangentToTheFacesItRounds) {
 
 // Fandisk's fits: its concentric front cylinders are found coaxial, its right angles exact, and no
 // relation costs a fit much of its quality.
-// Each tangent pair: a cylinder whose axis lies along the plane at its radius from it, neither
-// fit much worse for it.
+// Each tangent pair: a cylinder whose axis lies along the plane at its radius from it, or two
+// cylinders of one direction whose axes are the sum or the difference of their radii apart;
+// neither fit much worse for it.
 void expect_exactly_tangent(const std::vector<ClusterReport>& before,
                             const std::vector<ClusterReport>& after, const Groups& tangent,
                             double diagonal) {
   for (const auto& pair : tangent) {
+    for (const std::uint32_t c : pair)
+      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal);
+    const Primitive &a = after[pair[0]].primitive, &b = after[pair[1]].primitive;
+    if (a.type == PrimitiveType::Cylinder && b.type == PrimitiveType::Cylinder) {
+      EXPECT_LT(angle_between_lines_degrees(a.axis, b.axis), 1e-12);
+      const double distance = distance_from_axis(a.point, b);
+      EXPECT_NEAR(std::min(std::abs(distance - (a.radius + b.radius)),
+                           std::abs(distance - std::abs(a.radius - b.radius))),
+                  0, 1e-12 * diagonal);
+      continue;
+    }
     const bool cylinder_first = after[pair[0]].primitive.type == PrimitiveType::Cylinder;
     const Primitive& cylinder = after[pair[cylinder_first ? 0 : 1]].primitive;
     const Primitive& plane = after[pair[cylinder_first ? 1 : 0]].primitive;
@@ -540,8 +552,6 @@ void expect_exactly_tangent(const std::vector<ClusterReport>& before,
     const Vec3 offset{cylinder.point[0] - plane.point[0], cylinder.point[1] - plane.point[1],
                       cylinder.point[2] - plane.point[2]};
     EXPECT_NEAR(std::abs(dot(plane.axis, offset)), cylinder.radius, 1e-12 * diagonal);
-    for (const std::uint32_t c : pair)
-      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal);
   }
 }
 
@@ -723,6 +733,35 @@ TEST(Relations, ALengthToleranceMakesFandisksFilletTangentToItsFace) {
           regularized_part("fandisk.off", with_length_tolerance(0.8 * fillet->deviation)).relations,
           4, 7),
       nullptr);
+}
+
+TEST(Relations, FandisksFilletIsTangentToTheCylinderItRounds) {
+  // fandisk's fillet of radius 0.143 (cluster 7 of its automatic level, borders refined) rounds
+  // the edge between its face 4 and its large cylinder 2 (radius 2.96), whose axis is parallel to
+  // its own: it is held tangent to the cylinder, and its deviation is its own fit's gap to the
+  // cylinder's.
+  const RegularizedPart part = regularized_part("fandisk.off");
+  const ClusterRelation* fillet = tangent_pair(part.relations, 2, 7);
+  ASSERT_NE(fillet, nullptr);
+  const Groups tangent = clusters_of(part.relations, ClusterRelation::Kind::Tangent);
+  const double diagonal = bounding_box_diagonal(part.hierarchy.mesh());
+  expect_exactly_tangent(part.level.reports, part.after, tangent, diagonal);
+  const Primitive& cylinder = part.after[2].primitive;
+  const Primitive& rounded = part.after[7].primitive;
+  ASSERT_EQ(cylinder.type, PrimitiveType::Cylinder);
+  ASSERT_EQ(rounded.type, PrimitiveType::Cylinder);
+  EXPECT_GT(cylinder.radius, 10 * rounded.radius);
+  // Outside each other: the axes are the sum of the radii apart.
+  EXPECT_NEAR(distance_from_axis(rounded.point, cylinder), cylinder.radius + rounded.radius,
+              1e-12 * diagonal);
+  const Primitive& own_fillet = part.level.reports[7].primitive;
+  const Primitive& own_cylinder = part.level.reports[2].primitive;
+  const double own_gap = std::abs(distance_from_axis(own_fillet.point, own_cylinder) -
+                                  own_cylinder.radius - own_fillet.radius);
+  std::printf("fandisk: fillet 7 (r %.6g) tangent to cylinder 2 (r %.6g), own gap %.3g\n",
+              rounded.radius, cylinder.radius, own_gap);
+  EXPECT_NEAR(fillet->deviation, own_gap, 1e-12 * diagonal);
+  EXPECT_LT(fillet->deviation, 1e-5 * diagonal);
 }
 
 TEST(Relations, ALugsRoundEndIsTangentToItsSideOnItsHolesLine) {

@@ -5,7 +5,8 @@
 /// directions at right angles, planes in one plane (the fragments of one face cut apart by holes),
 /// cylinders that share an axis line and spheres centred on it (a stepped shaft, the fragments of
 /// one bore, a ball end, a hole's spherical seat) and cylinders and spheres of one radius (a bolt
-/// circle's holes), and cylinders tangent to the planes they border (a fillet, a slot's round end).
+/// circle's holes), and cylinders tangent to the planes they border (a fillet, a slot's round end)
+/// or to the parallel cylinders they border (a fillet around a boss or in a bore).
 /// Making these relations exact is what reverse engineering wants of a scanned part's fits: a box
 /// with parallel faces, a flange face in one plane, a shaft with one axis, a fillet tangent to its
 /// faces (after GlobFit, Li et al. 2011).
@@ -53,6 +54,10 @@ struct ClusterRelation {
     /// plane's. The cylinders of a Coaxial set (fragments of one fillet, a lug's round end and
     /// the hole through it) stay on their one line; one whose radius an EqualRadius set shares
     /// with clusters off that line keeps that radius. Not for a line with spheres centred on it.
+    /// Also two cylinders of one direction (a Parallel relation) that border each other, their
+    /// axes the sum of their radii apart (a fillet around a boss, an arc of a profile blending
+    /// into another) or the difference (a fillet inside a bore): the one with fewer vertices is
+    /// refitted tangent to the other, which is held as the other relations left it.
     Tangent,
   };
   Kind kind = Kind::Parallel;
@@ -70,7 +75,9 @@ struct ClusterRelation {
   /// own axis, at its point, or centre from the shared line), EqualRadius (the largest difference
   /// of two members' radii), Coplanar (the largest distance of a member's own centroid from the
   /// shared plane) and Tangent (the cylinder's own gap: its axis's distance from the plane, at
-  /// its point, minus its radius, in absolute value).
+  /// its point, minus its radius, in absolute value; for two cylinders, the distance of the
+  /// smaller one's axis, at its point, from the larger's, minus the sum or the difference of
+  /// their radii, whichever is nearer).
   double deviation = 0;
 };
 
@@ -104,7 +111,8 @@ struct RelationOptions {
   /// cylinder patch of a freeform surface) takes part in none. The same fraction of a sphere's
   /// radius bounds its centre's distance from a cylinder's axis, and how well that distance must
   /// be known, for the sphere to be centred on the axis; and of a cylinder's radius, the gap
-  /// between it and its axis's distance from a plane, for the cylinder to be made tangent to it.
+  /// between it and its axis's distance from a plane (or from a parallel cylinder's axis, against
+  /// the sum or the difference of their radii), for the cylinder to be made tangent to it.
   double max_radius_difference = 0.05;
   /// The directions and the refits use each cluster's inlier vertices: those within this many
   /// robust deviations (1.4826 × the median distance) of its primitive. > 0.
@@ -135,7 +143,9 @@ void validate(const RelationOptions& options);
 /// with the cylinders coaxial with it on their one line (a likelihood-ratio test of the refit
 /// decides; a line with spheres on it stays as it is), each fitted on its points away from the band
 /// about their contact line where the two surfaces are within the noise of each other (the plane
-/// keeps its normal, and its offset unless a coplanar set shares it). Its report's
+/// keeps its normal, and its offset unless a coplanar set shares it); likewise tangent to a
+/// cylinder of its direction group that it borders and that has more vertices, held as it is (the
+/// larger lines first, so that a held cylinder is where it ends). Its report's
 /// `primitive`, `rms` and `max` are replaced (`rms` and `max` measured as describe_clusters() does,
 /// on all the cluster's vertices); every other report is left bit for bit. Deterministic, O(F log
 /// F). Every test "within the significance" also passes a difference within

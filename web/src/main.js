@@ -542,8 +542,9 @@ class Viewer {
       let text = this.relationText(relation);
       if (relation.kind === 'equal_radius') text += `, r = ${format(this.primitiveOf(this.levelRelations[i].members[0]).radius)}`;
       if (relation.kind === 'tangent') {
-        const cylinder = this.levelRelations[i].members.map((c) => this.primitiveOf(c)).find((p) => TYPE_NAMES[p.type] === 'cylinder');
-        if (cylinder) text += `, r = ${format(cylinder.radius)}`;
+        const radii = this.levelRelations[i].members.map((c) => this.primitiveOf(c))
+          .filter((p) => TYPE_NAMES[p.type] === 'cylinder').map((p) => format(p.radius));
+        if (radii.length) text += `, r = ${radii.join(' and ')}`;
       }
       const angular = relation.kind === 'parallel' || relation.kind === 'orthogonal';
       text += `, off by ${format(relation.deviation)}${angular ? '°' : ''}`;

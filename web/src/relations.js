@@ -11,7 +11,7 @@ export const RELATION_MEANINGS = {
   orthogonal: 'two directions made exactly orthogonal (the clusters before | against those after)',
   equal_radius: 'cylinders and spheres made one radius, each keeping its axis line or centre',
   coplanar: 'planes made one plane, each keeping its side: the fragments of one face',
-  tangent: 'a cylinder made tangent to a plane it borders: a fillet and a face it rounds',
+  tangent: 'a cylinder made tangent to a plane or a parallel cylinder it borders: a fillet and a face or a boss it rounds',
 };
 
 export class LevelRelations {

@@ -416,7 +416,7 @@ test('fandisk --regularize: each level lists primseg cut --regularize\'s relatio
   const { page, errors } = await openViewer(browser, html);
   const diagonal = await page.evaluate(async () => (await window.primseg.ready).header.bboxDiagonal);
   const kinds = new Set();
-  let refitted = 0;
+  let refitted = 0, tangentCylinders = 0;
   for (const K of [1, 10, 27, 34, 60, 100]) {
     const labelsFile = join(work, 'r.labels'), jsonFile = join(work, 'r.json');
     primseg('cut', tree, '--clusters', String(K), '--regularize', '--labels', labelsFile, '--json', jsonFile, '--quiet');
@@ -443,12 +443,17 @@ test('fandisk --regularize: each level lists primseg cut --regularize\'s relatio
       const deviation = Number(/off by ([-0-9.e+]+)/.exec(shown.rows[i])?.[1]);
       assert.ok(Math.abs(deviation - r.deviation) <= 1e-4 * r.deviation, `K = ${K}: ${shown.rows[i]}`);
     });
-    // A tangent pair's row names its cylinder's radius, as primseg reports it.
+    // A tangent pair's row names its cylinders' radii (one, or two for a fillet and a cylinder),
+    // as primseg reports them.
     cli.relations.forEach((r, i) => {
       if (r.kind !== 'tangent') return;
-      const cylinder = r.clusters.map((c) => cli.clusters[c]).find((c) => c.type === 'cylinder');
-      const radius = Number(/r = ([-0-9.e+]+)/.exec(shown.rows[i])?.[1]);
-      assert.ok(Math.abs(radius - cylinder.params.radius) <= 1e-3 * cylinder.params.radius, `K = ${K}: ${shown.rows[i]}`);
+      const radii = r.clusters.map((c) => cli.clusters[c]).filter((c) => c.type === 'cylinder')
+        .map((c) => c.params.radius).sort((a, b) => a - b);
+      const listed = /r = ([-0-9.e+]+)(?: and ([-0-9.e+]+))?/.exec(shown.rows[i]).slice(1)
+        .filter((x) => x !== undefined).map(Number).sort((a, b) => a - b);
+      assert.equal(listed.length, radii.length, `K = ${K}: ${shown.rows[i]}`);
+      listed.forEach((radius, k) => assert.ok(Math.abs(radius - radii[k]) <= 1e-3 * radii[k], `K = ${K}: ${shown.rows[i]}`));
+      if (radii.length === 2) ++tangentCylinders;
     });
     for (const r of cli.relations) kinds.add(r.kind);
     // Every cluster's panel: the fit as cut --regularize reports it (the members' made exact),
@@ -462,6 +467,7 @@ test('fandisk --regularize: each level lists primseg cut --regularize\'s relatio
     }
   }
   for (const kind of ['parallel', 'coaxial', 'orthogonal', 'equal_radius', 'tangent']) assert.ok(kinds.has(kind), `a ${kind} relation is compared`);
+  assert.ok(tangentCylinders >= 2, `${tangentCylinders} fillets tangent to a cylinder compared`);
   assert.ok(refitted > 50, `${refitted} exact fits compared`);
   // Beyond the page's levels, and on a cut by tolerance no count gives, none is listed; a cut by
   // tolerance that is a level by count lists that level's.
