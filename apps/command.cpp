@@ -211,7 +211,15 @@ CLI::Validator number_range(double low, std::optional<double> high, const std::s
 
 }  // namespace
 
-void add_relation_options(CLI::App& command, RelationOptions& options) {
+RelationOptions RelationChoice::for_mesh(const Mesh& mesh) const {
+  RelationOptions resolved = options;
+  resolved.length_tolerance =
+      parse_length(length_tolerance, bounding_box_diagonal(mesh), "--relation-length-tolerance");
+  return resolved;
+}
+
+void add_relation_options(CLI::App& command, RelationChoice& choice) {
+  RelationOptions& options = choice.options;
   command
       .add_option("--relation-significance", options.significance,
                   "--regularize: directions, axis lines and radii agree when they are within "
@@ -233,12 +241,13 @@ void add_relation_options(CLI::App& command, RelationOptions& options) {
       ->check(number_range(0, 90, "an angle in [0, 90) degrees", true))
       ->capture_default_str();
   command
-      .add_option("--relation-length-tolerance", options.length_tolerance,
+      .add_option("--relation-length-tolerance", choice.length_tolerance,
                   "--regularize: axis lines, plane offsets, sphere centres on lines, radii and "
                   "tangency gaps within this distance agree whatever their uncertainty, and a "
                   "joint fit that raises a member's RMS residual by at most this much (in "
-                  "quadrature) keeps it (input units, >= 0; 0: the significance alone)")
-      ->check(number_range(0, std::nullopt, "a distance >= 0", true))
+                  "quadrature) keeps it (input units, or L% of the bounding-box diagonal; >= 0; "
+                  "0: the significance alone)")
+      ->check(length_syntax_error, "L or L%")
       ->capture_default_str();
   command
       .add_option("--max-radius-difference", options.max_radius_difference,
@@ -253,7 +262,10 @@ void add_relation_options(CLI::App& command, RelationOptions& options) {
       ->capture_default_str();
 }
 
-void validate_relation_options(const RelationOptions& options) {
+void validate_relation_options(const RelationChoice& choice) {
+  RelationOptions options = choice.options;
+  options.length_tolerance =
+      parse_length(choice.length_tolerance, 1, "--relation-length-tolerance");
   if (!(options.angle_tolerance_degrees < options.max_angle_degrees))
     throw InvalidInputError("--relation-angle-tolerance " +
                             CLI::detail::to_string(options.angle_tolerance_degrees) +
@@ -262,7 +274,8 @@ void validate_relation_options(const RelationOptions& options) {
   validate(options);
 }
 
-std::string relation_options_signature(const RelationOptions& options) {
+std::string relation_options_signature(const RelationChoice& choice) {
+  const RelationOptions& options = choice.options;
   const RelationOptions defaults;
   std::string signature;
   // Round-trip digits: options that differ only beyond a fixed number of decimals still differ.
@@ -274,7 +287,13 @@ std::string relation_options_signature(const RelationOptions& options) {
   add("max_relation_angle", options.max_angle_degrees, defaults.max_angle_degrees);
   add("relation_angle_tolerance", options.angle_tolerance_degrees,
       defaults.angle_tolerance_degrees);
-  add("relation_length_tolerance", options.length_tolerance, defaults.length_tolerance);
+  // A length as a number, as before percentages were accepted: earlier outputs still resume.
+  if (is_percentage(choice.length_tolerance))
+    signature += " relation_length_tolerance=" + nlohmann::json(choice.length_tolerance).dump();
+  else
+    add("relation_length_tolerance",
+        parse_length(choice.length_tolerance, 1, "--relation-length-tolerance"),
+        defaults.length_tolerance);
   add("max_radius_difference", options.max_radius_difference, defaults.max_radius_difference);
   return signature;
 }
@@ -311,7 +330,8 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, Chose
   }
   std::vector<ClusterRelation> relations;
   if (options.regularize) {
-    relations = regularize_clusters(hierarchy, segmentation, reports, options.relations);
+    relations = regularize_clusters(hierarchy, segmentation, reports,
+                                    options.relations.for_mesh(hierarchy.mesh()));
     summary["relations"] = relations_json(relations);
   }
   summary["timing"]["cut_seconds"] = seconds_since(cut_start);

@@ -90,13 +90,23 @@ class Progress {
 /// The "mesh" entry of the JSON summary.
 nlohmann::json mesh_summary(const std::string& file, const Hierarchy& hierarchy);
 
+/// The options of --regularize as given on the command line. --relation-length-tolerance may be a
+/// percentage of the bounding-box diagonal, so that one command line suits meshes of any size
+/// (batch): it becomes a length for each mesh.
+struct RelationChoice {
+  RelationOptions options;             // all but the length tolerance, which is 0 here
+  std::string length_tolerance = "0";  // --relation-length-tolerance L or L%
+  /// The options for `mesh`, the length tolerance in its units.
+  RelationOptions for_mesh(const Mesh& mesh) const;
+};
+
 /// A level (--clusters / --tolerance), the per-level output files and --quiet.
 struct LevelOptions {
   LevelChoice level;
   OutputFiles files;
-  std::uint32_t refine = 0;   // --refine N: boundary refinement passes after the cut
-  bool regularize = false;    // --regularize: make the fits' relations exact and report them
-  RelationOptions relations;  // --relation-significance, --max-relation-angle, ...
+  std::uint32_t refine = 0;  // --refine N: boundary refinement passes after the cut
+  bool regularize = false;   // --regularize: make the fits' relations exact and report them
+  RelationChoice relations;  // --relation-significance, --max-relation-angle, ...
   bool quiet = false;
 };
 
@@ -114,13 +124,14 @@ void add_fit_options(CLI::App& command, LevelOptions& options);
 /// Adds --relation-significance, --max-relation-angle, --relation-angle-tolerance,
 /// --relation-length-tolerance and --max-radius-difference (the RelationOptions of --regularize),
 /// checked by validate_relation_options() when the command runs.
-void add_relation_options(CLI::App& command, RelationOptions& options);
+void add_relation_options(CLI::App& command, RelationChoice& choice);
 /// validate(RelationOptions), with the bound between two options named by their flags: throws
 /// InvalidInputError.
-void validate_relation_options(const RelationOptions& options);
-/// The options of `relations` that differ from the defaults, as " name=value" pairs (a resumed
-/// batch redoes outputs made with others): empty for the defaults.
-std::string relation_options_signature(const RelationOptions& options);
+void validate_relation_options(const RelationChoice& choice);
+/// The options of `choice` that differ from the defaults, as " name=value" pairs (a resumed
+/// batch redoes outputs made with others): empty for the defaults. A length tolerance in percent
+/// is the text given.
+std::string relation_options_signature(const RelationChoice& choice);
 
 /// Checks the output names before any work (validate_output_files) and turns `quiet` on when an
 /// output goes to standard output ('-'), which must then carry that output alone.

@@ -2,21 +2,40 @@
 
 #include <charconv>
 #include <cmath>
+#include <string>
+#include <string_view>
 
 #include "primseg/error.hpp"
 
 namespace primseg::cli {
 
-double parse_tolerance(const std::string& text, double bounding_box_diagonal) {
-  const bool percent = !text.empty() && text.back() == '%';
+bool is_percentage(const std::string& text) {
+  return !text.empty() && text.back() == '%';
+}
+
+std::string length_syntax_error(const std::string& text) {
+  const bool percent = is_percentage(text);
   const std::string number = percent ? text.substr(0, text.size() - 1) : text;
   double value = 0;
   const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), value);
   if (number.empty() || error != std::errc() || end != number.data() + number.size() ||
       !std::isfinite(value) || value < 0)
-    throw InvalidInputError("--tolerance: '" + text +
-                            "' is not a non-negative number (optionally followed by %)");
+    return "'" + text + "' is not a non-negative number (optionally followed by %)";
+  return {};
+}
+
+double parse_length(const std::string& text, double bounding_box_diagonal,
+                    std::string_view option) {
+  if (const std::string error = length_syntax_error(text); !error.empty())
+    throw InvalidInputError(std::string(option) + ": " + error);
+  const bool percent = is_percentage(text);
+  double value = 0;
+  std::from_chars(text.data(), text.data() + text.size() - (percent ? 1 : 0), value);
   return percent ? value / 100 * bounding_box_diagonal : value;
+}
+
+double parse_tolerance(const std::string& text, double bounding_box_diagonal) {
+  return parse_length(text, bounding_box_diagonal, "--tolerance");
 }
 
 std::optional<std::uint32_t> parse_cluster_count(const std::string& text) {

@@ -403,7 +403,7 @@ Command add_view_command(CLI::App& app) {
     std::optional<std::string> skeleton_clusters;  // K or auto; default: the page's level
     bool regularize = false;
     std::optional<std::uint32_t> regularize_clusters;  // default: kRelationClusters
-    RelationOptions relations;
+    RelationChoice relations;
     double band = SkinningOptions{}.band;
     unsigned threads = 0;
     bool quiet = false;
@@ -510,8 +510,9 @@ Command add_view_command(CLI::App& app) {
         std::string html(page.substr(0, marker));
         double fit_seconds = 0, relations_seconds = 0;
         html += page_data(hierarchy, input_name(std::filesystem::path(o->mesh_path).filename()),
-                          initial, automatic, skeleton, relation_clusters, o->relations, o->threads,
-                          fit_seconds, relations_seconds);
+                          initial, automatic, skeleton, relation_clusters,
+                          o->relations.for_mesh(hierarchy.mesh()), o->threads, fit_seconds,
+                          relations_seconds);
         html += page.substr(marker + kViewerDataMarker.size());
         detail::write_file_atomically(o->output, html);
         if (!o->quiet) {

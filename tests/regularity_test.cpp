@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -971,7 +972,7 @@ bool has_relation(const Relations& relations, Kind kind, const std::vector<std::
 struct FilletOnACircle {
   double big_radius, radius, plate, plate_end;
   bool internal;
-  double shift = 0;
+  double shift = 0, noise = 0.001;
 
   double distance() const { return internal ? big_radius - radius : big_radius + radius; }
   // The fillet's centre: at the radius from the line, at distance() from the circle's centre.
@@ -989,7 +990,7 @@ struct FilletOnACircle {
         {profile_arc({0, 0}, big_radius, from, towards, 24),
          profile_arc(c, radius, internal ? towards : towards + 180, internal ? 90 : 270, 12),
          profile_line({c.x(), plate}, {plate_end, plate}, {0, 1}, 20)},
-        0.001, rng);
+        noise, rng);
   }
   // Each cluster's own fit: the circle's, the fillet's, the line's.
   std::vector<Primitive> fits(const std::vector<Cluster>& clusters) const {
@@ -1047,6 +1048,57 @@ TEST(Regularity, AFilletIsHeldTangentToTheBossItRounds) {
 TEST(Regularity, AFilletIsHeldTangentToTheBoreItRounds) {
   // A bore of radius 0.5 meets a face 0.2 above its axis through a fillet of radius 0.1 inside.
   expect_fillet_tangent_to_circle_and_line({0.5, 0.1, 0.2, -0.8, true});
+}
+
+// The root mean square distance of `cluster`'s points from `primitive`.
+double rms_distance(const Primitive& primitive, const Cluster& cluster) {
+  double squares = 0;
+  for (const Vec3& x : cluster.points) squares += std::pow(primitive.distance(x), 2);
+  return std::sqrt(squares / static_cast<double>(cluster.points.size()));
+}
+
+TEST(Regularity, TangentCylindersAreExactWheneverFound) {
+  // 120 random fillets on circles, outside and inside, exact and noisy, some set off the circle by
+  // up to 2% of their radius. Whenever the fillet is made tangent to the circle, it is so to
+  // round-off, the circle is where the other relations put it, and the fillet's fit is not much
+  // worse for it; every exact one that touches its circle is found tangent to it.
+  std::mt19937_64 rng(35);
+  std::uniform_real_distribution<double> unit(0, 1);
+  int exact = 0, found = 0;
+  for (int trial = 0; trial < 120; ++trial) {
+    SCOPED_TRACE(trial);
+    FilletOnACircle shape{0.3 + 0.7 * unit(rng), 0, 0, 0, trial % 2 == 1};
+    shape.radius = shape.big_radius * (0.05 + 0.4 * unit(rng));
+    const double degree = std::numbers::pi / 180;
+    const double height = shape.distance() * std::sin((-60 + 120 * unit(rng)) * degree);
+    shape.plate = shape.internal ? height + shape.radius : height - shape.radius;
+    shape.plate_end = shape.centre().x() + (shape.internal ? -1 : 1);
+    shape.noise = std::array{0.0, 0.0005, 0.002}[trial % 3];
+    if (trial % 4 == 3) shape.shift = 0.02 * shape.radius * (2 * unit(rng) - 1);
+    const std::vector<Cluster> clusters = shape.clusters(static_cast<std::uint64_t>(trial));
+    std::vector<Primitive> primitives = shape.fits(clusters);
+    const double own_rms = rms_distance(primitives[1], clusters[1]);
+    std::vector<Primitive> held = primitives;
+    detail::RegularityOptions no_tangency;
+    no_tangency.tangency = false;
+    regularize(held, clusters, no_tangency);
+    const Relations relations = regularize(primitives, clusters);
+    const bool touching = shape.noise == 0 && shape.shift == 0;
+    exact += touching;
+    if (!has_relation(relations, Kind::Tangent, {0, 1})) {
+      EXPECT_FALSE(touching) << "an exact fillet on its circle";
+      continue;
+    }
+    found += touching;
+    EXPECT_EQ(primitives[0].radius, held[0].radius);
+    EXPECT_EQ(primitives[0].point, held[0].point);
+    const double r = primitives[1].radius, big = primitives[0].radius;
+    EXPECT_NEAR(axis_offset(primitives[1], primitives[0]), shape.internal ? big - r : big + r,
+                1e-13);
+    EXPECT_LE(rms_distance(primitives[1], clusters[1]), 1.25 * own_rms + 1e-9);
+  }
+  std::printf("exact fillets on their circle: %d of %d found tangent\n", found, exact);
+  EXPECT_GT(exact, 10);
 }
 
 TEST(Regularity, AFilletSetOffTheBossIsNotTangentToIt) {

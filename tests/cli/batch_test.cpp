@@ -155,6 +155,26 @@ TEST(Batch, RefinedAndRegularizedOutputsAreSegments) {
   batch = json::parse(testing::file_contents(dir / "out" / "parts" / "hole.ply.json"));
   EXPECT_NE(batch["batch_options"].get<std::string>().find("max_relation_angle=5"),
             std::string::npos);
+  // A length tolerance in percent is each file's own length, as `segment` takes it; the
+  // percentage is the outputs' option, so that resuming with another redoes them.
+  ASSERT_EQ(primseg(base + " --regularize --relation-length-tolerance 0.5%"), 0);
+  ASSERT_EQ(primseg("segment '" + (in / "parts" / "hole.ply").string() +
+                    "' -q --clusters 7 --refine 2 --regularize --relation-length-tolerance 0.5% "
+                    "--json '" +
+                    (dir / "hole.json").string() + "'"),
+            0);
+  batch = json::parse(testing::file_contents(dir / "out" / "parts" / "hole.ply.json"));
+  segment = json::parse(testing::file_contents(dir / "hole.json"));
+  EXPECT_EQ(batch["relations"], segment["relations"]);
+  EXPECT_EQ(batch["clusters"], segment["clusters"]);
+  EXPECT_NE(batch["batch_options"].get<std::string>().find("relation_length_tolerance=\"0.5%\""),
+            std::string::npos);
+  ASSERT_EQ(primseg(base + " --regularize --relation-length-tolerance 0.5% --resume"), 0);
+  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
+    EXPECT_EQ(row.substr(row.find(',')), ",skipped") << file;
+  ASSERT_EQ(primseg(base + " --regularize --relation-length-tolerance 0.25% --resume"), 0);
+  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
+    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
   fs::remove_all(dir);
 }
 

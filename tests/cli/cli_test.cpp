@@ -1045,7 +1045,7 @@ TEST(Cli, RegularizeMakesTheRelationsExactAndListsThem) {
 // The options of --regularize reach the library: the relations and fits are those of
 // regularize_clusters() with them. A bound tighter than the noise's tilts leaves no direction
 // relation; a significance too strict for the noise relates less, and tolerances wider than the
-// noise then relate more.
+// noise then relate more. A length tolerance of T% is T/100 of the bounding-box diagonal.
 TEST(Cli, RegularizeOptionsAreTheLibrarys) {
   TempDir dir("regularize-options");
   write_noisy_box_with_hole(dir / "in.off");
@@ -1060,6 +1060,8 @@ TEST(Cli, RegularizeOptionsAreTheLibrarys) {
   RelationOptions tolerant = strict;
   tolerant.angle_tolerance_degrees = 5;
   tolerant.length_tolerance = 0.05;
+  RelationOptions tolerant_in_percent = tolerant;
+  tolerant_in_percent.length_tolerance = 2.5 / 100 * bounding_box_diagonal(hierarchy.mesh());
   const std::vector<ClusterReport> described = describe_clusters(hierarchy, cut);
   std::vector<ClusterReport> strict_reports = described;
   const std::size_t strictly = regularize_clusters(hierarchy, cut, strict_reports, strict).size();
@@ -1069,7 +1071,10 @@ TEST(Cli, RegularizeOptionsAreTheLibrarys) {
                   "--max-radius-difference 0.01"},
         std::pair{tolerant,
                   " --relation-significance 0.01 --relation-angle-tolerance 5 "
-                  "--relation-length-tolerance 0.05"}}) {
+                  "--relation-length-tolerance 0.05"},
+        std::pair{tolerant_in_percent,
+                  " --relation-significance 0.01 --relation-angle-tolerance 5 "
+                  "--relation-length-tolerance 2.5%"}}) {
     SCOPED_TRACE(flags);
     std::vector<ClusterReport> reports = described;
     const std::vector<ClusterRelation> relations =
@@ -1094,6 +1099,34 @@ TEST(Cli, RegularizeOptionsAreTheLibrarys) {
     for (std::size_t c = 0; c < reports.size(); ++c)
       EXPECT_EQ(j["clusters"][c]["rms"].get<double>(), reports[c].rms) << c;
   }
+}
+
+// --relation-length-tolerance T% is T/100 of the mesh's bounding-box diagonal: on fandisk
+// (diagonal 1.452) 0.0014% is 2.03e-5, which makes its fillet 7 tangent to its face 4 (1.7e-5
+// off, docs/method.md), as that length does, bit for bit; 0.0014% of 1 (the percentage read as a
+// fraction) does not.
+TEST(Cli, ARelationLengthToleranceInPercentIsOfTheDiagonal) {
+  TempDir dir("length-tolerance-percent");
+  const fs::path fandisk = testing::cgal_mesh("fandisk.off");
+  const double diagonal = bounding_box_diagonal(read_mesh(fandisk));
+  const auto relations = [&](const std::string& tolerance) {
+    EXPECT_EXIT_OK(run("segment " + quote(fandisk) +
+                       " --clusters auto --refine 2 --regularize --relation-length-tolerance " +
+                       tolerance + " --quiet --json " + dir.q("r.json")));
+    const json j = read_json(dir / "r.json");
+    return std::pair{j["relations"], j["clusters"]};
+  };
+  char length[32];
+  std::snprintf(length, sizeof length, "%.17g", 0.0014 / 100 * diagonal);
+  const auto in_percent = relations("0.0014%");
+  EXPECT_EQ(in_percent, relations(length));
+  const auto tangent_4_7 = [](const json& list) {
+    return std::any_of(list.begin(), list.end(), [](const json& r) {
+      return r["kind"] == "tangent" && r["clusters"] == json::array({4, 7});
+    });
+  };
+  EXPECT_TRUE(tangent_4_7(in_percent.first));
+  EXPECT_FALSE(tangent_4_7(relations("0.000014").first));
 }
 
 TEST(Cli, EvalScoresTheGeneratedShapes) {
@@ -1152,7 +1185,15 @@ TEST(Cli, BadOptionsAreRejectedWithAMessage) {
        {"--relation-angle-tolerance", "below --max-relation-angle"}},
       {"--relation-length-tolerance inf",
        "view " + mesh + " --regularize --relation-length-tolerance inf",
-       {"--relation-length-tolerance", ">= 0"},
+       {"--relation-length-tolerance", "'inf' is not a non-negative number"},
+       false},
+      {"--relation-length-tolerance -1%",
+       "batch " + mesh + " --out x --regularize --relation-length-tolerance -1%",
+       {"--relation-length-tolerance", "'-1%' is not a non-negative number"},
+       false},
+      {"--relation-length-tolerance 1%%",
+       "segment " + mesh + " --regularize --relation-length-tolerance 1%%",
+       {"--relation-length-tolerance", "(optionally followed by %)"},
        false},
       {"--max-radius-difference 1",
        "segment " + mesh + " --regularize --max-radius-difference 1",
