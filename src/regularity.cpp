@@ -2296,6 +2296,8 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
   std::stable_sort(first_held, lines.end(),
                    [&](const auto& a, const auto& b) { return largest(a) > largest(b); });
   std::vector<bool> settled(primitives.size(), false);  // where it ends: its line was processed
+  // Each held cylinder's own fit, for its covariance.
+  std::map<std::size_t, std::optional<HeldLineFit>> partner_fits;
   for (const auto& line : lines) {
     const std::size_t first = line.first;
     const std::vector<std::size_t>& cylinders = line.second;
@@ -2390,9 +2392,13 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
              CircleHold{centre, other.radius, contact->partner_sign, contact->own_sign, radius}},
             own->y);
         gap = hold.row.dot(own->y) - hold.target;
-        const CoaxialMember alone{points[contact->plane], weights[contact->plane], other.radius};
-        const std::optional<HeldLineFit> partner =
-            fit_held_line(direction, centre, {&alone, 1}, {});
+        // Fitted once: a held cylinder no longer moves.
+        auto [fitted, added] = partner_fits.try_emplace(contact->plane);
+        if (added) {
+          const CoaxialMember alone{points[contact->plane], weights[contact->plane], other.radius};
+          fitted->second = fit_held_line(direction, centre, {&alone, 1}, {});
+        }
+        const std::optional<HeldLineFit>& partner = fitted->second;
         if (!partner) continue;
         Eigen::Vector3d partner_row;
         partner_row << -hold.row.head<2>(), -contact->partner_sign;
