@@ -99,7 +99,7 @@ assert np.sum(angles < 7) >= 5 and np.sum(angles > 80) >= 5
 # %% [markdown]
 # ## The design intent
 # Which fits are parallel, coaxial, at right angles, of one radius or tangent (a cylinder and a face
-# it borders) within their uncertainty; with
+# or a cylinder of its direction it borders) within their uncertainty; with
 # `regularize=True` the clusters' primitives have these relations made exact (the CLI's
 # `--regularize`), as a CAD model would have them.
 
@@ -127,17 +127,45 @@ for same in (r["clusters"] for r in relations if r["kind"] == "equal_radius"):
     radii = {exact[c]["params"]["radius"] for c in same}
     print("one radius for the clusters", same, ":", radii)
     assert len(radii) == 1
-# A tangent cylinder's axis lies along its plane, at its radius from it.
+
+
+def check_tangent(pairs, fits):
+    """A tangent cylinder's axis lies along its plane, at its radius from it; two tangent
+    cylinders share their direction, their axes the sum or the difference of their radii apart."""
+    def direction_of(c):
+        return np.array(fits[c]["params"].get("normal", fits[c]["params"].get("axis")))
+
+    for pair in pairs:
+        cylinder, other = sorted(pair, key=lambda c: fits[c]["type"] != "cylinder")
+        point = np.array(fits[cylinder]["params"]["point"])
+        radius = fits[cylinder]["params"]["radius"]
+        if fits[other]["type"] == "cylinder":
+            axis = np.array(fits[other]["params"]["axis"])
+            offset = point - fits[other]["params"]["point"]
+            apart = np.linalg.norm(offset - (offset @ axis) * axis)
+            others = fits[other]["params"]["radius"]
+            print(f"cylinders {cylinder} and {other} of radii {radius:.4f} and {others:.4f} tangent:"
+                  f" their axes {apart:.4f} apart")
+            assert np.all(np.abs(direction_of(cylinder)) == np.abs(axis))
+            assert min(abs(apart - (radius + others)), abs(apart - abs(radius - others))) < 1e-12
+            continue
+        normal = direction_of(other)
+        gap = abs(normal @ (point - fits[other]["params"]["point"]))
+        print(f"cylinder {cylinder} of radius {radius:.4f} tangent to plane {other}: its axis"
+              f" {gap:.4f} from it")
+        assert abs(normal @ direction_of(cylinder)) < 1e-14
+        assert abs(gap - radius) < 1e-12
+
+
 tangent = [r["clusters"] for r in relations if r["kind"] == "tangent"]
 assert tangent
-for pair in tangent:
-    cylinder, plane = sorted(pair, key=lambda c: exact[c]["type"] != "cylinder")
-    normal = direction(plane)
-    gap = abs(normal @ (np.array(exact[cylinder]["params"]["point"]) - exact[plane]["params"]["point"]))
-    print(f"cylinder {cylinder} of radius {exact[cylinder]['params']['radius']:.4f} tangent to plane"
-          f" {plane}: its axis {gap:.4f} from it")
-    assert abs(normal @ direction(cylinder)) < 1e-14
-    assert abs(gap - exact[cylinder]["params"]["radius"]) < 1e-12
+check_tangent(tangent, exact)
+# At the automatic level (34 clusters) a fillet also rounds the edge between a face and a large
+# cylinder of its direction, and is made tangent to the cylinder.
+automatic = [r["clusters"] for r in tree.relations("auto") if r["kind"] == "tangent"]
+automatic_fits = tree.clusters("auto", regularize=True)
+assert any(all(automatic_fits[c]["type"] == "cylinder" for c in pair) for pair in automatic)
+check_tangent(automatic, automatic_fits)
 
 # %% [markdown]
 # ## A CAD part's tolerances
