@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -13,25 +14,31 @@ bool is_percentage(const std::string& text) {
   return !text.empty() && text.back() == '%';
 }
 
-std::string length_syntax_error(const std::string& text) {
-  const bool percent = is_percentage(text);
-  const std::string number = percent ? text.substr(0, text.size() - 1) : text;
+namespace {
+
+// The number of a length "T" or "T%", if it is finite and non-negative.
+std::optional<double> length_number(const std::string& text) {
+  const std::size_t size = text.size() - (is_percentage(text) ? 1 : 0);
   double value = 0;
-  const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), value);
-  if (number.empty() || error != std::errc() || end != number.data() + number.size() ||
-      !std::isfinite(value) || value < 0)
-    return "'" + text + "' is not a non-negative number (optionally followed by %)";
-  return {};
+  const auto [end, error] = std::from_chars(text.data(), text.data() + size, value);
+  if (size == 0 || error != std::errc() || end != text.data() + size || !std::isfinite(value) ||
+      value < 0)
+    return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+std::string length_syntax_error(const std::string& text) {
+  if (length_number(text)) return {};
+  return "'" + text + "' is not a non-negative number (optionally followed by %)";
 }
 
 double parse_length(const std::string& text, double bounding_box_diagonal,
                     std::string_view option) {
-  if (const std::string error = length_syntax_error(text); !error.empty())
-    throw InvalidInputError(std::string(option) + ": " + error);
-  const bool percent = is_percentage(text);
-  double value = 0;
-  std::from_chars(text.data(), text.data() + text.size() - (percent ? 1 : 0), value);
-  return percent ? value / 100 * bounding_box_diagonal : value;
+  const std::optional<double> value = length_number(text);
+  if (!value) throw InvalidInputError(std::string(option) + ": " + length_syntax_error(text));
+  return is_percentage(text) ? *value / 100 * bounding_box_diagonal : *value;
 }
 
 double parse_tolerance(const std::string& text, double bounding_box_diagonal) {

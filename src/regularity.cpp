@@ -1886,6 +1886,30 @@ struct CircleHold {
   Eigen::Index member = 2;  // rᵢ's index in y
 };
 
+// How far apart the lines through two points along a unit `direction` are.
+double distance_across(const Eigen::Vector3d& apart, const Eigen::Vector3d& direction) {
+  return (apart - apart.dot(direction) * direction).norm();
+}
+
+// Two circles (cylinders of one direction, seen along it) whose centres are `distance` apart touch
+// when it is the sum of their radii (each outside the other) or their difference (one inside the
+// other). The nearer condition, as a CircleHold's signs for the circle of radius `radius` held
+// tangent to the one of radius `held`, and the gap from it: distance − (partner_sign · held +
+// own_sign · radius).
+struct CircleContact {
+  double partner_sign = 1, own_sign = 1, gap = 0;
+};
+
+CircleContact nearest_circle_contact(double distance, double radius, double held) {
+  CircleContact nearest{1, 1, distance - (held + radius)};
+  for (const auto& [partner_sign, own_sign] : {std::pair{1.0, -1.0}, {-1.0, 1.0}}) {
+    const double target = partner_sign * held + own_sign * radius;
+    if (target > 0 && std::abs(distance - target) < std::abs(nearest.gap))
+      nearest = {partner_sign, own_sign, distance - target};
+  }
+  return nearest;
+}
+
 // A condition on cylinders of fixed direction on one axis line, on y = (c, r₀, r₁, …): the line's
 // position c in orthonormal_pair(direction) coordinates and each member's radius. Linear ones are
 // row · y = target. Member i tangent to a plane of unit normal n (orthogonal to the axis; (n·u,
@@ -2158,11 +2182,10 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
             std::pair(points[a].size(), b) > std::pair(points[b].size(), a))
           continue;
         // a is the smaller; b the held partner.
-        const Eigen::Vector3d& direction = groups[g].direction;
-        const Eigen::Vector3d apart = to_eigen(primitives[a].point) - to_eigen(primitives[b].point);
-        const double distance = (apart - apart.dot(direction) * direction).norm();
-        const double r = primitives[a].radius, big = primitives[b].radius;
-        if (!(std::min(std::abs(distance - (big + r)), std::abs(distance - std::abs(big - r))) <=
+        const double distance = distance_across(
+            to_eigen(primitives[a].point) - to_eigen(primitives[b].point), groups[g].direction);
+        const double r = primitives[a].radius;
+        if (!(std::abs(nearest_circle_contact(distance, r, primitives[b].radius).gap) <=
               options.max_radius_difference * r) ||
             !share_a_point(points[a], sorted(b)))
           continue;
@@ -2219,20 +2242,14 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       // Circles of nearly one curvature, one inside the other, stay within the noise of each
       // other too far from their contact to tell a tangency: none below a quarter of 1/r.
       const Eigen::Vector3d apart = to_eigen(cylinder.point) - to_eigen(primitives[p].point);
-      const Eigen::Vector3d normal = apart - apart.dot(direction) * direction;
-      const double distance = normal.norm(), r = cylinder.radius, big = primitives[p].radius;
-      Contact contact{c, p, direction.cross(normal / distance).normalized()};
-      double best = std::numeric_limits<double>::infinity();
-      for (const auto& [partner_sign, own_sign] : {std::pair{1.0, 1.0}, {1.0, -1.0}, {-1.0, 1.0}}) {
-        const double target = partner_sign * big + own_sign * r;
-        if (target > 0 && std::abs(distance - target) < best) {
-          best = std::abs(distance - target);
-          contact.partner_sign = partner_sign;
-          contact.own_sign = own_sign;
-        }
-      }
-      const double curvature = std::abs(1 / r + contact.partner_sign * contact.own_sign / big);
-      if (!(curvature * r >= 0.25) || !(distance > 0)) continue;
+      const double distance = distance_across(apart, direction), big = primitives[p].radius;
+      Contact contact{c, p, direction.cross(apart).normalized()};
+      const CircleContact nearest = nearest_circle_contact(distance, cylinder.radius, big);
+      contact.partner_sign = nearest.partner_sign;
+      contact.own_sign = nearest.own_sign;
+      const double curvature =
+          std::abs(1 / cylinder.radius + contact.partner_sign * contact.own_sign / big);
+      if (!(curvature * cylinder.radius >= 0.25) || !(distance > 0)) continue;
       contact.band = std::sqrt(2 * deviation / curvature);
       add_contact(contact);
     }
@@ -2426,9 +2443,9 @@ void make_tangent(const std::vector<DirectionGroup>& groups,
       // A condition the kept ones imply (a fragment's second face, once the line and the other
       // fragments are held) holds to round-off or not at all: it adds no freedom to test.
       const Eigen::VectorXd& at = fit ? fit->y : own->y;
-      if (implied_by(holds, linearised(hold, at).row, at)) {
+      const LineHold there = linearised(hold, at);
+      if (implied_by(holds, there.row, at)) {
         const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-        const LineHold there = fit ? linearised(hold, fit->y) : hold;
         if (fit && std::abs(there.row.dot(fit->y) - there.target) <= kImplied * fit->y(radius))
           kept.emplace_back(cylinders[m], p);
         continue;
@@ -2535,9 +2552,8 @@ double deviation(const ClusterRelation& related, std::span<const Primitive> own,
       // Two cylinders: the distance of the smaller one's axis, at its point, from the larger's
       // line, against the sum or the difference of their radii, whichever is nearer.
       if (own[c].radius > own[p].radius) std::swap(c, p);
-      const double distance = (point(c) - point(p)).cross(axis(p).normalized()).norm();
-      return std::min(std::abs(distance - (own[c].radius + own[p].radius)),
-                      std::abs(distance - std::abs(own[c].radius - own[p].radius)));
+      const double distance = distance_across(point(c) - point(p), axis(p).normalized());
+      return std::abs(nearest_circle_contact(distance, own[c].radius, own[p].radius).gap);
     }
   }
   return 0;
