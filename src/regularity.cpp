@@ -19,15 +19,47 @@
 
 #include "eigen_conversions.hpp"
 #include "orthonormal_pair.hpp"
+#include "regularity_shared.hpp"
 
 namespace primseg::detail {
+
+bool within_tolerance(double size, double tolerance) {
+  return tolerance > 0 && size <= tolerance;
+}
+
+double tolerated(double score, double bound, double size, double tolerance) {
+  if (!(tolerance > 0)) return score;
+  const double scaled = size / tolerance;
+  return std::min(score, bound * scaled * scaled);
+}
+
+double chi_square_bound(double significance, std::size_t freedom) {
+  if (freedom == 1) return significance * significance;
+  const double tail = std::erfc(significance / std::numbers::sqrt2);
+  if (freedom == 2) return -2 * std::log(tail);
+  const double k = static_cast<double>(freedom), spread = 2 / (9 * k);
+  return k * std::pow(1 - spread + significance * std::sqrt(spread), 3);
+}
+
+double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2,
+                       int parameters, double length_tolerance) {
+  const double n = static_cast<double>(count);
+  const double rise = n * (joint_rms * joint_rms - own_rms * own_rms);
+  return tolerated(rise / (significance2 * own_rms * own_rms * n / (n - parameters)), 1,
+                   std::sqrt(std::max(rise / n, 0.0)), length_tolerance);
+}
+
+void place_cylinder(Primitive& cylinder, const Eigen::Vector3d& direction,
+                    const Eigen::Vector2d& centre, double radius) {
+  const auto [u, v] = orthonormal_pair(direction);
+  cylinder.axis = to_vec3(direction.dot(to_eigen(cylinder.axis)) < 0 ? -direction : direction);
+  const Eigen::Vector3d on_axis = centre.x() * u + centre.y() * v;
+  cylinder.point = to_vec3(on_axis + direction * direction.dot(to_eigen(cylinder.point) - on_axis));
+  cylinder.radius = radius;
+}
+
 namespace {
 
-// A fit's residual deviation is never taken below this fraction of its size (a plane's extent,
-// a cylinder's radius). An exact input (a CAD tessellation) has residuals of rounding only, which
-// would make every direction and axis certain beyond its own rounding and no two of them equal;
-// any measured surface has residuals far above it.
-constexpr double kResolution = 1e-9;
 // Two directions the right angles made one, to round-off (radians).
 constexpr double kSameDirection = 1e-12;
 
@@ -40,16 +72,6 @@ struct Oriented {
   // Covariance of the tilt (radians²) along the tangent directions `frame` (columns).
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   Eigen::Matrix<double, 3, 2> frame;
-};
-
-// Directions tested parallel, and their common direction: the minimiser over unit d of
-// Σ δᵢᵀ Cᵢ⁻¹ δᵢ, δᵢ the tilt of d from member i's direction in its frame, which is the smallest
-// eigenvector of Σ Fᵢ Cᵢ⁻¹ Fᵢᵀ (for a plane, its scatter matrix over the residual variance).
-struct DirectionGroup {
-  Eigen::Vector3d direction;
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of the direction's tilt
-  std::vector<std::size_t> members;                      // indices into the Oriented items
 };
 
 // An item's information about its group's direction: Fᵢ Cᵢ⁻¹ Fᵢᵀ.
@@ -471,13 +493,6 @@ std::optional<JointFit> fit_cylinders_and_spheres(std::span<const Eigen::Vector3
   return fit;
 }
 
-// Cylinders on one axis line, each with its own radius.
-struct CoaxialMember {
-  std::span<const Vec3> points;
-  std::span<const double> weights;
-  double radius = 0;
-};
-
 struct CoaxialFit {
   Eigen::Vector2d centre;
   std::vector<double> radii;
@@ -561,21 +576,6 @@ struct PooledCentre {
   Eigen::Vector2d centre() const { return information.ldlt().solve(weighted); }
   Eigen::Matrix2d covariance() const { return information.inverse(); }
 };
-
-// Whether a difference of size `size` is within a tolerance (RegularityOptions::angle_tolerance,
-// length_tolerance), which then passes a test whatever its statistic; never for a tolerance of 0.
-bool within_tolerance(double size, double tolerance) {
-  return tolerance > 0 && size <= tolerance;
-}
-
-// A test's score with a tolerance, where candidates rank by their scores: passed at or below
-// `bound`, it also passes when within_tolerance(size, tolerance), and such a difference then ranks
-// by its size against the tolerance. A tolerance of 0 leaves the score as it is.
-double tolerated(double score, double bound, double size, double tolerance) {
-  if (!(tolerance > 0)) return score;
-  const double scaled = size / tolerance;
-  return std::min(score, bound * scaled * scaled);
-}
 
 // Visited from the best-determined direction, each joins the group it is within the significance
 // (or the angle tolerance) of (the best score), else starts one.
@@ -700,30 +700,6 @@ double family_significance(double significance, std::size_t tests) {
   return high;
 }
 
-// How far a joint fit explains a member worse than its own fit did: the rise of its residual sum
-// over significance² times its residual variance (estimated with the degrees of freedom of the
-// member's own fit, of `parameters` parameters), or, when lower, the rise of its mean square
-// against the square of the length tolerance. Above 1, it does not belong.
-double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2,
-                       int parameters, double length_tolerance) {
-  const double n = static_cast<double>(count);
-  const double rise = n * (joint_rms * joint_rms - own_rms * own_rms);
-  return tolerated(rise / (significance2 * own_rms * own_rms * n / (n - parameters)), 1,
-                   std::sqrt(std::max(rise / n, 0.0)), length_tolerance);
-}
-
-// `cylinder` on the line of `direction` through `centre` (orthonormal_pair(direction)
-// coordinates), its axis on its own side and its point the line's nearest to the old one, so
-// that it stays by the cluster.
-void place_cylinder(Primitive& cylinder, const Eigen::Vector3d& direction,
-                    const Eigen::Vector2d& centre, double radius) {
-  const auto [u, v] = orthonormal_pair(direction);
-  cylinder.axis = to_vec3(direction.dot(to_eigen(cylinder.axis)) < 0 ? -direction : direction);
-  const Eigen::Vector3d on_axis = centre.x() * u + centre.y() * v;
-  cylinder.point = to_vec3(on_axis + direction * direction.dot(to_eigen(cylinder.point) - on_axis));
-  cylinder.radius = radius;
-}
-
 // Whether a 2D position of covariance `covariance` is known to within `bound` at the
 // significance, in its worst direction (the interval rule of the spheres' centres).
 bool known_within(const Eigen::Matrix2d& covariance, double significance, double bound) {
@@ -732,9 +708,6 @@ bool known_within(const Eigen::Matrix2d& covariance, double significance, double
       (covariance(0, 0) + covariance(1, 1)) / 2 + std::hypot(half_difference, covariance(0, 1));
   return significance * std::sqrt(largest) <= bound;
 }
-
-// Not in a relation yet.
-constexpr std::size_t kNoRelation = std::numeric_limits<std::size_t>::max();
 
 // The surfaces with a radius, for the spheres on axes and the equal radii: the cylinders refitted
 // so far, each on an axis line (coaxial ones on a shared one), and the spheres, each on its
@@ -987,17 +960,6 @@ void align_cylinders(const Eigen::Vector3d& direction, const Eigen::Matrix3d& di
           {c, false, line, 0, joint.radii[j], joint.radius_variances[j], joint.rms[j]});
     }
   }
-}
-
-// The χ² value a sum of `freedom` squared standard normals exceeds as rarely as one normal exceeds
-// `significance` in magnitude: exact for one and two degrees of freedom, Wilson–Hilferty's
-// approximation beyond (within 2% from three on at a significance of 3).
-double chi_square_bound(double significance, std::size_t freedom) {
-  if (freedom == 1) return significance * significance;
-  const double tail = std::erfc(significance / std::numbers::sqrt2);
-  if (freedom == 2) return -2 * std::log(tail);
-  const double k = static_cast<double>(freedom), spread = 2 / (9 * k);
-  return k * std::pow(1 - spread + significance * std::sqrt(spread), 3);
 }
 
 // A plane aligned with a group's direction, by where it is along it.
@@ -1874,615 +1836,6 @@ void merge_parallel_groups(std::vector<DirectionGroup>& groups,
   }
   std::sort(orthogonal.begin(), orthogonal.end());
   orthogonal.erase(std::unique(orthogonal.begin(), orthogonal.end()), orthogonal.end());
-}
-
-// Member i of a line tangent to a held cylinder of the same direction, whose axis is at `centre`
-// (orthonormal_pair(direction) coordinates) and whose radius is R: |c − centre| = partner_sign · R
-// + own_sign · rᵢ. (+1, +1): each outside the other (a fillet around a boss); (+1, −1): inside the
-// held one (a fillet in a bore); (−1, +1): around it.
-struct CircleHold {
-  Eigen::Vector2d centre;
-  double radius = 0, partner_sign = 1, own_sign = 1;
-  Eigen::Index member = 2;  // rᵢ's index in y
-};
-
-// How far apart the lines through two points along a unit `direction` are.
-double distance_across(const Eigen::Vector3d& apart, const Eigen::Vector3d& direction) {
-  return (apart - apart.dot(direction) * direction).norm();
-}
-
-// Two circles (cylinders of one direction, seen along it) whose centres are `distance` apart touch
-// when it is the sum of their radii (each outside the other) or their difference (one inside the
-// other). The nearer condition, as a CircleHold's signs for the circle of radius `radius` held
-// tangent to the one of radius `held`, and the gap from it: distance − (partner_sign · held +
-// own_sign · radius).
-struct CircleContact {
-  double partner_sign = 1, own_sign = 1, gap = 0;
-};
-
-CircleContact nearest_circle_contact(double distance, double radius, double held) {
-  CircleContact nearest{1, 1, distance - (held + radius)};
-  for (const auto& [partner_sign, own_sign] : {std::pair{1.0, -1.0}, {-1.0, 1.0}}) {
-    const double target = partner_sign * held + own_sign * radius;
-    if (target > 0 && std::abs(distance - target) < std::abs(nearest.gap))
-      nearest = {partner_sign, own_sign, distance - target};
-  }
-  return nearest;
-}
-
-// A condition on cylinders of fixed direction on one axis line, on y = (c, r₀, r₁, …): the line's
-// position c in orthonormal_pair(direction) coordinates and each member's radius. Linear ones are
-// row · y = target. Member i tangent to a plane of unit normal n (orthogonal to the axis; (n·u,
-// n·v) in those coordinates) and offset n · x = o, with the axis on `side` (±1) of it: row = (n·u,
-// n·v, 0, …, −side at rᵢ, …), target = o. Member i of a given radius (shared with others of equal
-// radius off the line): row = e(rᵢ), target = r. Members i and j of one radius: row = e(rᵢ) −
-// e(rⱼ), target = 0. Member i tangent to a parallel cylinder: `circle`, and `row` and `target` its
-// linearisation at the y it was tested at (linearised()).
-struct LineHold {
-  Eigen::VectorXd row;
-  double target = 0;
-  std::optional<CircleHold> circle;
-};
-
-// `hold` as a linear condition at y: itself, or a circle's tangent plane there (row · y − target
-// is the circle's own excess |c − centre| − partner_sign · R − own_sign · rᵢ at y).
-LineHold linearised(const LineHold& hold, const Eigen::VectorXd& y) {
-  if (!hold.circle) return hold;
-  const CircleHold& circle = *hold.circle;
-  const Eigen::Vector2d apart = y.head<2>() - circle.centre;
-  const double distance = apart.norm();
-  LineHold linear{Eigen::VectorXd::Zero(y.size()), 0, circle};
-  linear.row.head<2>() = apart / distance;
-  linear.row(circle.member) = -circle.own_sign;
-  const double excess =
-      distance - circle.partner_sign * circle.radius - circle.own_sign * y(circle.member);
-  linear.target = linear.row.dot(y) - excess;
-  return linear;
-}
-
-// Round-off of a condition its holds imply, relative to the row or the radius.
-constexpr double kImplied = 1e-9;
-
-struct HeldLineFit {
-  Eigen::VectorXd y;     // (c, r₀, r₁, …)
-  double rms = 0;        // unweighted, over every member's points, at least kResolution × a radius
-  std::size_t free = 0;  // the parameters − the number of holds
-  std::size_t count = 0;       // points
-  Eigen::MatrixXd covariance;  // of y, from the unweighted residuals
-};
-
-// The cylinders `members` of axis direction `direction`, on one line, fitted to their points by
-// geometric least squares (weighted residuals |Q(x − c)| − rᵢ) subject to `holds` (at most as
-// many as the parameters, 2 + the members): Gauss–Newton over the free coordinates z of y = y₀ +
-// N z, y₀ the start (`centre` and the members' radii) projected onto the holds and N an
-// orthonormal basis of their rows' null space. A circle's hold is linearised again at every step,
-// y projected onto it again and N formed again (a Newton step on the condition, then one of
-// Gauss–Newton along it: a fixed point meets the condition and is stationary along it). Nothing
-// when the holds are (nearly) dependent (one plane twice, parallel planes on one side of the
-// axis), the iteration does not converge in 50 steps, a radius ends non-positive or the points do
-// not outnumber the free parameters.
-std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
-                                         const Eigen::Vector2d& centre,
-                                         std::span<const CoaxialMember> members,
-                                         std::span<const LineHold> holds) {
-  const Eigen::Index size = 2 + static_cast<Eigen::Index>(members.size());
-  const Eigen::Index k = static_cast<Eigen::Index>(holds.size());
-  std::size_t count = 0;
-  double largest_radius = 0;
-  for (const CoaxialMember& member : members) {
-    count += member.points.size();
-    largest_radius = std::max(largest_radius, member.radius);
-  }
-  if (k > size || count <= static_cast<std::size_t>(size - k)) return std::nullopt;
-  Eigen::VectorXd y(size);
-  y.head<2>() = centre;
-  for (Eigen::Index i = 2; i < size; ++i) y(i) = members[static_cast<std::size_t>(i - 2)].radius;
-  const bool curved = std::any_of(holds.begin(), holds.end(),
-                                  [](const LineHold& hold) { return hold.circle.has_value(); });
-  Eigen::MatrixXd basis = Eigen::MatrixXd::Identity(size, size), basis_rows = basis;
-  double violation = 0;  // how far y was from the holds, linearised, before their last projection
-  // Projects y onto the holds (linearised at y) and forms the basis of their null space; false
-  // when they are (nearly) dependent: their rows' Gram determinant, normalised (1 for orthogonal
-  // rows, 0 for dependent ones), at most 1e-12.
-  const auto constrain = [&] {
-    if (k == 0) return true;
-    Eigen::MatrixXd rows(size, k);
-    Eigen::VectorXd excess(k);
-    double norms = 1;
-    for (Eigen::Index i = 0; i < k; ++i) {
-      const LineHold hold = linearised(holds[static_cast<std::size_t>(i)], y);
-      rows.col(i) = hold.row;
-      excess(i) = hold.row.dot(y) - hold.target;
-      norms *= hold.row.squaredNorm();
-    }
-    const Eigen::MatrixXd gram = rows.transpose() * rows;
-    if (!(gram.determinant() > 1e-12 * norms)) return false;
-    violation = excess.norm();
-    y -= rows * gram.ldlt().solve(excess);
-    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(rows);
-    basis = (qr.householderQ() * Eigen::MatrixXd::Identity(size, size)).rightCols(size - k);
-    basis_rows = basis.transpose();
-    return true;
-  };
-  if (!constrain()) return std::nullopt;
-  const Eigen::Index free = size - k;
-  const auto [u, v] = orthonormal_pair(direction);
-  std::vector<std::vector<Eigen::Vector2d>> projected(members.size());
-  for (std::size_t m = 0; m < members.size(); ++m)
-    for (const Vec3& p : members[m].points)
-      projected[m].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
-  // Σ w e² and its Gauss–Newton system in z (weighted or not); returns the unweighted Σ e².
-  Eigen::MatrixXd normal(free, free);
-  Eigen::VectorXd gradient(free);
-  Eigen::VectorXd row(free);  // a residual's derivative in z
-  auto linearise = [&](bool weighted) {
-    normal.setZero();
-    gradient.setZero();
-    double squares = 0;
-    for (std::size_t m = 0; m < members.size(); ++m)
-      for (std::size_t i = 0; i < projected[m].size(); ++i) {
-        const Eigen::Vector2d d = projected[m][i] - y.head<2>();
-        const double length = d.norm();
-        if (!(length > 0)) continue;
-        const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-        const double e = length - y(radius), w = weighted ? members[m].weights[i] : 1.0;
-        row.noalias() = -(d.x() / length) * basis_rows.col(0) -
-                        (d.y() / length) * basis_rows.col(1) - basis_rows.col(radius);
-        normal.noalias() += w * row * row.transpose();
-        gradient.noalias() += (w * e) * row;
-        squares += e * e;
-      }
-    return squares;
-  };
-  bool converged = free == 0 && !curved;
-  for (int step = 0; step < 50 && !converged; ++step) {
-    // A circle's hold linearised again, and y projected onto it: settled once y was on it.
-    const bool projected_again = curved && step > 0;
-    if (projected_again && !constrain()) return std::nullopt;
-    const bool on_holds = !projected_again || !(violation > 1e-14 * y.norm());
-    if (free == 0) {
-      converged = projected_again && on_holds;
-      continue;
-    }
-    linearise(true);
-    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
-    if (!delta.allFinite()) return std::nullopt;
-    const Eigen::VectorXd move = basis * delta;
-    y += move;
-    converged = !(move.norm() > 1e-14 * y.norm()) && on_holds;
-  }
-  if (!converged || !y.allFinite() || !(y.tail(size - 2).minCoeff() > 0)) return std::nullopt;
-  const double squares = linearise(false);
-  HeldLineFit fit{y, 0, static_cast<std::size_t>(free), count, Eigen::MatrixXd::Zero(size, size)};
-  const double n = static_cast<double>(count);
-  fit.rms = std::max(std::sqrt(squares / n), kResolution * largest_radius);
-  if (free > 0) {
-    const double variance = std::max(squares / (n - static_cast<double>(free)),
-                                     kResolution * kResolution * largest_radius * largest_radius);
-    fit.covariance = basis * normal.inverse() * basis.transpose() * variance;
-    if (!fit.covariance.allFinite()) return std::nullopt;
-  }
-  return fit;
-}
-
-// Whether `row` is a combination of the holds' rows (linearised at y), to round-off.
-bool implied_by(std::span<const LineHold> holds, const Eigen::VectorXd& row,
-                const Eigen::VectorXd& y) {
-  if (holds.empty()) return false;
-  Eigen::MatrixXd rows(row.size(), static_cast<Eigen::Index>(holds.size()));
-  for (std::size_t i = 0; i < holds.size(); ++i)
-    rows.col(static_cast<Eigen::Index>(i)) = linearised(holds[i], y).row;
-  const Eigen::VectorXd combination = rows.colPivHouseholderQr().solve(row);
-  return (rows * combination - row).norm() <= kImplied * row.norm();
-}
-
-// Whether a point of `points` is also one of `sorted` (sorted): whether two clusters border each
-// other (a vertex on their border is an inlier of both).
-bool share_a_point(std::span<const Vec3> points, std::span<const Vec3> sorted) {
-  return std::any_of(points.begin(), points.end(), [&](const Vec3& p) {
-    return std::binary_search(sorted.begin(), sorted.end(), p);
-  });
-}
-
-// Cylinders held tangent to the planes they border: a fillet, a slot's round end. A cylinder
-// whose direction group a right angle made exactly orthogonal to a plane's (`orthogonal`, indices
-// into `groups`) is tested against each plane of the other group that it borders (they share an
-// inlier point). The cylinders of a Coaxial relation of `relations` (the fragments of one fillet
-// the hierarchy cut apart, a counterbore's steps) are tested on their one line, together: its
-// position and their radii are fitted at once, and a tangency of one moves them all. A line with
-// spheres centred on it is left out.
-//
-// Likewise a cylinder tangent to a cylinder of its direction group that it borders, on another
-// line: a fillet around a boss or inside a bore, the arcs of an extruded profile. The one with
-// fewer points is refitted, the other held (as a plane is): |c − c'| = R ± r, a CircleHold,
-// nonlinear in the line's position c, which fit_held_line() linearises at every step. Its band is
-// where the circles part by less than the noise, √(2σ / |1/r ± 1/R|); circles of nearly one
-// curvature, one inside the other, are left out. A held cylinder must be where it ends, so lines
-// with such partners come after the others, the largest first, and a partner still to move is not
-// held.
-//
-// A tangent join is a band about the contact line (the foot of the cylinder's axis on the plane,
-// from its fit as it comes) where the two surfaces are within the noise of each other, and the
-// hierarchy's border through it follows the noise: a point there joins the surface its noise
-// moves it towards. A row of the plane's side counted in the cylinder (√(r² + t²) from its axis,
-// t along the plane from the contact line) also pulls its radius up. On a noisy fillet cut by the
-// hierarchy the gap between the axis's distance from a face and the radius came out up to 4
-// deviations too small, and one of its two tangencies was refused in 4 draws of 30. So each side
-// keeps only its points beyond the band on its own side: a choice by where points are along the
-// plane, across the noise, which does not bias the fits (1 of 30). A plane's offset is
-// refitted with its normal from its points beyond every candidate cylinder's band (not a coplanar
-// set's shared offset). The band is as narrow as it can be, so that the points next to the
-// contact line still tell a kink of a few degrees from a tangency.
-//
-// The gap to each plane, from the line's cylinders refitted on their points with its direction
-// (a radius an EqualRadius relation shares with clusters off the line held, one shared only on
-// the line one parameter), must be within the significance (its standard deviation from that
-// fit's covariance) or the length tolerance, within max_radius_difference of the radius and known
-// to better than that (the interval rule of the spheres' centres). Candidates are tried from the
-// nearest in standard deviations, each kept when the line refitted tangent to it and to those kept
-// before (fit_held_line(): a lone cylinder keeps 2 parameters for one plane, 1 for two) raises its
-// residual sum by at most the χ² bound of that many conditions times its residual variance (a
-// likelihood-ratio test), or its mean square by at most the length tolerance's square. A condition
-// the kept ones imply (a fragment's face once another fragment of the same radius is tangent to it)
-// is kept when it holds to round-off. The planes are held at their offsets: a face has far more
-// points than a fillet's narrow arc. The cylinders are written back, and the planes they are
-// tangent to with their refitted offsets; each pair is a Tangent relation of `tangents`.
-void make_tangent(const std::vector<DirectionGroup>& groups,
-                  const std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
-                  const std::vector<std::vector<std::size_t>>& refitted,
-                  const RegularityOptions& options, std::vector<Primitive>& primitives,
-                  const std::vector<std::vector<Vec3>>& points,
-                  const std::vector<std::vector<double>>& weights,
-                  const std::vector<Relation>& relations, std::vector<Relation>& tangents) {
-  std::vector<bool> shares_offset(primitives.size(), false);
-  // Each cluster's Coaxial and EqualRadius relations.
-  std::vector<std::size_t> line_of(primitives.size(), kNoRelation),
-      radius_of(primitives.size(), kNoRelation);
-  for (std::size_t r = 0; r < relations.size(); ++r)
-    for (const std::size_t c : relations[r].members) {
-      if (relations[r].kind == Relation::Kind::Coaxial) line_of[c] = r;
-      if (relations[r].kind == Relation::Kind::EqualRadius) radius_of[c] = r;
-      if (relations[r].kind == Relation::Kind::Coplanar) shares_offset[c] = true;
-    }
-  // Each candidate cylinder's direction group and the planes it may be tangent to.
-  std::map<std::size_t, std::pair<std::size_t, std::vector<std::size_t>>> candidates;
-  const auto pair_up = [&](std::size_t cylinder_group, std::size_t plane_group) {
-    for (const std::size_t c : refitted[cylinder_group]) {
-      if (primitives[c].type != PrimitiveType::Cylinder) continue;
-      auto& candidate = candidates[c];
-      candidate.first = cylinder_group;
-      for (const std::size_t p : refitted[plane_group])
-        if (primitives[p].type == PrimitiveType::Plane) candidate.second.push_back(p);
-    }
-  };
-  for (const auto& [i, j] : orthogonal) {
-    pair_up(i, j);
-    pair_up(j, i);
-  }
-  std::map<std::size_t, std::vector<Vec3>> sorted_points;  // of the candidate planes and partners
-  const auto sorted = [&](std::size_t c) -> const std::vector<Vec3>& {
-    std::vector<Vec3>& list = sorted_points[c];
-    if (list.empty()) {
-      list = points[c];
-      std::sort(list.begin(), list.end());
-    }
-    return list;
-  };
-  // Cylinders of one direction group on different axis lines that border each other: the one of
-  // fewer points (a fillet) may be held tangent to the other, which is held as it is. Its axis
-  // must be about the sum or the difference of their radii from the other's (within
-  // max_radius_difference of its radius) before their points are compared.
-  std::map<std::size_t, std::vector<std::size_t>> partners;
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    for (const std::size_t a : refitted[g])
-      for (const std::size_t b : refitted[g]) {
-        if (primitives[a].type != PrimitiveType::Cylinder ||
-            primitives[b].type != PrimitiveType::Cylinder || a == b ||
-            (line_of[a] != kNoRelation && line_of[a] == line_of[b]) ||
-            std::pair(points[a].size(), b) > std::pair(points[b].size(), a))
-          continue;
-        // a is the smaller; b the held partner.
-        const double distance = distance_across(
-            to_eigen(primitives[a].point) - to_eigen(primitives[b].point), groups[g].direction);
-        const double r = primitives[a].radius;
-        if (!(std::abs(nearest_circle_contact(distance, r, primitives[b].radius).gap) <=
-              options.max_radius_difference * r) ||
-            !share_a_point(points[a], sorted(b)))
-          continue;
-        partners[a].push_back(b);
-        candidates[a].first = g;
-      }
-  // A contact line of a cylinder and a plane or a held cylinder it borders: across the axis along
-  // the plane (direction × normal; for a cylinder, the normal at the contact: along the line
-  // joining the axes), where the axis is, the sign of the cylinder's side, and the half-width of
-  // the band about it where the two surfaces are within the noise of each other. A held
-  // cylinder's contact also has the signs of its CircleHold.
-  struct Contact {
-    std::size_t cylinder = 0, plane = 0;
-    Eigen::Vector3d across;
-    double at = 0, side = 1, band = 0;
-    double partner_sign = 0, own_sign = 0;  // 0 for a plane
-  };
-  // Where x is across a contact line: above 0 on the cylinder's side, below on the plane's.
-  const auto across_contact = [](const Contact& contact, const Vec3& x) {
-    return (contact.across.dot(to_eigen(x)) - contact.at) * contact.side;
-  };
-  std::vector<Contact> contacts;
-  for (const auto& [key, candidate] : candidates) {
-    const std::size_t c = key;  // not the binding: clang 14 refuses it in a lambda
-    // No plane twice: each is in one direction group, and each pair of groups is one right angle.
-    const Eigen::Vector3d& direction = groups[candidate.first].direction;
-    // At a distance t along the plane from the contact line the cylinder is t²/2r from it: the
-    // surfaces are within the cylinder's residual deviation σ of each other for t < √(2 r σ).
-    const Primitive& cylinder = primitives[c];
-    double squares = 0;
-    for (const Vec3& x : points[c]) squares += std::pow(cylinder.distance(x), 2);
-    const double deviation = std::max(std::sqrt(squares / static_cast<double>(points[c].size())),
-                                      kResolution * cylinder.radius);
-    const double band = std::sqrt(2 * cylinder.radius * deviation);
-    const auto add_contact = [&](Contact contact) {
-      contact.at = contact.across.dot(to_eigen(primitives[c].point));
-      double side = 0;
-      for (std::size_t i = 0; i < points[c].size(); ++i)
-        side += weights[c][i] * (contact.across.dot(to_eigen(points[c][i])) - contact.at);
-      contact.side = side < 0 ? -1 : 1;
-      contacts.push_back(contact);
-    };
-    for (const std::size_t p : candidate.second) {
-      if (!share_a_point(points[c], sorted(p))) continue;
-      Contact contact{c, p, direction.cross(to_eigen(primitives[p].axis)).normalized()};
-      contact.band = band;
-      add_contact(contact);
-    }
-    const auto held = partners.find(c);
-    if (held == partners.end()) continue;
-    for (const std::size_t p : held->second) {
-      // The condition nearest to the fits as they are; two circles of curvatures 1/r and ±1/R
-      // part by t²/2 |1/r ± 1/R| at t from their contact, so the band is √(2σ / |1/r ± 1/R|).
-      // Circles of nearly one curvature, one inside the other, stay within the noise of each
-      // other too far from their contact to tell a tangency: none below a quarter of 1/r.
-      const Eigen::Vector3d apart = to_eigen(cylinder.point) - to_eigen(primitives[p].point);
-      const double distance = distance_across(apart, direction), big = primitives[p].radius;
-      Contact contact{c, p, direction.cross(apart).normalized()};
-      const CircleContact nearest = nearest_circle_contact(distance, cylinder.radius, big);
-      contact.partner_sign = nearest.partner_sign;
-      contact.own_sign = nearest.own_sign;
-      const double curvature =
-          std::abs(1 / cylinder.radius + contact.partner_sign * contact.own_sign / big);
-      if (!(curvature * cylinder.radius >= 0.25) || !(distance > 0)) continue;
-      contact.band = std::sqrt(2 * deviation / curvature);
-      add_contact(contact);
-    }
-  }
-  // Each bordered plane's offset from its points beyond every candidate cylinder's band.
-  std::map<std::size_t, std::vector<const Contact*>> contacts_of_plane;
-  for (const Contact& contact : contacts)
-    if (contact.own_sign == 0) contacts_of_plane[contact.plane].push_back(&contact);
-  std::map<std::size_t, double> offsets;
-  for (const auto& [p, bordering] : contacts_of_plane) {
-    const Eigen::Vector3d normal = to_eigen(primitives[p].axis);
-    double& offset = offsets[p] = normal.dot(to_eigen(primitives[p].point));
-    if (shares_offset[p]) continue;
-    double total = 0, sum = 0;
-    for (std::size_t i = 0; i < points[p].size(); ++i) {
-      const Vec3& x = points[p][i];  // not the binding p: clang 14 refuses it in a lambda
-      if (std::any_of(bordering.begin(), bordering.end(), [&](const Contact* contact) {
-            return across_contact(*contact, x) > -contact->band;
-          }))
-        continue;
-      total += weights[p][i];
-      sum += weights[p][i] * normal.dot(to_eigen(x));
-    }
-    if (total > 0) offset = sum / total;
-  }
-  std::vector<bool> moved(primitives.size(), false);  // planes to write their offset back to
-  const double significance2 = options.significance * options.significance;
-  // Each line: a candidate cylinder alone, or the cylinders of a Coaxial relation (all in one
-  // direction group). A line with spheres centred on it is left as it is (a sphere is no
-  // candidate): moving the line would move them, and a joint held fit of spheres on a line is not
-  // modelled.
-  // (the candidate that found it, its cylinders)
-  std::vector<std::pair<std::size_t, std::vector<std::size_t>>> lines;
-  std::vector<bool> done(primitives.size(), false), on_a_line(primitives.size(), false);
-  for (const auto& [first, candidate] : candidates) {
-    if (done[first]) continue;
-    std::vector<std::size_t> cylinders = line_of[first] == kNoRelation
-                                             ? std::vector<std::size_t>{first}
-                                             : relations[line_of[first]].members;
-    for (const std::size_t c : cylinders) done[c] = true;
-    if (std::all_of(cylinders.begin(), cylinders.end(),
-                    [&](std::size_t c) { return candidates.contains(c); })) {
-      for (const std::size_t c : cylinders) on_a_line[c] = true;
-      lines.emplace_back(first, std::move(cylinders));
-    }
-  }
-  // A line tangent to a held cylinder must come after that cylinder's own line, which may move
-  // it: lines with partners go last, the largest first (by their largest member's points); a
-  // partner whose line comes later is not held.
-  const auto has_partner = [&](const auto& line) {
-    return std::any_of(line.second.begin(), line.second.end(),
-                       [&](std::size_t c) { return partners.contains(c); });
-  };
-  const auto largest = [&](const auto& line) {
-    std::pair<std::size_t, std::size_t> key{0, 0};  // (points, the lowest cluster first)
-    for (const std::size_t c : line.second) key = std::max(key, {points[c].size(), ~c});
-    return key;
-  };
-  const auto first_held = std::stable_partition(
-      lines.begin(), lines.end(), [&](const auto& line) { return !has_partner(line); });
-  std::stable_sort(first_held, lines.end(),
-                   [&](const auto& a, const auto& b) { return largest(a) > largest(b); });
-  std::vector<bool> settled(primitives.size(), false);  // where it ends: its line was processed
-  // Each held cylinder's own fit, for its covariance.
-  std::map<std::size_t, std::optional<HeldLineFit>> partner_fits;
-  for (const auto& line : lines) {
-    const std::size_t first = line.first;
-    const std::vector<std::size_t>& cylinders = line.second;
-    for (const std::size_t c : cylinders) settled[c] = true;
-    // Contacts with a cylinder that is still to move are left out.
-    std::vector<const Contact*> bordered;
-    for (const Contact& contact : contacts)
-      if (std::find(cylinders.begin(), cylinders.end(), contact.cylinder) != cylinders.end() &&
-          (contact.own_sign == 0 || !on_a_line[contact.plane] || settled[contact.plane]))
-        bordered.push_back(&contact);
-    if (bordered.empty()) continue;
-    const auto& candidate = candidates.at(first);
-    // Each cylinder's points on its own side of every contact line of its own.
-    const std::size_t count = cylinders.size();
-    std::vector<std::vector<Vec3>> own_points(count);
-    std::vector<std::vector<double>> own_weights(count);
-    std::vector<CoaxialMember> members;
-    for (std::size_t m = 0; m < count; ++m) {
-      const std::size_t c = cylinders[m];
-      for (std::size_t i = 0; i < points[c].size(); ++i)
-        if (std::none_of(bordered.begin(), bordered.end(), [&](const Contact* contact) {
-              return contact->cylinder == c &&
-                     across_contact(*contact, points[c][i]) < contact->band;
-            })) {
-          own_points[m].push_back(points[c][i]);
-          own_weights[m].push_back(weights[c][i]);
-        }
-      members.push_back({own_points[m], own_weights[m], primitives[c].radius});
-    }
-    const Eigen::Vector3d& direction = groups[candidate.first].direction;
-    const auto frame = orthonormal_pair(direction);
-    const auto in_frame = [&frame](const Eigen::Vector3d& x) {
-      return Eigen::Vector2d(frame.first.dot(x), frame.second.dot(x));
-    };
-    const Eigen::Vector2d start = in_frame(to_eigen(primitives[first].point));
-    const Eigen::Index size = 2 + static_cast<Eigen::Index>(count);
-    const auto unit = [size](Eigen::Index i) {
-      return Eigen::VectorXd(Eigen::VectorXd::Unit(size, i));
-    };
-    // A radius shared with clusters off the line is held; one shared only by cylinders on the
-    // line (fragments of one fillet) is one parameter of the fit: holding it at the value fitted
-    // to the same points would make the tests overconfident. `tied[m]`: the first member of m's
-    // class on the line, itself for a radius of its own, kNoRelation for a held one.
-    std::vector<LineHold> holds;
-    std::vector<std::size_t> tied(count);
-    for (std::size_t m = 0; m < count; ++m) {
-      const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-      tied[m] = m;
-      if (radius_of[cylinders[m]] == kNoRelation) continue;
-      const std::vector<std::size_t>& shared = relations[radius_of[cylinders[m]]].members;
-      if (std::any_of(shared.begin(), shared.end(), [&](std::size_t c) {
-            return std::find(cylinders.begin(), cylinders.end(), c) == cylinders.end();
-          })) {
-        tied[m] = kNoRelation;
-        holds.push_back({unit(radius), primitives[cylinders[m]].radius, std::nullopt});
-        continue;
-      }
-      for (std::size_t j = 0; j < m && tied[m] == m; ++j)
-        if (radius_of[cylinders[j]] == radius_of[cylinders[m]]) tied[m] = j;
-      if (tied[m] != m)
-        holds.push_back(
-            {unit(radius) - unit(2 + static_cast<Eigen::Index>(tied[m])), 0, std::nullopt});
-    }
-    const std::optional<HeldLineFit> own = fit_held_line(direction, start, members, holds);
-    if (!own || own->free == 0) continue;
-    // (score, plane or held cylinder, its cylinder's index in `cylinders`, its hold) of the
-    // contacts that pass.
-    std::vector<std::tuple<double, std::size_t, std::size_t, LineHold>> tested;
-    for (const Contact* contact : bordered) {
-      const std::size_t m = static_cast<std::size_t>(
-          std::find(cylinders.begin(), cylinders.end(), contact->cylinder) - cylinders.begin());
-      const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-      const double r = own->y(radius);
-      LineHold hold{Eigen::VectorXd::Zero(size), 0, std::nullopt};
-      double gap = 0, variance = 0;
-      const Primitive& other = primitives[contact->plane];
-      if (contact->own_sign == 0) {
-        const Eigen::Vector3d normal = to_eigen(other.axis);
-        const double offset = offsets[contact->plane];
-        const Eigen::Vector2d normal_in_frame = in_frame(normal);
-        const double distance = normal_in_frame.dot(own->y.head<2>()) - offset;
-        hold.target = offset;
-        hold.row.head<2>() = normal_in_frame;
-        hold.row(radius) = distance < 0 ? 1 : -1;
-        gap = std::abs(distance) - r;
-        variance = hold.row.dot(own->covariance * hold.row);
-      } else {
-        // The held cylinder's axis and radius are uncertain too: its own fit's covariance counts.
-        const Eigen::Vector2d centre = in_frame(to_eigen(other.point));
-        hold = linearised(
-            {Eigen::VectorXd(), 0,
-             CircleHold{centre, other.radius, contact->partner_sign, contact->own_sign, radius}},
-            own->y);
-        gap = hold.row.dot(own->y) - hold.target;
-        // Fitted once: a held cylinder no longer moves.
-        auto [fitted, added] = partner_fits.try_emplace(contact->plane);
-        if (added) {
-          const CoaxialMember alone{points[contact->plane], weights[contact->plane], other.radius};
-          fitted->second = fit_held_line(direction, centre, {&alone, 1}, {});
-        }
-        const std::optional<HeldLineFit>& partner = fitted->second;
-        if (!partner) continue;
-        Eigen::Vector3d partner_row;
-        partner_row << -hold.row.head<2>(), -contact->partner_sign;
-        variance = hold.row.dot(own->covariance * hold.row) +
-                   partner_row.dot(partner->covariance * partner_row);
-      }
-      const double bound = options.max_radius_difference * r;
-      if (std::abs(gap) <= bound && significance2 * variance <= bound * bound &&
-          (gap * gap <= significance2 * variance ||
-           within_tolerance(std::abs(gap), options.length_tolerance)))
-        tested.emplace_back(
-            tolerated(gap * gap / variance, significance2, std::abs(gap), options.length_tolerance),
-            contact->plane, m, hold);
-    }
-    std::sort(tested.begin(), tested.end(), [](const auto& a, const auto& b) {
-      return std::tie(std::get<0>(a), std::get<1>(a), std::get<2>(a)) <
-             std::tie(std::get<0>(b), std::get<1>(b), std::get<2>(b));
-    });
-    const std::size_t own_holds = holds.size();
-    for (std::size_t m = 0; m < count; ++m)  // each trial starts from the own fit
-      members[m].radius = own->y(2 + static_cast<Eigen::Index>(m));
-    std::vector<std::pair<std::size_t, std::size_t>> kept;  // (cylinder, plane)
-    std::optional<HeldLineFit> fit;
-    for (const auto& [score, p, m, hold] : tested) {
-      // A condition the kept ones imply (a fragment's second face, once the line and the other
-      // fragments are held) holds to round-off or not at all: it adds no freedom to test.
-      const Eigen::VectorXd& at = fit ? fit->y : own->y;
-      const LineHold there = linearised(hold, at);
-      if (implied_by(holds, there.row, at)) {
-        const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-        if (fit && std::abs(there.row.dot(fit->y) - there.target) <= kImplied * fit->y(radius))
-          kept.emplace_back(cylinders[m], p);
-        continue;
-      }
-      holds.push_back(hold);
-      std::optional<HeldLineFit> trial = fit_held_line(direction, own->y.head<2>(), members, holds);
-      const std::size_t conditions = holds.size() - own_holds;
-      if (trial && residual_excess(own->rms, trial->rms, own->count,
-                                   chi_square_bound(options.significance, conditions),
-                                   static_cast<int>(own->free), options.length_tolerance) <= 1) {
-        fit = trial;
-        kept.emplace_back(cylinders[m], p);
-      } else {
-        holds.pop_back();
-      }
-    }
-    if (!fit) continue;
-    for (std::size_t m = 0; m < count; ++m) {
-      Primitive& cylinder = primitives[cylinders[m]];
-      // A held or tied radius is met to round-off: its class's radius stays one set of bits.
-      place_cylinder(cylinder, direction, fit->y.head<2>(),
-                     tied[m] == kNoRelation ? cylinder.radius
-                                            : fit->y(2 + static_cast<Eigen::Index>(tied[m])));
-    }
-    for (const auto& [c, p] : kept) {
-      moved[p] = true;
-      Relation& relation = tangents.emplace_back();
-      relation.kind = Relation::Kind::Tangent;
-      relation.members = {std::min(c, p), std::max(c, p)};
-    }
-  }
-  for (const auto& [p, offset] : offsets) {
-    if (!moved[p]) continue;
-    const Eigen::Vector3d normal = to_eigen(primitives[p].axis);
-    const Eigen::Vector3d point = to_eigen(primitives[p].point);
-    primitives[p].point = to_vec3(point + (offset - normal.dot(point)) * normal);
-  }
 }
 
 // ClusterRelation::deviation of `related`: how far the clusters' own fits (`own`) were from it;
