@@ -71,7 +71,7 @@ class Hierarchy:
         relation_significance: float = 3.0,
         max_relation_angle: float = 20.0,
         relation_angle_tolerance: float = 0.0,
-        relation_length_tolerance: float = 0.0,
+        relation_length_tolerance: float | str = 0.0,
         max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def borders(
@@ -85,7 +85,7 @@ class Hierarchy:
         relation_significance: float = 3.0,
         max_relation_angle: float = 20.0,
         relation_angle_tolerance: float = 0.0,
-        relation_length_tolerance: float = 0.0,
+        relation_length_tolerance: float | str = 0.0,
         max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def relations(
@@ -98,7 +98,7 @@ class Hierarchy:
         relation_significance: float = 3.0,
         max_relation_angle: float = 20.0,
         relation_angle_tolerance: float = 0.0,
-        relation_length_tolerance: float = 0.0,
+        relation_length_tolerance: float | str = 0.0,
         max_radius_difference: float = 0.05,
     ) -> list[dict[str, Any]]: ...
     def relations_of_levels(
@@ -108,7 +108,7 @@ class Hierarchy:
         relation_significance: float = 3.0,
         max_relation_angle: float = 20.0,
         relation_angle_tolerance: float = 0.0,
-        relation_length_tolerance: float = 0.0,
+        relation_length_tolerance: float | str = 0.0,
         max_radius_difference: float = 0.05,
         threads: int = 0,
     ) -> list[dict[str, Any]]: ...

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -417,21 +418,44 @@ const char* kRelationArguments =
   put on an axis no farther than that fraction of its radius from it, and a cylinder made tangent
   to a plane or a parallel cylinder no farther than that fraction of its radius from tangent).
   relation_angle_tolerance (degrees, at least 0 and below max_relation_angle) and
-  relation_length_tolerance (input units, >= 0; RelationOptions angle_tolerance_degrees,
+  relation_length_tolerance (input units, >= 0, or a string "L%": L percent of the bounding-box
+  diagonal, as the CLI's --relation-length-tolerance L%; RelationOptions angle_tolerance_degrees,
   length_tolerance): directions, and axis lines, offsets, centres, radii and tangency gaps, that
   agree within them are related whatever their uncertainty (for CAD parts, whose tessellation errs
   by more than the fits' statistics allow); 0, the default, leaves the significance alone. Raise
   InvalidInputError (a ValueError) outside these ranges.)";
 
+// relation_length_tolerance as Python gives it: a length (input units), or "L%", L percent of the
+// bounding-box diagonal.
+using LengthArgument = std::variant<double, std::string>;
+
+// The length of `argument` on `mesh`: a percentage as the CLI computes it (the same double);
+// InvalidInputError, naming the keyword, for a string that is not a non-negative number and '%'.
+double length_argument(const LengthArgument& argument, const Mesh& mesh) {
+  if (const double* length = std::get_if<double>(&argument)) return *length;
+  const std::string& text = std::get<std::string>(argument);
+  const char* const end = text.data() + text.size() - (text.ends_with('%') ? 1 : 0);
+  double percent = 0;
+  const auto [stop, error] = std::from_chars(text.data(), end, percent);
+  if (!text.ends_with('%') || error != std::errc() || stop != end || !std::isfinite(percent) ||
+      percent < 0)
+    throw InvalidInputError("relation_length_tolerance is '" + text +
+                            "', must be a non-negative length or a percentage of the "
+                            "bounding-box diagonal such as '0.01%'");
+  return percent / 100 * bounding_box_diagonal(mesh);
+}
+
 // The RelationOptions of relation_significance, max_relation_angle, relation_angle_tolerance,
-// relation_length_tolerance and max_radius_difference; InvalidInputError, naming the keyword,
-// outside their ranges.
-RelationOptions relation_arguments(double significance, double max_angle, double angle_tolerance,
-                                   double length_tolerance, double max_difference) {
+// relation_length_tolerance and max_radius_difference for a level of `mesh`; InvalidInputError,
+// naming the keyword, outside their ranges.
+RelationOptions relation_arguments(const Mesh& mesh, double significance, double max_angle,
+                                   double angle_tolerance, const LengthArgument& length,
+                                   double max_difference) {
   auto refuse = [](const char* keyword, double value, const char* range) {
     throw InvalidInputError(std::string(keyword) + " is " + std::to_string(value) + ", must be " +
                             range);
   };
+  const double length_tolerance = length_argument(length, mesh);
   if (!(significance > 0 && std::isfinite(significance)))
     refuse("relation_significance", significance, "a positive number");
   if (!(max_angle > 0 && max_angle < 90)) refuse("max_relation_angle", max_angle, "in (0, 90)");
@@ -1255,8 +1279,8 @@ labels as the CLI's --labels.)",
           "clusters",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
              std::optional<double> relative_tolerance, std::int64_t refine, bool regularize,
-             double significance, double max_angle, double angle_tolerance, double length_tolerance,
-             double max_difference) {
+             double significance, double max_angle, double angle_tolerance,
+             const LengthArgument& length_tolerance, double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterReport> reports;
             {
@@ -1264,8 +1288,8 @@ labels as the CLI's --labels.)",
               std::vector<ClusterRelation> relations;
               refined_level(*self.hierarchy, level, refine, &reports,
                             regularize ? &relations : nullptr,
-                            relation_arguments(significance, max_angle, angle_tolerance,
-                                               length_tolerance, max_difference));
+                            relation_arguments(self.hierarchy->mesh(), significance, max_angle,
+                                               angle_tolerance, length_tolerance, max_difference));
             }
             py::list clusters;
             for (const ClusterReport& report : reports) clusters.append(cluster_dict(report));
@@ -1296,8 +1320,8 @@ as lists). json.dumps() takes it as it is.)",
           "borders",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
              std::optional<double> relative_tolerance, std::int64_t refine, bool regularize,
-             double significance, double max_angle, double angle_tolerance, double length_tolerance,
-             double max_difference) {
+             double significance, double max_angle, double angle_tolerance,
+             const LengthArgument& length_tolerance, double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterBorder> borders;
             {
@@ -1306,8 +1330,8 @@ as lists). json.dumps() takes it as it is.)",
               std::vector<ClusterRelation> relations;
               const Segmentation segmentation = refined_level(
                   *self.hierarchy, level, refine, &reports, regularize ? &relations : nullptr,
-                  relation_arguments(significance, max_angle, angle_tolerance, length_tolerance,
-                                     max_difference));
+                  relation_arguments(self.hierarchy->mesh(), significance, max_angle,
+                                     angle_tolerance, length_tolerance, max_difference));
               borders = cluster_borders(self.hierarchy->mesh(), segmentation.labels,
                                         cluster_primitives(reports));
             }
@@ -1340,7 +1364,7 @@ order along each curve. json.dumps() takes it as it is.)",
           "relations",
           [](const PyHierarchy& self, ClusterCount k, std::optional<double> tolerance,
              std::optional<double> relative_tolerance, std::int64_t refine, double significance,
-             double max_angle, double angle_tolerance, double length_tolerance,
+             double max_angle, double angle_tolerance, const LengthArgument& length_tolerance,
              double max_difference) {
             const LevelArguments level{std::move(k), tolerance, relative_tolerance};
             std::vector<ClusterRelation> relations;
@@ -1348,8 +1372,8 @@ order along each curve. json.dumps() takes it as it is.)",
               py::gil_scoped_release release;
               std::vector<ClusterReport> reports;
               refined_level(*self.hierarchy, level, refine, &reports, &relations,
-                            relation_arguments(significance, max_angle, angle_tolerance,
-                                               length_tolerance, max_difference));
+                            relation_arguments(self.hierarchy->mesh(), significance, max_angle,
+                                               angle_tolerance, length_tolerance, max_difference));
             }
             return relations_list(relations);
           },
@@ -1382,10 +1406,11 @@ clusters(..., regularize=True) gives the primitives with these relations made ex
       .def(
           "relations_of_levels",
           [](const PyHierarchy& self, const std::vector<std::int64_t>& ks, double significance,
-             double max_angle, double angle_tolerance, double length_tolerance,
+             double max_angle, double angle_tolerance, const LengthArgument& length_tolerance,
              double max_difference, unsigned threads) {
-            const RelationOptions options = relation_arguments(
-                significance, max_angle, angle_tolerance, length_tolerance, max_difference);
+            const RelationOptions options =
+                relation_arguments(self.hierarchy->mesh(), significance, max_angle, angle_tolerance,
+                                   length_tolerance, max_difference);
             std::vector<std::uint32_t> counts;
             counts.reserve(ks.size());
             for (std::size_t i = 0; i < ks.size(); ++i) {

@@ -128,14 +128,18 @@ def test_coplanar_faces_of_a_part_share_one_plane(cgal_mesh):
 TIGHT_RELATIONS = dict(relation_significance=2.5, max_relation_angle=10.0, max_radius_difference=0.001)
 # A CAD part's tolerances: fandisk's exact tessellation errs by more than its fits' statistics.
 CAD_TOLERANCES = dict(relation_angle_tolerance=0.05, relation_length_tolerance=2e-5)
+# The same as a percentage of the bounding-box diagonal, as the CLI spells it.
+CAD_TOLERANCES_IN_PERCENT = dict(relation_angle_tolerance=0.05, relation_length_tolerance="0.0014%")
 
 
 def cli_options(keywords):
     return [text for name, value in keywords.items()
-            for text in ("--" + name.replace("_", "-"), repr(value))]
+            for text in ("--" + name.replace("_", "-"),
+                         value if isinstance(value, str) else repr(value))]
 
 
-@pytest.mark.parametrize("keywords", [TIGHT_RELATIONS, CAD_TOLERANCES], ids=["tight", "cad"])
+@pytest.mark.parametrize("keywords", [TIGHT_RELATIONS, CAD_TOLERANCES, CAD_TOLERANCES_IN_PERCENT],
+                         ids=["tight", "cad", "cad-percent"])
 def test_relation_options_are_the_clis(cli, fandisk, fandisk_tree, tmp_path, keywords):
     # The options of --regularize, as keywords: the same relations and fits as the CLI's, other
     # relations than the defaults (fewer equal radii with a tighter radius bound, more with
@@ -152,10 +156,26 @@ def test_relation_options_are_the_clis(cli, fandisk, fandisk_tree, tmp_path, key
     for bad in (dict(relation_significance=0.0), dict(max_relation_angle=90.0),
                 dict(relation_angle_tolerance=-1.0), dict(relation_angle_tolerance=20.0),
                 dict(relation_length_tolerance=-1e-9), dict(relation_length_tolerance=float("inf")),
-                dict(max_radius_difference=1.0)):
+                dict(relation_length_tolerance="0.01"), dict(relation_length_tolerance="-1%"),
+                dict(relation_length_tolerance="inf%"), dict(relation_length_tolerance="%"),
+                dict(relation_length_tolerance="1e-3 %"), dict(max_radius_difference=1.0)):
         (keyword,) = bad
         with pytest.raises(ValueError, match=keyword):  # named as the caller spells it
             fandisk_tree.relations(60, **bad)
+
+
+def test_a_relation_length_tolerance_in_percent_is_of_the_diagonal(fandisk_tree):
+    # "L%" is L percent of the bounding-box diagonal, the same double the CLI computes. Fandisk's
+    # fillet 4 is tangent to its face 7 at 0.0014% (its own fit is 0.0012% of the diagonal from
+    # tangent), and not at 0.001%.
+    diagonal = fandisk_tree.mesh.bounding_box_diagonal
+    in_percent = fandisk_tree.relations("auto", refine=2, relation_length_tolerance="0.0014%")
+    assert in_percent == fandisk_tree.relations("auto", refine=2,
+                                                relation_length_tolerance=0.0014 / 100 * diagonal)
+    tangent = {"kind": "tangent", "clusters": [4, 7]}
+    assert any(r.items() >= tangent.items() for r in in_percent)
+    closer = fandisk_tree.relations("auto", refine=2, relation_length_tolerance="0.001%")
+    assert not any(r.items() >= tangent.items() for r in closer)
 
 
 def assert_levels_are_the_one_level_calls(tree, levels, ks, **keywords):
@@ -183,7 +203,7 @@ def test_relations_of_levels_are_the_one_level_calls(fandisk_tree):
     assert {r["kind"] for r in levels[0]["relations"]} >= {"parallel", "orthogonal", "coaxial"}
     assert levels[0]["clusters"] != fandisk_tree.clusters(60)
     # The relation options, as relations() and clusters() spell them.
-    for keywords in (TIGHT_RELATIONS, CAD_TOLERANCES):
+    for keywords in (TIGHT_RELATIONS, CAD_TOLERANCES, CAD_TOLERANCES_IN_PERCENT):
         other = fandisk_tree.relations_of_levels([60, 30], **keywords)
         assert_levels_are_the_one_level_calls(fandisk_tree, other, [60, 30], **keywords)
         assert other[0]["relations"] != levels[0]["relations"]
