@@ -4,7 +4,8 @@
 // uncertainty share one direction, estimated from all of them, directions at right angles within
 // it are made orthogonal, planes of one direction whose offsets agree are made one plane, cylinders
 // of one direction whose axes agree share one axis line, spheres centred on such a line within it
-// are centred on it, and cylinders and spheres whose radii agree share one radius.
+// are centred on it, and cylinders and spheres whose radii agree share one radius. The stages are
+// in src/regularity/, one source each (src/regularity/stages.hpp).
 
 #include <cstddef>
 #include <span>

@@ -1,7 +1,7 @@
 #pragma once
 // Clusters sampled from planes, cylinders, spheres and swept profiles with known answers, their
-// own fits, and detail::regularize() on them: the fixtures of tests/regularity_test.cpp and
-// tests/regularity_tangency_test.cpp.
+// own fits, and detail::regularize() on them: the fixtures of tests/regularity/regularity_test.cpp
+// and tests/regularity/tangency_test.cpp.
 
 #include <Eigen/Core>
 #include <cstddef>

@@ -1,5 +1,6 @@
 // The tangency stage of regularize(): cylinders held tangent to the planes and the parallel
 // cylinders they border (make_tangent(), whose rules are at its definition).
+#include "regularity/stages.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -15,7 +16,6 @@
 
 #include "eigen_conversions.hpp"
 #include "orthonormal_pair.hpp"
-#include "regularity_shared.hpp"
 
 namespace primseg::detail {
 

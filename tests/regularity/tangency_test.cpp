@@ -1,4 +1,4 @@
-// detail::regularize's tangencies (src/regularity_tangency.cpp): fillets held tangent to the
+// detail::regularize's tangencies (src/regularity/tangency.cpp): fillets held tangent to the
 // faces and the bosses or bores they round, exactly, and nothing held where a round meets its
 // neighbours at a kink or is set off them.
 #include <gtest/gtest.h>

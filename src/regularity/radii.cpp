@@ -1,0 +1,473 @@
+// Spheres centred on axis lines, lines of spheres, and cylinders and spheres of one radius.
+#include "regularity/stages.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "eigen_conversions.hpp"
+#include "orthonormal_pair.hpp"
+
+namespace primseg::detail {
+
+namespace {
+
+// Whether a 2D position of covariance `covariance` is known to within `bound` at the
+// significance, in its worst direction (the interval rule of the spheres' centres).
+bool known_within(const Eigen::Matrix2d& covariance, double significance, double bound) {
+  const double half_difference = (covariance(0, 0) - covariance(1, 1)) / 2;
+  const double largest =
+      (covariance(0, 0) + covariance(1, 1)) / 2 + std::hypot(half_difference, covariance(0, 1));
+  return significance * std::sqrt(largest) <= bound;
+}
+
+// Refits line l with its cylinders and the spheres `spheres` (indices into settled.surfaces) on
+// it, each sphere one parameter along it: while any member's residual sum rises by more than the
+// significance, corrected for the number of members, allows, the sphere whose rise is largest
+// leaves. Writes the line, its members and their primitives back, and adds the spheres to the
+// line's coaxial relation (started when it has none), unless fewer spheres than `fewest` stay.
+// Returns whether it did.
+bool settle_on_line(SettledSurfaces& settled, std::size_t l,
+                    const std::vector<std::size_t>& cylinders, std::vector<std::size_t> spheres,
+                    const RegularityOptions& options, std::vector<Primitive>& primitives,
+                    const std::vector<std::vector<Vec3>>& points,
+                    const std::vector<std::vector<double>>& weights,
+                    std::vector<Relation>& relations, std::size_t fewest = 1) {
+  std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
+  SettledSurfaces::Line& line = settled.lines[l];
+  std::optional<JointFit> fit;
+  std::vector<CylinderTerm> terms;
+  std::vector<SphereTerm> sphere_terms;
+  while (spheres.size() >= fewest) {
+    terms.clear();
+    sphere_terms.clear();
+    std::vector<double> radii;
+    std::vector<Eigen::Vector3d> centres;
+    for (const std::size_t k : cylinders) {
+      const std::size_t c = surfaces[k].cluster;
+      terms.push_back({points[c], weights[c], 0, radii.size()});
+      radii.push_back(surfaces[k].radius);
+    }
+    for (const std::size_t k : spheres) {
+      const std::size_t c = surfaces[k].cluster;
+      sphere_terms.push_back({points[c], weights[c], radii.size(), 0});
+      radii.push_back(surfaces[k].radius);
+      centres.push_back(settled.centres[surfaces[k].centre]);
+    }
+    fit = fit_cylinders_and_spheres({&line.direction, 1}, {&line.centre, 1}, centres, radii, terms,
+                                    sphere_terms, true);
+    const std::size_t members = cylinders.size() + spheres.size();
+    const double bound = family_significance(options.significance, members);
+    double worst_excess = 1, worst_sphere_excess = -std::numeric_limits<double>::infinity();
+    std::size_t worst_sphere = 0;
+    for (std::size_t j = 0; j < members; ++j) {
+      const bool is_sphere = j >= cylinders.size();
+      const SettledSurfaces::Surface& surface =
+          surfaces[is_sphere ? spheres[j - cylinders.size()] : cylinders[j]];
+      // A sphere's own fit has 4 parameters, a cylinder's (on its direction) 3.
+      const double excess =
+          fit ? residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(),
+                                bound * bound, is_sphere ? 4 : 3, options.length_tolerance)
+              : std::numeric_limits<double>::infinity();
+      worst_excess = std::max(worst_excess, excess);
+      if (is_sphere && excess > worst_sphere_excess) {
+        worst_sphere_excess = excess;
+        worst_sphere = j - cylinders.size();
+      }
+    }
+    if (!(worst_excess > 1)) break;
+    spheres.erase(spheres.begin() + static_cast<std::ptrdiff_t>(worst_sphere));
+    fit.reset();
+  }
+  if (!fit) return false;
+  // Written back: the line, its cylinders and its spheres, with their radii's variances.
+  const Eigen::Index first_radius = 2 + static_cast<Eigen::Index>(spheres.size());
+  line.centre = fit->centres[0];
+  line.covariance = fit->covariance.topLeftCorner<2, 2>();
+  std::vector<std::size_t> members;
+  for (std::size_t j = 0; j < cylinders.size() + spheres.size(); ++j) {
+    const bool is_sphere = j >= cylinders.size();
+    SettledSurfaces::Surface& surface =
+        surfaces[is_sphere ? spheres[j - cylinders.size()] : cylinders[j]];
+    const Eigen::Index q = static_cast<Eigen::Index>(j);
+    surface.radius = fit->radii[j];
+    surface.radius_variance = fit->covariance(first_radius + q, first_radius + q);
+    surface.rms = fit->rms[j];
+    Primitive& primitive = primitives[surface.cluster];
+    if (is_sphere) {
+      surface.line = l;
+      settled.centres[surface.centre] = fit->sphere_centres[j - cylinders.size()];
+      primitive.point = to_vec3(settled.centres[surface.centre]);
+      primitive.radius = surface.radius;
+    } else {
+      place_cylinder(primitive, line.direction, line.centre, surface.radius);
+    }
+    members.push_back(surface.cluster);
+  }
+  if (line.coaxial == kNoRelation) {
+    line.coaxial = relations.size();
+    relations.push_back({Relation::Kind::Coaxial, {}, {}});
+  }
+  std::vector<std::size_t>& coaxial = relations[line.coaxial].members;
+  coaxial.insert(coaxial.end(), members.begin(), members.end());
+  std::sort(coaxial.begin(), coaxial.end());
+  coaxial.erase(std::unique(coaxial.begin(), coaxial.end()), coaxial.end());
+  return true;
+}
+
+}  // namespace
+
+void centre_spheres_on_axes(SettledSurfaces& settled, const RegularityOptions& options,
+                            std::vector<Primitive>& primitives,
+                            const std::vector<std::vector<Vec3>>& points,
+                            const std::vector<std::vector<double>>& weights,
+                            std::vector<Relation>& relations) {
+  std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
+  const std::size_t line_count = settled.lines.size();
+  std::vector<std::vector<std::size_t>> cylinders_on(line_count), spheres_on(line_count);
+  std::vector<double> smallest_radius(line_count, std::numeric_limits<double>::infinity());
+  for (std::size_t k = 0; k < surfaces.size(); ++k)
+    if (!surfaces[k].sphere) {
+      cylinders_on[surfaces[k].line].push_back(k);
+      smallest_radius[surfaces[k].line] =
+          std::min(smallest_radius[surfaces[k].line], surfaces[k].radius);
+    }
+  // An offset is two normals: the bound they exceed as rarely as one normal the significance.
+  const double significance = options.significance;
+  const double offset_bound = chi_square_bound(significance, 2);
+  // Each line's frame (orthonormal_pair(direction) as rows), or none when it is not placed well
+  // enough to hold a sphere.
+  std::vector<std::optional<Eigen::Matrix<double, 2, 3>>> frames(line_count);
+  for (std::size_t l = 0; l < line_count; ++l) {
+    const SettledSurfaces::Line& line = settled.lines[l];
+    if (!(std::sqrt(line.covariance.trace()) < smallest_radius[l])) continue;
+    const auto [u, v] = orthonormal_pair(line.direction);
+    frames[l].emplace();
+    *frames[l] << u.transpose(), v.transpose();
+  }
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    const SettledSurfaces::Surface& sphere = surfaces[k];
+    if (!sphere.sphere) continue;
+    const Eigen::Vector3d& centre = settled.centres[sphere.centre];
+    const Eigen::Matrix3d& covariance = settled.centre_covariances[sphere.centre];
+    const double largest_offset = options.max_radius_difference * sphere.radius;
+    std::size_t nearest = line_count;
+    double nearest_score = offset_bound;
+    for (std::size_t l = 0; l < line_count; ++l) {
+      if (!frames[l]) continue;
+      const SettledSurfaces::Line& line = settled.lines[l];
+      const Eigen::Matrix<double, 2, 3>& frame = *frames[l];
+      const Eigen::Vector2d offset = frame * centre - line.centre;
+      if (!(offset.norm() <= largest_offset)) continue;
+      const double height = line.direction.dot(centre) - line.middle;
+      const Eigen::Matrix2d combined =
+          frame * covariance * frame.transpose() + line.covariance + height * height * line.tilt;
+      if (!known_within(combined, significance, largest_offset)) continue;
+      const double score = tolerated(offset.dot(combined.ldlt().solve(offset)), offset_bound,
+                                     offset.norm(), options.length_tolerance);
+      if (score <= nearest_score) {
+        nearest_score = score;
+        nearest = l;
+      }
+    }
+    if (nearest < line_count) spheres_on[nearest].push_back(k);
+  }
+  for (std::size_t l = 0; l < line_count; ++l)
+    if (!spheres_on[l].empty())
+      settle_on_line(settled, l, cylinders_on[l], spheres_on[l], options, primitives, points,
+                     weights, relations);
+}
+
+namespace {
+
+// The fewest spheres that make a line with no cylinder. Two centres fall on a line of one of the
+// design directions by chance on freeform parts (bunny00's default level with `--refine 2`: 30
+// pairs among its 39 directions, mech-holes-shark's 10; and 1 and 0 sets of three or more).
+constexpr std::size_t kFewestSpheresOnALine = 3;
+
+}  // namespace
+
+void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>& groups,
+                     const std::vector<std::vector<std::size_t>>& refitted,
+                     const RegularityOptions& options, std::vector<Primitive>& primitives,
+                     const std::vector<std::vector<Vec3>>& points,
+                     const std::vector<std::vector<double>>& weights,
+                     std::vector<Relation>& relations) {
+  const double bound = chi_square_bound(options.significance, 2);
+  struct Placed {
+    std::size_t surface = 0;
+    Eigen::Vector2d position;
+    Eigen::Matrix2d covariance;
+    double height = 0;
+  };
+  struct Set {
+    std::vector<std::size_t> surfaces;
+    double height = 0;  // its first member's
+    PooledCentre pooled;
+  };
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (refitted[g].empty()) continue;
+    const Eigen::Vector3d& direction = groups[g].direction;
+    const auto [u, v] = orthonormal_pair(direction);
+    Eigen::Matrix<double, 2, 3> frame;
+    frame << u.transpose(), v.transpose();
+    const Eigen::Matrix2d tilt = tilt_in_frame(direction, groups[g].covariance);
+    std::vector<Placed> placed;
+    for (std::size_t k = 0; k < settled.surfaces.size(); ++k) {
+      const SettledSurfaces::Surface& sphere = settled.surfaces[k];
+      if (!sphere.sphere || sphere.line != kNoLine) continue;
+      const Eigen::Vector3d& centre = settled.centres[sphere.centre];
+      const Eigen::Matrix2d covariance =
+          frame * settled.centre_covariances[sphere.centre] * frame.transpose();
+      if (!known_within(covariance, options.significance,
+                        options.max_radius_difference * sphere.radius))
+        continue;
+      placed.push_back({k, frame * centre, covariance, direction.dot(centre)});
+    }
+    std::stable_sort(placed.begin(), placed.end(), [](const Placed& a, const Placed& b) {
+      return a.covariance.trace() < b.covariance.trace();
+    });
+    std::vector<Set> sets;
+    for (const Placed& sphere : placed) {
+      const double largest_offset =
+          options.max_radius_difference * settled.surfaces[sphere.surface].radius;
+      std::size_t joined = sets.size();
+      for (std::size_t s = 0; s < sets.size() && joined == sets.size(); ++s) {
+        const Eigen::Vector2d offset = sphere.position - sets[s].pooled.centre();
+        if (!(offset.norm() <= largest_offset)) continue;  // most pairs, before any covariance
+        const double height = sphere.height - sets[s].height;
+        const Eigen::Matrix2d combined =
+            sphere.covariance + sets[s].pooled.covariance() + height * height * tilt;
+        if (offset.dot(combined.ldlt().solve(offset)) <= bound ||
+            within_tolerance(offset.norm(), options.length_tolerance))
+          joined = s;
+      }
+      if (joined == sets.size()) sets.emplace_back().height = sphere.height;
+      sets[joined].surfaces.push_back(sphere.surface);
+      sets[joined].pooled.add(sphere.position, sphere.covariance);
+    }
+    for (Set& set : sets) {
+      if (set.surfaces.size() < kFewestSpheresOnALine) continue;
+      std::vector<std::size_t> clusters;
+      for (const std::size_t k : set.surfaces) clusters.push_back(settled.surfaces[k].cluster);
+      settled.lines.push_back({direction, set.pooled.centre(), set.pooled.covariance(), kNoRelation,
+                               middle_along(direction, clusters, points, weights), tilt});
+      if (!settle_on_line(settled, settled.lines.size() - 1, {}, set.surfaces, options, primitives,
+                          points, weights, relations, kFewestSpheresOnALine))
+        settled.lines.pop_back();
+    }
+  }
+}
+
+namespace {
+
+// Classes of radii that are one radius within the significance: in increasing order of radius,
+// a class grows while its radii stay consistent with their information-weighted mean (their χ²
+// about it within chi_square_bound of its degrees of freedom) and its smallest within
+// max_radius_difference of its largest (relative to the largest). A radius whose significance
+// interval is wider than that bound joins none: any two such radii within the bound would pass, so
+// the bound and not the data would decide (cylinder patches of a freeform surface; a nearly flat
+// cylinder). Returns each surface's class.
+std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surface>& surfaces,
+                                        const RegularityOptions& options) {
+  const std::size_t n = surfaces.size();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return surfaces[a].radius < surfaces[b].radius;
+  });
+  std::vector<std::size_t> class_of(n);
+  std::size_t classes = 0, open = 0;
+  // The open class: its first radius, and Σ 1/σ², Σ d/σ², Σ d²/σ² of its radii's differences d
+  // from that first one (differences keep the sums exact on CAD radii known to 1e-9).
+  double first = 0, information = 0, moment = 0, square = 0;
+  std::size_t members = 0;
+  for (const std::size_t k : order) {
+    const double r = surfaces[k].radius, variance = surfaces[k].radius_variance;
+    if (!(variance > 0) ||
+        options.significance * std::sqrt(variance) > options.max_radius_difference * r) {
+      class_of[k] = classes++;  // a class of its own
+      continue;
+    }
+    const double d = r - first;
+    const double joined_information = information + 1 / variance,
+                 joined_moment = moment + d / variance, joined_square = square + d * d / variance;
+    const double spread = joined_square - joined_moment * joined_moment / joined_information;
+    if (members == 0 || r - first > options.max_radius_difference * r ||
+        (spread > chi_square_bound(options.significance, members) &&
+         !within_tolerance(r - first, options.length_tolerance))) {
+      first = r;
+      information = 1 / variance;
+      moment = square = 0;
+      members = 1;
+      open = classes++;
+      class_of[k] = open;
+      continue;
+    }
+    information = joined_information;
+    moment = joined_moment;
+    square = joined_square;
+    ++members;
+    class_of[k] = open;
+  }
+  return class_of;
+}
+
+}  // namespace
+
+void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& options,
+                    std::vector<Primitive>& primitives,
+                    const std::vector<std::vector<Vec3>>& points,
+                    const std::vector<std::vector<double>>& weights,
+                    std::vector<Relation>& relations) {
+  const std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
+  const std::size_t n = surfaces.size();
+  std::vector<std::size_t> class_of = radius_classes(surfaces, options);
+  std::vector<std::size_t> class_size(n, 0);
+  for (const std::size_t q : class_of) ++class_size[q];
+  // Components: union-find over the surfaces, through shared classes and shared lines.
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](std::size_t k) {
+    std::size_t top = k;
+    while (parent[top] != top) top = parent[top];
+    while (parent[k] != top) k = std::exchange(parent[k], top);
+    return top;
+  };
+  auto join = [&](std::size_t& first, std::size_t k) {
+    if (first == n)
+      first = k;
+    else
+      parent[root(k)] = root(first);
+  };
+  std::vector<std::size_t> first_of_class(n, n), first_on_line(settled.lines.size(), n);
+  for (std::size_t k = 0; k < n; ++k) {
+    join(first_of_class[class_of[k]], k);
+    if (surfaces[k].line != kNoLine) join(first_on_line[surfaces[k].line], k);
+  }
+  std::vector<std::vector<std::size_t>> components(n);
+  for (std::size_t k = 0; k < n; ++k) components[root(k)].push_back(k);
+  // A component's lines and radii, numbered in the joint fit; only its own entries are reset, so
+  // that many small components cost no more than one large one.
+  std::vector<std::size_t> line_index(settled.lines.size(), n), radius_of_class(n, n);
+  for (const std::vector<std::size_t>& component : components) {
+    if (std::none_of(component.begin(), component.end(),
+                     [&](std::size_t k) { return class_size[class_of[k]] >= 2; }))
+      continue;
+    std::optional<JointFit> fit;
+    std::vector<CylinderTerm> terms;
+    std::vector<SphereTerm> spheres;
+    std::vector<Eigen::Vector3d> directions, sphere_centres;
+    std::vector<Eigen::Vector2d> centres;
+    std::vector<double> radii;
+    // Each member's term: its index among the fit's cylinder terms, or among its spheres.
+    std::vector<std::size_t> term_of(component.size());
+    while (true) {
+      terms.clear();
+      spheres.clear();
+      directions.clear();
+      sphere_centres.clear();
+      centres.clear();
+      radii.clear();
+      for (const std::size_t k : component) {
+        if (surfaces[k].line != kNoLine) line_index[surfaces[k].line] = n;
+        radius_of_class[class_of[k]] = n;
+      }
+      for (std::size_t j = 0; j < component.size(); ++j) {
+        const SettledSurfaces::Surface& surface = surfaces[component[j]];
+        // A class of two or more has one radius, started from its first member's.
+        std::size_t& radius = radius_of_class[class_of[component[j]]];
+        if (radius == n || class_size[class_of[component[j]]] < 2) {
+          radius = radii.size();
+          radii.push_back(surface.radius);
+        }
+        std::size_t line = kNoLine;
+        if (surface.line != kNoLine) {
+          line = line_index[surface.line];
+          if (line == n) {
+            line = line_index[surface.line] = directions.size();
+            directions.push_back(settled.lines[surface.line].direction);
+            centres.push_back(settled.lines[surface.line].centre);
+          }
+        }
+        if (surface.sphere) {
+          term_of[j] = spheres.size();
+          spheres.push_back({points[surface.cluster], weights[surface.cluster], radius, line});
+          sphere_centres.push_back(settled.centres[surface.centre]);
+          continue;
+        }
+        term_of[j] = terms.size();
+        terms.push_back({points[surface.cluster], weights[surface.cluster], line, radius});
+      }
+      fit = fit_cylinders_and_spheres(directions, centres, sphere_centres, radii, terms, spheres,
+                                      false);
+      if (!fit) break;
+      // One test per member: at the significance each, a plate of a hundred equal holes would
+      // lose one in four times.
+      const std::size_t tested = static_cast<std::size_t>(
+          std::count_if(component.begin(), component.end(),
+                        [&](std::size_t k) { return class_size[class_of[k]] >= 2; }));
+      const double bound = family_significance(options.significance, tested);
+      std::size_t worst = component.size();
+      double worst_excess = 1;
+      for (std::size_t j = 0; j < component.size(); ++j) {
+        const SettledSurfaces::Surface& surface = surfaces[component[j]];
+        if (class_size[class_of[component[j]]] < 2) continue;
+        const double rms = fit->rms[surface.sphere ? terms.size() + term_of[j] : term_of[j]];
+        // A sphere's own fit has 4 parameters (2 on a line), a cylinder's (on its direction) 3.
+        const int parameters = !surface.sphere ? 3 : surface.line == kNoLine ? 4 : 2;
+        const double excess = residual_excess(surface.rms, rms, points[surface.cluster].size(),
+                                              bound * bound, parameters, options.length_tolerance);
+        if (excess > worst_excess) {
+          worst_excess = excess;
+          worst = j;
+        }
+      }
+      if (worst == component.size()) break;
+      // The worst takes a class of its own, under any unused number.
+      --class_size[class_of[component[worst]]];
+      const auto free_class = std::find(class_size.begin(), class_size.end(), 0);
+      class_of[component[worst]] = static_cast<std::size_t>(free_class - class_size.begin());
+      *free_class = 1;
+    }
+    if (!fit) continue;
+    // Written back: the members of classes of two or more, and the surfaces on their lines.
+    std::vector<bool> moved_line(settled.lines.size(), false);
+    for (const std::size_t k : component)
+      if (class_size[class_of[k]] >= 2 && surfaces[k].line != kNoLine)
+        moved_line[surfaces[k].line] = true;
+    std::map<std::size_t, std::vector<std::size_t>> members_of_class;
+    for (std::size_t j = 0; j < component.size(); ++j) {
+      const SettledSurfaces::Surface& surface = surfaces[component[j]];
+      const bool member = class_size[class_of[component[j]]] >= 2;
+      Primitive& primitive = primitives[surface.cluster];
+      if (surface.sphere) {
+        if (!member && (surface.line == kNoLine || !moved_line[surface.line])) continue;
+        primitive.point = to_vec3(fit->sphere_centres[term_of[j]]);
+        primitive.radius = fit->radii[spheres[term_of[j]].radius];
+      } else {
+        if (!moved_line[surface.line]) continue;
+        const CylinderTerm& term = terms[term_of[j]];
+        place_cylinder(primitive, directions[term.line], fit->centres[term.line],
+                       fit->radii[term.radius]);
+      }
+      if (member) members_of_class[class_of[component[j]]].push_back(surface.cluster);
+    }
+    for (auto& [unused, members] : members_of_class) {
+      Relation& relation = relations.emplace_back();
+      relation.kind = Relation::Kind::EqualRadius;
+      std::sort(members.begin(), members.end());
+      relation.members = std::move(members);
+    }
+  }
+}
+
+}  // namespace primseg::detail

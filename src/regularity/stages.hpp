@@ -1,0 +1,449 @@
+#pragma once
+// The stages of regularize() (src/regularity.hpp), one source each in src/regularity/, and what
+// they hand one another. In the order regularize() runs them: directions grouped where they agree
+// (directions.cpp), each group's coplanar planes (coplanar.cpp) and coaxial cylinders (coaxial.cpp)
+// counted as one, right angles made exact; then each group's planes and cylinders refitted with
+// its direction, on shared planes and axis lines; spheres centred on the lines and cylinders and
+// spheres of one radius (radii.cpp); last, tangencies (tangency.cpp). The joint least-squares fits
+// of cylinders and spheres are in joint_fit.cpp, the tests they share in statistics.cpp.
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "primseg/primitive.hpp"
+#include "regularity.hpp"
+
+namespace primseg::detail {
+
+/// A fit's residual deviation is never taken below this fraction of its size (a plane's extent,
+/// a cylinder's radius). An exact input (a CAD tessellation) has residuals of rounding only, which
+/// would make every direction and axis certain beyond its own rounding and no two of them equal;
+/// any measured surface has residuals far above it.
+inline constexpr double kResolution = 1e-9;
+
+/// Not in a relation yet.
+inline constexpr std::size_t kNoRelation = std::numeric_limits<std::size_t>::max();
+
+// ---- Tests and tolerances (statistics.cpp)
+
+/// Whether a difference of size `size` is within a tolerance (RegularityOptions::angle_tolerance,
+/// length_tolerance), which then passes a test whatever its statistic; never for a tolerance of 0.
+bool within_tolerance(double size, double tolerance);
+
+/// A test's score with a tolerance, where candidates rank by their scores: passed at or below
+/// `bound`, it also passes when within_tolerance(size, tolerance), and such a difference then
+/// ranks by its size against the tolerance. A tolerance of 0 leaves the score as it is.
+double tolerated(double score, double bound, double size, double tolerance);
+
+/// The χ² value a sum of `freedom` squared standard normals exceeds as rarely as one normal
+/// exceeds `significance` in magnitude: exact for one and two degrees of freedom,
+/// Wilson–Hilferty's approximation beyond (within 2% from three on at a significance of 3).
+double chi_square_bound(double significance, std::size_t freedom);
+
+/// How far a joint fit explains a member worse than its own fit did: the rise of its residual sum
+/// over significance² times its residual variance (estimated with the degrees of freedom of the
+/// member's own fit, of `parameters` parameters), or, when lower, the rise of its mean square
+/// against the square of the length tolerance. Above 1, it does not belong.
+double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2,
+                       int parameters, double length_tolerance);
+
+/// The covariance of a direction's tilt (radians², 3x3) in orthonormal_pair(direction)
+/// coordinates.
+Eigen::Matrix2d tilt_in_frame(const Eigen::Vector3d& direction, const Eigen::Matrix3d& covariance);
+
+/// The significance at which each of `tests` tests must be passed for all of them to fail together
+/// as rarely as one test at `significance` does (Bonferroni: the two-sided normal tail divided by
+/// their number).
+double family_significance(double significance, std::size_t tests);
+
+// ---- Directions (directions.cpp)
+
+/// A primitive with a direction (a plane's normal, a cylinder's axis) and how well its inliers
+/// determine it.
+struct Oriented {
+  std::size_t cluster = 0;
+  Eigen::Vector3d direction;
+  double variance = 0;  // of its tilt, radians², in the worst direction
+  // Covariance of the tilt (radians²) along the tangent directions `frame` (columns).
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  Eigen::Matrix<double, 3, 2> frame;
+};
+
+/// Directions tested parallel, and their common direction: the minimiser over unit d of
+/// Σ δᵢᵀ Cᵢ⁻¹ δᵢ, δᵢ the tilt of d from member i's direction in its frame, which is the smallest
+/// eigenvector of Σ Fᵢ Cᵢ⁻¹ Fᵢᵀ (for a plane, its scatter matrix over the residual variance).
+struct DirectionGroup {
+  Eigen::Vector3d direction;
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of the direction's tilt (radians²)
+  std::vector<std::size_t> members;                      ///< indices into the Oriented items
+};
+
+/// The angle between two lines of directions a and b (radians, in [0, π/2]).
+double angle_between_lines(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
+/// A plane cluster's normal from its unweighted least-squares fit to `points` (its inliers), with
+/// its tilt's covariance (σ̂²/λ along each in-plane eigenvector of the scatter); nothing for fewer
+/// than 6 points or collinear ones.
+std::optional<Oriented> oriented_plane(std::size_t cluster, std::span<const Vec3> points);
+
+/// A cylinder's axis, with its tilt's covariance from the Jacobian of its residuals on `points`
+/// (its inliers) at `cylinder`; nothing for fewer than 12 points, a radius that is not positive or
+/// a singular fit.
+std::optional<Oriented> oriented_cylinder(std::size_t cluster, const Primitive& cylinder,
+                                          std::span<const Vec3> points);
+
+/// The group's direction and its covariance, from its information.
+void form_direction(DirectionGroup& group);
+
+/// Visited from the best-determined direction, each joins the group it is within the significance
+/// (or the angle tolerance) of (the best score), else starts one.
+std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
+                                             const RegularityOptions& options);
+
+/// `joined` counts as the members of `set` (clusters, increasing) in their group's direction: the
+/// sum of the members' information gives way to its. The group's direction is formed again by the
+/// caller.
+void count_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
+                  std::span<const std::size_t> set, const Oriented& joined);
+
+/// Pairs of direction groups at right angles within the significance (or the angle tolerance),
+/// made exactly so.
+///
+/// Pairs are taken by increasing score, each scored again when it comes up on the directions the
+/// pairs kept before it left (a kept pair moves its component's directions), so pairs up to twice
+/// the significance wait in the queue. The kept pairs join the
+/// groups into components. In a component of at most kLargestFrame groups (a part's frames: its
+/// directions at right angles) every constraint is met by least squares from the measured
+/// directions, each moved along its covariance (sweeps of make_orthogonal), and a pair within a
+/// component is tried only when it closes a triangle (two directions orthogonal to a third, made
+/// orthogonal to each other); other cycles need not be satisfiable. A larger component is a tree
+/// of chance right angles between a freeform surface's many planes (bunny00: 486 pairs among 488
+/// groups): a pair joining two of them is met by its own two directions, each side turning
+/// rigidly with its own, so it costs O(G), not sweeps over every constraint. Either way the pair
+/// is kept only when no direction ends beyond the significance (or the angle tolerance) of its
+/// measurement. Returns the kept pairs (indices into `groups`, first < second), in increasing
+/// order.
+std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<DirectionGroup>& groups,
+                                                               const RegularityOptions& options);
+
+/// Groups the right angles made one direction. On an exact CAD mesh directions are known to a
+/// tiny fraction of a degree, and two groups of faces the part means to be parallel can differ by
+/// more than that before the right angles; each then made orthogonal to the same two others, they
+/// end with one direction to round-off. They are one group: the first keeps its direction and
+/// takes the other's members, information, coplanar sets and right angles (`orthogonal`, indices
+/// into `groups`, renumbered; the emptied group keeps none).
+void merge_parallel_groups(std::vector<DirectionGroup>& groups,
+                           std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
+                           std::vector<std::vector<std::vector<std::size_t>>>& coplanar);
+
+// ---- Joint fits of cylinders and spheres (joint_fit.cpp)
+
+/// One cylinder of a joint fit: its inliers, and the axis line and the radius it takes (indices
+/// into the fit's lines and radii).
+struct CylinderTerm {
+  std::span<const Vec3> points;
+  std::span<const double> weights;
+  std::size_t line = 0;
+  std::size_t radius = 0;
+};
+
+/// No line: the `line` of a sphere (a joint fit's term, a settled surface) whose centre is its own.
+inline constexpr std::size_t kNoLine = std::numeric_limits<std::size_t>::max();
+
+/// A sphere's points: sphere s of a joint fit has one of its radii, and its own centre, or its
+/// centre on one of its lines (one parameter along it).
+struct SphereTerm {
+  std::span<const Vec3> points;
+  std::span<const double> weights;
+  std::size_t radius = 0;
+  std::size_t line = kNoLine;
+};
+
+/// Axis lines of fixed directions, sphere centres and radii fitted together by geometric least
+/// squares: each cylinder term's residuals are its points' distances to its line minus its radius,
+/// each sphere's their distances to its centre minus its radius. Several terms on one line are
+/// coaxial cylinders (and spheres centred on their axis); several on one radius, cylinders (and
+/// spheres) of equal radius.
+struct JointFit {
+  std::vector<Eigen::Vector2d> centres;  // per line, in orthonormal_pair(direction) coordinates
+  std::vector<Eigen::Vector3d> sphere_centres;
+  std::vector<double> radii;
+  // Per cylinder term, then per sphere; unweighted, at least kResolution × the radius.
+  std::vector<double> rms;
+  // Of (line centres, free sphere centres, the positions along their lines of the spheres on
+  // one, radii), from the unweighted residuals (if asked).
+  Eigen::MatrixXd covariance;
+};
+
+/// A cylinder of several on one axis line, each with its own radius: its inliers (input units),
+/// their weights, and its radius (a fit's start).
+struct CoaxialMember {
+  std::span<const Vec3> points;
+  std::span<const double> weights;
+  double radius = 0;
+};
+
+/// Cylinders of fixed direction on one axis line, each with its own radius, fitted together
+/// (fit_coaxial()): the line's position, the radii, and how well the fit knows them.
+struct CoaxialFit {
+  Eigen::Vector2d centre;
+  std::vector<double> radii;
+  std::vector<double> rms;  // per member, unweighted
+  std::vector<double> radius_variances;
+  Eigen::Matrix2d centre_covariance = Eigen::Matrix2d::Zero();
+};
+
+/// Gauss–Newton from `centres`, `sphere_centres` and `radii` (weighted steps; the uncertainty,
+/// when asked for, from the unweighted residuals at the solution); a sphere on a line starts from
+/// its centre's projection onto it. Nothing when it diverges, a radius ends non-positive or the
+/// points do not outnumber the parameters. A step of one line and no sphere solves the normal
+/// equations whole; otherwise it eliminates each line's and each free sphere's position first (a
+/// 2x2 or 3x3 block that couples only to its own terms' radii; a sphere on a line, its position
+/// along it before the line's), so that a plate of n holes of one radius costs O(n), not O(n³).
+std::optional<JointFit> fit_cylinders_and_spheres(
+    std::span<const Eigen::Vector3d> directions, std::span<const Eigen::Vector2d> centres,
+    std::span<const Eigen::Vector3d> sphere_centres, std::span<const double> radii,
+    std::span<const CylinderTerm> terms, std::span<const SphereTerm> spheres, bool with_covariance);
+
+/// The cylinders `members` on one line of direction `axis` through `centre`
+/// (orthonormal_pair(axis) coordinates), each keeping its own radius: fit_cylinders_and_spheres()
+/// with its covariance.
+std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::Vector2d& centre,
+                                      std::span<const CoaxialMember> members);
+
+/// `cylinder` refitted alone on its inliers with the axis direction `direction`, from its own axis
+/// point and radius.
+std::optional<CoaxialFit> fit_alone(const Primitive& cylinder, const Eigen::Vector3d& direction,
+                                    std::span<const Vec3> points, std::span<const double> weights);
+
+/// The weighted mean of direction · x over the points of `clusters`.
+double middle_along(const Eigen::Vector3d& direction, std::span<const std::size_t> clusters,
+                    const std::vector<std::vector<Vec3>>& points,
+                    const std::vector<std::vector<double>>& weights);
+
+/// `cylinder` on the line of `direction` through `centre` (orthonormal_pair(direction)
+/// coordinates), its axis on its own side and its point the line's nearest to the old one, so
+/// that it stays by the cluster.
+void place_cylinder(Primitive& cylinder, const Eigen::Vector3d& direction,
+                    const Eigen::Vector2d& centre, double radius);
+
+/// The information-weighted mean of axis positions: where a coaxial set's axis is, and how well.
+struct PooledCentre {
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d weighted = Eigen::Vector2d::Zero();  // Σ information × centre
+
+  void add(const CoaxialFit& fit) { add(fit.centre, fit.centre_covariance); }
+  void add(const Eigen::Vector2d& centre, const Eigen::Matrix2d& covariance) {
+    const Eigen::Matrix2d own = covariance.inverse();
+    information += own;
+    weighted += own * centre;
+  }
+  Eigen::Vector2d centre() const { return information.ldlt().solve(weighted); }
+  Eigen::Matrix2d covariance() const { return information.inverse(); }
+};
+
+// ---- Spheres on axis lines, and equal radii (radii.cpp)
+
+/// The surfaces with a radius, for the spheres on axes and the equal radii: the cylinders refitted
+/// so far, each on an axis line (coaxial ones on a shared one), and the spheres, each on its
+/// centre (on a line, once centred on one).
+struct SettledSurfaces {
+  struct Line {
+    Eigen::Vector3d direction;
+    Eigen::Vector2d centre;  // orthonormal_pair(direction) coordinates
+    // Of `centre`, the direction fixed: how well the line is placed where its points are.
+    Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+    std::size_t coaxial = kNoRelation;  // its coaxial relation's index
+    // Where its cylinders' points are along it (their weighted mean of direction · x), and the
+    // covariance of the direction's tilt (radians², orthonormal_pair(direction) coordinates):
+    // at a distance h from there the line is placed to within covariance + h² tilt.
+    double middle = 0;
+    Eigen::Matrix2d tilt = Eigen::Matrix2d::Zero();
+  };
+  struct Surface {
+    std::size_t cluster = 0;
+    bool sphere = false;
+    std::size_t line = 0;    // into `lines`: a cylinder's; a sphere's centre's, or kNoLine
+    std::size_t centre = 0;  // a sphere's, into `centres`
+    double radius = 0, radius_variance = 0, rms = 0;
+  };
+  std::vector<Line> lines;
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<Eigen::Matrix3d> centre_covariances;  // of each sphere's own fit
+  std::vector<Surface> surfaces;
+};
+
+/// Spheres centred on an axis line: a ball end, a hemispherical cap, a spherical seat of a hole.
+/// Each sphere whose centre is within the significance of a line (Mahalanobis, over the offset in
+/// the line's plane, with the covariances of the centre, of the line's position and of its tilt
+/// times the centre's distance along it from the line's points, against the χ² bound of two
+/// degrees of freedom) and within
+/// max_radius_difference of its radius joins the nearest such line. As for the radii, an offset
+/// whose significance interval is wider than that joins none: the centres of sphere patches of a
+/// freeform surface are known to a few percent of their radii, and any line would do (bunny00's
+/// level of 391 clusters had 22 such pairs without this rule, none with it; CAD parts' centres are
+/// known to 1e-6 of their radii, fandisk's to 5e-4). Nor does a line known less well than its
+/// cylinders' radius (a nearly flat cylinder's axis could be anywhere). Each line's cylinders and
+/// spheres are then refitted together, every sphere with one parameter along the line instead of
+/// three; as for a coaxial set, while a member's residual sum rises by more than the significance
+/// corrected for the number of members allows, the sphere that rises most leaves. Appends each
+/// joined sphere to its line's coaxial relation, which it starts when the line had one cylinder.
+void centre_spheres_on_axes(SettledSurfaces& settled, const RegularityOptions& options,
+                            std::vector<Primitive>& primitives,
+                            const std::vector<std::vector<Vec3>>& points,
+                            const std::vector<std::vector<double>>& weights,
+                            std::vector<Relation>& relations);
+
+/// Spheres centred on one line of a design direction with no cylinder on it: the arcs of a
+/// revolved profile (couplingdown has seven spheres centred on one line along z). For each
+/// direction a relation made exact (refitted[g] not empty), in order, the spheres on no line yet,
+/// best located first, each join the first set whose pooled position in the plane orthogonal to
+/// the direction they are within the significance of (the χ² bound of two degrees of freedom, with
+/// the covariances of the centre, of the pooled position and of the direction's tilt times the
+/// height between them) and within max_radius_difference of their radius; a centre known less well
+/// than that joins none. A set of kFewestSpheresOnALine or more becomes a line of its own, refitted
+/// with its spheres (settle_on_line, as many staying), and a coaxial relation of them.
+void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>& groups,
+                     const std::vector<std::vector<std::size_t>>& refitted,
+                     const RegularityOptions& options, std::vector<Primitive>& primitives,
+                     const std::vector<std::vector<Vec3>>& points,
+                     const std::vector<std::vector<double>>& weights,
+                     std::vector<Relation>& relations);
+
+/// Cylinders and spheres of equal radius within the significance (radius_classes) share one
+/// radius: each component of surfaces joined by a class or by an axis line (a coaxial set) is
+/// refitted by one joint least squares over its lines' positions, its spheres' centres and its
+/// radii, the directions kept. As for a coaxial set, a member the joint fit explains worse than
+/// its own by more than the significance leaves its class, the worst first. Appends the classes
+/// of two or more to `relations`.
+void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& options,
+                    std::vector<Primitive>& primitives,
+                    const std::vector<std::vector<Vec3>>& points,
+                    const std::vector<std::vector<double>>& weights,
+                    std::vector<Relation>& relations);
+
+// ---- Axis lines (coaxial.cpp)
+
+/// A cylinder of a direction group, refitted alone with the group's direction.
+struct AlignedCylinder {
+  std::size_t cluster = 0;
+  CoaxialFit fit;
+  double middle = 0;  // where its inliers are along the direction: middle_along()
+};
+
+/// Cylinder `c` refitted alone with `direction` (fit_alone()), and where it is along it.
+std::optional<AlignedCylinder> aligned_cylinder(std::size_t c, const Primitive& cylinder,
+                                                const Eigen::Vector3d& direction,
+                                                const std::vector<std::vector<Vec3>>& points,
+                                                const std::vector<std::vector<double>>& weights);
+
+/// Refits the cylinders of a direction group: each coaxial set around one axis line (each member
+/// keeping its own radius), the others alone with the group's direction. Appends the coaxial sets
+/// of two or more to `relations`, and every cylinder refitted to `settled`.
+void align_cylinders(const Eigen::Vector3d& direction, const Eigen::Matrix3d& direction_covariance,
+                     std::vector<AlignedCylinder> cylinders, const RegularityOptions& options,
+                     std::vector<Primitive>& primitives,
+                     const std::vector<std::vector<Vec3>>& points,
+                     const std::vector<std::vector<double>>& weights,
+                     std::vector<Relation>& relations, SettledSurfaces& settled);
+
+/// Each coaxial set of a group's cylinders counts as one item: its members fitted on one line of
+/// free direction. The sets are align_cylinders()'s, except that the joint fit a set must pass is
+/// this one: the group's direction, still to be settled, need not suit all members at once (two
+/// steps of a shaft far apart tell the axis better together than the group's direction gives it).
+/// Returns whether any set counted.
+bool count_coaxial_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
+                          const std::vector<Primitive>& primitives,
+                          const std::vector<std::vector<Vec3>>& points,
+                          const std::vector<std::vector<double>>& weights,
+                          const RegularityOptions& options);
+
+// ---- Planes (coplanar.cpp)
+
+/// A plane aligned with a group's direction, by where it is along it.
+struct AlignedPlane {
+  std::size_t cluster = 0;
+  Eigen::Vector3d centroid;  // its inliers' weighted centroid: the aligned plane's point
+  double offset = 0;         // direction · centroid
+  double variance = 0;       // the offset's
+  double weight = 0;         // Σ w
+};
+
+/// The plane with normal ±`direction` (its own side) through its inliers' weighted centroid;
+/// false (the plane unchanged) when they weigh nothing.
+bool align_plane(Primitive& plane, const Eigen::Vector3d& direction, std::span<const Vec3> points,
+                 std::span<const double> weights);
+
+/// Its offset along `direction` (that of its inliers' weighted centroid, where align_plane()
+/// puts it), and how well it is known: the weighted mean of the inliers' offsets has variance
+/// σ̂² Σw² / (Σw)², σ̂² their weighted mean square about it with the plane's 3 degrees of freedom
+/// taken (floored at the resolution of its extent, as its direction's is).
+std::optional<AlignedPlane> aligned_plane(std::size_t cluster, const Eigen::Vector3d& direction,
+                                          std::span<const Vec3> points,
+                                          std::span<const double> weights);
+
+/// The planes of `set` (aligned with `direction` through their inliers' weighted centroids) made
+/// one plane through all their inliers, each keeping its side: the least-squares offset with the
+/// direction fixed is the weighted mean of theirs. Appends the Coplanar relation.
+void share_one_plane(const Eigen::Vector3d& direction, const std::vector<std::size_t>& set,
+                     std::vector<Primitive>& primitives,
+                     const std::vector<std::vector<double>>& weights,
+                     std::vector<Relation>& relations);
+
+/// Sets of a direction group's planes (aligned with its direction, of covariance
+/// `direction_covariance`) that are one plane within the significance: the fragments
+/// of one face that a hole, a boss or the hierarchy cut apart. Best-located first, each joins the
+/// first set whose pooled offset it is within the significance of, counting both offsets'
+/// variances and the direction's tilt over the distance between its centroid and the set's first
+/// member's; else it starts one. A set must then be explained by one plane of the direction
+/// through all its inliers as each member was by its own: the guard of the coaxial sets (the
+/// significance corrected for the number of members), the worst member leaving first. Returns the
+/// sets of two or more, as clusters, increasing.
+std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direction_covariance,
+                                                    std::vector<AlignedPlane> planes,
+                                                    const RegularityOptions& options);
+
+/// Each coplanar set of a group counts as one plane: the union's scatter (about the union's
+/// centroid) also holds how far apart the fragments lie, so the direction is known better than
+/// from the members' own scatters. Returns whether any did.
+bool count_coplanar_as_one(DirectionGroup& group, const std::vector<Oriented>& items,
+                           const std::vector<std::vector<std::size_t>>& sets,
+                           const std::vector<std::vector<Vec3>>& points);
+
+// ---- Tangencies (tangency.cpp)
+
+/// How far apart the lines through two points along a unit `direction` are.
+double distance_across(const Eigen::Vector3d& apart, const Eigen::Vector3d& direction);
+
+/// Two circles (cylinders of one direction, seen along it) whose centres are `distance` apart
+/// touch when it is the sum of their radii (each outside the other) or their difference (one
+/// inside the other). The nearer condition for the circle of radius `radius` held tangent to the
+/// one of radius `held`: |c − c'| = partner_sign · held + own_sign · radius, and the gap from it,
+/// distance − (partner_sign · held + own_sign · radius).
+struct CircleContact {
+  double partner_sign = 1, own_sign = 1, gap = 0;
+};
+CircleContact nearest_circle_contact(double distance, double radius, double held);
+
+/// The tangency stage of regularize() (RegularityOptions::tangency): cylinders held tangent to
+/// the planes and the larger parallel cylinders they border, from the direction `groups`, the
+/// pairs of them made `orthogonal`, the clusters each group `refitted`, and the `relations` made so
+/// far. Writes the cylinders and planes it moves into `primitives`, and appends a Tangent relation
+/// per pair to `tangents`. The rules are at its definition.
+void make_tangent(const std::vector<DirectionGroup>& groups,
+                  const std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
+                  const std::vector<std::vector<std::size_t>>& refitted,
+                  const RegularityOptions& options, std::vector<Primitive>& primitives,
+                  const std::vector<std::vector<Vec3>>& points,
+                  const std::vector<std::vector<double>>& weights,
+                  const std::vector<Relation>& relations, std::vector<Relation>& tangents);
+
+}  // namespace primseg::detail

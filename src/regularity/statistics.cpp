@@ -1,0 +1,58 @@
+// The tests and tolerances the stages of regularize() share: χ² bounds, Bonferroni
+// corrections, tolerated scores, residual excesses.
+#include "regularity/stages.hpp"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <numbers>
+
+#include "orthonormal_pair.hpp"
+
+namespace primseg::detail {
+
+bool within_tolerance(double size, double tolerance) {
+  return tolerance > 0 && size <= tolerance;
+}
+
+double tolerated(double score, double bound, double size, double tolerance) {
+  if (!(tolerance > 0)) return score;
+  const double scaled = size / tolerance;
+  return std::min(score, bound * scaled * scaled);
+}
+
+double chi_square_bound(double significance, std::size_t freedom) {
+  if (freedom == 1) return significance * significance;
+  const double tail = std::erfc(significance / std::numbers::sqrt2);
+  if (freedom == 2) return -2 * std::log(tail);
+  const double k = static_cast<double>(freedom), spread = 2 / (9 * k);
+  return k * std::pow(1 - spread + significance * std::sqrt(spread), 3);
+}
+
+double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2,
+                       int parameters, double length_tolerance) {
+  const double n = static_cast<double>(count);
+  const double rise = n * (joint_rms * joint_rms - own_rms * own_rms);
+  return tolerated(rise / (significance2 * own_rms * own_rms * n / (n - parameters)), 1,
+                   std::sqrt(std::max(rise / n, 0.0)), length_tolerance);
+}
+
+Eigen::Matrix2d tilt_in_frame(const Eigen::Vector3d& direction, const Eigen::Matrix3d& covariance) {
+  const auto [u, v] = orthonormal_pair(direction);
+  Eigen::Matrix<double, 3, 2> frame;
+  frame << u, v;
+  return frame.transpose() * covariance * frame;
+}
+
+double family_significance(double significance, std::size_t tests) {
+  const double tail = std::erfc(significance / std::numbers::sqrt2) / static_cast<double>(tests);
+  double low = significance, high = significance + 40;
+  for (int step = 0; step < 100; ++step) {
+    const double middle = (low + high) / 2;
+    (std::erfc(middle / std::numbers::sqrt2) > tail ? low : high) = middle;
+  }
+  return high;
+}
+
+}  // namespace primseg::detail
