@@ -44,7 +44,8 @@ double tolerated(double score, double bound, double size, double tolerance);
 
 /// The χ² value a sum of `freedom` squared standard normals exceeds as rarely as one normal
 /// exceeds `significance` in magnitude: exact for one and two degrees of freedom,
-/// Wilson–Hilferty's approximation beyond (within 2% from three on at a significance of 3).
+/// Wilson–Hilferty's approximation beyond (within 1.1% of the exact quantile from three on at a
+/// significance of 3).
 double chi_square_bound(double significance, std::size_t freedom);
 
 /// How far a joint fit explains a member worse than its own fit did: the rise of its residual sum
