@@ -1,0 +1,166 @@
+// The uncertainties every test of regularize() weighs differences by, against Monte Carlo: a
+// plane's and a cylinder's tilt covariance (src/regularity/directions.cpp), and the covariance of
+// the joint fits' line positions, sphere positions and radii (src/regularity/joint_fit.cpp). Over
+// many noisy draws of one shape, each estimate's squared error in units of its own predicted
+// covariance must average its degrees of freedom: an overconfident covariance would relate
+// nothing, an underconfident one everything. And on exact points the fits are exact.
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "eigen_conversions.hpp"
+#include "orthonormal_pair.hpp"
+#include "regularity/stages.hpp"
+#include "support/regularity_shapes.hpp"
+
+namespace primseg {
+namespace {
+
+using detail::to_eigen;
+using detail::to_vec3;
+using testing::Cluster;
+using testing::fitted_cylinder;
+using testing::noisy_cylinder;
+using testing::noisy_plane;
+using testing::noisy_sphere_cap;
+
+constexpr int kDraws = 400;
+
+// The mean of χ² values of k degrees of freedom over kDraws draws is k within 4 standard errors
+// (√(2k / kDraws) each).
+void expect_calibrated(double sum, int freedom, const char* what) {
+  const double mean = sum / kDraws, error = std::sqrt(2.0 * freedom / kDraws);
+  std::printf("%s: mean squared error in its own deviations %.3f (expected %d)\n", what, mean,
+              freedom);
+  EXPECT_NEAR(mean, freedom, 4 * error) << what;
+}
+
+// δᵀ C⁻¹ δ for a tilt δ from the truth in an item's frame.
+double tilt_chi_square(const detail::Oriented& item, const Eigen::Vector3d& truth) {
+  const Eigen::Vector3d direction =
+      item.direction.dot(truth) < 0 ? -item.direction : item.direction;
+  const Eigen::Vector2d tilt = item.frame.transpose() * (direction - truth);
+  return tilt.dot(item.covariance.inverse() * tilt);
+}
+
+TEST(RegularityUncertainty, APlanesTiltCovarianceIsCalibrated) {
+  const Eigen::Vector3d normal = Eigen::Vector3d(1, -2, 2).normalized();
+  std::mt19937_64 rng(11);
+  double sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster plane = noisy_plane(normal, {0.3, 0.1, -0.2}, 2, 0.01, rng);
+    const std::optional<detail::Oriented> item = detail::oriented_plane(0, plane.points);
+    ASSERT_TRUE(item);
+    sum += tilt_chi_square(*item, normal);
+  }
+  expect_calibrated(sum, 2, "plane tilt");
+}
+
+TEST(RegularityUncertainty, ACylindersAxisCovarianceIsCalibrated) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.2, 1, 0.1).normalized(), centre(1, 0, 0);
+  std::mt19937_64 rng(12);
+  double sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster cylinder = noisy_cylinder(axis, centre, 0.5, 2, 0.005, rng);
+    const Primitive fit = fitted_cylinder(cylinder, axis, centre, 0.5);
+    const std::optional<detail::Oriented> item = detail::oriented_cylinder(0, fit, cylinder.points);
+    ASSERT_TRUE(item);
+    sum += tilt_chi_square(*item, axis);
+  }
+  expect_calibrated(sum, 2, "cylinder axis tilt");
+}
+
+TEST(RegularityUncertainty, ACoaxialFitsLineAndRadiiCovarianceIsCalibrated) {
+  // Two steps of a shaft on one line: the line's position and both radii.
+  const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ(), centre(0.2, -0.1, 0);
+  const auto [u, v] = detail::orthonormal_pair(axis);
+  const Eigen::Vector2d truth(u.dot(centre), v.dot(centre));
+  std::mt19937_64 rng(13);
+  double line_sum = 0, radius_sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster thin =
+        noisy_cylinder(axis, centre + Eigen::Vector3d(0, 0, -1), 0.3, 1, 0.004, rng, 8);
+    const Cluster thick =
+        noisy_cylinder(axis, centre + Eigen::Vector3d(0, 0, 1), 0.6, 1, 0.004, rng, 8);
+    const detail::CoaxialMember members[] = {{thin.points, thin.weights, 0.31},
+                                             {thick.points, thick.weights, 0.59}};
+    const std::optional<detail::CoaxialFit> fit =
+        detail::fit_coaxial(axis, truth + Eigen::Vector2d(0.01, -0.01), members);
+    ASSERT_TRUE(fit);
+    const Eigen::Vector2d error = fit->centre - truth;
+    line_sum += error.dot(fit->centre_covariance.inverse() * error);
+    radius_sum += std::pow(fit->radii[0] - 0.3, 2) / fit->radius_variances[0] +
+                  std::pow(fit->radii[1] - 0.6, 2) / fit->radius_variances[1];
+  }
+  expect_calibrated(line_sum, 2, "coaxial line position");
+  expect_calibrated(radius_sum, 2, "coaxial radii");
+}
+
+TEST(RegularityUncertainty, ASphereOnALineIsCalibratedAlongItAndInItsRadius) {
+  // A shaft closed by a ball end centred on its axis: the sphere's position along the line and
+  // its radius, with the line's position, in one fit (x = (line, position along it, radii)).
+  const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  std::mt19937_64 rng(14);
+  double sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster shaft = noisy_cylinder(axis, Eigen::Vector3d::Zero(), 0.4, 2, 0.004, rng, 10);
+    const Cluster ball = noisy_sphere_cap({0, 0, 1}, 0.5, axis, 1.2, 0.004, rng);
+    const Eigen::Vector3d direction = axis;
+    const Eigen::Vector2d line(0.005, -0.005);
+    const Eigen::Vector3d sphere_centre(0, 0, 1.01);
+    const double radii[] = {0.41, 0.49};
+    const detail::CylinderTerm terms[] = {{shaft.points, shaft.weights, 0, 0}};
+    const detail::SphereTerm spheres[] = {{ball.points, ball.weights, 1, 0}};
+    const std::optional<detail::JointFit> fit = detail::fit_cylinders_and_spheres(
+        {&direction, 1}, {&line, 1}, {&sphere_centre, 1}, radii, terms, spheres, true);
+    ASSERT_TRUE(fit);
+    ASSERT_EQ(fit->covariance.rows(), 5);
+    // (line u, line v, position along it, radius 0, radius 1) against the truth.
+    Eigen::Matrix<double, 5, 1> error;
+    error << fit->centres[0].x(), fit->centres[0].y(), fit->sphere_centres[0].dot(axis) - 1,
+        fit->radii[0] - 0.4, fit->radii[1] - 0.5;
+    sum += error.dot(fit->covariance.inverse() * error);
+  }
+  expect_calibrated(sum, 5, "cylinder and sphere on its line");
+}
+
+TEST(RegularityUncertainty, JointFitsAreExactOnExactPoints) {
+  // Three holes of one radius on three lines and a free sphere of that radius: one radius.
+  const Eigen::Vector3d axis = Eigen::Vector3d(0, 1, 1).normalized();
+  const auto [u, v] = detail::orthonormal_pair(axis);
+  std::mt19937_64 rng(15);
+  std::vector<Cluster> holes;
+  std::vector<Eigen::Vector2d> truths, starts;
+  for (int h = 0; h < 3; ++h) {
+    const Eigen::Vector3d centre = (0.9 * h) * u + (0.3 * h - 0.2) * v;
+    holes.push_back(noisy_cylinder(axis, centre, 0.25, 1, 0, rng, 6));
+    truths.emplace_back(u.dot(centre), v.dot(centre));
+    starts.push_back(truths.back() + Eigen::Vector2d(0.01, 0.02));
+  }
+  const Eigen::Vector3d ball_centre(2, 1, -1);
+  const Cluster ball = noisy_sphere_cap(ball_centre, 0.25, Eigen::Vector3d::UnitX(), 1, 0, rng);
+  std::vector<detail::CylinderTerm> terms;
+  std::vector<Eigen::Vector3d> directions(3, axis);
+  for (std::size_t h = 0; h < 3; ++h) terms.push_back({holes[h].points, holes[h].weights, h, 0});
+  const detail::SphereTerm spheres[] = {{ball.points, ball.weights, 0, detail::kNoLine}};
+  const Eigen::Vector3d ball_start = ball_centre + Eigen::Vector3d(0.01, 0, 0.01);
+  const double radius_start = 0.27;
+  const std::optional<detail::JointFit> fit = detail::fit_cylinders_and_spheres(
+      directions, starts, {&ball_start, 1}, {&radius_start, 1}, terms, spheres, true);
+  ASSERT_TRUE(fit);
+  for (std::size_t h = 0; h < 3; ++h) EXPECT_LT((fit->centres[h] - truths[h]).norm(), 1e-12);
+  EXPECT_LT((fit->sphere_centres[0] - ball_centre).norm(), 1e-12);
+  EXPECT_NEAR(fit->radii[0], 0.25, 1e-12);
+  // Residuals of rounding only: each RMS is its floor, kResolution × the radius.
+  for (const double rms : fit->rms) EXPECT_DOUBLE_EQ(rms, detail::kResolution * fit->radii[0]);
+}
+
+}  // namespace
+}  // namespace primseg
