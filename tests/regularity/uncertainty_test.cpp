@@ -63,6 +63,23 @@ TEST(RegularityUncertainty, APlanesTiltCovarianceIsCalibrated) {
   expect_calibrated(sum, 2, "plane tilt");
 }
 
+TEST(RegularityUncertainty, APlanesOffsetVarianceIsCalibrated) {
+  // The offset along a known direction, from unequal weights (σ̂² Σw² / (Σw)²).
+  const Eigen::Vector3d normal = Eigen::Vector3d(2, 1, -2).normalized(), centre(0.5, -0.3, 0.8);
+  std::mt19937_64 rng(16);
+  std::uniform_real_distribution<double> weight(0.2, 3);
+  double sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    Cluster plane = noisy_plane(normal, centre, 2, 0.01, rng, 6);
+    for (double& w : plane.weights) w = weight(rng);
+    const std::optional<detail::AlignedPlane> aligned =
+        detail::aligned_plane(0, normal, plane.points, plane.weights);
+    ASSERT_TRUE(aligned);
+    sum += std::pow(aligned->offset - normal.dot(centre), 2) / aligned->variance;
+  }
+  expect_calibrated(sum, 1, "plane offset");
+}
+
 TEST(RegularityUncertainty, ACylindersAxisCovarianceIsCalibrated) {
   const Eigen::Vector3d axis = Eigen::Vector3d(0.2, 1, 0.1).normalized(), centre(1, 0, 0);
   std::mt19937_64 rng(12);
