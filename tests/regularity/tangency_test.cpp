@@ -17,6 +17,7 @@
 
 #include "eigen_conversions.hpp"
 #include "regularity.hpp"
+#include "regularity/stages.hpp"
 #include "support/regularity_shapes.hpp"
 
 namespace primseg {
@@ -126,6 +127,31 @@ void expect_fillet_tangent_to_both_faces(std::size_t fragments) {
   // Held by its faces, the fillet's narrow arc is known far better.
   expect_held_in_nearly_every_draw("fillet in " + std::to_string(fragments) + " cluster(s)", kDraws,
                                    tangent_draws, own_squares, tangent_squares, 2);
+}
+
+TEST(Regularity, CirclesTouchAtTheSumOrTheDifferenceOfTheirRadii) {
+  // distance_across: the lines through two points along a direction, whatever the points'
+  // positions along it.
+  const Eigen::Vector3d direction = Eigen::Vector3d(1, 2, 2) / 3;
+  const Eigen::Vector3d across = Eigen::Vector3d(2, -1, 0).normalized();
+  EXPECT_NEAR(detail::distance_across(0.7 * across + 5 * direction, direction), 0.7, 1e-15);
+  // A fillet of radius 0.1 held to a boss of radius 0.5: outside it (+1, +1) at 0.6, inside a
+  // bore of that radius (+1, −1) at 0.4, around a pin of radius 0.05 from inside (−1, +1) at
+  // 0.05; the gap is the distance's excess over the nearest of these.
+  const auto expect_contact = [](double distance, double radius, double held, double partner_sign,
+                                 double own_sign, double gap) {
+    const detail::CircleContact contact = detail::nearest_circle_contact(distance, radius, held);
+    EXPECT_EQ(contact.partner_sign, partner_sign) << distance;
+    EXPECT_EQ(contact.own_sign, own_sign) << distance;
+    EXPECT_NEAR(contact.gap, gap, 1e-15) << distance;
+  };
+  expect_contact(0.61, 0.1, 0.5, 1, 1, 0.01);
+  expect_contact(0.59, 0.1, 0.5, 1, 1, -0.01);
+  expect_contact(0.41, 0.1, 0.5, 1, -1, 0.01);
+  expect_contact(0.38, 0.1, 0.5, 1, -1, -0.02);
+  expect_contact(0.06, 0.1, 0.05, -1, 1, 0.01);
+  // Halfway between the sum and the difference, the sum (each outside the other) wins the tie.
+  expect_contact(0.5, 0.1, 0.5, 1, 1, -0.1);
 }
 
 TEST(Regularity, AFilletIsHeldTangentToBothFacesItRounds) {
