@@ -323,17 +323,13 @@ std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surfa
 
 }  // namespace
 
-void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& options,
-                    std::vector<Primitive>& primitives,
-                    const std::vector<std::vector<Vec3>>& points,
-                    const std::vector<std::vector<double>>& weights,
-                    std::vector<Relation>& relations) {
-  const std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
-  const std::size_t n = surfaces.size();
-  std::vector<std::size_t> class_of = radius_classes(surfaces, options);
-  std::vector<std::size_t> class_size(n, 0);
-  for (const std::size_t q : class_of) ++class_size[q];
-  // Components: union-find over the surfaces, through shared classes and shared lines.
+namespace {
+
+// The surfaces linked by a class of radii (`class_of`) or by an axis line, by union-find: each
+// component's surfaces in increasing order, at the index of its root (the others empty).
+std::vector<std::vector<std::size_t>> linked_components(const SettledSurfaces& settled,
+                                                        const std::vector<std::size_t>& class_of) {
+  const std::size_t n = settled.surfaces.size();
   std::vector<std::size_t> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   auto root = [&](std::size_t k) {
@@ -351,121 +347,172 @@ void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& opt
   std::vector<std::size_t> first_of_class(n, n), first_on_line(settled.lines.size(), n);
   for (std::size_t k = 0; k < n; ++k) {
     join(first_of_class[class_of[k]], k);
-    if (surfaces[k].line != kNoLine) join(first_on_line[surfaces[k].line], k);
+    if (settled.surfaces[k].line != kNoLine) join(first_on_line[settled.surfaces[k].line], k);
   }
   std::vector<std::vector<std::size_t>> components(n);
   for (std::size_t k = 0; k < n; ++k) components[root(k)].push_back(k);
-  // A component's lines and radii, numbered in the joint fit; only its own entries are reset, so
-  // that many small components cost no more than one large one.
+  return components;
+}
+
+// A component's joint fit, as fit_cylinders_and_spheres() takes it: its lines, spheres and radii
+// (a class of two or more has one radius, started from its first member's), and each member's
+// term, its index among the cylinder terms or among the spheres.
+struct RadiusProblem {
+  std::vector<CylinderTerm> terms;
+  std::vector<SphereTerm> spheres;
+  std::vector<Eigen::Vector3d> directions, sphere_centres;
+  std::vector<Eigen::Vector2d> centres;
+  std::vector<double> radii;
+  std::vector<std::size_t> term_of;
+};
+
+// `line_index` and `radius_of_class` number the component's lines and radii in the joint fit;
+// only its own entries are reset, so that many small components cost no more than one large one.
+RadiusProblem radius_problem(
+    const SettledSurfaces& settled, const std::vector<std::size_t>& component,
+    const std::vector<std::size_t>& class_of, const std::vector<std::size_t>& class_size,
+    const std::vector<std::vector<Vec3>>& points, const std::vector<std::vector<double>>& weights,
+    std::vector<std::size_t>& line_index, std::vector<std::size_t>& radius_of_class) {
+  const std::size_t n = settled.surfaces.size();
+  RadiusProblem problem;
+  problem.term_of.resize(component.size());
+  for (const std::size_t k : component) {
+    if (settled.surfaces[k].line != kNoLine) line_index[settled.surfaces[k].line] = n;
+    radius_of_class[class_of[k]] = n;
+  }
+  for (std::size_t j = 0; j < component.size(); ++j) {
+    const SettledSurfaces::Surface& surface = settled.surfaces[component[j]];
+    std::size_t& radius = radius_of_class[class_of[component[j]]];
+    if (radius == n || class_size[class_of[component[j]]] < 2) {
+      radius = problem.radii.size();
+      problem.radii.push_back(surface.radius);
+    }
+    std::size_t line = kNoLine;
+    if (surface.line != kNoLine) {
+      line = line_index[surface.line];
+      if (line == n) {
+        line = line_index[surface.line] = problem.directions.size();
+        problem.directions.push_back(settled.lines[surface.line].direction);
+        problem.centres.push_back(settled.lines[surface.line].centre);
+      }
+    }
+    if (surface.sphere) {
+      problem.term_of[j] = problem.spheres.size();
+      problem.spheres.push_back({points[surface.cluster], weights[surface.cluster], radius, line});
+      problem.sphere_centres.push_back(settled.centres[surface.centre]);
+      continue;
+    }
+    problem.term_of[j] = problem.terms.size();
+    problem.terms.push_back({points[surface.cluster], weights[surface.cluster], line, radius});
+  }
+  return problem;
+}
+
+// The member of a class of two or more (an index into `component`) that the joint `fit` explains
+// worst beyond the significance corrected for their number, or component.size() for none.
+std::size_t worst_member(const SettledSurfaces& settled, const std::vector<std::size_t>& component,
+                         const std::vector<std::size_t>& class_of,
+                         const std::vector<std::size_t>& class_size, const RadiusProblem& problem,
+                         const JointFit& fit, const RegularityOptions& options,
+                         const std::vector<std::vector<Vec3>>& points) {
+  // One test per member: at the significance each, a plate of a hundred equal holes would lose
+  // one in four times.
+  const std::size_t tested = static_cast<std::size_t>(
+      std::count_if(component.begin(), component.end(),
+                    [&](std::size_t k) { return class_size[class_of[k]] >= 2; }));
+  const double bound = family_significance(options.significance, tested);
+  std::size_t worst = component.size();
+  double worst_excess = 1;
+  for (std::size_t j = 0; j < component.size(); ++j) {
+    const SettledSurfaces::Surface& surface = settled.surfaces[component[j]];
+    if (class_size[class_of[component[j]]] < 2) continue;
+    const double rms =
+        fit.rms[surface.sphere ? problem.terms.size() + problem.term_of[j] : problem.term_of[j]];
+    // A sphere's own fit has 4 parameters (2 on a line), a cylinder's (on its direction) 3.
+    const int parameters = !surface.sphere ? 3 : surface.line == kNoLine ? 4 : 2;
+    const double excess = residual_excess(surface.rms, rms, points[surface.cluster].size(),
+                                          bound * bound, parameters, options.length_tolerance);
+    if (excess > worst_excess) {
+      worst_excess = excess;
+      worst = j;
+    }
+  }
+  return worst;
+}
+
+// Writes the joint `fit` back: the members of classes of two or more, and the surfaces on their
+// lines; appends each class of two or more as an EqualRadius relation.
+void write_equal_radii(const SettledSurfaces& settled, const std::vector<std::size_t>& component,
+                       const std::vector<std::size_t>& class_of,
+                       const std::vector<std::size_t>& class_size, const RadiusProblem& problem,
+                       const JointFit& fit, std::vector<Primitive>& primitives,
+                       std::vector<Relation>& relations) {
+  const std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
+  std::vector<bool> moved_line(settled.lines.size(), false);
+  for (const std::size_t k : component)
+    if (class_size[class_of[k]] >= 2 && surfaces[k].line != kNoLine)
+      moved_line[surfaces[k].line] = true;
+  std::map<std::size_t, std::vector<std::size_t>> members_of_class;
+  for (std::size_t j = 0; j < component.size(); ++j) {
+    const SettledSurfaces::Surface& surface = surfaces[component[j]];
+    const bool member = class_size[class_of[component[j]]] >= 2;
+    Primitive& primitive = primitives[surface.cluster];
+    if (surface.sphere) {
+      if (!member && (surface.line == kNoLine || !moved_line[surface.line])) continue;
+      primitive.point = to_vec3(fit.sphere_centres[problem.term_of[j]]);
+      primitive.radius = fit.radii[problem.spheres[problem.term_of[j]].radius];
+    } else {
+      if (!moved_line[surface.line]) continue;
+      const CylinderTerm& term = problem.terms[problem.term_of[j]];
+      place_cylinder(primitive, problem.directions[term.line], fit.centres[term.line],
+                     fit.radii[term.radius]);
+    }
+    if (member) members_of_class[class_of[component[j]]].push_back(surface.cluster);
+  }
+  for (auto& [unused, members] : members_of_class) {
+    Relation& relation = relations.emplace_back();
+    relation.kind = Relation::Kind::EqualRadius;
+    std::sort(members.begin(), members.end());
+    relation.members = std::move(members);
+  }
+}
+
+}  // namespace
+
+void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& options,
+                    std::vector<Primitive>& primitives,
+                    const std::vector<std::vector<Vec3>>& points,
+                    const std::vector<std::vector<double>>& weights,
+                    std::vector<Relation>& relations) {
+  const std::size_t n = settled.surfaces.size();
+  std::vector<std::size_t> class_of = radius_classes(settled.surfaces, options);
+  std::vector<std::size_t> class_size(n, 0);
+  for (const std::size_t q : class_of) ++class_size[q];
   std::vector<std::size_t> line_index(settled.lines.size(), n), radius_of_class(n, n);
-  for (const std::vector<std::size_t>& component : components) {
+  for (const std::vector<std::size_t>& component : linked_components(settled, class_of)) {
     if (std::none_of(component.begin(), component.end(),
                      [&](std::size_t k) { return class_size[class_of[k]] >= 2; }))
       continue;
-    std::optional<JointFit> fit;
-    std::vector<CylinderTerm> terms;
-    std::vector<SphereTerm> spheres;
-    std::vector<Eigen::Vector3d> directions, sphere_centres;
-    std::vector<Eigen::Vector2d> centres;
-    std::vector<double> radii;
-    // Each member's term: its index among the fit's cylinder terms, or among its spheres.
-    std::vector<std::size_t> term_of(component.size());
+    // While the joint fit explains a member worse than its own beyond the significance, the
+    // worst takes a class of its own, under any unused number.
     while (true) {
-      terms.clear();
-      spheres.clear();
-      directions.clear();
-      sphere_centres.clear();
-      centres.clear();
-      radii.clear();
-      for (const std::size_t k : component) {
-        if (surfaces[k].line != kNoLine) line_index[surfaces[k].line] = n;
-        radius_of_class[class_of[k]] = n;
-      }
-      for (std::size_t j = 0; j < component.size(); ++j) {
-        const SettledSurfaces::Surface& surface = surfaces[component[j]];
-        // A class of two or more has one radius, started from its first member's.
-        std::size_t& radius = radius_of_class[class_of[component[j]]];
-        if (radius == n || class_size[class_of[component[j]]] < 2) {
-          radius = radii.size();
-          radii.push_back(surface.radius);
-        }
-        std::size_t line = kNoLine;
-        if (surface.line != kNoLine) {
-          line = line_index[surface.line];
-          if (line == n) {
-            line = line_index[surface.line] = directions.size();
-            directions.push_back(settled.lines[surface.line].direction);
-            centres.push_back(settled.lines[surface.line].centre);
-          }
-        }
-        if (surface.sphere) {
-          term_of[j] = spheres.size();
-          spheres.push_back({points[surface.cluster], weights[surface.cluster], radius, line});
-          sphere_centres.push_back(settled.centres[surface.centre]);
-          continue;
-        }
-        term_of[j] = terms.size();
-        terms.push_back({points[surface.cluster], weights[surface.cluster], line, radius});
-      }
-      fit = fit_cylinders_and_spheres(directions, centres, sphere_centres, radii, terms, spheres,
-                                      false);
+      const RadiusProblem problem = radius_problem(settled, component, class_of, class_size, points,
+                                                   weights, line_index, radius_of_class);
+      const std::optional<JointFit> fit =
+          fit_cylinders_and_spheres(problem.directions, problem.centres, problem.sphere_centres,
+                                    problem.radii, problem.terms, problem.spheres, false);
       if (!fit) break;
-      // One test per member: at the significance each, a plate of a hundred equal holes would
-      // lose one in four times.
-      const std::size_t tested = static_cast<std::size_t>(
-          std::count_if(component.begin(), component.end(),
-                        [&](std::size_t k) { return class_size[class_of[k]] >= 2; }));
-      const double bound = family_significance(options.significance, tested);
-      std::size_t worst = component.size();
-      double worst_excess = 1;
-      for (std::size_t j = 0; j < component.size(); ++j) {
-        const SettledSurfaces::Surface& surface = surfaces[component[j]];
-        if (class_size[class_of[component[j]]] < 2) continue;
-        const double rms = fit->rms[surface.sphere ? terms.size() + term_of[j] : term_of[j]];
-        // A sphere's own fit has 4 parameters (2 on a line), a cylinder's (on its direction) 3.
-        const int parameters = !surface.sphere ? 3 : surface.line == kNoLine ? 4 : 2;
-        const double excess = residual_excess(surface.rms, rms, points[surface.cluster].size(),
-                                              bound * bound, parameters, options.length_tolerance);
-        if (excess > worst_excess) {
-          worst_excess = excess;
-          worst = j;
-        }
+      const std::size_t worst =
+          worst_member(settled, component, class_of, class_size, problem, *fit, options, points);
+      if (worst == component.size()) {
+        write_equal_radii(settled, component, class_of, class_size, problem, *fit, primitives,
+                          relations);
+        break;
       }
-      if (worst == component.size()) break;
-      // The worst takes a class of its own, under any unused number.
       --class_size[class_of[component[worst]]];
       const auto free_class = std::find(class_size.begin(), class_size.end(), 0);
       class_of[component[worst]] = static_cast<std::size_t>(free_class - class_size.begin());
       *free_class = 1;
-    }
-    if (!fit) continue;
-    // Written back: the members of classes of two or more, and the surfaces on their lines.
-    std::vector<bool> moved_line(settled.lines.size(), false);
-    for (const std::size_t k : component)
-      if (class_size[class_of[k]] >= 2 && surfaces[k].line != kNoLine)
-        moved_line[surfaces[k].line] = true;
-    std::map<std::size_t, std::vector<std::size_t>> members_of_class;
-    for (std::size_t j = 0; j < component.size(); ++j) {
-      const SettledSurfaces::Surface& surface = surfaces[component[j]];
-      const bool member = class_size[class_of[component[j]]] >= 2;
-      Primitive& primitive = primitives[surface.cluster];
-      if (surface.sphere) {
-        if (!member && (surface.line == kNoLine || !moved_line[surface.line])) continue;
-        primitive.point = to_vec3(fit->sphere_centres[term_of[j]]);
-        primitive.radius = fit->radii[spheres[term_of[j]].radius];
-      } else {
-        if (!moved_line[surface.line]) continue;
-        const CylinderTerm& term = terms[term_of[j]];
-        place_cylinder(primitive, directions[term.line], fit->centres[term.line],
-                       fit->radii[term.radius]);
-      }
-      if (member) members_of_class[class_of[component[j]]].push_back(surface.cluster);
-    }
-    for (auto& [unused, members] : members_of_class) {
-      Relation& relation = relations.emplace_back();
-      relation.kind = Relation::Kind::EqualRadius;
-      std::sort(members.begin(), members.end());
-      relation.members = std::move(members);
     }
   }
 }
