@@ -7,6 +7,7 @@
 #include <span>
 
 #include "../src/file_io.hpp"
+#include "../src/length_text.hpp"
 #include "command.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
@@ -181,8 +182,7 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
       "angles become orthogonal, fragments of one face share one plane, cylinders "
       "share one axis line and spheres are centred on it, cylinders and spheres "
       "share one radius, and fillets become tangent to the faces and parallel cylinders "
-      "they border "
-      "(listed as \"relations\" in the JSON)");
+      "they border (listed as \"relations\" in the JSON)");
   add_relation_options(command, options.relations);
 }
 
@@ -213,8 +213,8 @@ CLI::Validator number_range(double low, std::optional<double> high, const std::s
 
 RelationOptions RelationChoice::for_mesh(const Mesh& mesh) const {
   RelationOptions resolved = options;
-  resolved.length_tolerance =
-      parse_length(length_tolerance, bounding_box_diagonal(mesh), "--relation-length-tolerance");
+  resolved.length_tolerance = detail::parse_length(length_tolerance, bounding_box_diagonal(mesh),
+                                                   "--relation-length-tolerance");
   return resolved;
 }
 
@@ -247,7 +247,7 @@ void add_relation_options(CLI::App& command, RelationChoice& choice) {
                   "joint fit that raises a member's RMS residual by at most this much (in "
                   "quadrature) keeps it (input units, or L% of the bounding-box diagonal; >= 0; "
                   "0: the significance alone)")
-      ->check(length_syntax_error, "L or L%")
+      ->check(detail::length_syntax_error, "L or L%")
       ->capture_default_str();
   command
       .add_option("--max-radius-difference", options.max_radius_difference,
@@ -265,7 +265,7 @@ void add_relation_options(CLI::App& command, RelationChoice& choice) {
 void validate_relation_options(const RelationChoice& choice) {
   RelationOptions options = choice.options;
   options.length_tolerance =
-      parse_length(choice.length_tolerance, 1, "--relation-length-tolerance");
+      detail::parse_length(choice.length_tolerance, 1, "--relation-length-tolerance");
   if (!(options.angle_tolerance_degrees < options.max_angle_degrees))
     throw InvalidInputError("--relation-angle-tolerance " +
                             CLI::detail::to_string(options.angle_tolerance_degrees) +
@@ -288,11 +288,11 @@ std::string relation_options_signature(const RelationChoice& choice) {
   add("relation_angle_tolerance", options.angle_tolerance_degrees,
       defaults.angle_tolerance_degrees);
   // A length as a number, as before percentages were accepted: earlier outputs still resume.
-  if (is_percentage(choice.length_tolerance))
+  if (detail::is_percentage(choice.length_tolerance))
     signature += " relation_length_tolerance=" + nlohmann::json(choice.length_tolerance).dump();
   else
     add("relation_length_tolerance",
-        parse_length(choice.length_tolerance, 1, "--relation-length-tolerance"),
+        detail::parse_length(choice.length_tolerance, 1, "--relation-length-tolerance"),
         defaults.length_tolerance);
   add("max_radius_difference", options.max_radius_difference, defaults.max_radius_difference);
   return signature;

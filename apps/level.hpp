@@ -3,7 +3,6 @@
 
 #include <optional>
 #include <string>
-#include <string_view>
 
 #include "primseg/auto_level.hpp"
 #include "primseg/cut.hpp"
@@ -15,16 +14,8 @@ struct LevelChoice {
   std::optional<std::string> tolerance;  // --tolerance T or T% (of the bounding-box diagonal)
 };
 
-/// Parses a length given as "T" (input units) or "T%" (of `bounding_box_diagonal`), finite and
-/// non-negative, into input units. Throws InvalidInputError naming `option`.
-double parse_length(const std::string& text, double bounding_box_diagonal, std::string_view option);
-/// parse_length() of --tolerance.
+/// detail::parse_length() of --tolerance ("T" or "T%" of `bounding_box_diagonal`).
 double parse_tolerance(const std::string& text, double bounding_box_diagonal);
-/// Whether a length parse_length() accepts is a percentage.
-bool is_percentage(const std::string& text);
-/// What is wrong with a length parse_length() refuses (without the option's name); empty when
-/// it accepts it.
-std::string length_syntax_error(const std::string& text);
 
 /// Parses --clusters: a count, or std::nullopt for "auto". Throws InvalidInputError naming the
 /// option for anything else (including counts beyond 32 bits).

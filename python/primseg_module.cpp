@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -21,6 +20,7 @@
 #include <variant>
 #include <vector>
 
+#include "../src/length_text.hpp"
 #include "../src/parallel.hpp"
 #include "../src/tree_nodes.hpp"
 #include "doxygen_docstrings.hpp"
@@ -429,20 +429,16 @@ const char* kRelationArguments =
 // bounding-box diagonal.
 using LengthArgument = std::variant<double, std::string>;
 
-// The length of `argument` on `mesh`: a percentage as the CLI computes it (the same double);
-// InvalidInputError, naming the keyword, for a string that is not a non-negative number and '%'.
+// The length of `argument` on `mesh`: a percentage by the CLI's parser (detail::parse_length, the
+// same double); InvalidInputError, naming the keyword, for a string that is not one.
 double length_argument(const LengthArgument& argument, const Mesh& mesh) {
   if (const double* length = std::get_if<double>(&argument)) return *length;
   const std::string& text = std::get<std::string>(argument);
-  const char* const end = text.data() + text.size() - (text.ends_with('%') ? 1 : 0);
-  double percent = 0;
-  const auto [stop, error] = std::from_chars(text.data(), end, percent);
-  if (!text.ends_with('%') || error != std::errc() || stop != end || !std::isfinite(percent) ||
-      percent < 0)
+  if (!detail::is_percentage(text))
     throw InvalidInputError("relation_length_tolerance is '" + text +
                             "', must be a non-negative length or a percentage of the "
                             "bounding-box diagonal such as '0.01%'");
-  return percent / 100 * bounding_box_diagonal(mesh);
+  return detail::parse_length(text, bounding_box_diagonal(mesh), "relation_length_tolerance");
 }
 
 // The RelationOptions of relation_significance, max_relation_angle, relation_angle_tolerance,
