@@ -10,23 +10,122 @@
 
 namespace primseg::cli {
 
+namespace {
+
+struct DenoiseCommandOptions {
+  std::string mesh_path, output_path, primitives = "plane,cylinder,sphere";
+  int iterations = 1;
+  int smoothing_steps = DenoiseOptions{}.smoothing_steps;
+  bool stylize = false;
+  bool bilateral = false;
+  double max_move = DenoiseOptions{}.max_move_edge_lengths;
+  double min_crease_angle = DenoiseOptions{}.min_crease_angle_degrees;
+  int relabel_passes = DenoiseOptions{}.relabel_passes;
+  double relation_significance = DenoiseOptions{}.relation_significance;
+  std::optional<double> noise_factor;
+  unsigned threads = 0;
+  LevelOptions level;
+  ResourceLimits limits;
+};
+
+// The library's options for the command's, checked.
+DenoiseOptions denoise_options(const DenoiseCommandOptions& o) {
+  DenoiseOptions options;
+  options.mode = o.stylize ? SnapMode::NearestIncident : SnapMode::AllIncident;
+  options.max_move_edge_lengths = o.max_move;
+  options.smoothing_steps = o.smoothing_steps;
+  if (o.bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
+  options.min_crease_angle_degrees = o.min_crease_angle;
+  options.relabel_passes = o.relabel_passes;
+  options.relation_significance = o.relation_significance;
+  options.noise_tolerance_factor = o.noise_factor;
+  options.hierarchy.primitives = parse_primitives(o.primitives);
+  options.hierarchy.threads = o.threads;
+  validate(options);
+  return options;
+}
+
+// The level a round snaps onto: with --clusters auto, denoising's own automatic level (under
+// noise, a multiple of the noise), else the cut the level options ask for.
+ChosenLevel round_level(const Denoiser& denoiser, const Hierarchy& hierarchy,
+                        const LevelChoice& choice) {
+  if (!choice.clusters || parse_cluster_count(*choice.clusters)) return cut(hierarchy, choice);
+  DenoiseLevel chosen = denoiser.automatic_level(hierarchy);
+  ChosenLevel level{std::move(chosen.segmentation), std::move(chosen.automatic), std::nullopt};
+  if (chosen.by_noise) level.by_noise = {chosen.noise, chosen.tolerance};
+  return level;
+}
+
+// A round's entry of the JSON's "rounds".
+nlohmann::json round_json(const SnapReport& r) {
+  return {{"clusters", r.clusters},   {"boundary_vertices", r.boundary_vertices},
+          {"snapped", r.snapped},     {"moved", r.moved},
+          {"fallbacks", r.fallbacks}, {"blocked", r.blocked},
+          {"mean_move", r.mean_move}, {"max_move", r.max_move}};
+}
+
+void print_round(int round, const ChosenLevel& level, const SnapReport& r) {
+  if (level.by_noise)
+    std::printf(
+        "round %d: no jump in the error curve; level by noise: estimate %.6g, clusters within "
+        "RMS %.6g\n",
+        round, level.by_noise->noise, level.by_noise->tolerance);
+  std::printf(
+      "round %d: %s, %s snapped (%u on cluster borders, %u onto fewer primitives), %u moved, %u "
+      "blocked; mean move %.6g, max %.6g\n",
+      round, count_of(r.clusters, "cluster").c_str(),
+      count_of(r.snapped, "vertex", "vertices").c_str(), r.boundary_vertices, r.fallbacks, r.moved,
+      r.blocked, r.mean_move, r.max_move);
+}
+
+// Runs `primseg denoise` with its parsed options (quiet once an output goes to standard output).
+void run_denoise(DenoiseCommandOptions& o) {
+  const DenoiseOptions options = denoise_options(o);
+  validate_level_outputs(o.level);
+  mesh_format_from_path(o.output_path);  // an unknown extension fails before any work
+  const auto start = Clock::now();
+  Mesh mesh = read_geometry_within(o.mesh_path, o.limits, o.level.files.png ? kPictureBytes : 0);
+  validate_level(o.level.level, mesh.face_count());
+  Denoiser denoiser(std::move(mesh), options);
+  std::unique_ptr<Hierarchy> hierarchy;
+  ChosenLevel level;
+  nlohmann::json rounds = nlohmann::json::array();
+  for (int i = 0; i < o.iterations; ++i) {
+    hierarchy =
+        std::make_unique<Hierarchy>(build_hierarchy(denoiser.segmented_mesh(), options.hierarchy));
+    level = round_level(denoiser, *hierarchy, o.level.level);
+    const SnapReport report = denoiser.snap(*hierarchy, level.segmentation);
+    rounds.push_back(round_json(report));
+    if (!o.level.quiet) print_round(i + 1, level, report);
+  }
+  write_mesh(o.output_path, denoiser.mesh());
+  nlohmann::json summary;
+  summary["mesh"] = mesh_summary(o.mesh_path, *hierarchy);
+  summary["denoise"] = {{"output", o.output_path},
+                        {"mode", o.stylize ? "stylize" : "denoise"},
+                        {"segmented_copy", o.bilateral             ? "bilateral"
+                                           : o.smoothing_steps > 0 ? "taubin"
+                                                                   : "input"},
+                        {"rounds", rounds}};
+  summary["timing"] = {{"denoise_seconds", seconds_since(start)}};
+  // The level outputs show the last round's snap: its clusters after relabelling, with the
+  // primitives the vertices went onto, on the denoised mesh (whose borders are the recovered
+  // feature lines). The error curve and the linkage are the last round's hierarchy's, built on
+  // the segmented copy.
+  const SnappedLevel& snapped = denoiser.snapped_level();
+  summary["level"] =
+      level_summary(o.level, level, static_cast<std::uint32_t>(snapped.clusters.size()));
+  summary["level"]["hierarchy_clusters"] = level.segmentation.cluster_count();
+  summary["relations"] = relations_json(snapped.relations);
+  write_level_outputs(*hierarchy, denoiser.mesh(), snapped.labels, snapped.clusters, o.level.files,
+                      summary);
+  if (!o.level.quiet) print_summary(snapped.clusters, snapped.relations);
+}
+
+}  // namespace
+
 Command add_denoise_command(CLI::App& app) {
-  struct Options {
-    std::string mesh_path, output_path, primitives = "plane,cylinder,sphere";
-    int iterations = 1;
-    int smoothing_steps = DenoiseOptions{}.smoothing_steps;
-    bool stylize = false;
-    bool bilateral = false;
-    double max_move = DenoiseOptions{}.max_move_edge_lengths;
-    double min_crease_angle = DenoiseOptions{}.min_crease_angle_degrees;
-    int relabel_passes = DenoiseOptions{}.relabel_passes;
-    double relation_significance = DenoiseOptions{}.relation_significance;
-    std::optional<double> noise_factor;
-    unsigned threads = 0;
-    LevelOptions level;
-    ResourceLimits limits;
-  };
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<DenoiseCommandOptions>();
   auto* denoise = app.add_subcommand(
       "denoise",
       "Snap every vertex onto the primitives of a level: denoising and sharp-edge recovery");
@@ -89,87 +188,7 @@ Command add_denoise_command(CLI::App& app) {
       ->capture_default_str();
   add_limit_options(*denoise, o->limits, kDenoiseBytesPerFace);
 
-  return {denoise, [o] {
-            DenoiseOptions options;
-            options.mode = o->stylize ? SnapMode::NearestIncident : SnapMode::AllIncident;
-            options.max_move_edge_lengths = o->max_move;
-            options.smoothing_steps = o->smoothing_steps;
-            if (o->bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
-            options.min_crease_angle_degrees = o->min_crease_angle;
-            options.relabel_passes = o->relabel_passes;
-            options.relation_significance = o->relation_significance;
-            options.noise_tolerance_factor = o->noise_factor;
-            options.hierarchy.primitives = parse_primitives(o->primitives);
-            options.hierarchy.threads = o->threads;
-            validate(options);
-            validate_level_outputs(o->level);
-            mesh_format_from_path(o->output_path);  // an unknown extension fails before any work
-            const auto start = Clock::now();
-            Mesh mesh = read_geometry_within(o->mesh_path, o->limits,
-                                             o->level.files.png ? kPictureBytes : 0);
-            validate_level(o->level.level, mesh.face_count());
-            Denoiser denoiser(std::move(mesh), options);
-            const bool automatic =
-                o->level.level.clusters && !parse_cluster_count(*o->level.level.clusters);
-            std::unique_ptr<Hierarchy> hierarchy;
-            ChosenLevel level;
-            nlohmann::json rounds = nlohmann::json::array();
-            for (int i = 0; i < o->iterations; ++i) {
-              hierarchy = std::make_unique<Hierarchy>(
-                  build_hierarchy(denoiser.segmented_mesh(), options.hierarchy));
-              if (automatic) {
-                // Denoising's own automatic level: under noise, a multiple of the noise.
-                DenoiseLevel chosen = denoiser.automatic_level(*hierarchy);
-                level = {std::move(chosen.segmentation), std::move(chosen.automatic), std::nullopt};
-                if (chosen.by_noise) level.by_noise = {chosen.noise, chosen.tolerance};
-              } else {
-                level = cut(*hierarchy, o->level.level);
-              }
-              const SnapReport r = denoiser.snap(*hierarchy, level.segmentation);
-              if (level.by_noise && !o->level.quiet)
-                std::printf(
-                    "round %d: no jump in the error curve; level by noise: estimate %.6g, "
-                    "clusters within RMS %.6g\n",
-                    i + 1, level.by_noise->noise, level.by_noise->tolerance);
-              rounds.push_back({{"clusters", r.clusters},
-                                {"boundary_vertices", r.boundary_vertices},
-                                {"snapped", r.snapped},
-                                {"moved", r.moved},
-                                {"fallbacks", r.fallbacks},
-                                {"blocked", r.blocked},
-                                {"mean_move", r.mean_move},
-                                {"max_move", r.max_move}});
-              if (!o->level.quiet)
-                std::printf(
-                    "round %d: %s, %s snapped (%u on cluster borders, %u onto fewer "
-                    "primitives), %u moved, %u blocked; mean move %.6g, max %.6g\n",
-                    i + 1, count_of(r.clusters, "cluster").c_str(),
-                    count_of(r.snapped, "vertex", "vertices").c_str(), r.boundary_vertices,
-                    r.fallbacks, r.moved, r.blocked, r.mean_move, r.max_move);
-            }
-            write_mesh(o->output_path, denoiser.mesh());
-            nlohmann::json summary;
-            summary["mesh"] = mesh_summary(o->mesh_path, *hierarchy);
-            summary["denoise"] = {{"output", o->output_path},
-                                  {"mode", o->stylize ? "stylize" : "denoise"},
-                                  {"segmented_copy", o->bilateral             ? "bilateral"
-                                                     : o->smoothing_steps > 0 ? "taubin"
-                                                                              : "input"},
-                                  {"rounds", rounds}};
-            summary["timing"] = {{"denoise_seconds", seconds_since(start)}};
-            // The level outputs show the last round's snap: its clusters after relabelling, with
-            // the primitives the vertices went onto, on the denoised mesh (whose borders are the
-            // recovered feature lines). The error curve and the linkage are the last round's
-            // hierarchy's, built on the segmented copy.
-            const SnappedLevel& snapped = denoiser.snapped_level();
-            summary["level"] =
-                level_summary(o->level, level, static_cast<std::uint32_t>(snapped.clusters.size()));
-            summary["level"]["hierarchy_clusters"] = level.segmentation.cluster_count();
-            summary["relations"] = relations_json(snapped.relations);
-            write_level_outputs(*hierarchy, denoiser.mesh(), snapped.labels, snapped.clusters,
-                                o->level.files, summary);
-            if (!o->level.quiet) print_summary(snapped.clusters, snapped.relations);
-          }};
+  return {denoise, [o] { run_denoise(*o); }};
 }
 
 }  // namespace primseg::cli

@@ -94,13 +94,10 @@ double deviation(const ClusterRelation& related, std::span<const Primitive> own,
   return 0;
 }
 
-}  // namespace
-
-std::vector<Relation> regularize(std::vector<Primitive>& primitives,
-                                 const std::vector<std::vector<Vec3>>& points,
-                                 const std::vector<std::vector<double>>& weights,
-                                 const RegularityOptions& options) {
-  std::vector<Relation> relations;
+// The planes and cylinders whose direction is known well enough to compare (a finite, positive
+// variance), in cluster order.
+std::vector<Oriented> oriented_items(const std::vector<Primitive>& primitives,
+                                     const std::vector<std::vector<Vec3>>& points) {
   std::vector<Oriented> items;
   for (std::size_t c = 0; c < primitives.size(); ++c) {
     std::optional<Oriented> item;
@@ -110,18 +107,25 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
       item = oriented_cylinder(c, primitives[c], points[c]);
     if (item && std::isfinite(item->variance) && item->variance > 0) items.push_back(*item);
   }
-  std::vector<DirectionGroup> groups = group_directions(items, options);
-  // Each group's coplanar sets and coaxial sets, found before the directions are made orthogonal:
-  // each counts as one plane or one line in its group's direction.
+  return items;
+}
+
+// Each group's coplanar sets (returned, per group) and coaxial sets, found before the directions
+// are made orthogonal: each set counts as one plane or one line in its group's direction, which
+// is formed again when one does.
+std::vector<std::vector<std::vector<std::size_t>>> count_sets_as_one(
+    std::vector<DirectionGroup>& groups, const std::vector<Oriented>& items,
+    const std::vector<Primitive>& primitives, const std::vector<std::vector<Vec3>>& points,
+    const std::vector<std::vector<double>>& weights, const RegularityOptions& options) {
   std::vector<std::vector<std::vector<std::size_t>>> coplanar(groups.size());
+  const auto is_plane = [&](std::size_t i) {
+    return primitives[items[i].cluster].type == PrimitiveType::Plane;
+  };
   for (std::size_t g = 0; g < groups.size(); ++g) {
     DirectionGroup& group = groups[g];
     if (group.members.size() < 2) continue;
     bool counted = false;
     std::vector<AlignedPlane> planes;
-    const auto is_plane = [&](std::size_t i) {
-      return primitives[items[i].cluster].type == PrimitiveType::Plane;
-    };
     if (options.coplanar &&
         std::count_if(group.members.begin(), group.members.end(), is_plane) >= 2)
       for (const std::size_t i : group.members) {
@@ -141,16 +145,21 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     form_direction(group);
     if (group.direction.dot(before) < 0) group.direction = -group.direction;
   }
-  std::vector<std::pair<std::size_t, std::size_t>> orthogonal;
-  if (options.orthogonal) {
-    orthogonal = orthogonalize(groups, options);
-    merge_parallel_groups(groups, orthogonal, coplanar);
-  }
-  std::vector<bool> constrained(groups.size(), false);
-  for (const auto& [i, j] : orthogonal) constrained[i] = constrained[j] = true;
-  // The clusters each group refitted, for the orthogonal relations.
+  return coplanar;
+}
+
+// Refits every member of each group of two or more (or in a right angle) with the group's
+// direction, then its coplanar sets with one plane and its cylinders on their shared lines. Adds
+// the parallel, coplanar and coaxial relations; returns the clusters each group refitted, in
+// increasing order, for the right angles and the relations after.
+std::vector<std::vector<std::size_t>> align_groups(
+    const std::vector<DirectionGroup>& groups, const std::vector<bool>& constrained,
+    const std::vector<std::vector<std::vector<std::size_t>>>& coplanar,
+    const std::vector<Oriented>& items, const RegularityOptions& options,
+    std::vector<Primitive>& primitives, const std::vector<std::vector<Vec3>>& points,
+    const std::vector<std::vector<double>>& weights, std::vector<Relation>& relations,
+    SettledSurfaces& settled) {
   std::vector<std::vector<std::size_t>> refitted(groups.size());
-  SettledSurfaces settled;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const DirectionGroup& group = groups[g];
     if (group.members.size() < 2 && !constrained[g]) continue;
@@ -178,37 +187,88 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
     align_cylinders(group.direction, group.covariance, std::move(cylinders), options, primitives,
                     points, weights, relations, settled);
   }
+  return refitted;
+}
+
+// Adds to `settled` the surfaces no direction relation refitted, for the radii and the spheres'
+// centres: each such cylinder on its own axis (fitted again with it, for its radius's
+// uncertainty; written back only if it joins a relation), and every sphere, fitted again alone.
+void settle_the_others(const std::vector<Oriented>& items, const std::vector<Primitive>& primitives,
+                       const std::vector<std::vector<Vec3>>& points,
+                       const std::vector<std::vector<double>>& weights, SettledSurfaces& settled) {
+  std::vector<bool> is_settled(primitives.size(), false);
+  for (const SettledSurfaces::Surface& surface : settled.surfaces)
+    is_settled[surface.cluster] = true;
+  for (const Oriented& item : items) {
+    const std::size_t c = item.cluster;
+    if (primitives[c].type != PrimitiveType::Cylinder || is_settled[c]) continue;
+    if (const std::optional<CoaxialFit> fit =
+            fit_alone(primitives[c], item.direction, points[c], weights[c])) {
+      settled.surfaces.push_back({c, false, settled.lines.size(), 0, fit->radii[0],
+                                  fit->radius_variances[0], fit->rms[0]});
+      settled.lines.push_back({item.direction, fit->centre, fit->centre_covariance, kNoRelation,
+                               middle_along(item.direction, {&c, 1}, points, weights),
+                               item.covariance});
+    }
+  }
+  for (std::size_t c = 0; c < primitives.size(); ++c) {
+    if (primitives[c].type != PrimitiveType::Sphere || points[c].empty()) continue;
+    const Eigen::Vector3d centre = to_eigen(primitives[c].point);
+    const SphereTerm term{points[c], weights[c], 0};
+    if (const std::optional<JointFit> fit = fit_cylinders_and_spheres(
+            {}, {}, {&centre, 1}, {&primitives[c].radius, 1}, {}, {&term, 1}, true)) {
+      settled.surfaces.push_back({c, true, kNoLine, settled.centres.size(), fit->radii[0],
+                                  fit->covariance(3, 3), fit->rms[0]});
+      settled.centres.push_back(fit->sphere_centres[0]);
+      settled.centre_covariances.emplace_back(fit->covariance.topLeftCorner<3, 3>());
+    }
+  }
+}
+
+// One orthogonal relation per pair of groups at right angles that both refitted a cluster: the
+// group of the lower cluster first, the relations in the order of their clusters.
+std::vector<Relation> right_angle_relations(
+    const std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
+    const std::vector<std::vector<std::size_t>>& refitted) {
+  std::vector<Relation> right_angles;
+  for (const auto& [i, j] : orthogonal) {
+    if (refitted[i].empty() || refitted[j].empty()) continue;
+    Relation& relation = right_angles.emplace_back();
+    relation.kind = Relation::Kind::Orthogonal;
+    const bool swap = refitted[j].front() < refitted[i].front();
+    relation.members = swap ? refitted[j] : refitted[i];
+    relation.others = swap ? refitted[i] : refitted[j];
+  }
+  std::sort(right_angles.begin(), right_angles.end(), [](const Relation& a, const Relation& b) {
+    return std::tie(a.members, a.others) < std::tie(b.members, b.others);
+  });
+  return right_angles;
+}
+
+}  // namespace
+
+std::vector<Relation> regularize(std::vector<Primitive>& primitives,
+                                 const std::vector<std::vector<Vec3>>& points,
+                                 const std::vector<std::vector<double>>& weights,
+                                 const RegularityOptions& options) {
+  const std::vector<Oriented> items = oriented_items(primitives, points);
+  std::vector<DirectionGroup> groups = group_directions(items, options);
+  std::vector<std::vector<std::vector<std::size_t>>> coplanar =
+      count_sets_as_one(groups, items, primitives, points, weights, options);
+  std::vector<std::pair<std::size_t, std::size_t>> orthogonal;
+  if (options.orthogonal) {
+    orthogonal = orthogonalize(groups, options);
+    merge_parallel_groups(groups, orthogonal, coplanar);
+  }
+  std::vector<bool> constrained(groups.size(), false);
+  for (const auto& [i, j] : orthogonal) constrained[i] = constrained[j] = true;
+  std::vector<Relation> relations;
+  SettledSurfaces settled;
+  const std::vector<std::vector<std::size_t>> refitted =
+      align_groups(groups, constrained, coplanar, items, options, primitives, points, weights,
+                   relations, settled);
   if (options.equal_radii || options.spheres_on_axes) {
-    // The cylinders no direction relation refitted take part too, each on its own axis (fitted
-    // again with it, for its radius's uncertainty; written back only if it joins a relation), and
-    // the spheres, each fitted again on its own.
-    std::vector<bool> is_settled(primitives.size(), false);
-    for (const SettledSurfaces::Surface& surface : settled.surfaces)
-      is_settled[surface.cluster] = true;
-    for (const Oriented& item : items) {
-      const std::size_t c = item.cluster;
-      if (primitives[c].type != PrimitiveType::Cylinder || is_settled[c]) continue;
-      if (const std::optional<CoaxialFit> fit =
-              fit_alone(primitives[c], item.direction, points[c], weights[c])) {
-        settled.surfaces.push_back({c, false, settled.lines.size(), 0, fit->radii[0],
-                                    fit->radius_variances[0], fit->rms[0]});
-        settled.lines.push_back({item.direction, fit->centre, fit->centre_covariance, kNoRelation,
-                                 middle_along(item.direction, {&c, 1}, points, weights),
-                                 item.covariance});
-      }
-    }
-    for (std::size_t c = 0; c < primitives.size(); ++c) {
-      if (primitives[c].type != PrimitiveType::Sphere || points[c].empty()) continue;
-      const Eigen::Vector3d centre = to_eigen(primitives[c].point);
-      const SphereTerm term{points[c], weights[c], 0};
-      if (const std::optional<JointFit> fit = fit_cylinders_and_spheres(
-              {}, {}, {&centre, 1}, {&primitives[c].radius, 1}, {}, {&term, 1}, true)) {
-        settled.surfaces.push_back({c, true, kNoLine, settled.centres.size(), fit->radii[0],
-                                    fit->covariance(3, 3), fit->rms[0]});
-        settled.centres.push_back(fit->sphere_centres[0]);
-        settled.centre_covariances.emplace_back(fit->covariance.topLeftCorner<3, 3>());
-      }
-    }
+    settle_the_others(items, primitives, points, weights, settled);
     if (options.spheres_on_axes) {
       centre_spheres_on_axes(settled, options, primitives, points, weights, relations);
       line_up_spheres(settled, groups, refitted, options, primitives, points, weights, relations);
@@ -220,19 +280,7 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
   if (options.tangency)
     make_tangent(groups, orthogonal, refitted, options, primitives, points, weights, relations,
                  tangents);
-  std::vector<Relation> right_angles;
-  for (const auto& [i, j] : orthogonal) {
-    if (refitted[i].empty() || refitted[j].empty()) continue;
-    Relation& relation = right_angles.emplace_back();
-    relation.kind = Relation::Kind::Orthogonal;
-    // The group of the lower cluster first.
-    const bool swap = refitted[j].front() < refitted[i].front();
-    relation.members = swap ? refitted[j] : refitted[i];
-    relation.others = swap ? refitted[i] : refitted[j];
-  }
-  std::sort(right_angles.begin(), right_angles.end(), [](const Relation& a, const Relation& b) {
-    return std::tie(a.members, a.others) < std::tie(b.members, b.others);
-  });
+  const std::vector<Relation> right_angles = right_angle_relations(orthogonal, refitted);
   relations.insert(relations.end(), right_angles.begin(), right_angles.end());
   relations.insert(relations.end(), tangents.begin(), tangents.end());
   return relations;
