@@ -392,24 +392,115 @@ bool same_mesh(const Mesh& a, const Mesh& b) {
          a.polygon_vertices == b.polygon_vertices;
 }
 
+struct ViewCommandOptions {
+  std::string mesh_path, output, primitives = "plane,cylinder,sphere";
+  std::optional<std::string> tree_path;
+  std::optional<std::string> clusters;  // K or auto
+  bool skeleton = false;
+  std::optional<std::string> skeleton_clusters;  // K or auto; default: the page's level
+  bool regularize = false;
+  std::optional<std::uint32_t> regularize_clusters;  // default: kRelationClusters
+  RelationChoice relations;
+  double band = SkinningOptions{}.band;
+  unsigned threads = 0;
+  bool quiet = false;
+  ResourceLimits limits;
+};
+// The viewer page embedded at build time and the position of its data marker, or
+// InvalidInputError when this primseg was built without it.
+std::pair<std::string_view, std::size_t> viewer_page() {
+  const std::string_view page = viewer_template();
+  const std::size_t marker = page.find(kViewerDataMarker);
+  if (page.empty() || marker == std::string_view::npos)
+    throw InvalidInputError(
+        "view: this primseg was built without the web viewer (npm was not available). To enable "
+        "it: cd web && npm ci, then configure and build primseg again (CMake bundles web/ with "
+        "esbuild and embeds the page)");
+  return {page, marker};
+}
+
+// The hierarchy of `mesh`: built, or read from --tree and checked to be that mesh's.
+Hierarchy view_hierarchy(const ViewCommandOptions& o, std::shared_ptr<const Mesh> mesh,
+                         const HierarchyOptions& options) {
+  if (!o.tree_path) return HierarchyBuilder(mesh, options).finish(Progress("hierarchy", o.quiet));
+  Hierarchy tree = read_input_tree(*o.tree_path, nullptr, o.limits.max_memory);
+  if (!same_mesh(tree.mesh(), *mesh))
+    throw InvalidInputError("view: the tree from " + input_name(*o.tree_path) +
+                            " was not built from " + input_name(o.mesh_path));
+  return tree;
+}
+
+// The skeleton the page draws: of --skeleton-clusters' level, else of the level it opens at.
+PageSkeleton page_skeleton(const ViewCommandOptions& o, const Mesh& mesh,
+                           const Hierarchy& hierarchy, const Segmentation& opening_level) {
+  const Segmentation bones = o.skeleton_clusters
+                                 ? cut(hierarchy, {o.skeleton_clusters, std::nullopt}).segmentation
+                                 : opening_level;
+  SkinningOptions skinning;
+  skinning.band = o.band;
+  Skeleton extracted = extract_skeleton(hierarchy, bones);
+  SkinWeights weights = compute_skin_weights(mesh, extracted, skinning);
+  return PageSkeleton{std::move(extracted), std::move(weights), o.band};
+}
+
+// Runs `primseg view` with its parsed options.
+void run_view(const ViewCommandOptions& o) {
+  const auto [page, marker] = viewer_page();
+  HierarchyOptions options;
+  options.primitives = parse_primitives(o.primitives);
+  options.threads = o.threads;
+  validate(options);
+  validate_relation_options(o.relations);
+  if (o.tree_path == kStandardInput && o.mesh_path == kStandardInput)
+    throw InvalidInputError("view: only one of MESH and --tree can be standard input ('-')");
+  auto mesh =
+      std::make_shared<const Mesh>(read_geometry_within(o.mesh_path, o.limits, kViewerPageBytes));
+  if (!(std::isfinite(o.band) && o.band >= 0))
+    throw InvalidInputError("--band: must be a finite number >= 0");
+  if (o.clusters) validate_level({o.clusters, std::nullopt}, mesh->face_count());
+  if (o.skeleton_clusters) validate_level({o.skeleton_clusters, std::nullopt}, mesh->face_count());
+  const auto build_start = Clock::now();
+  const Hierarchy hierarchy = view_hierarchy(o, mesh, options);
+  const double build_seconds = seconds_since(build_start);
+  const ChosenLevel level = cut(hierarchy, {o.clusters, std::nullopt});
+  const std::uint32_t initial = level.segmentation.cluster_count();
+  const AutoLevel automatic = level.automatic ? *level.automatic : choose_level(hierarchy);
+  std::optional<PageSkeleton> skeleton;
+  if (o.skeleton || o.skeleton_clusters)
+    skeleton = page_skeleton(o, *mesh, hierarchy, level.segmentation);
+  const std::uint32_t relation_clusters =
+      o.regularize_clusters
+          ? *o.regularize_clusters
+          : (o.regularize ? std::clamp(initial, kRelationClusters, kMaxDefaultRelationClusters)
+                          : 0);
+  std::string html(page.substr(0, marker));
+  double fit_seconds = 0, relations_seconds = 0;
+  html += page_data(hierarchy, input_name(std::filesystem::path(o.mesh_path).filename()), initial,
+                    automatic, skeleton, relation_clusters, o.relations.for_mesh(hierarchy.mesh()),
+                    o.threads, fit_seconds, relations_seconds);
+  html += page.substr(marker + kViewerDataMarker.size());
+  detail::write_file_atomically(o.output, html);
+  if (o.quiet) return;
+  const std::string bones =
+      skeleton ? ", skeleton of " + count_of(skeleton->skeleton.cluster_count(), "bone") : "";
+  char relations[96] = "";
+  if (relation_clusters > 0)
+    std::snprintf(relations, sizeof relations,
+                  ", relations of the levels of up to %u clusters in %.3f s",
+                  std::min(relation_clusters, mesh->face_count()), relations_seconds);
+  std::printf(
+      "%s: %s, hierarchy %s in %.3f s, geometric fits in %.3f s%s; %s: %.1f MB, opens at %s "
+      "(automatic level %u)%s\n",
+      input_name(o.mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
+      o.tree_path ? "read" : "built", build_seconds, fit_seconds, relations, o.output.c_str(),
+      static_cast<double>(html.size()) / 1e6, count_of(initial, "cluster").c_str(),
+      automatic.clusters, bones.c_str());
+}
+
 }  // namespace
 
 Command add_view_command(CLI::App& app) {
-  struct Options {
-    std::string mesh_path, output, primitives = "plane,cylinder,sphere";
-    std::optional<std::string> tree_path;
-    std::optional<std::string> clusters;  // K or auto
-    bool skeleton = false;
-    std::optional<std::string> skeleton_clusters;  // K or auto; default: the page's level
-    bool regularize = false;
-    std::optional<std::uint32_t> regularize_clusters;  // default: kRelationClusters
-    RelationChoice relations;
-    double band = SkinningOptions{}.band;
-    unsigned threads = 0;
-    bool quiet = false;
-    ResourceLimits limits;
-  };
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<ViewCommandOptions>();
   auto* view = app.add_subcommand(
       "view", "Write a self-contained HTML page to browse the whole hierarchy in a browser");
   view->add_option("MESH", o->mesh_path, "Input mesh (.off .obj .ply .stl; - for standard input)")
@@ -452,87 +543,7 @@ Command add_view_command(CLI::App& app) {
   view->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
   add_limit_options(*view, o->limits, kViewBytesPerFace);
 
-  return {
-      view, [o] {
-        const std::string_view page = viewer_template();
-        const std::size_t marker = page.find(kViewerDataMarker);
-        if (page.empty() || marker == std::string_view::npos)
-          throw InvalidInputError(
-              "view: this primseg was built without the web viewer (npm was not available). "
-              "To enable it: cd web && npm ci, then configure and build primseg again "
-              "(CMake bundles web/ with esbuild and embeds the page)");
-        HierarchyOptions options;
-        options.primitives = parse_primitives(o->primitives);
-        options.threads = o->threads;
-        validate(options);
-        validate_relation_options(o->relations);
-        if (o->tree_path == kStandardInput && o->mesh_path == kStandardInput)
-          throw InvalidInputError("view: only one of MESH and --tree can be standard input ('-')");
-        auto mesh = std::make_shared<const Mesh>(
-            read_geometry_within(o->mesh_path, o->limits, kViewerPageBytes));
-        if (!(std::isfinite(o->band) && o->band >= 0))
-          throw InvalidInputError("--band: must be a finite number >= 0");
-        if (o->clusters) validate_level({o->clusters, std::nullopt}, mesh->face_count());
-        if (o->skeleton_clusters)
-          validate_level({o->skeleton_clusters, std::nullopt}, mesh->face_count());
-        const auto build_start = Clock::now();
-        const Hierarchy hierarchy = [&] {
-          if (!o->tree_path)
-            return HierarchyBuilder(mesh, options).finish(Progress("hierarchy", o->quiet));
-          Hierarchy tree = read_input_tree(*o->tree_path, nullptr, o->limits.max_memory);
-          if (!same_mesh(tree.mesh(), *mesh))
-            throw InvalidInputError("view: the tree from " + input_name(*o->tree_path) +
-                                    " was not built from " + input_name(o->mesh_path));
-          return tree;
-        }();
-        const double build_seconds = seconds_since(build_start);
-        const ChosenLevel level = cut(hierarchy, {o->clusters, std::nullopt});
-        const std::uint32_t initial = level.segmentation.cluster_count();
-        const AutoLevel automatic = level.automatic ? *level.automatic : choose_level(hierarchy);
-        std::optional<PageSkeleton> skeleton;
-        if (o->skeleton || o->skeleton_clusters) {
-          const Segmentation bones =
-              o->skeleton_clusters
-                  ? cut(hierarchy, {o->skeleton_clusters, std::nullopt}).segmentation
-                  : level.segmentation;
-          SkinningOptions skinning;
-          skinning.band = o->band;
-          Skeleton extracted = extract_skeleton(hierarchy, bones);
-          SkinWeights weights = compute_skin_weights(*mesh, extracted, skinning);
-          skeleton = PageSkeleton{std::move(extracted), std::move(weights), o->band};
-        }
-        const std::uint32_t relation_clusters =
-            o->regularize_clusters
-                ? *o->regularize_clusters
-                : (o->regularize
-                       ? std::clamp(initial, kRelationClusters, kMaxDefaultRelationClusters)
-                       : 0);
-        std::string html(page.substr(0, marker));
-        double fit_seconds = 0, relations_seconds = 0;
-        html += page_data(hierarchy, input_name(std::filesystem::path(o->mesh_path).filename()),
-                          initial, automatic, skeleton, relation_clusters,
-                          o->relations.for_mesh(hierarchy.mesh()), o->threads, fit_seconds,
-                          relations_seconds);
-        html += page.substr(marker + kViewerDataMarker.size());
-        detail::write_file_atomically(o->output, html);
-        if (!o->quiet) {
-          const std::string bones =
-              skeleton ? ", skeleton of " + count_of(skeleton->skeleton.cluster_count(), "bone")
-                       : "";
-          char relations[96] = "";
-          if (relation_clusters > 0)
-            std::snprintf(relations, sizeof relations,
-                          ", relations of the levels of up to %u clusters in %.3f s",
-                          std::min(relation_clusters, mesh->face_count()), relations_seconds);
-          std::printf(
-              "%s: %s, hierarchy %s in %.3f s, geometric fits in %.3f s%s; %s: %.1f MB, opens "
-              "at %s (automatic level %u)%s\n",
-              input_name(o->mesh_path).c_str(), count_of(mesh->face_count(), "face").c_str(),
-              o->tree_path ? "read" : "built", build_seconds, fit_seconds, relations,
-              o->output.c_str(), static_cast<double>(html.size()) / 1e6,
-              count_of(initial, "cluster").c_str(), automatic.clusters, bones.c_str());
-        }
-      }};
+  return {view, [o] { run_view(*o); }};
 }
 
 }  // namespace primseg::cli

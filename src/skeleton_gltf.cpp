@@ -213,35 +213,35 @@ std::string glb(const json& gltf, const std::string& bin) {
   return out;
 }
 
-}  // namespace
-
-std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWeights& weights,
-                        const GltfOptions& options) {
-  check_inputs(mesh, skeleton, weights);
-  const std::uint32_t k = skeleton.cluster_count();
-  std::vector<std::uint32_t> ends;  // virtual joints, in id order
+// The virtual joints that end a single bone (a limb's tip), in id order: nodes of the skin
+// beyond the bones, so that a viewer draws the last bone's length.
+std::vector<std::uint32_t> end_joints(const Skeleton& skeleton) {
+  std::vector<std::uint32_t> ends;
   for (const Joint& joint : skeleton.joints)
     if (joint.kind == JointKind::Virtual && joint.bones.size() == 1) ends.push_back(joint.id);
-  const std::size_t skin_joints = std::size_t{k} + ends.size();
-  if (skin_joints > kMaxSkinJoints)
+  const std::size_t k = skeleton.cluster_count();
+  if (k + ends.size() > kMaxSkinJoints)
     throw InvalidInputError("glTF skin: " + std::to_string(k) + " bones and " +
                             std::to_string(ends.size()) +
                             " end joints are more than a glTF skin's 16-bit joint indices hold");
+  return ends;
+}
 
-  const BoneTree tree = bone_tree(skeleton);
-  // Each bone turns about its pivot: the joint it hangs from, or its own axis point at a root.
-  std::vector<Vec3> pivots(k);
-  for (std::uint32_t b = 0; b < k; ++b)
+// The point each bone turns about: the joint it hangs from, or its own axis point at a root.
+std::vector<Vec3> bone_pivots(const Skeleton& skeleton, const BoneTree& tree) {
+  std::vector<Vec3> pivots(skeleton.cluster_count());
+  for (std::uint32_t b = 0; b < pivots.size(); ++b)
     pivots[b] = tree.parent_joint[b] == kNone ? skeleton.bones[b].point
                                               : skeleton.joints[tree.parent_joint[b]].position;
+  return pivots;
+}
 
-  // Positions and pivots are written relative to the centre of the bounding box, where the
-  // skeleton node stands: float32 then holds a part far from the origin (a scan in survey
-  // coordinates) as finely as one at it.
+// The mesh primitive's attributes (positions relative to `origin`, normals, joints and weights
+// of each influence set) appended to `buffer`, by attribute name.
+json add_vertex_attributes(BufferBuilder& buffer, const Mesh& mesh, const Vec3& origin,
+                           const std::vector<Triangle>& triangles,
+                           const std::vector<InfluenceSet>& sets) {
   const std::uint32_t n = mesh.vertex_count();
-  const Vec3 origin = bounding_box_centre(mesh);
-
-  BufferBuilder buffer;
   std::vector<float> positions(3 * std::size_t{n});
   std::array<float, 3> low{}, high{};
   for (std::size_t v = 0; v < n; ++v)
@@ -251,39 +251,31 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
       low[i] = v == 0 ? x : std::min(low[i], x);
       high[i] = v == 0 ? x : std::max(high[i], x);
     }
-  json primitive_attributes;
-  primitive_attributes["POSITION"] =
-      buffer.add(positions, n, "VEC3", kFloat, kArrayBuffer,
-                 {{"min", json::array({low[0], low[1], low[2]})},
-                  {"max", json::array({high[0], high[1], high[2]})}});
-  const std::vector<Triangle> triangles = oriented_triangles(mesh);
-  const auto normals = vertex_normals(mesh, triangles);
-  primitive_attributes["NORMAL"] = buffer.add(normals, n, "VEC3", kFloat, kArrayBuffer);
-
-  const std::vector<InfluenceSet> sets =
-      influence_sets(weights, skeleton.root_bone(), options.max_influences);
+  json attributes;
+  attributes["POSITION"] = buffer.add(positions, n, "VEC3", kFloat, kArrayBuffer,
+                                      {{"min", json::array({low[0], low[1], low[2]})},
+                                       {"max", json::array({high[0], high[1], high[2]})}});
+  attributes["NORMAL"] =
+      buffer.add(vertex_normals(mesh, triangles), n, "VEC3", kFloat, kArrayBuffer);
   for (std::size_t set = 0; set < sets.size(); ++set) {
     // (Appended, not "_" + to_string(): g++ 12 warns falsely on that, -Wrestrict.)
     std::string joints_name = "JOINTS_", weights_name = "WEIGHTS_";
     joints_name += std::to_string(set);
     weights_name += std::to_string(set);
-    primitive_attributes[joints_name] =
-        buffer.add(sets[set].joints, n, "VEC4", kUnsignedShort, kArrayBuffer);
-    primitive_attributes[weights_name] =
-        buffer.add(sets[set].weights, n, "VEC4", kFloat, kArrayBuffer);
+    attributes[joints_name] = buffer.add(sets[set].joints, n, "VEC4", kUnsignedShort, kArrayBuffer);
+    attributes[weights_name] = buffer.add(sets[set].weights, n, "VEC4", kFloat, kArrayBuffer);
   }
+  return attributes;
+}
 
-  std::vector<std::uint32_t> indices;
-  indices.reserve(3 * mesh.triangles.size());
-  for (const Triangle& t : triangles) indices.insert(indices.end(), t.begin(), t.end());
-  const std::size_t index_accessor =
-      buffer.add(indices, indices.size(), "SCALAR", kUnsignedInt, kElementArrayBuffer);
-
-  // Inverse bind matrices (column-major): the rest pose has every node unrotated, so each one
-  // only moves its joint's rest position (relative to the centre, as the positions are) to the
-  // origin.
+// The inverse bind matrices (column-major) of the bones' pivots, then of the end joints: the
+// rest pose has every node unrotated, so each one only moves its joint's rest position (relative
+// to `origin`, as the positions are) to the origin. Returns the accessor's index.
+std::size_t add_inverse_binds(BufferBuilder& buffer, const Skeleton& skeleton,
+                              const std::vector<Vec3>& pivots,
+                              const std::vector<std::uint32_t>& ends, const Vec3& origin) {
   std::vector<float> inverse_binds;
-  inverse_binds.reserve(16 * skin_joints);
+  inverse_binds.reserve(16 * (pivots.size() + ends.size()));
   const auto add_inverse_bind = [&inverse_binds](const Vec3& at) {
     const float matrix[16] = {1,
                               0,
@@ -303,12 +295,18 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
                               1};
     inverse_binds.insert(inverse_binds.end(), matrix, matrix + 16);
   };
-  for (std::uint32_t b = 0; b < k; ++b) add_inverse_bind(pivots[b] - origin);
+  for (const Vec3& pivot : pivots) add_inverse_bind(pivot - origin);
   for (const std::uint32_t j : ends) add_inverse_bind(skeleton.joints[j].position - origin);
-  const std::size_t inverse_bind_accessor =
-      buffer.add(inverse_binds, skin_joints, "MAT4", kFloat, std::nullopt);
+  return buffer.add(inverse_binds, pivots.size() + ends.size(), "MAT4", kFloat, std::nullopt);
+}
 
-  constexpr std::size_t kFirstBoneNode = 2;
+constexpr std::size_t kFirstBoneNode = 2;
+
+// The scene's nodes: the mesh, the skeleton at `origin`, one node per bone at its pivot
+// (relative to its parent's), then one per end joint, children in node order.
+json skeleton_nodes(const Skeleton& skeleton, const BoneTree& tree, const std::vector<Vec3>& pivots,
+                    const std::vector<std::uint32_t>& ends, const Vec3& origin) {
+  const std::uint32_t k = skeleton.cluster_count();
   json nodes = json::array();
   nodes.push_back({{"name", "mesh"}, {"mesh", 0}, {"skin", 0}});
   nodes.push_back(
@@ -325,8 +323,8 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
                      {"extras", std::move(extras)}});
     if (parent == kNone) nodes[1]["children"].push_back(kFirstBoneNode + b);
   }
-  for (std::size_t e = 0; e < ends.size(); ++e) {
-    const Joint& joint = skeleton.joints[ends[e]];
+  for (const std::uint32_t end : ends) {
+    const Joint& joint = skeleton.joints[end];
     const std::uint32_t bone = joint.bones[0];
     nodes.push_back({{"name", "end_" + std::to_string(joint.id)},
                      {"translation", vec3_json(joint.position - pivots[bone])},
@@ -339,17 +337,45 @@ std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWe
   for (std::size_t e = 0; e < ends.size(); ++e)
     nodes[kFirstBoneNode + skeleton.joints[ends[e]].bones[0]]["children"].push_back(kFirstBoneNode +
                                                                                     k + e);
+  return nodes;
+}
+
+}  // namespace
+
+std::string skinned_glb(const Mesh& mesh, const Skeleton& skeleton, const SkinWeights& weights,
+                        const GltfOptions& options) {
+  check_inputs(mesh, skeleton, weights);
+  const std::vector<std::uint32_t> ends = end_joints(skeleton);
+  const std::size_t skin_joints = std::size_t{skeleton.cluster_count()} + ends.size();
+  const BoneTree tree = bone_tree(skeleton);
+  const std::vector<Vec3> pivots = bone_pivots(skeleton, tree);
+  // Positions and pivots are written relative to the centre of the bounding box, where the
+  // skeleton node stands: float32 then holds a part far from the origin (a scan in survey
+  // coordinates) as finely as one at it.
+  const Vec3 origin = bounding_box_centre(mesh);
+
+  BufferBuilder buffer;
+  const std::vector<Triangle> triangles = oriented_triangles(mesh);
+  const json attributes =
+      add_vertex_attributes(buffer, mesh, origin, triangles,
+                            influence_sets(weights, skeleton.root_bone(), options.max_influences));
+  std::vector<std::uint32_t> indices;
+  indices.reserve(3 * mesh.triangles.size());
+  for (const Triangle& t : triangles) indices.insert(indices.end(), t.begin(), t.end());
+  const std::size_t index_accessor =
+      buffer.add(indices, indices.size(), "SCALAR", kUnsignedInt, kElementArrayBuffer);
+  const std::size_t inverse_bind_accessor =
+      add_inverse_binds(buffer, skeleton, pivots, ends, origin);
 
   json skin_joint_nodes = json::array();
   for (std::size_t i = 0; i < skin_joints; ++i) skin_joint_nodes.push_back(kFirstBoneNode + i);
-
   json gltf;
   gltf["asset"] = {{"version", "2.0"}, {"generator", "primseg"}};
   gltf["scene"] = 0;
   gltf["scenes"] = json::array({{{"nodes", json::array({0, 1})}}});
-  gltf["nodes"] = std::move(nodes);
+  gltf["nodes"] = skeleton_nodes(skeleton, tree, pivots, ends, origin);
   gltf["meshes"] = json::array({{{"name", "mesh"},
-                                 {"primitives", json::array({{{"attributes", primitive_attributes},
+                                 {"primitives", json::array({{{"attributes", attributes},
                                                               {"indices", index_accessor},
                                                               {"mode", kTriangles}}})}}});
   gltf["skins"] = json::array({{{"joints", std::move(skin_joint_nodes)},
