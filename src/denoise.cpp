@@ -575,12 +575,22 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
     throw InvalidInputError("denoise: the segmentation has " +
                             std::to_string(segmentation.labels.size()) + " labels for " +
                             std::to_string(mesh_.face_count()) + " faces");
+  Segmentation labelled;
+  const std::vector<Primitive> primitives = snap_primitives(hierarchy, segmentation, labelled);
+  SnapReport report = move_vertices(labelled, primitives);
+  report.clusters = static_cast<std::uint32_t>(snapped_level_.clusters.size());
+  return report;
+}
+
+std::vector<Primitive> Denoiser::snap_primitives(const Hierarchy& hierarchy,
+                                                 const Segmentation& level,
+                                                 Segmentation& labelled) {
   const std::vector<Primitive> hierarchy_fits =
-      cluster_primitives(describe_clusters(hierarchy, segmentation));
+      cluster_primitives(describe_clusters(hierarchy, level));
   std::vector<Primitive> primitives = hierarchy_fits;
-  if (options_.refit_outlier_threshold > 0) refit(segmentation, primitives);
-  Segmentation labelled = segmentation;
-  relabel(segmented, primitives, labelled);
+  if (options_.refit_outlier_threshold > 0) refit(level, primitives);
+  labelled = level;
+  relabel(hierarchy.mesh(), primitives, labelled);
   // The vertices of each final cluster, for the relations and the snapped level's reports.
   std::vector<std::vector<Vec3>> points;
   std::vector<std::vector<double>> weights;
@@ -588,49 +598,50 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   std::vector<ClusterRelation> relations;
   if (options_.relation_significance > 0 && options_.refit_outlier_threshold > 0)
     relations = regularize(points, weights, primitives);
-  snapped_level_ = describe_snap(segmentation, labelled, points, weights, hierarchy_fits,
-                                 primitives, std::move(relations));
+  snapped_level_ = describe_snap(level, labelled, points, weights, hierarchy_fits, primitives,
+                                 std::move(relations));
+  return primitives;
+}
 
+void Denoiser::incident_clusters(std::uint32_t v, const Segmentation& labelled,
+                                 const std::vector<Primitive>& primitives, const Vec3& position,
+                                 std::vector<std::uint32_t>& clusters) const {
+  clusters.clear();
+  for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i)
+    clusters.push_back(labelled.labels[mesh_.face_of_triangle[vertex_triangles_[i]]]);
+  std::sort(clusters.begin(), clusters.end());
+  clusters.erase(std::unique(clusters.begin(), clusters.end()), clusters.end());
+  std::vector<std::pair<double, std::uint32_t>> by_distance;
+  by_distance.reserve(clusters.size());
+  for (const std::uint32_t c : clusters)
+    by_distance.emplace_back(primitives[c].distance(position), c);
+  std::sort(by_distance.begin(), by_distance.end());
+  for (std::size_t i = 0; i < by_distance.size(); ++i) clusters[i] = by_distance[i].second;
+}
+
+bool Denoiser::keeps_orientation(std::uint32_t v, const Vec3& target) const {
+  for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i) {
+    const std::uint32_t t = vertex_triangles_[i];
+    std::array<Eigen::Vector3d, 3> corner;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = mesh_.triangles[t][k];
+      corner[k] = to_eigen(u == v ? target : mesh_.positions[u]);
+    }
+    if (triangle_normal(corner[0], corner[1], corner[2]).dot(to_eigen(input_normals_[t])) < 0)
+      return false;
+  }
+  return true;
+}
+
+SnapReport Denoiser::move_vertices(const Segmentation& labelled,
+                                   const std::vector<Primitive>& primitives) {
   SnapReport report;
-  report.clusters = static_cast<std::uint32_t>(snapped_level_.clusters.size());
   const double eigenvalue_ratio =
       std::pow(std::tan(options_.min_crease_angle_degrees * std::numbers::pi / 360), 2);
   const bool bounded =
       options_.mode == SnapMode::AllIncident && std::isfinite(options_.max_move_edge_lengths);
   const std::vector<Vec3> start = mesh_.positions;
   estimate_copy_.set(nullptr);  // of positions about to move
-
-  // Candidate targets of a vertex, most preferred first: all incident primitives, then without
-  // the farthest one, and so on down to the nearest alone.
-  auto candidates = [&](std::uint32_t v, std::vector<std::uint32_t>& clusters) {
-    clusters.clear();
-    for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i)
-      clusters.push_back(labelled.labels[mesh_.face_of_triangle[vertex_triangles_[i]]]);
-    std::sort(clusters.begin(), clusters.end());
-    clusters.erase(std::unique(clusters.begin(), clusters.end()), clusters.end());
-    std::vector<std::pair<double, std::uint32_t>> by_distance;
-    by_distance.reserve(clusters.size());
-    for (const std::uint32_t c : clusters)
-      by_distance.emplace_back(primitives[c].distance(start[v]), c);
-    std::sort(by_distance.begin(), by_distance.end());
-    for (std::size_t i = 0; i < by_distance.size(); ++i) clusters[i] = by_distance[i].second;
-  };
-
-  // True when moving v to `target` inverts none of its triangles (against the input's
-  // orientation; a triangle flattened to zero area is allowed).
-  auto keeps_orientation = [&](std::uint32_t v, const Eigen::Vector3d& target) {
-    for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i) {
-      const std::uint32_t t = vertex_triangles_[i];
-      std::array<Eigen::Vector3d, 3> corner;
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t u = mesh_.triangles[t][k];
-        corner[k] = u == v ? target : to_eigen(mesh_.positions[u]);
-      }
-      if (triangle_normal(corner[0], corner[1], corner[2]).dot(to_eigen(input_normals_[t])) < 0)
-        return false;
-    }
-    return true;
-  };
 
   constexpr double kRoundOffMove = 1e-12;
   const std::uint32_t n = mesh_.vertex_count();
@@ -644,7 +655,7 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
       settled[v] = 2;
       continue;
     }
-    candidates(v, clusters);
+    incident_clusters(v, labelled, primitives, start[v], clusters);
     incident_count[v] = static_cast<std::uint32_t>(clusters.size());
     (clusters.size() == 1 ? report.interior_vertices : report.boundary_vertices)++;
   }
@@ -656,7 +667,7 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
     bool changed = false;
     for (std::uint32_t v = 0; v < n; ++v) {
       if (settled[v]) continue;
-      candidates(v, clusters);
+      incident_clusters(v, labelled, primitives, start[v], clusters);
       const std::size_t most = options_.mode == SnapMode::AllIncident ? clusters.size() : 1;
       const Eigen::Vector3d x = to_eigen(start[v]);
       const double bound = options_.max_move_edge_lengths * local_edge_length_[v];
@@ -672,7 +683,7 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
             kRoundOffMove * (local_edge_length_[v] + x.lpNorm<Eigen::Infinity>()))
           target = x;
         if (!target.allFinite() || (bounded && (target - x).norm() > bound) ||
-            !keeps_orientation(v, target))
+            !keeps_orientation(v, to_vec3(target)))
           continue;
         mesh_.positions[v] = to_vec3(target);
         settled[v] = 1;

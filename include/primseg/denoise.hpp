@@ -89,13 +89,13 @@ struct DenoiseOptions {
   /// spheres centred on such a line are centred on it. The members are refitted on their inliers
   /// (regularize_clusters() does the same for a level's fits, and also gives cylinders and
   /// spheres of equal radius one radius, and the fragments of one face one plane, which do not
-  /// lower a snap's error and are left out here). A relation of the part (opposite faces of a box, a cylinder and its caps, a stepped
-  /// shaft, a ball end, a box's corner) then costs one direction or one axis instead of one per
-  /// primitive, which lowers what the fits leave of the noise: the generated noisy box and
-  /// capped cylinder on their true regions (edges 2% of the diagonal) 12.0x → 18.0x and 13.5x →
-  /// 23.9x lower RMS; fandisk with 0.3% noise on the clean mesh's 30 clusters 5.5x → 6.7x, at
-  /// the automatic level 3.79x → 4.07x. Needs the refit (refit_outlier_threshold > 0). 0
-  /// disables. >= 0.
+  /// lower a snap's error and are left out here). A relation of the part (opposite faces of a box,
+  /// a cylinder and its caps, a stepped shaft, a ball end, a box's corner) then costs one direction
+  /// or one axis instead of one per primitive, which lowers what the fits leave of the noise: the
+  /// generated noisy box and capped cylinder on their true regions (edges 2% of the diagonal) 12.0x
+  /// → 18.0x and 13.5x → 23.9x lower RMS; fandisk with 0.3% noise on the clean mesh's 30
+  /// clusters 5.5x → 6.7x, at the automatic level 3.79x → 4.07x. Needs the refit
+  /// (refit_outlier_threshold > 0). 0 disables. >= 0.
   double relation_significance = 3.0;
   /// The automatic level (Denoiser::automatic_level) cuts a hierarchy without a significant jump
   /// at this multiple of the noise estimate (estimate_noise). Unset: by the copy that is
@@ -222,6 +222,21 @@ class Denoiser {
   const SnappedLevel& snapped_level() const { return snapped_level_; }
 
  private:
+  // snap()'s primitives: the hierarchy's fits of `level`'s clusters refitted on their vertices,
+  // the faces relabelled into `labelled`, the relations made exact; sets snapped_level_.
+  std::vector<Primitive> snap_primitives(const Hierarchy& hierarchy, const Segmentation& level,
+                                         Segmentation& labelled);
+  // Moves every vertex onto the primitives of its clusters in `labelled`, within the safeguards.
+  // The report's cluster count is left to the caller.
+  SnapReport move_vertices(const Segmentation& labelled, const std::vector<Primitive>& primitives);
+  // The clusters of v's triangles in `labelled`, nearest primitive to `position` first: the
+  // targets of a snap, most preferred first, down to the nearest alone.
+  void incident_clusters(std::uint32_t v, const Segmentation& labelled,
+                         const std::vector<Primitive>& primitives, const Vec3& position,
+                         std::vector<std::uint32_t>& clusters) const;
+  // True when moving v to `target` inverts none of its triangles (against the input's
+  // orientation; a triangle flattened to zero area is allowed).
+  bool keeps_orientation(std::uint32_t v, const Vec3& target) const;
   void refit(const Segmentation& segmentation, std::vector<Primitive>& primitives) const;
   // The snap's clusters (snapped_level) on the current positions, before they move.
   // `points` and `weights` are cluster_vertices() of `relabelled`.
