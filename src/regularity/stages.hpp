@@ -434,6 +434,54 @@ struct CircleContact {
 };
 CircleContact nearest_circle_contact(double distance, double radius, double held);
 
+/// Member i of a line tangent to a held cylinder of the same direction, whose axis is at `centre`
+/// (orthonormal_pair(direction) coordinates) and whose radius is R: |c − centre| = partner_sign · R
+/// + own_sign · rᵢ. (+1, +1): each outside the other (a fillet around a boss); (+1, −1): inside the
+/// held one (a fillet in a bore); (−1, +1): around it.
+struct CircleHold {
+  Eigen::Vector2d centre;
+  double radius = 0, partner_sign = 1, own_sign = 1;
+  Eigen::Index member = 2;  ///< rᵢ's index in y
+};
+
+/// A condition on cylinders of fixed direction on one axis line, on y = (c, r₀, r₁, …): the line's
+/// position c in orthonormal_pair(direction) coordinates and each member's radius. Linear ones are
+/// row · y = target. Member i tangent to a plane of unit normal n (orthogonal to the axis; (n·u,
+/// n·v) in those coordinates) and offset n · x = o, with the axis on `side` (±1) of it: row = (n·u,
+/// n·v, 0, …, −side at rᵢ, …), target = o. Member i of a given radius (shared with others of equal
+/// radius off the line): row = e(rᵢ), target = r. Members i and j of one radius: row = e(rᵢ) −
+/// e(rⱼ), target = 0. Member i tangent to a parallel cylinder: `circle`, and `row` and `target` its
+/// linearisation at the y it was tested at (linearised()).
+struct LineHold {
+  Eigen::VectorXd row;
+  double target = 0;
+  std::optional<CircleHold> circle;
+};
+
+/// fit_held_line()'s result.
+struct HeldLineFit {
+  Eigen::VectorXd y;  ///< (c, r₀, r₁, …), as LineHold's
+  double rms = 0;     ///< unweighted, over every member's points, at least kResolution × a radius
+  std::size_t free = 0;        ///< the parameters − the number of holds
+  std::size_t count = 0;       ///< points
+  Eigen::MatrixXd covariance;  ///< of y, from the unweighted residuals; rank `free`
+};
+
+/// The cylinders `members` of axis direction `direction`, on one line, fitted to their points by
+/// geometric least squares (weighted residuals |Q(x − c)| − rᵢ) subject to `holds` (at most as
+/// many as the parameters, 2 + the members): Gauss–Newton over the free coordinates z of y = y₀ +
+/// N z, y₀ the start (`centre` and the members' radii) projected onto the holds and N an
+/// orthonormal basis of their rows' null space. A circle's hold is linearised again at every step,
+/// y projected onto it again and N formed again (a Newton step on the condition, then one of
+/// Gauss–Newton along it: a fixed point meets the condition and is stationary along it). Nothing
+/// when the holds are (nearly) dependent (one plane twice, parallel planes on one side of the
+/// axis), the iteration does not converge in 50 steps, a radius ends non-positive or the points do
+/// not outnumber the free parameters.
+std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
+                                         const Eigen::Vector2d& centre,
+                                         std::span<const CoaxialMember> members,
+                                         std::span<const LineHold> holds);
+
 /// The tangency stage of regularize() (RegularityOptions::tangency): cylinders held tangent to
 /// the planes and the larger parallel cylinders they border, from the direction `groups`, the
 /// pairs of them made `orthogonal`, the clusters each group `refitted`, and the `relations` made so

@@ -35,30 +35,6 @@ CircleContact nearest_circle_contact(double distance, double radius, double held
 
 namespace {
 
-// Member i of a line tangent to a held cylinder of the same direction, whose axis is at `centre`
-// (orthonormal_pair(direction) coordinates) and whose radius is R: |c − centre| = partner_sign · R
-// + own_sign · rᵢ. (+1, +1): each outside the other (a fillet around a boss); (+1, −1): inside the
-// held one (a fillet in a bore); (−1, +1): around it.
-struct CircleHold {
-  Eigen::Vector2d centre;
-  double radius = 0, partner_sign = 1, own_sign = 1;
-  Eigen::Index member = 2;  // rᵢ's index in y
-};
-
-// A condition on cylinders of fixed direction on one axis line, on y = (c, r₀, r₁, …): the line's
-// position c in orthonormal_pair(direction) coordinates and each member's radius. Linear ones are
-// row · y = target. Member i tangent to a plane of unit normal n (orthogonal to the axis; (n·u,
-// n·v) in those coordinates) and offset n · x = o, with the axis on `side` (±1) of it: row = (n·u,
-// n·v, 0, …, −side at rᵢ, …), target = o. Member i of a given radius (shared with others of equal
-// radius off the line): row = e(rᵢ), target = r. Members i and j of one radius: row = e(rᵢ) −
-// e(rⱼ), target = 0. Member i tangent to a parallel cylinder: `circle`, and `row` and `target` its
-// linearisation at the y it was tested at (linearised()).
-struct LineHold {
-  Eigen::VectorXd row;
-  double target = 0;
-  std::optional<CircleHold> circle;
-};
-
 // `hold` as a linear condition at y: itself, or a circle's tangent plane there (row · y − target
 // is the circle's own excess |c − centre| − partner_sign · R − own_sign · rᵢ at y).
 LineHold linearised(const LineHold& hold, const Eigen::VectorXd& y) {
@@ -77,128 +53,6 @@ LineHold linearised(const LineHold& hold, const Eigen::VectorXd& y) {
 
 // Round-off of a condition its holds imply, relative to the row or the radius.
 constexpr double kImplied = 1e-9;
-
-struct HeldLineFit {
-  Eigen::VectorXd y;     // (c, r₀, r₁, …)
-  double rms = 0;        // unweighted, over every member's points, at least kResolution × a radius
-  std::size_t free = 0;  // the parameters − the number of holds
-  std::size_t count = 0;       // points
-  Eigen::MatrixXd covariance;  // of y, from the unweighted residuals
-};
-
-// The cylinders `members` of axis direction `direction`, on one line, fitted to their points by
-// geometric least squares (weighted residuals |Q(x − c)| − rᵢ) subject to `holds` (at most as
-// many as the parameters, 2 + the members): Gauss–Newton over the free coordinates z of y = y₀ +
-// N z, y₀ the start (`centre` and the members' radii) projected onto the holds and N an
-// orthonormal basis of their rows' null space. A circle's hold is linearised again at every step,
-// y projected onto it again and N formed again (a Newton step on the condition, then one of
-// Gauss–Newton along it: a fixed point meets the condition and is stationary along it). Nothing
-// when the holds are (nearly) dependent (one plane twice, parallel planes on one side of the
-// axis), the iteration does not converge in 50 steps, a radius ends non-positive or the points do
-// not outnumber the free parameters.
-std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
-                                         const Eigen::Vector2d& centre,
-                                         std::span<const CoaxialMember> members,
-                                         std::span<const LineHold> holds) {
-  const Eigen::Index size = 2 + static_cast<Eigen::Index>(members.size());
-  const Eigen::Index k = static_cast<Eigen::Index>(holds.size());
-  std::size_t count = 0;
-  double largest_radius = 0;
-  for (const CoaxialMember& member : members) {
-    count += member.points.size();
-    largest_radius = std::max(largest_radius, member.radius);
-  }
-  if (k > size || count <= static_cast<std::size_t>(size - k)) return std::nullopt;
-  Eigen::VectorXd y(size);
-  y.head<2>() = centre;
-  for (Eigen::Index i = 2; i < size; ++i) y(i) = members[static_cast<std::size_t>(i - 2)].radius;
-  const bool curved = std::any_of(holds.begin(), holds.end(),
-                                  [](const LineHold& hold) { return hold.circle.has_value(); });
-  Eigen::MatrixXd basis = Eigen::MatrixXd::Identity(size, size), basis_rows = basis;
-  double violation = 0;  // how far y was from the holds, linearised, before their last projection
-  // Projects y onto the holds (linearised at y) and forms the basis of their null space; false
-  // when they are (nearly) dependent: their rows' Gram determinant, normalised (1 for orthogonal
-  // rows, 0 for dependent ones), at most 1e-12.
-  const auto constrain = [&] {
-    if (k == 0) return true;
-    Eigen::MatrixXd rows(size, k);
-    Eigen::VectorXd excess(k);
-    double norms = 1;
-    for (Eigen::Index i = 0; i < k; ++i) {
-      const LineHold hold = linearised(holds[static_cast<std::size_t>(i)], y);
-      rows.col(i) = hold.row;
-      excess(i) = hold.row.dot(y) - hold.target;
-      norms *= hold.row.squaredNorm();
-    }
-    const Eigen::MatrixXd gram = rows.transpose() * rows;
-    if (!(gram.determinant() > 1e-12 * norms)) return false;
-    violation = excess.norm();
-    y -= rows * gram.ldlt().solve(excess);
-    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(rows);
-    basis = (qr.householderQ() * Eigen::MatrixXd::Identity(size, size)).rightCols(size - k);
-    basis_rows = basis.transpose();
-    return true;
-  };
-  if (!constrain()) return std::nullopt;
-  const Eigen::Index free = size - k;
-  const auto [u, v] = orthonormal_pair(direction);
-  std::vector<std::vector<Eigen::Vector2d>> projected(members.size());
-  for (std::size_t m = 0; m < members.size(); ++m)
-    for (const Vec3& p : members[m].points)
-      projected[m].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
-  // Σ w e² and its Gauss–Newton system in z (weighted or not); returns the unweighted Σ e².
-  Eigen::MatrixXd normal(free, free);
-  Eigen::VectorXd gradient(free);
-  Eigen::VectorXd row(free);  // a residual's derivative in z
-  auto linearise = [&](bool weighted) {
-    normal.setZero();
-    gradient.setZero();
-    double squares = 0;
-    for (std::size_t m = 0; m < members.size(); ++m)
-      for (std::size_t i = 0; i < projected[m].size(); ++i) {
-        const Eigen::Vector2d d = projected[m][i] - y.head<2>();
-        const double length = d.norm();
-        if (!(length > 0)) continue;
-        const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-        const double e = length - y(radius), w = weighted ? members[m].weights[i] : 1.0;
-        row.noalias() = -(d.x() / length) * basis_rows.col(0) -
-                        (d.y() / length) * basis_rows.col(1) - basis_rows.col(radius);
-        normal.noalias() += w * row * row.transpose();
-        gradient.noalias() += (w * e) * row;
-        squares += e * e;
-      }
-    return squares;
-  };
-  bool converged = free == 0 && !curved;
-  for (int step = 0; step < 50 && !converged; ++step) {
-    // A circle's hold linearised again, and y projected onto it: settled once y was on it.
-    const bool projected_again = curved && step > 0;
-    if (projected_again && !constrain()) return std::nullopt;
-    const bool on_holds = !projected_again || !(violation > 1e-14 * y.norm());
-    if (free == 0) {
-      converged = projected_again && on_holds;
-      continue;
-    }
-    linearise(true);
-    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
-    if (!delta.allFinite()) return std::nullopt;
-    const Eigen::VectorXd move = basis * delta;
-    y += move;
-    converged = !(move.norm() > 1e-14 * y.norm()) && on_holds;
-  }
-  if (!converged || !y.allFinite() || !(y.tail(size - 2).minCoeff() > 0)) return std::nullopt;
-  const double squares = linearise(false);
-  HeldLineFit fit{y, 0, static_cast<std::size_t>(free), count, Eigen::MatrixXd::Zero(size, size)};
-  const double n = static_cast<double>(count);
-  fit.rms = std::max(std::sqrt(squares / n), kResolution * largest_radius);
-  if (free > 0) {
-    const double variance = std::max(squares / (n - static_cast<double>(free)),
-                                     kResolution * kResolution * largest_radius * largest_radius);
-    fit.covariance = basis * normal.inverse() * basis.transpose() * variance;
-    if (!fit.covariance.allFinite()) return std::nullopt;
-  }
-  return fit;
-}
 
 // Whether `row` is a combination of the holds' rows (linearised at y), to round-off.
 bool implied_by(std::span<const LineHold> holds, const Eigen::VectorXd& row,
@@ -310,7 +164,8 @@ class Tangency {
                        const std::vector<std::vector<std::size_t>>& refitted);
   // Each candidate's contact lines with the surfaces it borders, and their bands.
   void find_contacts();
-  // Each bordered plane's offset from its points beyond every candidate cylinder's band.
+  // Each bordered plane's offset from its points beyond every candidate cylinder's band, and its
+  // variance.
   void fit_plane_offsets();
   // The lines to hold, in the order they are processed.
   std::vector<TangentLine> lines_in_order();
@@ -342,7 +197,13 @@ class Tangency {
   std::map<std::size_t, TangentCandidate> candidates_;
   std::map<std::size_t, std::vector<Vec3>> sorted_points_;  // of candidate planes and partners
   std::vector<Contact> contacts_;
-  std::map<std::size_t, double> offsets_;  // each bordered plane's
+  // Each bordered plane's offset, and its variance (aligned_plane()'s of the points it is fitted
+  // from: for a plane of a coplanar set, which keeps the set's offset, its own points, whose
+  // offset is known less well than the set's).
+  struct HeldOffset {
+    double offset = 0, variance = 0;
+  };
+  std::map<std::size_t, HeldOffset> offsets_;
   std::vector<bool> on_a_line_, settled_, moved_;
   std::map<std::size_t, std::optional<HeldLineFit>> partner_fits_;  // fitted once, alone
 };
@@ -470,21 +331,30 @@ void Tangency::fit_plane_offsets() {
   std::map<std::size_t, std::vector<const Contact*>> contacts_of_plane;
   for (const Contact& contact : contacts_)
     if (contact.with_plane()) contacts_of_plane[contact.other].push_back(&contact);
+  std::vector<Vec3> kept;
+  std::vector<double> kept_weights;
   for (const auto& [p, bordering] : contacts_of_plane) {
     const Eigen::Vector3d normal = to_eigen(primitives_[p].axis);
-    double& offset = offsets_[p] = normal.dot(to_eigen(primitives_[p].point));
-    if (shares_offset_[p]) continue;
+    HeldOffset& held = offsets_[p];
+    held.offset = normal.dot(to_eigen(primitives_[p].point));
+    kept.clear();
+    kept_weights.clear();
     double total = 0, sum = 0;
     for (std::size_t i = 0; i < points_[p].size(); ++i) {
       const Vec3& x = points_[p][i];  // not the binding p: clang 14 refuses it in a lambda
-      if (std::any_of(bordering.begin(), bordering.end(), [&](const Contact* contact) {
+      if (!shares_offset_[p] &&
+          std::any_of(bordering.begin(), bordering.end(), [&](const Contact* contact) {
             return across_contact(*contact, x) > -contact->band;
           }))
         continue;
+      kept.push_back(x);
+      kept_weights.push_back(weights_[p][i]);
       total += weights_[p][i];
       sum += weights_[p][i] * normal.dot(to_eigen(x));
     }
-    if (total > 0) offset = sum / total;
+    if (!shares_offset_[p] && total > 0) held.offset = sum / total;
+    if (const std::optional<AlignedPlane> plane = aligned_plane(p, normal, kept, kept_weights))
+      held.variance = plane->variance;
   }
 }
 
@@ -591,14 +461,16 @@ std::vector<TestedContact> Tangency::tested_contacts(const TangentLine& line,
     const Primitive& other = primitives_[contact->other];
     if (contact->with_plane()) {
       const Eigen::Vector3d normal = to_eigen(other.axis);
-      const double offset = offsets_.at(contact->other);
+      const HeldOffset& held = offsets_.at(contact->other);
+      const double offset = held.offset;
       const Eigen::Vector2d normal_in_frame = in_frame(frame, normal);
       const double distance = normal_in_frame.dot(own.y.head<2>()) - offset;
       hold.target = offset;
       hold.row.head<2>() = normal_in_frame;
       hold.row(radius) = distance < 0 ? 1 : -1;
       gap = std::abs(distance) - r;
-      variance = hold.row.dot(own.covariance * hold.row);
+      // The plane's offset is uncertain too, as the held cylinder's fit below.
+      variance = hold.row.dot(own.covariance * hold.row) + held.variance;
     } else {
       // The held cylinder's axis and radius are uncertain too: its own fit's covariance counts.
       const Eigen::Vector2d centre = in_frame(frame, to_eigen(other.point));
@@ -700,15 +572,119 @@ void Tangency::hold_tangent(const TangentLine& line, std::vector<Relation>& tang
 }
 
 void Tangency::write_plane_offsets() {
-  for (const auto& [p, offset] : offsets_) {
+  for (const auto& [p, held] : offsets_) {
     if (!moved_[p]) continue;
     const Eigen::Vector3d normal = to_eigen(primitives_[p].axis);
     const Eigen::Vector3d point = to_eigen(primitives_[p].point);
-    primitives_[p].point = to_vec3(point + (offset - normal.dot(point)) * normal);
+    primitives_[p].point = to_vec3(point + (held.offset - normal.dot(point)) * normal);
   }
 }
 
 }  // namespace
+
+std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
+                                         const Eigen::Vector2d& centre,
+                                         std::span<const CoaxialMember> members,
+                                         std::span<const LineHold> holds) {
+  const Eigen::Index size = 2 + static_cast<Eigen::Index>(members.size());
+  const Eigen::Index k = static_cast<Eigen::Index>(holds.size());
+  std::size_t count = 0;
+  double largest_radius = 0;
+  for (const CoaxialMember& member : members) {
+    count += member.points.size();
+    largest_radius = std::max(largest_radius, member.radius);
+  }
+  if (k > size || count <= static_cast<std::size_t>(size - k)) return std::nullopt;
+  Eigen::VectorXd y(size);
+  y.head<2>() = centre;
+  for (Eigen::Index i = 2; i < size; ++i) y(i) = members[static_cast<std::size_t>(i - 2)].radius;
+  const bool curved = std::any_of(holds.begin(), holds.end(),
+                                  [](const LineHold& hold) { return hold.circle.has_value(); });
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Identity(size, size), basis_rows = basis;
+  double violation = 0;  // how far y was from the holds, linearised, before their last projection
+  // Projects y onto the holds (linearised at y) and forms the basis of their null space; false
+  // when they are (nearly) dependent: their rows' Gram determinant, normalised (1 for orthogonal
+  // rows, 0 for dependent ones), at most 1e-12.
+  const auto constrain = [&] {
+    if (k == 0) return true;
+    Eigen::MatrixXd rows(size, k);
+    Eigen::VectorXd excess(k);
+    double norms = 1;
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const LineHold hold = linearised(holds[static_cast<std::size_t>(i)], y);
+      rows.col(i) = hold.row;
+      excess(i) = hold.row.dot(y) - hold.target;
+      norms *= hold.row.squaredNorm();
+    }
+    const Eigen::MatrixXd gram = rows.transpose() * rows;
+    if (!(gram.determinant() > 1e-12 * norms)) return false;
+    violation = excess.norm();
+    y -= rows * gram.ldlt().solve(excess);
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(rows);
+    basis = (qr.householderQ() * Eigen::MatrixXd::Identity(size, size)).rightCols(size - k);
+    basis_rows = basis.transpose();
+    return true;
+  };
+  if (!constrain()) return std::nullopt;
+  const Eigen::Index free = size - k;
+  const auto [u, v] = orthonormal_pair(direction);
+  std::vector<std::vector<Eigen::Vector2d>> projected(members.size());
+  for (std::size_t m = 0; m < members.size(); ++m)
+    for (const Vec3& p : members[m].points)
+      projected[m].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
+  // Σ w e² and its Gauss–Newton system in z (weighted or not); returns the unweighted Σ e².
+  Eigen::MatrixXd normal(free, free);
+  Eigen::VectorXd gradient(free);
+  Eigen::VectorXd row(free);  // a residual's derivative in z
+  auto linearise = [&](bool weighted) {
+    normal.setZero();
+    gradient.setZero();
+    double squares = 0;
+    for (std::size_t m = 0; m < members.size(); ++m)
+      for (std::size_t i = 0; i < projected[m].size(); ++i) {
+        const Eigen::Vector2d d = projected[m][i] - y.head<2>();
+        const double length = d.norm();
+        if (!(length > 0)) continue;
+        const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
+        const double e = length - y(radius), w = weighted ? members[m].weights[i] : 1.0;
+        row.noalias() = -(d.x() / length) * basis_rows.col(0) -
+                        (d.y() / length) * basis_rows.col(1) - basis_rows.col(radius);
+        normal.noalias() += w * row * row.transpose();
+        gradient.noalias() += (w * e) * row;
+        squares += e * e;
+      }
+    return squares;
+  };
+  bool converged = free == 0 && !curved;
+  for (int step = 0; step < 50 && !converged; ++step) {
+    // A circle's hold linearised again, and y projected onto it: settled once y was on it.
+    const bool projected_again = curved && step > 0;
+    if (projected_again && !constrain()) return std::nullopt;
+    const bool on_holds = !projected_again || !(violation > 1e-14 * y.norm());
+    if (free == 0) {
+      converged = projected_again && on_holds;
+      continue;
+    }
+    linearise(true);
+    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
+    if (!delta.allFinite()) return std::nullopt;
+    const Eigen::VectorXd move = basis * delta;
+    y += move;
+    converged = !(move.norm() > 1e-14 * y.norm()) && on_holds;
+  }
+  if (!converged || !y.allFinite() || !(y.tail(size - 2).minCoeff() > 0)) return std::nullopt;
+  const double squares = linearise(false);
+  HeldLineFit fit{y, 0, static_cast<std::size_t>(free), count, Eigen::MatrixXd::Zero(size, size)};
+  const double n = static_cast<double>(count);
+  fit.rms = std::max(std::sqrt(squares / n), kResolution * largest_radius);
+  if (free > 0) {
+    const double variance = std::max(squares / (n - static_cast<double>(free)),
+                                     kResolution * kResolution * largest_radius * largest_radius);
+    fit.covariance = basis * normal.inverse() * basis.transpose() * variance;
+    if (!fit.covariance.allFinite()) return std::nullopt;
+  }
+  return fit;
+}
 
 // Cylinders held tangent to the planes they border: a fillet, a slot's round end. A cylinder
 // whose direction group a right angle made exactly orthogonal to a plane's (`orthogonal`, indices

@@ -1,12 +1,14 @@
 // The uncertainties every test of regularize() weighs differences by, against Monte Carlo: a
-// plane's and a cylinder's tilt covariance (src/regularity/directions.cpp), and the covariance of
-// the joint fits' line positions, sphere positions and radii (src/regularity/joint_fit.cpp). Over
+// plane's and a cylinder's tilt covariance (src/regularity/directions.cpp), the covariance of the
+// joint fits' line positions, sphere positions and radii (src/regularity/joint_fit.cpp), and that
+// of a fillet's line and radius, free or held tangent (src/regularity/tangency.cpp). Over
 // many noisy draws of one shape, each estimate's squared error in units of its own predicted
 // covariance must average its degrees of freedom: an overconfident covariance would relate
 // nothing, an underconfident one everything. And on exact points the fits are exact.
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <cmath>
 #include <cstddef>
@@ -177,6 +179,126 @@ TEST(RegularityUncertainty, JointFitsAreExactOnExactPoints) {
   EXPECT_NEAR(fit->radii[0], 0.25, 1e-12);
   // Residuals of rounding only: each RMS is its floor, kResolution × the radius.
   for (const double rms : fit->rms) EXPECT_DOUBLE_EQ(rms, detail::kResolution * fit->radii[0]);
+}
+
+// δᵀ C⁺ δ over the `rank` largest eigenpairs of a covariance C whose other eigenvalues are zero (a
+// fit held by conditions varies only along them), and δ's part outside their span.
+std::pair<double, double> chi_square_in_span(const Eigen::MatrixXd& covariance,
+                                             const Eigen::VectorXd& error, Eigen::Index rank) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(covariance);
+  const Eigen::Index size = covariance.rows();
+  const Eigen::MatrixXd span = eigen.eigenvectors().rightCols(rank);
+  const Eigen::VectorXd along = span.transpose() * error;
+  double chi_square = 0;
+  for (Eigen::Index i = 0; i < rank; ++i)
+    chi_square += along(i) * along(i) / eigen.eigenvalues()(size - rank + i);
+  return {chi_square, (error - span * along).norm()};
+}
+
+// A concave fillet of radius 0.2 swept along y, its axis through (x, z) = `centre`: the quarter of
+// its circle from `from_degrees` to `to_degrees` (13 points a row, 21 rows), noise 0.002 along its
+// normals.
+struct Fillet {
+  Eigen::Vector2d centre;
+  double from_degrees, to_degrees;
+  static constexpr double kRadius = 0.2;
+
+  detail::CoaxialMember member(const Cluster& points) const {
+    return {points.points, points.weights, kRadius + 0.01};
+  }
+  Cluster draw(std::mt19937_64& rng) const {
+    return testing::swept_profile(
+        {testing::profile_arc(centre, kRadius, from_degrees, to_degrees, 12)}, 0.002, rng)[0];
+  }
+  // The fit's parameters y = (line position in orthonormal_pair(y axis) coordinates, radius).
+  Eigen::Vector3d truth() const {
+    const auto [u, v] = detail::orthonormal_pair(Eigen::Vector3d::UnitY());
+    const Eigen::Vector3d axis_point(centre.x(), 0, centre.y());
+    return {u.dot(axis_point), v.dot(axis_point), kRadius};
+  }
+};
+
+TEST(RegularityUncertainty, AFilletsOwnFitAndItsGapToAFaceAreCalibrated) {
+  // The fillet between the face z = 0 and a wall, tangent to the face: its own fit (the line and
+  // the radius), and the gap to the face the tangency test weighs by that fit's covariance and by
+  // the face's offset variance. The face is small (8 x 8 points, as noisy as the fillet): without
+  // its offset's variance the gap's mean square came out 1.6 deviations².
+  const Fillet fillet{{0, 0.2}, 180, 270};
+  const Eigen::Vector3d direction = Eigen::Vector3d::UnitY(), truth = fillet.truth();
+  const Eigen::Vector3d face_normal = Eigen::Vector3d::UnitZ();
+  const auto [u, v] = detail::orthonormal_pair(direction);
+  const Eigen::Vector2d normal(u.dot(face_normal), v.dot(face_normal));  // in the line's frame
+  std::mt19937_64 rng(17);
+  double fit_sum = 0, gap_sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster points = fillet.draw(rng);
+    const Cluster face = noisy_plane(face_normal, {0.5, 0, 0}, 0.5, 0.002, rng, 8);
+    const detail::CoaxialMember member = fillet.member(points);
+    const std::optional<detail::HeldLineFit> fit = detail::fit_held_line(
+        direction, truth.head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1}, {});
+    const std::optional<detail::AlignedPlane> plane =
+        detail::aligned_plane(1, face_normal, face.points, face.weights);
+    ASSERT_TRUE(fit && plane);
+    ASSERT_EQ(fit->free, 3u);
+    const Eigen::Vector3d error = fit->y - truth;
+    fit_sum += error.dot(fit->covariance.inverse() * error);
+    // As Tangency::tested_contacts: the axis above the face, so the gap is distance − r.
+    const double distance = normal.dot(fit->y.head<2>()) - plane->offset;
+    const Eigen::Vector3d row(normal.x(), normal.y(), -1);
+    gap_sum +=
+        std::pow(distance - fit->y(2), 2) / (row.dot(fit->covariance * row) + plane->variance);
+  }
+  expect_calibrated(fit_sum, 3, "fillet's own line and radius");
+  expect_calibrated(gap_sum, 1, "fillet's gap to a small face");
+}
+
+TEST(RegularityUncertainty, AFilletHeldTangentToAFaceIsCalibratedAlongIt) {
+  const Fillet fillet{{0, 0.2}, 180, 270};
+  const Eigen::Vector3d direction = Eigen::Vector3d::UnitY(), truth = fillet.truth();
+  const auto [u, v] = detail::orthonormal_pair(direction);
+  // n · c − r = 0: the axis at the radius above the face z = 0.
+  const detail::LineHold hold{Eigen::Vector3d(u.z(), v.z(), -1), 0, std::nullopt};
+  std::mt19937_64 rng(18);
+  double sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster points = fillet.draw(rng);
+    const detail::CoaxialMember member = fillet.member(points);
+    const std::optional<detail::HeldLineFit> fit = detail::fit_held_line(
+        direction, truth.head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1}, {&hold, 1});
+    ASSERT_TRUE(fit);
+    ASSERT_EQ(fit->free, 2u);
+    EXPECT_NEAR(hold.row.dot(fit->y), 0, 1e-14);
+    const auto [chi_square, across] = chi_square_in_span(fit->covariance, fit->y - truth, 2);
+    EXPECT_LT(across, 1e-14);
+    sum += chi_square;
+  }
+  expect_calibrated(sum, 2, "fillet held tangent to a face");
+}
+
+TEST(RegularityUncertainty, AFilletHeldTangentToABossIsCalibratedAlongIt) {
+  // A boss of radius 0.5 on the y axis and a fillet outside it, tangent at (x, z) = (0.5, 0):
+  // |c − 0| = 0.5 + r, a condition linearised again at every step of the fit.
+  const Fillet fillet{{0.7, 0}, 180, 270};
+  const Eigen::Vector3d direction = Eigen::Vector3d::UnitY(), truth = fillet.truth();
+  const detail::LineHold hold{Eigen::Vector3d::Zero(), 0,
+                              detail::CircleHold{Eigen::Vector2d::Zero(), 0.5, 1, 1, 2}};
+  std::mt19937_64 rng(19);
+  double sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster points = fillet.draw(rng);
+    const detail::CoaxialMember member = fillet.member(points);
+    const std::optional<detail::HeldLineFit> fit = detail::fit_held_line(
+        direction, truth.head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1}, {&hold, 1});
+    ASSERT_TRUE(fit);
+    ASSERT_EQ(fit->free, 2u);
+    EXPECT_NEAR(fit->y.head<2>().norm(), 0.5 + fit->y(2), 1e-14);
+    // The truth is on the curved condition, the fit's span is its tangent at the fit: the error
+    // leaves it only by the curvature, (deviation)² / (2 × 0.7).
+    const auto [chi_square, across] = chi_square_in_span(fit->covariance, fit->y - truth, 2);
+    EXPECT_LT(across, 1e-4);
+    sum += chi_square;
+  }
+  expect_calibrated(sum, 2, "fillet held tangent to a boss");
 }
 
 }  // namespace
