@@ -197,13 +197,15 @@ class Tangency {
   std::map<std::size_t, TangentCandidate> candidates_;
   std::map<std::size_t, std::vector<Vec3>> sorted_points_;  // of candidate planes and partners
   std::vector<Contact> contacts_;
-  // Each bordered plane's offset, and its variance (aligned_plane()'s of the points it is fitted
-  // from: for a plane of a coplanar set, which keeps the set's offset, its own points, whose
-  // offset is known less well than the set's).
+  // Each bordered plane's offset, its variance and the centroid it is known best at
+  // (aligned_plane()'s, of the points it is fitted from: for a plane of a coplanar set, which keeps
+  // the set's offset, its own points, whose offset is known less well than the set's).
   struct HeldOffset {
     double offset = 0, variance = 0;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   };
   std::map<std::size_t, HeldOffset> offsets_;
+  std::map<std::size_t, std::size_t> plane_group_;  // each candidate plane's direction group
   std::vector<bool> on_a_line_, settled_, moved_;
   std::map<std::size_t, std::optional<HeldLineFit>> partner_fits_;  // fitted once, alone
 };
@@ -250,7 +252,10 @@ void Tangency::find_candidates(const std::vector<std::pair<std::size_t, std::siz
       TangentCandidate& candidate = candidates_[c];
       candidate.group = cylinder_group;
       for (const std::size_t p : refitted[plane_group])
-        if (is(p, PrimitiveType::Plane)) candidate.planes.push_back(p);
+        if (is(p, PrimitiveType::Plane)) {
+          candidate.planes.push_back(p);
+          plane_group_[p] = plane_group;
+        }
     }
   };
   for (const auto& [i, j] : orthogonal) {
@@ -353,8 +358,10 @@ void Tangency::fit_plane_offsets() {
       sum += weights_[p][i] * normal.dot(to_eigen(x));
     }
     if (!shares_offset_[p] && total > 0) held.offset = sum / total;
-    if (const std::optional<AlignedPlane> plane = aligned_plane(p, normal, kept, kept_weights))
+    if (const std::optional<AlignedPlane> plane = aligned_plane(p, normal, kept, kept_weights)) {
       held.variance = plane->variance;
+      held.centroid = plane->centroid;
+    }
   }
 }
 
@@ -469,8 +476,16 @@ std::vector<TestedContact> Tangency::tested_contacts(const TangentLine& line,
       hold.row.head<2>() = normal_in_frame;
       hold.row(radius) = distance < 0 ? 1 : -1;
       gap = std::abs(distance) - r;
-      // The plane's offset is uncertain too, as the held cylinder's fit below.
-      variance = hold.row.dot(own.covariance * hold.row) + held.variance;
+      // The plane is uncertain too, as the held cylinder's fit below: its offset at its centroid,
+      // and its normal's tilt about the axis, which moves it at the contact by the tilt times the
+      // distance across from the centroid (the lever). Tilts towards the axis are left out: the
+      // right angle holds them.
+      const Eigen::Vector3d across_axis = direction.cross(normal);
+      const double lever =
+          in_frame(frame, across_axis).dot(own.y.head<2>()) - across_axis.dot(held.centroid);
+      const Eigen::Matrix3d& tilt = groups_[plane_group_.at(contact->other)].covariance;
+      variance = hold.row.dot(own.covariance * hold.row) + held.variance +
+                 lever * lever * across_axis.dot(tilt * across_axis);
     } else {
       // The held cylinder's axis and radius are uncertain too: its own fit's covariance counts.
       const Eigen::Vector2d centre = in_frame(frame, to_eigen(other.point));
