@@ -265,6 +265,34 @@ TEST(RegularityUncertainty, AFilletsOwnFitAndItsGapToAFaceAreCalibrated) {
   expect_calibrated(gap_sum, 1, "fillet's gap to a small face");
 }
 
+TEST(RegularityUncertainty, AFilletsGapToABossIsCalibrated) {
+  // A fillet outside a boss of radius 0.5 on the y axis, tangent to it at (x, z) = (0.5, 0): the
+  // gap |c − c'| − R − r as the tangency test weighs it, by both cylinders' own fits.
+  const Fillet fillet{{0.7, 0}, 180, 270};
+  const Eigen::Vector3d direction = Eigen::Vector3d::UnitY(), truth = fillet.truth();
+  std::mt19937_64 rng(20);
+  double sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster points = fillet.draw(rng);
+    const Cluster boss = noisy_cylinder(direction, Eigen::Vector3d::Zero(), 0.5, 1, 0.002, rng, 8);
+    const detail::CoaxialMember member = fillet.member(points);
+    const detail::CoaxialMember held{boss.points, boss.weights, 0.49};
+    const std::optional<detail::HeldLineFit> fit = detail::fit_held_line(
+        direction, truth.head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1}, {});
+    const std::optional<detail::HeldLineFit> boss_fit =
+        detail::fit_held_line(direction, Eigen::Vector2d(0.01, 0.01), {&held, 1}, {});
+    ASSERT_TRUE(fit && boss_fit);
+    const Eigen::Vector2d apart = fit->y.head<2>() - boss_fit->y.head<2>();
+    const double gap = apart.norm() - boss_fit->y(2) - fit->y(2);
+    // As Tangency::tested_contacts: the condition's row in each fit's parameters.
+    const Eigen::Vector2d across = apart.normalized();
+    const Eigen::Vector3d row(across.x(), across.y(), -1), boss_row(-across.x(), -across.y(), -1);
+    sum += gap * gap /
+           (row.dot(fit->covariance * row) + boss_row.dot(boss_fit->covariance * boss_row));
+  }
+  expect_calibrated(sum, 1, "fillet's gap to a boss");
+}
+
 TEST(RegularityUncertainty, AFilletHeldTangentToAFaceIsCalibratedAlongIt) {
   const Fillet fillet{{0, 0.2}, 180, 270};
   const Eigen::Vector3d direction = Eigen::Vector3d::UnitY(), truth = fillet.truth();
