@@ -77,17 +77,131 @@ struct Totals {
   }
 };
 
+struct EvalCommandOptions {
+  std::string variants = "cad,uniform,noisy", shapes, primitives = "plane,cylinder,sphere";
+  std::uint32_t seeds = 3, refine = 0;
+  unsigned threads = 0;
+  std::optional<std::string> json;
+  bool quiet = false;
+};
+
+// The variants of a --variants list, in its order.
+std::vector<const Variant*> chosen_variants(const std::string& list) {
+  std::vector<const Variant*> variants;
+  for (const std::string& name : split(list)) {
+    const auto it = std::find_if(std::begin(kVariants), std::end(kVariants),
+                                 [&](const Variant& v) { return v.name == name; });
+    if (it == std::end(kVariants))
+      throw InvalidInputError("--variants: unknown variant '" + name +
+                              "' (available: cad, uniform, noisy)");
+    variants.push_back(it);
+  }
+  return variants;
+}
+
+// One shape of one variant and seed, segmented at its true number of regions and scored.
+struct EvalCase {
+  SegmentationScore score;
+  std::uint32_t faces = 0, truth = 0, auto_clusters = 0;
+  double seconds = 0;  // the hierarchy, the cut and the cluster reports (or the refinement)
+};
+
+EvalCase evaluate(const std::string& shape_name, const Variant& variant, std::uint32_t seed,
+                  const HierarchyOptions& options, std::uint32_t refine) {
+  ShapeOptions shape_options;
+  shape_options.tessellation = variant.tessellation;
+  shape_options.noise = variant.noise;
+  shape_options.random_motion = true;
+  shape_options.seed = seed;
+  const GroundTruthShape shape = make_shape(shape_name, shape_options);
+  const auto start = Clock::now();
+  const Hierarchy hierarchy = build_hierarchy(shape.mesh, options);
+  EvalCase result;
+  result.faces = shape.mesh.face_count();
+  result.truth = static_cast<std::uint32_t>(shape.regions.size());
+  Segmentation segmentation = cut_by_count(hierarchy, result.truth);
+  std::vector<ClusterReport> reports;
+  if (refine > 0) {
+    BoundaryRefinementOptions refine_options;
+    refine_options.max_passes = refine;
+    RefinedLevel refined = refine_boundaries(hierarchy, segmentation, refine_options);
+    segmentation = std::move(refined.segmentation);
+    reports = std::move(refined.reports);
+  } else {
+    reports = describe_clusters(hierarchy, segmentation);
+  }
+  result.seconds = seconds_since(start);
+  result.auto_clusters = choose_level(hierarchy).clusters;
+  std::vector<PrimitiveType> types, truth_types;
+  for (const ClusterReport& r : reports) types.push_back(r.primitive.type);
+  for (const Primitive& p : shape.regions) truth_types.push_back(p.type);
+  result.score = score_segmentation(segmentation.labels, shape.region_of_face,
+                                    face_areas(shape.mesh), types, truth_types);
+  return result;
+}
+
+// Runs `primseg eval` with its parsed options.
+void run_eval(const EvalCommandOptions& o) {
+  HierarchyOptions options;
+  options.primitives = parse_primitives(o.primitives);
+  options.threads = o.threads;
+  validate(options);
+  const std::vector<const Variant*> variants = chosen_variants(o.variants);
+  const std::vector<std::string> shapes = o.shapes.empty() ? shape_names() : split(o.shapes);
+  for (const std::string& name : shapes) make_shape(name);  // unknown names fail first
+
+  nlohmann::json cases = nlohmann::json::array();
+  Totals all;
+  std::vector<Totals> by_variant(variants.size());
+  if (!o.quiet)
+    std::printf("%-8s %-26s %4s  %6s  %5s  %6s  %6s  %6s  %4s  %8s\n", "variant", "shape", "seed",
+                "faces", "truth", "iou", "types", "rand", "auto", "seconds");
+  for (std::size_t v = 0; v < variants.size(); ++v)
+    for (const std::string& name : shapes)
+      for (std::uint32_t seed = 1; seed <= o.seeds; ++seed) {
+        const EvalCase c = evaluate(name, *variants[v], seed, options, o.refine);
+        all.add(c.score, c.truth, c.auto_clusters, c.seconds);
+        by_variant[v].add(c.score, c.truth, c.auto_clusters, c.seconds);
+        if (!o.quiet)
+          std::printf("%-8s %-26s %4u  %6u  %5u  %6.4f  %6.4f  %6.4f  %4u  %8.3f\n",
+                      variants[v]->name.c_str(), name.c_str(), seed, c.faces, c.truth,
+                      c.score.mean_iou, c.score.type_accuracy, c.score.rand_index, c.auto_clusters,
+                      c.seconds);
+        cases.push_back({{"variant", variants[v]->name},
+                         {"shape", name},
+                         {"seed", seed},
+                         {"faces", c.faces},
+                         {"regions", c.truth},
+                         {"mean_iou", c.score.mean_iou},
+                         {"min_iou", c.score.min_iou},
+                         {"type_accuracy", c.score.type_accuracy},
+                         {"rand_index", c.score.rand_index},
+                         {"auto_clusters", c.auto_clusters},
+                         {"seconds", c.seconds}});
+      }
+  std::printf("\n%-8s %5s  %8s  %8s  %8s  %7s  %7s  %8s\n", "variant", "cases", "mean_iou", "types",
+              "rand", "auto=", "auto±1", "seconds");
+  nlohmann::json totals;
+  for (std::size_t v = 0; v < variants.size(); ++v) {
+    by_variant[v].print(variants[v]->name);
+    totals[variants[v]->name] = by_variant[v].json();
+  }
+  all.print("all");
+  totals["all"] = all.json();
+  for (int t = 0; t < kPrimitiveTypeCount; ++t)
+    if (all.area[t] > 0)
+      std::printf("type accuracy, %s regions: %.4f\n",
+                  std::string(to_string(static_cast<PrimitiveType>(t))).c_str(),
+                  all.correct[t] / all.area[t]);
+  if (o.json)
+    detail::write_file_atomically(
+        *o.json, nlohmann::json{{"cases", cases}, {"totals", totals}}.dump(2) + "\n");
+}
+
 }  // namespace
 
 Command add_eval_command(CLI::App& app) {
-  struct Options {
-    std::string variants = "cad,uniform,noisy", shapes, primitives = "plane,cylinder,sphere";
-    std::uint32_t seeds = 3, refine = 0;
-    unsigned threads = 0;
-    std::optional<std::string> json;
-    bool quiet = false;
-  };
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<EvalCommandOptions>();
   auto* eval = app.add_subcommand(
       "eval",
       "Score the segmenter on the generated shapes with ground truth: mean IoU, type accuracy "
@@ -108,99 +222,7 @@ Command add_eval_command(CLI::App& app) {
   eval->add_option("--json", o->json, "Write every case and the totals as JSON");
   eval->add_flag("--quiet,-q", o->quiet, "Print the totals only");
 
-  return {eval, [o] {
-            HierarchyOptions options;
-            options.primitives = parse_primitives(o->primitives);
-            options.threads = o->threads;
-            validate(options);
-            std::vector<const Variant*> variants;
-            for (const std::string& name : split(o->variants)) {
-              const auto it = std::find_if(std::begin(kVariants), std::end(kVariants),
-                                           [&](const Variant& v) { return v.name == name; });
-              if (it == std::end(kVariants))
-                throw InvalidInputError("--variants: unknown variant '" + name +
-                                        "' (available: cad, uniform, noisy)");
-              variants.push_back(it);
-            }
-            const std::vector<std::string> shapes =
-                o->shapes.empty() ? shape_names() : split(o->shapes);
-            for (const std::string& name : shapes) make_shape(name);  // unknown names fail first
-
-            nlohmann::json cases = nlohmann::json::array();
-            Totals all;
-            std::vector<Totals> by_variant(variants.size());
-            if (!o->quiet)
-              std::printf("%-8s %-26s %4s  %6s  %5s  %6s  %6s  %6s  %4s  %8s\n", "variant", "shape",
-                          "seed", "faces", "truth", "iou", "types", "rand", "auto", "seconds");
-            for (std::size_t v = 0; v < variants.size(); ++v)
-              for (const std::string& name : shapes)
-                for (std::uint32_t seed = 1; seed <= o->seeds; ++seed) {
-                  ShapeOptions shape_options;
-                  shape_options.tessellation = variants[v]->tessellation;
-                  shape_options.noise = variants[v]->noise;
-                  shape_options.random_motion = true;
-                  shape_options.seed = seed;
-                  const GroundTruthShape shape = make_shape(name, shape_options);
-                  const auto start = Clock::now();
-                  const Hierarchy hierarchy = build_hierarchy(shape.mesh, options);
-                  const auto truth = static_cast<std::uint32_t>(shape.regions.size());
-                  Segmentation segmentation = cut_by_count(hierarchy, truth);
-                  std::vector<ClusterReport> reports;
-                  if (o->refine > 0) {
-                    BoundaryRefinementOptions refine_options;
-                    refine_options.max_passes = o->refine;
-                    RefinedLevel refined =
-                        refine_boundaries(hierarchy, segmentation, refine_options);
-                    segmentation = std::move(refined.segmentation);
-                    reports = std::move(refined.reports);
-                  } else {
-                    reports = describe_clusters(hierarchy, segmentation);
-                  }
-                  const double seconds = seconds_since(start);
-                  const AutoLevel level = choose_level(hierarchy);
-                  std::vector<PrimitiveType> types, truth_types;
-                  for (const ClusterReport& r : reports) types.push_back(r.primitive.type);
-                  for (const Primitive& p : shape.regions) truth_types.push_back(p.type);
-                  const SegmentationScore score =
-                      score_segmentation(segmentation.labels, shape.region_of_face,
-                                         face_areas(shape.mesh), types, truth_types);
-                  all.add(score, truth, level.clusters, seconds);
-                  by_variant[v].add(score, truth, level.clusters, seconds);
-                  if (!o->quiet)
-                    std::printf("%-8s %-26s %4u  %6u  %5u  %6.4f  %6.4f  %6.4f  %4u  %8.3f\n",
-                                variants[v]->name.c_str(), name.c_str(), seed,
-                                shape.mesh.face_count(), truth, score.mean_iou, score.type_accuracy,
-                                score.rand_index, level.clusters, seconds);
-                  cases.push_back({{"variant", variants[v]->name},
-                                   {"shape", name},
-                                   {"seed", seed},
-                                   {"faces", shape.mesh.face_count()},
-                                   {"regions", truth},
-                                   {"mean_iou", score.mean_iou},
-                                   {"min_iou", score.min_iou},
-                                   {"type_accuracy", score.type_accuracy},
-                                   {"rand_index", score.rand_index},
-                                   {"auto_clusters", level.clusters},
-                                   {"seconds", seconds}});
-                }
-            std::printf("\n%-8s %5s  %8s  %8s  %8s  %7s  %7s  %8s\n", "variant", "cases",
-                        "mean_iou", "types", "rand", "auto=", "auto±1", "seconds");
-            nlohmann::json totals;
-            for (std::size_t v = 0; v < variants.size(); ++v) {
-              by_variant[v].print(variants[v]->name);
-              totals[variants[v]->name] = by_variant[v].json();
-            }
-            all.print("all");
-            totals["all"] = all.json();
-            for (int t = 0; t < kPrimitiveTypeCount; ++t)
-              if (all.area[t] > 0)
-                std::printf("type accuracy, %s regions: %.4f\n",
-                            std::string(to_string(static_cast<PrimitiveType>(t))).c_str(),
-                            all.correct[t] / all.area[t]);
-            if (o->json)
-              detail::write_file_atomically(
-                  *o->json, nlohmann::json{{"cases", cases}, {"totals", totals}}.dump(2) + "\n");
-          }};
+  return {eval, [o] { run_eval(*o); }};
 }
 
 }  // namespace primseg::cli
