@@ -197,11 +197,80 @@ bool make_orthogonal(Eigen::Vector3d& a, const Eigen::Matrix3d& covariance_a, Ei
 // The most groups a frame (a component closing a triangle of right angles) is solved over.
 constexpr std::size_t kLargestFrame = 16;
 
+using GroupPair = std::pair<std::size_t, std::size_t>;
+
+// The directions of a frame's groups `component` (their order) with the right angle (i, j) added
+// to its kept ones (`adjacent`): least squares from their measurements, by sweeps of
+// make_orthogonal over every right angle; nothing when the sweeps do not converge.
+std::optional<std::vector<Eigen::Vector3d>> solve_frame(
+    std::size_t i, std::size_t j, const std::vector<std::size_t>& component,
+    const std::vector<std::vector<std::size_t>>& adjacent,
+    const std::vector<Eigen::Vector3d>& measured, const std::vector<Eigen::Vector3d>& solved,
+    const std::vector<DirectionGroup>& groups) {
+  std::vector<GroupPair> constraints{{i, j}};
+  for (const std::size_t g : component)
+    for (const std::size_t h : adjacent[g])
+      if (g < h) constraints.emplace_back(g, h);
+  std::vector<Eigen::Vector3d> d = solved;
+  for (const std::size_t g : component) d[g] = measured[g];
+  bool converged = false;
+  for (int sweep = 0; sweep < 200 && !converged; ++sweep) {
+    converged = true;
+    for (const auto& [a, b] : constraints)
+      if (std::abs(d[a].dot(d[b])) > 1e-15) {
+        converged = false;
+        make_orthogonal(d[a], groups[a].covariance, d[b], groups[b].covariance);
+      }
+  }
+  if (!converged) return std::nullopt;
+  std::vector<Eigen::Vector3d> moved;
+  for (const std::size_t g : component) moved.push_back(d[g]);
+  return moved;
+}
+
+// The directions of a large component's groups `component` (their order), a tree joined by the
+// right angle (i, j) between the trees of i (`first_tree`) and j: the pair's two directions meet,
+// and each side turns rigidly with its own; nothing when they cannot meet.
+std::optional<std::vector<Eigen::Vector3d>> turn_trees(std::size_t i, std::size_t j,
+                                                       const std::vector<std::size_t>& component,
+                                                       const std::vector<std::size_t>& component_of,
+                                                       std::size_t first_tree,
+                                                       const std::vector<Eigen::Vector3d>& solved,
+                                                       const std::vector<DirectionGroup>& groups) {
+  Eigen::Vector3d a = solved[i], b = solved[j];
+  if (!make_orthogonal(a, groups[i].covariance, b, groups[j].covariance)) return std::nullopt;
+  const Eigen::Quaterniond turn_i = Eigen::Quaterniond::FromTwoVectors(solved[i], a);
+  const Eigen::Quaterniond turn_j = Eigen::Quaterniond::FromTwoVectors(solved[j], b);
+  std::vector<Eigen::Vector3d> moved;
+  for (const std::size_t g : component)
+    moved.push_back(
+        g == i   ? a
+        : g == j ? b
+                 : ((component_of[g] == first_tree ? turn_i : turn_j) * solved[g]).normalized());
+  return moved;
+}
+
+// Whether every direction of `component` ends, `moved`, within the significance of its
+// measurement (or within the angle tolerance of it).
+bool moves_within(const std::vector<std::size_t>& component,
+                  const std::vector<Eigen::Vector3d>& moved,
+                  const std::vector<Eigen::Vector3d>& measured,
+                  const std::vector<DirectionGroup>& groups, const RegularityOptions& options) {
+  const double significance2 = options.significance * options.significance;
+  for (std::size_t k = 0; k < component.size(); ++k) {
+    const Eigen::Vector3d tilt = moved[k] - measured[component[k]];
+    if (!(tilt.dot(groups[component[k]].information * tilt) <= significance2 ||
+          within_tolerance(angle_between_lines(moved[k], measured[component[k]]),
+                           options.angle_tolerance)))
+      return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<DirectionGroup>& groups,
                                                                const RegularityOptions& options) {
-  using Pair = std::pair<std::size_t, std::size_t>;
   const std::size_t count = groups.size();
   const double max_tilt = options.max_angle_degrees * std::numbers::pi / 180;
   const double significance2 = options.significance * options.significance;
@@ -232,8 +301,7 @@ std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<Direc
     component_of[g] = g;
     members[g] = {g};
   }
-  std::vector<Pair> kept;
-  std::vector<Eigen::Vector3d> moved;
+  std::vector<GroupPair> kept;
   while (!queue.empty()) {
     // Not a structured binding: clang 14 cannot capture one in the lambdas below.
     const double stale = std::get<0>(queue.top());
@@ -250,54 +318,19 @@ std::vector<std::pair<std::size_t, std::size_t>> orthogonalize(std::vector<Direc
     const std::size_t ci = component_of[i], cj = component_of[j];
     std::vector<std::size_t> component = members[ci];
     if (ci != cj) component.insert(component.end(), members[cj].begin(), members[cj].end());
-    moved.clear();
+    std::optional<std::vector<Eigen::Vector3d>> moved;
     if (component.size() <= kLargestFrame) {
       // Within a component, only a pair that closes a triangle of right angles.
       if (ci == cj && std::none_of(adjacent[i].begin(), adjacent[i].end(), [&](std::size_t k) {
             return std::find(adjacent[j].begin(), adjacent[j].end(), k) != adjacent[j].end();
           }))
         continue;
-      // Least squares from the measurements: sweeps of make_orthogonal over every constraint.
-      std::vector<Pair> constraints{{i, j}};
-      for (const std::size_t g : component)
-        for (const std::size_t h : adjacent[g])
-          if (g < h) constraints.emplace_back(g, h);
-      std::vector<Eigen::Vector3d> d = solved;
-      for (const std::size_t g : component) d[g] = measured[g];
-      bool converged = false;
-      for (int sweep = 0; sweep < 200 && !converged; ++sweep) {
-        converged = true;
-        for (const auto& [a, b] : constraints)
-          if (std::abs(d[a].dot(d[b])) > 1e-15) {
-            converged = false;
-            make_orthogonal(d[a], groups[a].covariance, d[b], groups[b].covariance);
-          }
-      }
-      if (!converged) continue;
-      for (const std::size_t g : component) moved.push_back(d[g]);
-    } else {
-      // A large component is a tree (no triangle is closed in one): the pair's two directions
-      // meet, and each side turns rigidly with its own.
-      if (ci == cj) continue;
-      Eigen::Vector3d a = solved[i], b = solved[j];
-      if (!make_orthogonal(a, groups[i].covariance, b, groups[j].covariance)) continue;
-      const Eigen::Quaterniond turn_i = Eigen::Quaterniond::FromTwoVectors(solved[i], a);
-      const Eigen::Quaterniond turn_j = Eigen::Quaterniond::FromTwoVectors(solved[j], b);
-      for (const std::size_t g : component)
-        moved.push_back(g == i ? a
-                        : g == j
-                            ? b
-                            : ((component_of[g] == ci ? turn_i : turn_j) * solved[g]).normalized());
+      moved = solve_frame(i, j, component, adjacent, measured, solved, groups);
+    } else if (ci != cj) {  // a large component is a tree: no triangle is closed in one
+      moved = turn_trees(i, j, component, component_of, ci, solved, groups);
     }
-    bool within = true;
-    for (std::size_t k = 0; within && k < component.size(); ++k) {
-      const Eigen::Vector3d tilt = moved[k] - measured[component[k]];
-      within = tilt.dot(groups[component[k]].information * tilt) <= significance2 ||
-               within_tolerance(angle_between_lines(moved[k], measured[component[k]]),
-                                options.angle_tolerance);
-    }
-    if (!within) continue;
-    for (std::size_t k = 0; k < component.size(); ++k) solved[component[k]] = moved[k];
+    if (!moved || !moves_within(component, *moved, measured, groups, options)) continue;
+    for (std::size_t k = 0; k < component.size(); ++k) solved[component[k]] = (*moved)[k];
     kept.emplace_back(i, j);
     adjacent[i].push_back(j);
     adjacent[j].push_back(i);
