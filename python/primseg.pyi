@@ -1,4 +1,5 @@
-# Type stubs of the primseg extension module (primseg_module.cpp), for type checkers and editors.
+# Type stubs of the primseg extension module (python/module.cpp and the *_binding.cpp it calls), for
+# type checkers and editors.
 # Installed beside the module. python/tests/test_stubs.py checks every name, parameter, keyword-only
 # marker and default here against the module itself; the docstrings (help(primseg)) say what
 # each one means.
