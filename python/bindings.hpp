@@ -14,12 +14,10 @@ void bind_exceptions(py::module_& m);
 // The Hierarchy class alone, registered before the functions that return it (their signatures
 // then name it); bind_hierarchy adds its methods.
 py::class_<PyHierarchy> declare_hierarchy_class(py::module_& m);
-void bind_segment(py::module_& m);
 void bind_hierarchy(py::module_& m, py::class_<PyHierarchy>& hierarchy_class);
 
 void bind_mesh(py::module_& m);
 void bind_denoise(py::module_& m);
-void bind_read_skeleton(py::module_& m);
 void bind_skeleton(py::module_& m);
 void bind_distance(py::module_& m);
 

@@ -196,17 +196,6 @@ const char* kLevelArguments =
 Raises InvalidInputError (a ValueError) for k outside 1..F, a string other than "auto", or a
 negative or NaN tolerance.)";
 
-}  // namespace
-
-py::class_<PyHierarchy> declare_hierarchy_class(py::module_& m) {
-  return py::class_<PyHierarchy>(
-      m, "Hierarchy",
-      join_docs({"The whole merge tree of a mesh (from segment or read_tree). Read-only; pickles "
-                 "as its tree file's bytes (Hierarchy.save).",
-                 cpp_doc("Hierarchy", doc::hierarchy__Hierarchy)})
-          .c_str());
-}
-
 void bind_segment(py::module_& m) {
   const char* segment_doc =
       R"(segment(mesh, *, primitives=("plane", "cylinder", "sphere"), weights="area", threads=0, exact_costs=False, eager=False, progress=None) -> Hierarchy
@@ -246,7 +235,19 @@ coordinates, index out of range, no faces) or bad options.)";
           .c_str());
 }
 
+}  // namespace
+
+py::class_<PyHierarchy> declare_hierarchy_class(py::module_& m) {
+  return py::class_<PyHierarchy>(
+      m, "Hierarchy",
+      join_docs({"The whole merge tree of a mesh (from segment or read_tree). Read-only; pickles "
+                 "as its tree file's bytes (Hierarchy.save).",
+                 cpp_doc("Hierarchy", doc::hierarchy__Hierarchy)})
+          .c_str());
+}
+
 void bind_hierarchy(py::module_& m, py::class_<PyHierarchy>& hierarchy_class) {
+  bind_segment(m);
   m.def(
       "read_tree",
       [](const std::filesystem::path& path) {

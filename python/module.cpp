@@ -30,13 +30,9 @@ PYBIND11_MODULE(primseg, m) {
 
   // Registered before the functions that return it, so that their signatures name it.
   py::class_<PyHierarchy> hierarchy_class = declare_hierarchy_class(m);
-  bind_mesh(m);  // Mesh, read_mesh, write_mesh, render
-  bind_segment(m);
-  // Before the Skeleton class, as it always was: the signature in its TypeError messages names
-  // the C++ type.
-  bind_read_skeleton(m);
-  bind_hierarchy(m, hierarchy_class);  // read_tree, the Hierarchy's methods
+  bind_mesh(m);                        // Mesh, read_mesh, write_mesh, render
+  bind_hierarchy(m, hierarchy_class);  // segment, read_tree, the Hierarchy's methods
   bind_denoise(m);
-  bind_skeleton(m);  // the Skeleton class, skeleton()
+  bind_skeleton(m);  // the Skeleton class, skeleton(), read_skeleton()
   bind_distance(m);
 }

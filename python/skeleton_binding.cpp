@@ -167,8 +167,7 @@ py::list bone_list(const Skeleton& skeleton) {
   return list;
 }
 
-}  // namespace
-
+// read_skeleton(), bound after the class it returns so that its signature names it.
 void bind_read_skeleton(py::module_& m) {
   m.def(
       "read_skeleton",
@@ -193,6 +192,8 @@ InvalidInputError when its face labels do not fit the mesh.)",
                  cpp_doc("parse_skeleton_json", doc::skeleton_io__parse_skeleton_json)})
           .c_str());
 }
+
+}  // namespace
 
 void bind_skeleton(py::module_& m) {
   py::class_<PySkeleton>(
@@ -446,6 +447,7 @@ default. The GIL is released while it works; Ctrl-C (KeyboardInterrupt) stops th
 build, and progress, if given, is called during it with the fraction done, as in segment.)",
            cpp_doc("skeleton.hpp", doc::skeleton__file)})
           .c_str());
+  bind_read_skeleton(m);
 }
 
 }  // namespace primseg::python

@@ -18,6 +18,23 @@ def test_exception_hierarchy():
     assert issubclass(primseg.InvalidInputError, ValueError)
 
 
+def test_a_call_with_wrong_arguments_names_python_types_only():
+    # pybind11's TypeError lists each overload's signature; a class registered after a function
+    # that returns it would show there as its C++ name (read_skeleton did, until session 37).
+    mesh = primseg.Mesh(V_OK, F_OK)
+    targets = []
+    for owner in (primseg, mesh, primseg.segment(mesh), primseg.skeleton(mesh, k=1)):
+        for name in dir(owner):
+            member = getattr(owner, name)
+            if not name.startswith("_") and callable(member) and not isinstance(member, type):
+                targets.append(member)
+    assert len(targets) > 25
+    for function in targets:
+        with pytest.raises(TypeError) as raised:
+            function(object(), object(), object(), object(), object(), object())
+        assert "primseg::" not in str(raised.value), str(raised.value)
+
+
 BAD_ARRAYS = {
     "V 1-D": (np.zeros(9), F_OK, r"V must have shape \(n, 3\), not \(9,\)"),
     "V (n, 2)": (np.zeros((4, 2)), F_OK, r"V must have shape \(n, 3\), not \(4, 2\)"),
