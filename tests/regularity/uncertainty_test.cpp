@@ -203,8 +203,13 @@ struct Fillet {
   double from_degrees, to_degrees;
   static constexpr double kRadius = 0.2;
 
-  detail::CoaxialMember member(const Cluster& points) const {
-    return {points.points, points.weights, kRadius + 0.01};
+  // fit_held_line() of `points` under `holds`, from a start off the truth.
+  std::optional<detail::HeldLineFit> fit(const Cluster& points,
+                                         std::span<const detail::LineHold> holds = {}) const {
+    const detail::CoaxialMember member{points.points, points.weights, kRadius + 0.01};
+    return detail::fit_held_line(Eigen::Vector3d::UnitY(),
+                                 truth().head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1},
+                                 holds);
   }
   Cluster draw(std::mt19937_64& rng) const {
     return testing::swept_profile(
@@ -234,9 +239,7 @@ TEST(RegularityUncertainty, AFilletsOwnFitAndItsGapToAFaceAreCalibrated) {
   for (int draw = 0; draw < kDraws; ++draw) {
     const Cluster points = fillet.draw(rng);
     const Cluster face = noisy_plane(Eigen::Vector3d::UnitZ(), {0.5, 0, 0}, 0.5, 0.002, rng, 8);
-    const detail::CoaxialMember member = fillet.member(points);
-    const std::optional<detail::HeldLineFit> fit = detail::fit_held_line(
-        direction, truth.head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1}, {});
+    const std::optional<detail::HeldLineFit> fit = fillet.fit(points);
     const std::optional<detail::Oriented> oriented = detail::oriented_plane(1, face.points);
     ASSERT_TRUE(fit && oriented);
     ASSERT_EQ(fit->free, 3u);
@@ -269,16 +272,14 @@ TEST(RegularityUncertainty, AFilletsGapToABossIsCalibrated) {
   // A fillet outside a boss of radius 0.5 on the y axis, tangent to it at (x, z) = (0.5, 0): the
   // gap |c − c'| − R − r as the tangency test weighs it, by both cylinders' own fits.
   const Fillet fillet{{0.7, 0}, 180, 270};
-  const Eigen::Vector3d direction = Eigen::Vector3d::UnitY(), truth = fillet.truth();
+  const Eigen::Vector3d direction = Eigen::Vector3d::UnitY();
   std::mt19937_64 rng(20);
   double sum = 0;
   for (int draw = 0; draw < kDraws; ++draw) {
     const Cluster points = fillet.draw(rng);
     const Cluster boss = noisy_cylinder(direction, Eigen::Vector3d::Zero(), 0.5, 1, 0.002, rng, 8);
-    const detail::CoaxialMember member = fillet.member(points);
     const detail::CoaxialMember held{boss.points, boss.weights, 0.49};
-    const std::optional<detail::HeldLineFit> fit = detail::fit_held_line(
-        direction, truth.head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1}, {});
+    const std::optional<detail::HeldLineFit> fit = fillet.fit(points);
     const std::optional<detail::HeldLineFit> boss_fit =
         detail::fit_held_line(direction, Eigen::Vector2d(0.01, 0.01), {&held, 1}, {});
     ASSERT_TRUE(fit && boss_fit);
@@ -303,9 +304,7 @@ TEST(RegularityUncertainty, AFilletHeldTangentToAFaceIsCalibratedAlongIt) {
   double sum = 0;
   for (int draw = 0; draw < kDraws; ++draw) {
     const Cluster points = fillet.draw(rng);
-    const detail::CoaxialMember member = fillet.member(points);
-    const std::optional<detail::HeldLineFit> fit = detail::fit_held_line(
-        direction, truth.head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1}, {&hold, 1});
+    const std::optional<detail::HeldLineFit> fit = fillet.fit(points, {&hold, 1});
     ASSERT_TRUE(fit);
     ASSERT_EQ(fit->free, 2u);
     EXPECT_NEAR(hold.row.dot(fit->y), 0, 1e-14);
@@ -320,16 +319,14 @@ TEST(RegularityUncertainty, AFilletHeldTangentToABossIsCalibratedAlongIt) {
   // A boss of radius 0.5 on the y axis and a fillet outside it, tangent at (x, z) = (0.5, 0):
   // |c − 0| = 0.5 + r, a condition linearised again at every step of the fit.
   const Fillet fillet{{0.7, 0}, 180, 270};
-  const Eigen::Vector3d direction = Eigen::Vector3d::UnitY(), truth = fillet.truth();
+  const Eigen::Vector3d truth = fillet.truth();
   const detail::LineHold hold{Eigen::Vector3d::Zero(), 0,
                               detail::CircleHold{Eigen::Vector2d::Zero(), 0.5, 1, 1, 2}};
   std::mt19937_64 rng(19);
   double sum = 0;
   for (int draw = 0; draw < kDraws; ++draw) {
     const Cluster points = fillet.draw(rng);
-    const detail::CoaxialMember member = fillet.member(points);
-    const std::optional<detail::HeldLineFit> fit = detail::fit_held_line(
-        direction, truth.head<2>() + Eigen::Vector2d(0.01, -0.01), {&member, 1}, {&hold, 1});
+    const std::optional<detail::HeldLineFit> fit = fillet.fit(points, {&hold, 1});
     ASSERT_TRUE(fit);
     ASSERT_EQ(fit->free, 2u);
     EXPECT_NEAR(fit->y.head<2>().norm(), 0.5 + fit->y(2), 1e-14);
