@@ -453,28 +453,128 @@ WorkingFrame working_frame_for(const Mesh& mesh) {
   return frame_of_box(lo, hi);
 }
 
+namespace {
+
+// The mesh's positions in the working frame.
+std::vector<Eigen::Vector3d> working_positions(const Mesh& mesh, const WorkingFrame& frame) {
+  std::vector<Eigen::Vector3d> positions(mesh.positions.size());
+  // A product by a power of two rounds once, as ldexp does, when the power is a double.
+  const double scale = std::ldexp(1.0, -frame.exponent);
+  if (scale > 0 && std::isfinite(scale)) {
+    for (std::size_t v = 0; v < positions.size(); ++v)
+      for (int a = 0; a < 3; ++a)
+        positions[v][a] = (mesh.positions[v][a] - frame.center[a]) * scale;
+  } else {
+    for (std::size_t v = 0; v < positions.size(); ++v)
+      positions[v] = frame.to_working(mesh.positions[v]);
+  }
+  return positions;
+}
+
+// The triangles' orientation, before closed components are turned outward: `flipped` per
+// triangle, each triangle's orientation component (numbered by its lowest triangle) and whether
+// each component is open (a boundary, or not orientable: no inside).
+struct Orientation {
+  std::vector<std::uint8_t> flipped;
+  std::vector<std::uint32_t> component;
+  std::vector<std::uint8_t> open;
+};
+
+// Breadth-first over manifold edges from the lowest unvisited triangle, the edges of a triangle
+// in increasing order (on a non-orientable component the order decides the flips).
+Orientation orient(const std::vector<TriangleSlots>& neighbours) {
+  const auto triangle_count = static_cast<std::uint32_t>(neighbours.size());
+  Orientation o{std::vector<std::uint8_t>(triangle_count, 0),
+                std::vector<std::uint32_t>(triangle_count, kNone),
+                {}};
+  std::vector<std::uint32_t> queue(triangle_count);  // every triangle enters it once
+  std::size_t queued = 0;
+  for (std::uint32_t seed = 0; seed < triangle_count; ++seed) {
+    if (o.component[seed] != kNone) continue;
+    const auto component = static_cast<std::uint32_t>(o.open.size());
+    o.open.push_back(0);
+    o.component[seed] = component;
+    queue[queued++] = seed;
+    for (std::size_t head = queued - 1; head < queued; ++head) {
+      if (head + 4 < queued) {
+        const TriangleSlots& ahead = neighbours[queue[head + 4]];
+        for (unsigned k = 0; k < ahead.count(); ++k) {
+          __builtin_prefetch(&o.component[ahead.other[k]]);
+          __builtin_prefetch(&o.flipped[ahead.other[k]]);
+        }
+      }
+      if (head + 8 < queued) __builtin_prefetch(&neighbours[queue[head + 8]]);
+      const std::uint32_t t = queue[head];
+      const TriangleSlots& slots = neighbours[t];
+      if (slots.open()) o.open[component] = 1;
+      for (unsigned k = 0; k < slots.count(); ++k) {
+        if (!slots.manifold(k)) continue;
+        const std::uint32_t other = slots.other[k];
+        const std::uint8_t wanted = o.flipped[t] ^ std::uint8_t{slots.same_direction(k)};
+        if (o.component[other] == kNone) {
+          o.component[other] = component;
+          o.flipped[other] = wanted;
+          queue[queued++] = other;
+        } else if (o.flipped[other] != wanted) {
+          o.open[component] = 1;  // not orientable (a Möbius band): no inside
+        }
+      }
+    }
+  }
+  return o;
+}
+
+// Closed components face outward: flips those of negative signed volume in `orientation`.
+// Returns each face's connected component of the dual graph and sets `count`: the components of
+// the orientation joined across the other links and within polygon faces; numbered by their
+// lowest member, as the orientation components are by their lowest triangle, they are numbered
+// by their lowest face.
+std::vector<std::uint32_t> turn_outward(const Mesh& mesh,
+                                        const std::vector<Eigen::Vector3d>& positions,
+                                        const std::vector<TriangleSlots>& neighbours,
+                                        const std::vector<std::uint32_t>& first_triangle,
+                                        Orientation& orientation, std::uint32_t& count) {
+  const std::uint32_t triangle_count = mesh.triangle_count();
+  const std::uint32_t face_count = mesh.face_count();
+  std::vector<double> volume(orientation.open.size(), 0.0);
+  UnionFind joined(orientation.open.size());
+  const bool polygons = face_count != triangle_count;
+  for (std::uint32_t t = 0; t < triangle_count; ++t) {
+    if (t + 16 < triangle_count)
+      for (std::uint32_t u : mesh.triangles[t + 16]) __builtin_prefetch(&positions[u]);
+    const Triangle tri = canonical_corners(mesh.triangles[t], positions);
+    const double v = positions[tri[0]].dot(positions[tri[1]].cross(positions[tri[2]]));
+    volume[orientation.component[t]] += orientation.flipped[t] ? -v : v;
+    const TriangleSlots& slots = neighbours[t];
+    for (unsigned k = 0; k < slots.count(); ++k)
+      if (!slots.manifold(k))
+        joined.unite(orientation.component[t], orientation.component[slots.other[k]]);
+    if (polygons && t > 0 && mesh.face_of_triangle[t] == mesh.face_of_triangle[t - 1])
+      joined.unite(orientation.component[t], orientation.component[t - 1]);
+  }
+  for (std::uint32_t t = 0; t < triangle_count; ++t) {
+    const std::uint32_t c = orientation.component[t];
+    if (!orientation.open[c] && volume[c] < 0) orientation.flipped[t] ^= 1;
+  }
+  const std::vector<std::uint32_t> label = std::move(joined).labels(count);
+  std::vector<std::uint32_t> component_of_face(face_count);
+  for (std::uint32_t f = 0; f < face_count; ++f)
+    component_of_face[f] = label[orientation.component[first_triangle[f]]];
+  return component_of_face;
+}
+
+}  // namespace
+
 DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
     : mesh_(&mesh), weights_(weights) {
   threads = detail::thread_count(threads);
-  const std::uint32_t triangle_count = mesh.triangle_count();
   const std::uint32_t face_count = mesh.face_count();
 
   valence_.assign(mesh.positions.size(), 0);
   for (const Triangle& t : mesh.triangles)
     for (std::uint32_t v : t) ++valence_[v];
   frame_ = working_frame_of_used(mesh, valence_);
-
-  positions_.resize(mesh.positions.size());
-  // A product by a power of two rounds once, as ldexp does, when the power is a double.
-  const double scale = std::ldexp(1.0, -frame_.exponent);
-  if (scale > 0 && std::isfinite(scale)) {
-    for (std::size_t v = 0; v < positions_.size(); ++v)
-      for (int a = 0; a < 3; ++a)
-        positions_[v][a] = (mesh.positions[v][a] - frame_.center[a]) * scale;
-  } else {
-    for (std::size_t v = 0; v < positions_.size(); ++v)
-      positions_[v] = frame_.to_working(mesh.positions[v]);
-  }
+  positions_ = working_positions(mesh, frame_);
 
   first_triangle_.assign(face_count + 1, 0);
   for (std::uint32_t f : mesh.face_of_triangle) ++first_triangle_[f + 1];
@@ -490,75 +590,11 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
     chunk_begin[chunk] = first_triangle_[chunk_face(chunk)];
   Links links = link_triangles(mesh, bucket_sides(mesh), chunk_begin);
   const std::vector<TriangleSlots>& neighbours = links.slots;
-
-  // Orientation: breadth-first over manifold edges from the lowest unvisited triangle, the edges
-  // of a triangle in increasing order (on a non-orientable component the order decides the flips).
-  flipped_.assign(triangle_count, 0);
   {
-    std::vector<std::uint32_t> orient_component(triangle_count, kNone);
-    std::vector<std::uint32_t> queue(triangle_count);  // every triangle enters it once
-    std::vector<std::uint8_t> component_open;
-    std::size_t queued = 0;
-    for (std::uint32_t seed = 0; seed < triangle_count; ++seed) {
-      if (orient_component[seed] != kNone) continue;
-      const auto component = static_cast<std::uint32_t>(component_open.size());
-      component_open.push_back(0);
-      orient_component[seed] = component;
-      queue[queued++] = seed;
-      for (std::size_t head = queued - 1; head < queued; ++head) {
-        if (head + 4 < queued) {
-          const TriangleSlots& ahead = neighbours[queue[head + 4]];
-          for (unsigned k = 0; k < ahead.count(); ++k) {
-            __builtin_prefetch(&orient_component[ahead.other[k]]);
-            __builtin_prefetch(&flipped_[ahead.other[k]]);
-          }
-        }
-        if (head + 8 < queued) __builtin_prefetch(&neighbours[queue[head + 8]]);
-        const std::uint32_t t = queue[head];
-        const TriangleSlots& slots = neighbours[t];
-        if (slots.open()) component_open[component] = 1;
-        for (unsigned k = 0; k < slots.count(); ++k) {
-          if (!slots.manifold(k)) continue;
-          const std::uint32_t other = slots.other[k];
-          const std::uint8_t wanted = flipped_[t] ^ std::uint8_t{slots.same_direction(k)};
-          if (orient_component[other] == kNone) {
-            orient_component[other] = component;
-            flipped_[other] = wanted;
-            queue[queued++] = other;
-          } else if (flipped_[other] != wanted) {
-            component_open[component] = 1;  // not orientable (a Möbius band): no inside
-          }
-        }
-      }
-    }
-    std::vector<std::uint32_t>().swap(queue);
-    // Closed components face outward: flip those of negative signed volume. The components of
-    // the dual graph are those of the orientation joined across the other links and within
-    // polygon faces; numbered by their lowest member, as the orientation components are by their
-    // lowest triangle, they are numbered by their lowest face.
-    std::vector<double> volume(component_open.size(), 0.0);
-    UnionFind joined(component_open.size());
-    const bool polygons = face_count != triangle_count;
-    for (std::uint32_t t = 0; t < triangle_count; ++t) {
-      if (t + 16 < triangle_count)
-        for (std::uint32_t u : mesh.triangles[t + 16]) __builtin_prefetch(&positions_[u]);
-      const Triangle tri = canonical_corners(mesh.triangles[t], positions_);
-      const double v = positions_[tri[0]].dot(positions_[tri[1]].cross(positions_[tri[2]]));
-      volume[orient_component[t]] += flipped_[t] ? -v : v;
-      const TriangleSlots& slots = neighbours[t];
-      for (unsigned k = 0; k < slots.count(); ++k)
-        if (!slots.manifold(k)) joined.unite(orient_component[t], orient_component[slots.other[k]]);
-      if (polygons && t > 0 && mesh.face_of_triangle[t] == mesh.face_of_triangle[t - 1])
-        joined.unite(orient_component[t], orient_component[t - 1]);
-    }
-    for (std::uint32_t t = 0; t < triangle_count; ++t) {
-      const std::uint32_t c = orient_component[t];
-      if (!component_open[c] && volume[c] < 0) flipped_[t] ^= 1;
-    }
-    const std::vector<std::uint32_t> label = std::move(joined).labels(component_count_);
-    component_of_face_.resize(face_count);
-    for (std::uint32_t f = 0; f < face_count; ++f)
-      component_of_face_[f] = label[orient_component[first_triangle_[f]]];
+    Orientation orientation = orient(neighbours);
+    component_of_face_ =
+        turn_outward(mesh, positions_, neighbours, first_triangle_, orientation, component_count_);
+    flipped_ = std::move(orientation.flipped);
   }
 
   // The dual edges: faces are independent, so ranges of them go to threads, their results
