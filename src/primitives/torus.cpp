@@ -22,7 +22,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <span>
+#include <utility>
 
 #include "eigen_conversions.hpp"
 #include "primitives/pratt_fit.hpp"
@@ -44,6 +46,104 @@ constexpr double kMaxRelativeMinorRadius = 20;
 // Levenberg–Marquardt steps on the sample (each O(32)).
 constexpr int kTorusRefinementSteps = 8;
 
+// The cluster's corner sample about its centroid, in units of its RMS spread (fixed capacity:
+// this runs for every candidate merge).
+struct TorusSample {
+  static constexpr std::size_t kCapacity = SampleReservoir::kCapacity;
+  std::size_t n = 0;
+  std::array<Vec3, kCapacity> points;
+  std::array<double, kCapacity> weights;  // the estimator weights
+  std::array<Eigen::Vector3d, kCapacity> positions, normals;
+  double weight = 0;  // Σ of the estimator weights
+};
+
+// The axis: the line (`direction`, through `point`, the axis point nearest the centroid) that the
+// samples' normal lines meet best. Rows l = (x × n, n) against (a, p × a). Nothing when the
+// normals are (nearly) coplanar.
+std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> revolution_axis(
+    const TorusSample& sample) {
+  Eigen::Matrix<double, 6, 6> lines = Eigen::Matrix<double, 6, 6>::Zero();
+  for (std::size_t i = 0; i < sample.n; ++i) {
+    Eigen::Matrix<double, 6, 1> l;
+    l << sample.positions[i].cross(sample.normals[i]), sample.normals[i];
+    lines.noalias() += sample.weights[i] * l * l.transpose();
+  }
+  const Eigen::Matrix3d nn = lines.bottomRightCorner<3, 3>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> normal_eigen(nn);
+  if (!(normal_eigen.eigenvalues()(0) > kTorusMinNormalSpread * sample.weight)) return std::nullopt;
+  const Eigen::Matrix3d nn_inverse = normal_eigen.eigenvectors() *
+                                     normal_eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                                     normal_eigen.eigenvectors().transpose();
+  const Eigen::Matrix3d cross_block = lines.topRightCorner<3, 3>();
+  const Eigen::Matrix3d reduced =
+      lines.topLeftCorner<3, 3>() - cross_block * nn_inverse * cross_block.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axis_eigen(reduced);
+  const Eigen::Vector3d axis = axis_eigen.eigenvectors().col(0).normalized();
+  Eigen::Vector3d moment = -nn_inverse * cross_block.transpose() * axis;
+  moment -= axis * axis.dot(moment);  // a Plücker line: moment ⊥ direction
+  return std::pair{axis, axis.cross(moment)};
+}
+
+// The tube's circle in the (ρ, h) half-plane of the axis through `on_axis`: its centre (ρ, h)
+// and radius. Nothing when Pratt's fit fails or the centre is not off the axis.
+std::optional<std::pair<Eigen::Vector2d, double>> tube_circle(const TorusSample& sample,
+                                                              const Eigen::Vector3d& axis,
+                                                              const Eigen::Vector3d& on_axis) {
+  detail::CentredMomentsND<2> profile;
+  std::array<Eigen::Vector2d, TorusSample::kCapacity> rho_h;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < sample.n; ++i) {
+    const Eigen::Vector3d y = sample.positions[i] - on_axis;
+    const double h = axis.dot(y);
+    rho_h[i] = {(y - h * axis).norm(), h};
+    mean += sample.weights[i] * rho_h[i];
+  }
+  mean /= sample.weight;
+  profile.weight = sample.weight;
+  profile.second.setZero();
+  profile.third.setZero();
+  for (std::size_t i = 0; i < sample.n; ++i) {
+    const Eigen::Vector2d p = rho_h[i] - mean;
+    profile.second.noalias() += sample.weights[i] * p * p.transpose();
+    profile.third += sample.weights[i] * p * p.squaredNorm();
+    profile.fourth += sample.weights[i] * p.squaredNorm() * p.squaredNorm();
+  }
+  const detail::PrattResult<2> circle = detail::pratt_fit(profile);
+  if (!circle.valid) return std::nullopt;
+  const Eigen::Vector2d tube_centre = mean + circle.centre;
+  if (!(tube_centre.x() > 0)) return std::nullopt;  // the centre circle must have a radius
+  return std::pair{tube_centre, circle.radius};
+}
+
+// Face normals must follow the torus's across each face: mean |n · ν| over the sample, ν the
+// torus's normal at the point nearest the corner, and again nearest the face's centroid (where
+// the cylinder and sphere compare them); the lower mean counts. The corners alone are not
+// enough: the vertices of a flat cap's fan all lie on the torus's top circle, where its normal
+// is the cap's, yet the faces between them leave the torus.
+double torus_normal_alignment(const Primitive& torus, const TorusSample& sample,
+                              const SampleReservoir& reservoir, double scale) {
+  const Eigen::Vector3d torus_centre = detail::to_eigen(torus.point);
+  const Eigen::Vector3d torus_axis = detail::to_eigen(torus.axis);
+  // |f · ν(x)| for the face normal f, 0 on the axis (no normal, no agreement).
+  auto agreement = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& face_normal) {
+    const Eigen::Vector3d y = x - torus_centre;
+    const Eigen::Vector3d radial = y - torus_axis * torus_axis.dot(y);
+    if (!(radial.squaredNorm() > 0)) return 0.0;
+    const Eigen::Vector3d nearest = detail::to_eigen(torus.closest_point(detail::to_vec3(x)));
+    const Eigen::Vector3d ring = torus_centre + radial.normalized() * torus.radius;
+    const Eigen::Vector3d normal = (nearest - ring).normalized();
+    return std::abs(normal.dot(face_normal));
+  };
+  double at_corners = 0, at_centroids = 0;
+  for (std::size_t i = 0; i < sample.n; ++i) {
+    at_corners += sample.weights[i] * agreement(sample.positions[i], sample.normals[i]);
+    const Eigen::Vector3d centroid =
+        sample.positions[i] + reservoir.samples[i].to_centroid.cast<double>() * scale;
+    at_centroids += sample.weights[i] * agreement(centroid, sample.normals[i]);
+  }
+  return std::min(at_corners, at_centroids) / sample.weight;
+}
+
 }  // namespace
 
 std::uint32_t TorusFitter::min_triangles() const {
@@ -64,68 +164,24 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   if (!(spread2 > 0) || !std::isfinite(spread2)) return result;
   const double scale = 1 / std::sqrt(spread2);
 
-  // Samples about the centroid, in units of the RMS spread (fixed capacity: this runs for every
-  // candidate merge).
-  constexpr std::size_t kCapacity = SampleReservoir::kCapacity;
-  std::array<Vec3, kCapacity> points;
-  std::array<double, kCapacity> weights;
-  std::array<Eigen::Vector3d, kCapacity> positions, normals;
-  double sample_weight = 0;
+  TorusSample sample;
+  sample.n = n;
   for (std::size_t i = 0; i < n; ++i) {
-    positions[i] = (reservoir.samples[i].position - m.origin()) * scale;
-    normals[i] = reservoir.samples[i].normal.cast<double>();
-    weights[i] = reservoir.estimator_weight(i);
-    points[i] = {positions[i].x(), positions[i].y(), positions[i].z()};
-    sample_weight += weights[i];
+    sample.positions[i] = (reservoir.samples[i].position - m.origin()) * scale;
+    sample.normals[i] = reservoir.samples[i].normal.cast<double>();
+    sample.weights[i] = reservoir.estimator_weight(i);
+    sample.points[i] = {sample.positions[i].x(), sample.positions[i].y(), sample.positions[i].z()};
+    sample.weight += sample.weights[i];
   }
-  if (!(sample_weight > 0)) return result;
+  if (!(sample.weight > 0)) return result;
 
-  // 1. The axis. Rows l = (x × n, n) against (a, p × a).
-  Eigen::Matrix<double, 6, 6> lines = Eigen::Matrix<double, 6, 6>::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    Eigen::Matrix<double, 6, 1> l;
-    l << positions[i].cross(normals[i]), normals[i];
-    lines.noalias() += weights[i] * l * l.transpose();
-  }
-  const Eigen::Matrix3d nn = lines.bottomRightCorner<3, 3>();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> normal_eigen(nn);
-  if (!(normal_eigen.eigenvalues()(0) > kTorusMinNormalSpread * sample_weight)) return result;
-  const Eigen::Matrix3d nn_inverse = normal_eigen.eigenvectors() *
-                                     normal_eigen.eigenvalues().cwiseInverse().asDiagonal() *
-                                     normal_eigen.eigenvectors().transpose();
-  const Eigen::Matrix3d cross_block = lines.topRightCorner<3, 3>();
-  const Eigen::Matrix3d reduced =
-      lines.topLeftCorner<3, 3>() - cross_block * nn_inverse * cross_block.transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axis_eigen(reduced);
-  Eigen::Vector3d axis = axis_eigen.eigenvectors().col(0).normalized();
-  Eigen::Vector3d moment = -nn_inverse * cross_block.transpose() * axis;
-  moment -= axis * axis.dot(moment);                   // a Plücker line: moment ⊥ direction
-  const Eigen::Vector3d on_axis = axis.cross(moment);  // the axis point nearest the centroid
-
-  // 2. The tube's circle in the (ρ, h) half-plane.
-  detail::CentredMomentsND<2> profile;
-  std::array<Eigen::Vector2d, kCapacity> rho_h;
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d y = positions[i] - on_axis;
-    const double h = axis.dot(y);
-    rho_h[i] = {(y - h * axis).norm(), h};
-    mean += weights[i] * rho_h[i];
-  }
-  mean /= sample_weight;
-  profile.weight = sample_weight;
-  profile.second.setZero();
-  profile.third.setZero();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d p = rho_h[i] - mean;
-    profile.second.noalias() += weights[i] * p * p.transpose();
-    profile.third += weights[i] * p * p.squaredNorm();
-    profile.fourth += weights[i] * p.squaredNorm() * p.squaredNorm();
-  }
-  const detail::PrattResult<2> circle = detail::pratt_fit(profile);
-  if (!circle.valid) return result;
-  const Eigen::Vector2d tube_centre = mean + circle.centre;
-  if (!(tube_centre.x() > 0)) return result;  // the tube's centre circle must have a radius
+  // 1. The axis; 2. the tube's circle.
+  const auto axis_line = revolution_axis(sample);
+  if (!axis_line) return result;
+  const auto& [axis, on_axis] = *axis_line;
+  const auto tube = tube_circle(sample, axis, on_axis);
+  if (!tube) return result;
+  const auto& [tube_centre, tube_radius] = *tube;
 
   // 3. Geometric refinement on the sample.
   Primitive start;
@@ -134,51 +190,27 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   start.point = {centre.x(), centre.y(), centre.z()};
   start.axis = {axis.x(), axis.y(), axis.z()};
   start.radius = tube_centre.x();
-  start.minor_radius = circle.radius;
+  start.minor_radius = tube_radius;
   GeometricFitOptions options;
   options.max_iterations = kTorusRefinementSteps;
-  const GeometricFit refined = fit_geometric(start, std::span<const Vec3>(points.data(), n),
-                                             std::span<const double>(weights.data(), n), options);
+  const GeometricFit refined =
+      fit_geometric(start, std::span<const Vec3>(sample.points.data(), n),
+                    std::span<const double>(sample.weights.data(), n), options);
   const Primitive& torus = refined.primitive;
   if (!(torus.minor_radius > 0 && torus.radius >= kMinRelativeMajorRadius * torus.minor_radius) ||
       !(torus.radius <= detail::kMaxRelativeRadius &&
         torus.minor_radius <= kMaxRelativeMinorRadius))
     return result;
-
-  // Face normals must follow the torus's across each face: mean |n · ν| over the sample, ν the
-  // torus's normal at the point nearest the corner, and again nearest the face's centroid (where
-  // the cylinder and sphere compare them); the lower mean counts. The corners alone are not
-  // enough: the vertices of a flat cap's fan all lie on the torus's top circle, where its normal
-  // is the cap's, yet the faces between them leave the torus.
-  const Eigen::Vector3d torus_centre(torus.point[0], torus.point[1], torus.point[2]);
-  const Eigen::Vector3d torus_axis(torus.axis[0], torus.axis[1], torus.axis[2]);
-  // |f · ν(x)| for the face normal f, 0 on the axis (no normal, no agreement).
-  auto agreement = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& face_normal) {
-    const Eigen::Vector3d y = x - torus_centre;
-    const Eigen::Vector3d radial = y - torus_axis * torus_axis.dot(y);
-    if (!(radial.squaredNorm() > 0)) return 0.0;
-    const Eigen::Vector3d nearest = detail::to_eigen(torus.closest_point(detail::to_vec3(x)));
-    const Eigen::Vector3d ring = torus_centre + radial.normalized() * torus.radius;
-    const Eigen::Vector3d normal = (nearest - ring).normalized();
-    return std::abs(normal.dot(face_normal));
-  };
-  double at_corners = 0, at_centroids = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    at_corners += weights[i] * agreement(positions[i], normals[i]);
-    const Eigen::Vector3d centroid =
-        positions[i] + reservoir.samples[i].to_centroid.cast<double>() * scale;
-    at_centroids += weights[i] * agreement(centroid, normals[i]);
-  }
-  result.normal_alignment = std::min(at_corners, at_centroids) / sample_weight;
+  result.normal_alignment = torus_normal_alignment(torus, sample, reservoir, scale);
   if (!(result.normal_alignment >= kMinNormalAlignment)) return result;
 
   double error = refined.rms * refined.rms * weight;  // refined.rms: Σ ŵ d² / Σ ŵ
   if (reservoir.threshold() > 0) error *= double(n) / double(n - kParameters);
   result.valid = true;
   result.error = error * spread2;
-  const Eigen::Vector3d input_centre = m.origin() + torus_centre / scale;
+  const Eigen::Vector3d input_centre = m.origin() + detail::to_eigen(torus.point) / scale;
   result.primitive = torus;
-  const Eigen::Vector3d canonical = canonical_axis(torus_axis);
+  const Eigen::Vector3d canonical = canonical_axis(detail::to_eigen(torus.axis));
   result.primitive.axis = {canonical.x(), canonical.y(), canonical.z()};
   result.primitive.point = {input_centre.x(), input_centre.y(), input_centre.z()};
   result.primitive.radius = torus.radius / scale;
