@@ -275,26 +275,8 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
           {"kinds", std::move(kind_names)}};
 }
 
-/// The page's data. `fit_seconds`, `relations_seconds`: set to the time the geometric fits and
-/// the relations (of the levels of at most `relation_clusters` clusters; 0: none) took.
-std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
-                      std::uint32_t initial_clusters, const AutoLevel& automatic,
-                      const std::optional<PageSkeleton>& skeleton, std::uint32_t relation_clusters,
-                      const RelationOptions& relation_options, unsigned threads,
-                      double& fit_seconds, double& relations_seconds) {
-  const Mesh& mesh = hierarchy.mesh();
-  const std::uint32_t f = hierarchy.face_count();
-  const auto merges = hierarchy.merges();
-
-  // Positions relative to the bounding-box centre, so that float32 keeps the shape's detail
-  // even far from the origin.
-  Vec3 low = mesh.positions.empty() ? Vec3{0, 0, 0} : mesh.positions[0], high = low;
-  for (const Vec3& p : mesh.positions)
-    for (int a = 0; a < 3; ++a) {
-      low[a] = std::min(low[a], p[a]);
-      high[a] = std::max(high[a], p[a]);
-    }
-  const Vec3 center{(low[0] + high[0]) / 2, (low[1] + high[1]) / 2, (low[2] + high[2]) / 2};
+/// The mesh as the page draws it: positions (float32, relative to `center`) and triangles.
+void append_mesh_arrays(std::string& html, const Mesh& mesh, const Vec3& center) {
   std::vector<float> positions(mesh.positions.size() * 3);
   for (std::size_t v = 0; v < mesh.positions.size(); ++v)
     for (int a = 0; a < 3; ++a)
@@ -302,7 +284,17 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
   std::vector<std::uint32_t> triangles(mesh.triangles.size() * 3);
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     std::copy(mesh.triangles[t].begin(), mesh.triangles[t].end(), triangles.begin() + 3 * t);
+  append_array(html, "positions", positions);
+  append_array(html, "triangles", triangles);
+  // Input faces of the triangles: only needed for polygon meshes (else the identity).
+  if (mesh.triangle_count() != mesh.face_count())
+    append_array(html, "face-of-triangle", mesh.face_of_triangle);
+}
 
+/// The tree as the page browses it: each merge's children, RMS estimate and primitive type.
+void append_tree_arrays(std::string& html, const Hierarchy& hierarchy) {
+  const std::uint32_t f = hierarchy.face_count();
+  const auto merges = hierarchy.merges();
   std::vector<std::uint32_t> children(merges.size() * 2);
   std::vector<double> rms(merges.size());
   std::vector<std::uint8_t> types(merges.size());
@@ -312,19 +304,47 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
     rms[i] = hierarchy.rms_estimate(static_cast<std::uint32_t>(f + i));
     types[i] = static_cast<std::uint8_t>(merges[i].primitive.type);
   }
-  // The clusters of the levels of at most kMaxClustersWithParameters clusters: the nodes whose
-  // parent is one of the last real merges, a trailing merge or none (component roots).
+  append_array(html, "children", children);
+  append_array(html, "rms", rms);
+  append_array(html, "types", types);
+}
+
+/// The clusters of the levels of at most kMaxClustersWithParameters clusters: the nodes whose
+/// parent is one of the last real merges, a trailing merge or none (component roots).
+std::vector<std::uint32_t> parameter_nodes(const Hierarchy& hierarchy) {
+  const std::uint32_t f = hierarchy.face_count();
   const std::uint32_t real = f - hierarchy.component_count();
   const std::uint32_t components = hierarchy.component_count();
-  const std::uint32_t carried_merges =
-      components > kMaxClustersWithParameters
-          ? 0
-          : std::min(real, kMaxClustersWithParameters - components);
   std::vector<std::uint32_t> carried;
-  if (components <= kMaxClustersWithParameters)
-    for (std::uint32_t node = 0; node < f + real; ++node)
-      if (is_cluster_of_a_level(hierarchy, node, carried_merges)) carried.push_back(node);
-  // Their primitives as every cut reports them: the geometric fit and its exact errors.
+  if (components > kMaxClustersWithParameters) return carried;
+  const std::uint32_t carried_merges = std::min(real, kMaxClustersWithParameters - components);
+  for (std::uint32_t node = 0; node < f + real; ++node)
+    if (is_cluster_of_a_level(hierarchy, node, carried_merges)) carried.push_back(node);
+  return carried;
+}
+
+/// The page's data. `fit_seconds`, `relations_seconds`: set to the time the geometric fits and
+/// the relations (of the levels of at most `relation_clusters` clusters; 0: none) took.
+std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
+                      std::uint32_t initial_clusters, const AutoLevel& automatic,
+                      const std::optional<PageSkeleton>& skeleton, std::uint32_t relation_clusters,
+                      const RelationOptions& relation_options, unsigned threads,
+                      double& fit_seconds, double& relations_seconds) {
+  const Mesh& mesh = hierarchy.mesh();
+  const std::uint32_t f = hierarchy.face_count();
+  // Positions relative to the bounding-box centre, so that float32 keeps the shape's detail
+  // even far from the origin.
+  Vec3 low = mesh.positions.empty() ? Vec3{0, 0, 0} : mesh.positions[0], high = low;
+  for (const Vec3& p : mesh.positions)
+    for (int a = 0; a < 3; ++a) {
+      low[a] = std::min(low[a], p[a]);
+      high[a] = std::max(high[a], p[a]);
+    }
+  const Vec3 center{(low[0] + high[0]) / 2, (low[1] + high[1]) / 2, (low[2] + high[2]) / 2};
+
+  // The parameter nodes' primitives as every cut reports them: the geometric fit and its exact
+  // errors.
+  const std::vector<std::uint32_t> carried = parameter_nodes(hierarchy);
   DescribeOptions describe;
   describe.threads = threads;
   const auto fit_start = Clock::now();
@@ -368,13 +388,8 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
   std::string html = "<script type=\"application/json\" id=\"primseg-header\">";
   html += script_safe(header);
   html += "</script>\n";
-  append_array(html, "positions", positions);
-  append_array(html, "triangles", triangles);
-  // Input faces of the triangles: only needed for polygon meshes (else the identity).
-  if (mesh.triangle_count() != f) append_array(html, "face-of-triangle", mesh.face_of_triangle);
-  append_array(html, "children", children);
-  append_array(html, "rms", rms);
-  append_array(html, "types", types);
+  append_mesh_arrays(html, mesh, center);
+  append_tree_arrays(html, hierarchy);
   append_array(html, "parameter-nodes", carried);
   append_array(html, "parameters", parameters);
   append_array(html, "errors", errors);
