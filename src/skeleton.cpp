@@ -170,6 +170,97 @@ Vec3 far_end(const Mesh& mesh, const Bone& bone, const std::vector<std::uint32_t
   return bone.point + (high_side ? high : low) * bone.axis;
 }
 
+// Each cluster's vertices (of its triangles), in increasing order.
+std::vector<std::vector<std::uint32_t>> vertices_of_clusters(
+    const Mesh& mesh, const std::vector<std::uint32_t>& labels, std::size_t k) {
+  std::vector<std::vector<std::uint32_t>> cluster_vertices(k);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (const std::uint32_t v : mesh.triangles[t]) cluster_vertices[labels[t]].push_back(v);
+  for (auto& vertices : cluster_vertices) {
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  }
+  return cluster_vertices;
+}
+
+// The groups of pair boundaries that touch (share a vertex: union-find over pairs), each a joint,
+// in the order of their lowest boundary vertex.
+std::vector<std::vector<std::uint32_t>> touching_boundaries(
+    const Mesh& mesh, const std::vector<ClusterPairBoundary>& pairs) {
+  std::vector<std::uint32_t> pair_parent(pairs.size());
+  std::iota(pair_parent.begin(), pair_parent.end(), 0u);
+  std::vector<std::uint32_t> vertex_pair(mesh.vertex_count(), kNone);  // a pair at the vertex
+  for (std::uint32_t p = 0; p < pairs.size(); ++p)
+    for (const std::uint32_t v : pairs[p].vertices) {
+      if (vertex_pair[v] == kNone) {
+        vertex_pair[v] = p;
+        continue;
+      }
+      const std::uint32_t a = find_root(pair_parent, vertex_pair[v]), b = find_root(pair_parent, p);
+      if (a != b) pair_parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::map<std::uint32_t, std::vector<std::uint32_t>> groups;  // root pair -> pairs
+  for (std::uint32_t p = 0; p < pairs.size(); ++p) groups[find_root(pair_parent, p)].push_back(p);
+  std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> ordered;
+  for (auto& [root, members] : groups) {
+    std::uint32_t lowest = kNone;
+    for (const std::uint32_t p : members) lowest = std::min(lowest, pairs[p].vertices.front());
+    ordered.emplace_back(lowest, std::move(members));
+  }
+  std::sort(ordered.begin(), ordered.end());
+  std::vector<std::vector<std::uint32_t>> joints;
+  for (auto& [lowest, members] : ordered) joints.push_back(std::move(members));
+  return joints;
+}
+
+// The joint of the touching pair boundaries `members`: at their length-weighted midpoint, between
+// the bones they separate; sensitive between two bones, locked among more.
+Joint boundary_joint(const Mesh& mesh, const std::vector<ClusterPairBoundary>& pairs,
+                     const std::vector<std::uint32_t>& members, std::uint32_t id) {
+  Joint joint;
+  joint.id = id;
+  double length = 0;
+  Vec3 weighted{0, 0, 0}, vertex_sum{0, 0, 0};
+  std::size_t vertex_count = 0;
+  for (const std::uint32_t p : members) {
+    length += pairs[p].length;
+    weighted = weighted + pairs[p].weighted_midpoints;
+    for (const std::uint32_t v : pairs[p].vertices) vertex_sum = vertex_sum + mesh.positions[v];
+    vertex_count += pairs[p].vertices.size();
+    joint.bones.push_back(pairs[p].first);
+    joint.bones.push_back(pairs[p].second);
+  }
+  // Zero-length boundaries (degenerate edges only): the mean of their vertices.
+  joint.position =
+      length > 0 ? (1 / length) * weighted : (1.0 / static_cast<double>(vertex_count)) * vertex_sum;
+  std::sort(joint.bones.begin(), joint.bones.end());
+  joint.bones.erase(std::unique(joint.bones.begin(), joint.bones.end()), joint.bones.end());
+  joint.kind = joint.bones.size() <= 2 ? JointKind::Sensitive : JointKind::Locked;
+  return joint;
+}
+
+// Virtual joints at the free ends of bone c: both ends of a bone with no neighbour, the end away
+// from its one neighbour's joint for a bone with one.
+std::vector<Vec3> free_ends(const Mesh& mesh, const Skeleton& skeleton, std::size_t c,
+                            const std::vector<std::uint32_t>& vertices) {
+  const Bone& bone = skeleton.bones[c];
+  std::vector<std::uint32_t> neighbours;
+  for (const std::uint32_t j : bone.joints)
+    for (const std::uint32_t b : skeleton.joints[j].bones)
+      if (b != c) neighbours.push_back(b);
+  std::sort(neighbours.begin(), neighbours.end());
+  neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
+  std::vector<Vec3> ends;
+  if (neighbours.empty()) {
+    ends.push_back(far_end(mesh, bone, vertices, nullptr, false));
+    ends.push_back(far_end(mesh, bone, vertices, nullptr, true));
+  } else if (neighbours.size() == 1) {
+    const Vec3 from = skeleton.joints[bone.joints.front()].position;
+    ends.push_back(far_end(mesh, bone, vertices, &from, false));
+  }
+  return ends;
+}
+
 }  // namespace
 
 Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_labels,
@@ -183,93 +274,28 @@ Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_
     skeleton.bones[c].id = static_cast<std::uint32_t>(c);
     skeleton.bones[c].cluster = static_cast<std::uint32_t>(c);
   }
-
   const std::vector<std::uint32_t> labels = triangle_labels(mesh, face_labels);
-  std::vector<std::vector<std::uint32_t>> cluster_vertices(k);
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    for (const std::uint32_t v : mesh.triangles[t]) cluster_vertices[labels[t]].push_back(v);
-  for (auto& vertices : cluster_vertices) {
-    std::sort(vertices.begin(), vertices.end());
-    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  }
+  const std::vector<std::vector<std::uint32_t>> cluster_vertices =
+      vertices_of_clusters(mesh, labels, k);
   describe_bones(mesh, labels, primitives, cluster_vertices, skeleton.bones);
 
-  // Pair boundaries that share a vertex belong to one joint (union-find over pairs).
   const std::vector<ClusterPairBoundary> pairs = cluster_pair_boundaries(mesh, labels);
-  std::vector<std::uint32_t> pair_parent(pairs.size());
-  std::iota(pair_parent.begin(), pair_parent.end(), 0u);
-  std::vector<std::uint32_t> vertex_pair(mesh.vertex_count(), kNone);  // a pair at the vertex
-  for (std::uint32_t p = 0; p < pairs.size(); ++p)
-    for (const std::uint32_t v : pairs[p].vertices) {
-      if (vertex_pair[v] == kNone) {
-        vertex_pair[v] = p;
-        continue;
-      }
-      const std::uint32_t a = find_root(pair_parent, vertex_pair[v]), b = find_root(pair_parent, p);
-      if (a != b) pair_parent[std::max(a, b)] = std::min(a, b);
-    }
-
-  // One joint per group of touching pair boundaries, numbered by lowest boundary vertex.
-  std::map<std::uint32_t, std::vector<std::uint32_t>> groups;  // root pair -> pairs
-  for (std::uint32_t p = 0; p < pairs.size(); ++p) groups[find_root(pair_parent, p)].push_back(p);
-  std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> ordered;
-  for (auto& [root, members] : groups) {
-    std::uint32_t lowest = kNone;
-    for (const std::uint32_t p : members) lowest = std::min(lowest, pairs[p].vertices.front());
-    ordered.emplace_back(lowest, std::move(members));
-  }
-  std::sort(ordered.begin(), ordered.end());
-  for (const auto& [lowest, members] : ordered) {
-    Joint joint;
-    joint.id = static_cast<std::uint32_t>(skeleton.joints.size());
-    double length = 0;
-    Vec3 weighted{0, 0, 0}, vertex_sum{0, 0, 0};
-    std::size_t vertex_count = 0;
-    for (const std::uint32_t p : members) {
-      length += pairs[p].length;
-      weighted = weighted + pairs[p].weighted_midpoints;
-      for (const std::uint32_t v : pairs[p].vertices) vertex_sum = vertex_sum + mesh.positions[v];
-      vertex_count += pairs[p].vertices.size();
-      joint.bones.push_back(pairs[p].first);
-      joint.bones.push_back(pairs[p].second);
-    }
-    // Zero-length boundaries (degenerate edges only): the mean of their vertices.
-    joint.position = length > 0 ? (1 / length) * weighted
-                                : (1.0 / static_cast<double>(vertex_count)) * vertex_sum;
-    std::sort(joint.bones.begin(), joint.bones.end());
-    joint.bones.erase(std::unique(joint.bones.begin(), joint.bones.end()), joint.bones.end());
-    joint.kind = joint.bones.size() <= 2 ? JointKind::Sensitive : JointKind::Locked;
+  for (const std::vector<std::uint32_t>& members : touching_boundaries(mesh, pairs)) {
+    Joint joint =
+        boundary_joint(mesh, pairs, members, static_cast<std::uint32_t>(skeleton.joints.size()));
     for (const std::uint32_t b : joint.bones) skeleton.bones[b].joints.push_back(joint.id);
     skeleton.joints.push_back(std::move(joint));
   }
-
-  // Virtual joints at the free ends.
-  for (std::size_t c = 0; c < k; ++c) {
-    Bone& bone = skeleton.bones[c];
-    std::vector<std::uint32_t> neighbours;
-    for (const std::uint32_t j : bone.joints)
-      for (const std::uint32_t b : skeleton.joints[j].bones)
-        if (b != c) neighbours.push_back(b);
-    std::sort(neighbours.begin(), neighbours.end());
-    neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
-    std::vector<Vec3> ends;
-    if (neighbours.empty()) {
-      ends.push_back(far_end(mesh, bone, cluster_vertices[c], nullptr, false));
-      ends.push_back(far_end(mesh, bone, cluster_vertices[c], nullptr, true));
-    } else if (neighbours.size() == 1) {
-      const Vec3 from = skeleton.joints[bone.joints.front()].position;
-      ends.push_back(far_end(mesh, bone, cluster_vertices[c], &from, false));
-    }
-    for (const Vec3& end : ends) {
+  for (std::size_t c = 0; c < k; ++c)
+    for (const Vec3& end : free_ends(mesh, skeleton, c, cluster_vertices[c])) {
       Joint joint;
       joint.id = static_cast<std::uint32_t>(skeleton.joints.size());
       joint.position = end;
       joint.kind = JointKind::Virtual;
       joint.bones = {static_cast<std::uint32_t>(c)};
-      bone.joints.push_back(joint.id);
+      skeleton.bones[c].joints.push_back(joint.id);
       skeleton.joints.push_back(std::move(joint));
     }
-  }
 
   for (Bone& bone : skeleton.bones)
     bone.visible = !std::all_of(bone.joints.begin(), bone.joints.end(), [&](std::uint32_t j) {
