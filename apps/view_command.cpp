@@ -435,7 +435,7 @@ std::pair<std::string_view, std::size_t> viewer_page() {
 }
 
 // The hierarchy of `mesh`: built, or read from --tree and checked to be that mesh's.
-Hierarchy view_hierarchy(const ViewCommandOptions& o, std::shared_ptr<const Mesh> mesh,
+Hierarchy view_hierarchy(const ViewCommandOptions& o, const std::shared_ptr<const Mesh>& mesh,
                          const HierarchyOptions& options) {
   if (!o.tree_path) return HierarchyBuilder(mesh, options).finish(Progress("hierarchy", o.quiet));
   Hierarchy tree = read_input_tree(*o.tree_path, nullptr, o.limits.max_memory);

@@ -209,6 +209,7 @@ std::vector<std::vector<std::uint32_t>> touching_boundaries(
   }
   std::sort(ordered.begin(), ordered.end());
   std::vector<std::vector<std::uint32_t>> joints;
+  joints.reserve(ordered.size());
   for (auto& [lowest, members] : ordered) joints.push_back(std::move(members));
   return joints;
 }

@@ -224,6 +224,7 @@ std::optional<std::vector<Eigen::Vector3d>> solve_frame(
   }
   if (!converged) return std::nullopt;
   std::vector<Eigen::Vector3d> moved;
+  moved.reserve(component.size());
   for (const std::size_t g : component) moved.push_back(d[g]);
   return moved;
 }
@@ -242,6 +243,7 @@ std::optional<std::vector<Eigen::Vector3d>> turn_trees(std::size_t i, std::size_
   const Eigen::Quaterniond turn_i = Eigen::Quaterniond::FromTwoVectors(solved[i], a);
   const Eigen::Quaterniond turn_j = Eigen::Quaterniond::FromTwoVectors(solved[j], b);
   std::vector<Eigen::Vector3d> moved;
+  moved.reserve(component.size());
   for (const std::size_t g : component)
     moved.push_back(
         g == i   ? a
