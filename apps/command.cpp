@@ -97,12 +97,20 @@ Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* byte
   return deserialize_tree({image.bytes.get(), image.size}, name);
 }
 
-std::vector<PrimitiveType> parse_primitives(const std::string& list) {
-  std::vector<PrimitiveType> types;
+std::vector<std::string> split_comma_list(const std::string& list) {
+  std::vector<std::string> items;
   std::size_t begin = 0;
   while (begin <= list.size()) {
     const std::size_t end = std::min(list.find(',', begin), list.size());
-    const std::string name = list.substr(begin, end - begin);
+    items.push_back(list.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  return items;
+}
+
+std::vector<PrimitiveType> parse_primitives(const std::string& list) {
+  std::vector<PrimitiveType> types;
+  for (const std::string& name : split_comma_list(list)) {
     const auto type = primitive_type_from_string(name);
     if (!type || !has_fitter(*type)) {
       std::string known;
@@ -114,7 +122,6 @@ std::vector<PrimitiveType> parse_primitives(const std::string& list) {
                               "' (available: " + known + ")");
     }
     types.push_back(*type);
-    begin = end + 1;
   }
   return types;
 }

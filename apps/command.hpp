@@ -72,6 +72,9 @@ Mesh read_geometry(const std::filesystem::path& path, std::uint64_t* bytes = nul
 Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* bytes = nullptr,
                           std::optional<std::uint64_t> max_memory = std::nullopt);
 
+/// The items of a comma-separated list, empty ones included ("" gives one empty item).
+std::vector<std::string> split_comma_list(const std::string& list);
+
 /// Parses "plane,sphere,cylinder" into types that have a fitter; throws InvalidInputError
 /// naming the unknown one and the available ones.
 std::vector<PrimitiveType> parse_primitives(const std::string& list);

@@ -26,17 +26,6 @@ const Variant kVariants[] = {{"cad", Tessellation::Cad, 0.0},
                              {"uniform", Tessellation::Uniform, 0.0},
                              {"noisy", Tessellation::Uniform, 0.002}};
 
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> items;
-  std::size_t begin = 0;
-  while (begin <= list.size()) {
-    const std::size_t end = std::min(list.find(',', begin), list.size());
-    items.push_back(list.substr(begin, end - begin));
-    begin = end + 1;
-  }
-  return items;
-}
-
 // Sums of one group of cases (a variant, or everything).
 struct Totals {
   int cases = 0, auto_exact = 0, auto_within_one = 0;
@@ -88,7 +77,7 @@ struct EvalCommandOptions {
 // The variants of a --variants list, in its order.
 std::vector<const Variant*> chosen_variants(const std::string& list) {
   std::vector<const Variant*> variants;
-  for (const std::string& name : split(list)) {
+  for (const std::string& name : split_comma_list(list)) {
     const auto it = std::find_if(std::begin(kVariants), std::end(kVariants),
                                  [&](const Variant& v) { return v.name == name; });
     if (it == std::end(kVariants))
@@ -147,7 +136,8 @@ void run_eval(const EvalCommandOptions& o) {
   options.threads = o.threads;
   validate(options);
   const std::vector<const Variant*> variants = chosen_variants(o.variants);
-  const std::vector<std::string> shapes = o.shapes.empty() ? shape_names() : split(o.shapes);
+  const std::vector<std::string> shapes =
+      o.shapes.empty() ? shape_names() : split_comma_list(o.shapes);
   for (const std::string& name : shapes) make_shape(name);  // unknown names fail first
 
   nlohmann::json cases = nlohmann::json::array();

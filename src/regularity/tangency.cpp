@@ -734,16 +734,18 @@ std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
 // The gap to each plane, from the line's cylinders refitted on their points with its direction
 // (a radius an EqualRadius relation shares with clusters off the line held, one shared only on
 // the line one parameter), must be within the significance (its standard deviation from that
-// fit's covariance) or the length tolerance, within max_radius_difference of the radius and known
-// to better than that (the interval rule of the spheres' centres). Candidates are tried from the
-// nearest in standard deviations, each kept when the line refitted tangent to it and to those kept
-// before (fit_held_line(): a lone cylinder keeps 2 parameters for one plane, 1 for two) raises its
-// residual sum by at most the χ² bound of that many conditions times its residual variance (a
-// likelihood-ratio test), or its mean square by at most the length tolerance's square. A condition
-// the kept ones imply (a fragment's face once another fragment of the same radius is tangent to it)
-// is kept when it holds to round-off. The planes are held at their offsets: a face has far more
-// points than a fillet's narrow arc. The cylinders are written back, and the planes they are
-// tangent to with their refitted offsets; each pair is a Tangent relation of `tangents`.
+// fit's covariance, the plane's offset variance and its normal's tilt about the axis times the
+// distance across from its centroid to the contact) or the length tolerance, within
+// max_radius_difference of the radius and known to better than that (the interval rule of the
+// spheres' centres). Candidates are tried from the nearest in standard deviations, each kept when
+// the line refitted tangent to it and to those kept before (fit_held_line(): a lone cylinder keeps
+// 2 parameters for one plane, 1 for two) raises its residual sum by at most the χ² bound of that
+// many conditions times its residual variance (a likelihood-ratio test), or its mean square by at
+// most the length tolerance's square. A condition the kept ones imply (a fragment's face once
+// another fragment of the same radius is tangent to it) is kept when it holds to round-off. In that
+// refit the planes are held at their offsets and normals: a face usually has far more points than a
+// fillet's narrow arc. The cylinders are written back, and the planes they are tangent to with
+// their refitted offsets; each pair is a Tangent relation of `tangents`.
 void make_tangent(const std::vector<DirectionGroup>& groups,
                   const std::vector<std::pair<std::size_t, std::size_t>>& orthogonal,
                   const std::vector<std::vector<std::size_t>>& refitted,
