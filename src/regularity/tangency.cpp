@@ -342,6 +342,7 @@ void Tangency::fit_plane_offsets() {
     const Eigen::Vector3d normal = to_eigen(primitives_[p].axis);
     HeldOffset& held = offsets_[p];
     held.offset = normal.dot(to_eigen(primitives_[p].point));
+    held.centroid = to_eigen(primitives_[p].point);  // its inliers' centroid (align_plane)
     kept.clear();
     kept_weights.clear();
     double total = 0, sum = 0;
