@@ -34,6 +34,115 @@ std::vector<std::vector<std::uint32_t>> face_neighbourhoods(const Mesh& mesh,
   return rings;
 }
 
+// The triangles' centroids, unit normals (zero for a degenerate triangle) and areas at
+// `positions`, each normal on the side the dual graph oriented its triangle to (`flipped`).
+struct FaceGeometry {
+  std::vector<Eigen::Vector3d> centroids, normals;
+  std::vector<double> areas;
+};
+
+FaceGeometry face_geometry(const Mesh& mesh, const std::vector<std::uint8_t>& flipped) {
+  const std::uint32_t face_count = mesh.triangle_count();
+  FaceGeometry geometry{std::vector<Eigen::Vector3d>(face_count),
+                        std::vector<Eigen::Vector3d>(face_count), std::vector<double>(face_count)};
+  for (std::uint32_t t = 0; t < face_count; ++t) {
+    const Triangle& c = mesh.triangles[t];
+    const Eigen::Vector3d a = to_eigen(mesh.positions[c[0]]), b = to_eigen(mesh.positions[c[1]]),
+                          d = to_eigen(mesh.positions[c[2]]);
+    const Eigen::Vector3d cross = flipped[t] ? (d - a).cross(b - a) : (b - a).cross(d - a);
+    geometry.centroids[t] = (a + b + d) / 3;
+    geometry.areas[t] = cross.norm() / 2;
+    geometry.normals[t] =
+        geometry.areas[t] > 0 ? Eigen::Vector3d(cross.normalized()) : Eigen::Vector3d::Zero();
+  }
+  return geometry;
+}
+
+// Normals are compared with the triangles consistently oriented, as the dual graph orients them:
+// files often list faces with mixed orientations, and a flipped neighbour would not average
+// with a face of the same plane, while one across a sharp wedge would look nearly parallel.
+std::vector<std::uint8_t> flipped_triangles(const Mesh& mesh, unsigned threads) {
+  std::vector<std::uint8_t> flipped(mesh.triangle_count());
+  const DualGraph graph(mesh, VertexWeights::Area, threads);
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) flipped[t] = graph.flipped(t) ? 1 : 0;
+  return flipped;
+}
+
+// The mean centroid distance of faces sharing an edge, estimated over the face rings (faces
+// sharing only a vertex are a little farther; the spatial sigma's multiple absorbs it); 1 when
+// no face has a neighbour.
+double mean_ring_distance(const FaceGeometry& geometry,
+                          const std::vector<std::vector<std::uint32_t>>& rings) {
+  double distance_sum = 0;
+  std::uint64_t distance_count = 0;
+  for (std::uint32_t t = 0; t < rings.size(); ++t)
+    for (const std::uint32_t u : rings[t])
+      if (u != t) {
+        distance_sum += (geometry.centroids[t] - geometry.centroids[u]).norm();
+        ++distance_count;
+      }
+  return distance_count ? distance_sum / static_cast<double>(distance_count) : 1;
+}
+
+// The passes of the normal filter: each face's normal becomes the mean of its ring's, weighted by
+// area and by Gaussians of the centroid distance and of the normal difference. Each face of a pass
+// reads only the previous pass: any number of threads.
+void filter_normals(FaceGeometry& geometry, const std::vector<std::vector<std::uint32_t>>& rings,
+                    double spatial, const BilateralSmoothingOptions& options, unsigned threads) {
+  const double spatial_factor = spatial > 0 ? 1 / (2 * spatial * spatial) : 0;
+  const double normal_factor = 1 / (2 * options.normal_sigma * options.normal_sigma);
+  const std::vector<Eigen::Vector3d>& centroids = geometry.centroids;
+  const std::vector<double>& areas = geometry.areas;
+  std::vector<Eigen::Vector3d>& normals = geometry.normals;
+  std::vector<Eigen::Vector3d> filtered(normals.size());
+  for (int pass = 0; pass < options.normal_iterations; ++pass) {
+    detail::parallel_for(normals.size(), threads, [&](std::size_t t) {
+      if (areas[t] == 0) {
+        filtered[t] = normals[t];
+        return;
+      }
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (const std::uint32_t u : rings[t]) {
+        const double d2 = (centroids[t] - centroids[u]).squaredNorm();
+        const double n2 = (normals[t] - normals[u]).squaredNorm();
+        sum += areas[u] * std::exp(-d2 * spatial_factor - n2 * normal_factor) * normals[u];
+      }
+      const double length = sum.norm();
+      filtered[t] = length > 0 ? Eigen::Vector3d(sum / length) : normals[t];
+    });
+    normals.swap(filtered);
+  }
+}
+
+// The vertex passes: each vertex moves to lower Σ_f (n_f · (x − c_f))² over its faces, one Jacobi
+// step at a time with the centroids of the current positions and the filtered `normals`.
+void fit_vertices_to_normals(Mesh& mesh, const VertexTriangles& around,
+                             const std::vector<Eigen::Vector3d>& normals, int iterations,
+                             unsigned threads) {
+  std::vector<Eigen::Vector3d> centroids(mesh.triangle_count());
+  std::vector<Vec3> next(mesh.positions.size());
+  for (int pass = 0; pass < iterations; ++pass) {
+    for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      const Triangle& c = mesh.triangles[t];
+      centroids[t] = (to_eigen(mesh.positions[c[0]]) + to_eigen(mesh.positions[c[1]]) +
+                      to_eigen(mesh.positions[c[2]])) /
+                     3;
+    }
+    detail::parallel_for(mesh.vertex_count(), threads, [&](std::size_t v) {
+      const Eigen::Vector3d x = to_eigen(mesh.positions[v]);
+      Eigen::Vector3d move = Eigen::Vector3d::Zero();
+      const std::uint32_t begin = around.offsets[v], end = around.offsets[v + 1];
+      for (std::uint32_t i = begin; i < end; ++i) {
+        const std::uint32_t t = around.triangles[i];
+        move += normals[t] * normals[t].dot(centroids[t] - x);
+      }
+      const Eigen::Vector3d moved = end > begin ? Eigen::Vector3d(x + move / (end - begin)) : x;
+      next[v] = to_vec3(moved);
+    });
+    mesh.positions.swap(next);
+  }
+}
+
 }  // namespace
 
 void validate(const BilateralSmoothingOptions& options) {
@@ -50,94 +159,14 @@ Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options
   mesh.validate();
   check_geometric_range(mesh);
   Mesh smoothed = mesh;
-  const std::uint32_t face_count = mesh.triangle_count();
-  if (face_count == 0) return smoothed;
+  if (mesh.triangle_count() == 0) return smoothed;
   const VertexTriangles around = vertex_triangles(mesh);
   const std::vector<std::vector<std::uint32_t>> rings = face_neighbourhoods(mesh, around);
-
-  // Normals are compared with the triangles consistently oriented, as the dual graph orients them:
-  // files often list faces with mixed orientations, and a flipped neighbour would not average
-  // with a face of the same plane, while one across a sharp wedge would look nearly parallel.
-  std::vector<std::uint8_t> flipped(face_count);
-  {
-    const DualGraph graph(mesh, VertexWeights::Area, options.threads);
-    for (std::uint32_t t = 0; t < face_count; ++t) flipped[t] = graph.flipped(t) ? 1 : 0;
-  }
-  std::vector<Eigen::Vector3d> centroids(face_count), normals(face_count);
-  std::vector<double> areas(face_count);
-  const auto update_geometry = [&] {
-    for (std::uint32_t t = 0; t < face_count; ++t) {
-      const Triangle& c = smoothed.triangles[t];
-      const Eigen::Vector3d a = to_eigen(smoothed.positions[c[0]]),
-                            b = to_eigen(smoothed.positions[c[1]]),
-                            d = to_eigen(smoothed.positions[c[2]]);
-      const Eigen::Vector3d cross = flipped[t] ? (d - a).cross(b - a) : (b - a).cross(d - a);
-      centroids[t] = (a + b + d) / 3;
-      areas[t] = cross.norm() / 2;
-      normals[t] = areas[t] > 0 ? Eigen::Vector3d(cross.normalized()) : Eigen::Vector3d::Zero();
-    }
-  };
-  update_geometry();
-
-  // The spatial width: the mean centroid distance of faces sharing an edge, estimated over the
-  // face rings (faces sharing only a vertex are a little farther; the multiple absorbs it).
-  double distance_sum = 0;
-  std::uint64_t distance_count = 0;
-  for (std::uint32_t t = 0; t < face_count; ++t)
-    for (const std::uint32_t u : rings[t])
-      if (u != t) {
-        distance_sum += (centroids[t] - centroids[u]).norm();
-        ++distance_count;
-      }
-  const double spatial = options.spatial_sigma *
-                         (distance_count ? distance_sum / static_cast<double>(distance_count) : 1);
-  const double spatial_factor = spatial > 0 ? 1 / (2 * spatial * spatial) : 0;
-  const double normal_factor = 1 / (2 * options.normal_sigma * options.normal_sigma);
-
-  // Each face and each vertex of a pass reads only the previous pass: any number of threads.
+  FaceGeometry geometry = face_geometry(mesh, flipped_triangles(mesh, options.threads));
   const unsigned threads = detail::thread_count(options.threads);
-  std::vector<Eigen::Vector3d> filtered(face_count);
-  for (int pass = 0; pass < options.normal_iterations; ++pass) {
-    detail::parallel_for(face_count, threads, [&](std::size_t t) {
-      if (areas[t] == 0) {
-        filtered[t] = normals[t];
-        return;
-      }
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (const std::uint32_t u : rings[t]) {
-        const double d2 = (centroids[t] - centroids[u]).squaredNorm();
-        const double n2 = (normals[t] - normals[u]).squaredNorm();
-        sum += areas[u] * std::exp(-d2 * spatial_factor - n2 * normal_factor) * normals[u];
-      }
-      const double length = sum.norm();
-      filtered[t] = length > 0 ? Eigen::Vector3d(sum / length) : normals[t];
-    });
-    normals.swap(filtered);
-  }
-
-  // Vertex update: each vertex moves to lower Σ_f (n_f · (x − c_f))² over its faces, one Jacobi
-  // step at a time with the centroids of the current positions and the filtered normals.
-  std::vector<Vec3> next(smoothed.positions.size());
-  for (int pass = 0; pass < options.vertex_iterations; ++pass) {
-    for (std::uint32_t t = 0; t < face_count; ++t) {
-      const Triangle& c = smoothed.triangles[t];
-      centroids[t] = (to_eigen(smoothed.positions[c[0]]) + to_eigen(smoothed.positions[c[1]]) +
-                      to_eigen(smoothed.positions[c[2]])) /
-                     3;
-    }
-    detail::parallel_for(smoothed.vertex_count(), threads, [&](std::size_t v) {
-      const Eigen::Vector3d x = to_eigen(smoothed.positions[v]);
-      Eigen::Vector3d move = Eigen::Vector3d::Zero();
-      const std::uint32_t begin = around.offsets[v], end = around.offsets[v + 1];
-      for (std::uint32_t i = begin; i < end; ++i) {
-        const std::uint32_t t = around.triangles[i];
-        move += normals[t] * normals[t].dot(centroids[t] - x);
-      }
-      const Eigen::Vector3d moved = end > begin ? Eigen::Vector3d(x + move / (end - begin)) : x;
-      next[v] = to_vec3(moved);
-    });
-    smoothed.positions.swap(next);
-  }
+  filter_normals(geometry, rings, options.spatial_sigma * mean_ring_distance(geometry, rings),
+                 options, threads);
+  fit_vertices_to_normals(smoothed, around, geometry.normals, options.vertex_iterations, threads);
   return smoothed;
 }
 

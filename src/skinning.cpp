@@ -5,8 +5,10 @@
 #include <limits>
 #include <map>
 #include <queue>
+#include <span>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "no_index.hpp"
 #include "primseg/error.hpp"
@@ -45,23 +47,11 @@ std::vector<std::vector<LabelledNeighbour>> labelled_adjacency(
   return adjacency;
 }
 
-}  // namespace
+// Triangles of each cluster at each vertex: per vertex, (cluster, count) rows sorted by cluster.
+using IncidentClusters = std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>>;
 
-SkinWeights compute_skin_weights(const Mesh& mesh, const Skeleton& skeleton,
-                                 const SkinningOptions& options) {
-  if (!(std::isfinite(options.band) && options.band >= 0))
-    throw InvalidInputError("compute_skin_weights: band must be finite and >= 0");
-  skeleton_detail::check_face_labels(mesh, skeleton, "compute_skin_weights");
-  for (const Triangle& tri : mesh.triangles)
-    for (const std::uint32_t v : tri)
-      if (v >= mesh.vertex_count())
-        throw InvalidInputError("compute_skin_weights: vertex index out of range");
-
-  const std::vector<std::uint32_t> labels = triangle_labels(mesh, skeleton.face_labels);
-  const auto adjacency = labelled_adjacency(mesh, labels);
-
-  // Triangles of each cluster at each vertex: (vertex, cluster) -> count, as sorted rows.
-  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> incident(mesh.vertex_count());
+IncidentClusters incident_clusters(const Mesh& mesh, std::span<const std::uint32_t> labels) {
+  IncidentClusters incident(mesh.vertex_count());
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (const std::uint32_t v : mesh.triangles[t]) {
       auto& row = incident[v];
@@ -73,17 +63,28 @@ SkinWeights compute_skin_weights(const Mesh& mesh, const Skeleton& skeleton,
         ++it->second;
     }
   for (auto& row : incident) std::sort(row.begin(), row.end());
+  return incident;
+}
 
-  // alpha[(vertex, own cluster)] -> neighbour cluster -> weight given to it, from the bounded
-  // Dijkstra distance inside the own cluster to the boundary with that neighbour.
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::map<std::uint32_t, double>> alpha;
+// (vertex, own cluster) -> neighbour cluster -> the weight the vertex gives that neighbour's
+// bone: half at their boundary, falling smoothly to 0 at `band` × the own bone's radius inside.
+using BoundaryBlend =
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::map<std::uint32_t, double>>;
+
+// Each side of each boundary between two clusters: the bounded Dijkstra distance inside the own
+// cluster from the boundary, and the weight it gives the other side.
+BoundaryBlend boundary_blend(const Mesh& mesh, const Skeleton& skeleton,
+                             std::span<const std::uint32_t> labels,
+                             const std::vector<std::vector<LabelledNeighbour>>& adjacency,
+                             double band_in_radii) {
+  BoundaryBlend alpha;
   std::vector<double> distance(mesh.vertex_count(), std::numeric_limits<double>::infinity());
   std::vector<std::uint32_t> touched;
   using Item = std::pair<double, std::uint32_t>;
   for (const ClusterPairBoundary& boundary : cluster_pair_boundaries(mesh, labels)) {
     for (const auto& [own, other] :
          {std::pair{boundary.first, boundary.second}, std::pair{boundary.second, boundary.first}}) {
-      const double band = options.band * skeleton.bones[own].radius;
+      const double band = band_in_radii * skeleton.bones[own].radius;
       std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
       for (const std::uint32_t v : boundary.vertices) {
         distance[v] = 0;
@@ -110,11 +111,16 @@ SkinWeights compute_skin_weights(const Mesh& mesh, const Skeleton& skeleton,
       touched.clear();
     }
   }
+  return alpha;
+}
 
+// Each vertex's weights: each incident cluster's share of its triangles, of which the cluster's
+// own bone keeps what the blend does not give its neighbours' bones; normalised, zeros dropped.
+SkinWeights blended_weights(const IncidentClusters& incident, const BoundaryBlend& alpha) {
   SkinWeights result;
-  result.offsets.reserve(mesh.vertex_count() + 1);
+  result.offsets.reserve(incident.size() + 1);
   std::map<std::uint32_t, double> row;
-  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+  for (std::uint32_t v = 0; v < incident.size(); ++v) {
     row.clear();
     double total_triangles = 0;
     for (const auto& [cluster, count] : incident[v]) total_triangles += count;
@@ -140,6 +146,24 @@ SkinWeights compute_skin_weights(const Mesh& mesh, const Skeleton& skeleton,
     result.offsets.push_back(static_cast<std::uint32_t>(result.bones.size()));
   }
   return result;
+}
+
+}  // namespace
+
+SkinWeights compute_skin_weights(const Mesh& mesh, const Skeleton& skeleton,
+                                 const SkinningOptions& options) {
+  if (!(std::isfinite(options.band) && options.band >= 0))
+    throw InvalidInputError("compute_skin_weights: band must be finite and >= 0");
+  skeleton_detail::check_face_labels(mesh, skeleton, "compute_skin_weights");
+  for (const Triangle& tri : mesh.triangles)
+    for (const std::uint32_t v : tri)
+      if (v >= mesh.vertex_count())
+        throw InvalidInputError("compute_skin_weights: vertex index out of range");
+
+  const std::vector<std::uint32_t> labels = triangle_labels(mesh, skeleton.face_labels);
+  return blended_weights(
+      incident_clusters(mesh, labels),
+      boundary_blend(mesh, skeleton, labels, labelled_adjacency(mesh, labels), options.band));
 }
 
 Vec3 RigidTransform::apply(const Vec3& x) const {
