@@ -250,6 +250,135 @@ std::pair<double, double> taubin_terms(const Gram& g, const ConeParameters& cone
   return {f.dot(quadratic_block(g).lazyProduct(f)), d};
 }
 
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+
+// Two unit vectors orthogonal to the unit axis u and to each other: the directions of its tilts.
+struct TiltFrame {
+  Eigen::Vector3d e1, e2;
+};
+
+TiltFrame tilt_frame(const Eigen::Vector3d& u) {
+  Eigen::Index least;
+  u.cwiseAbs().minCoeff(&least);
+  const Eigen::Vector3d e1 = u.cross(Eigen::Vector3d::Unit(least)).normalized();
+  return {e1, u.cross(e1)};
+}
+
+// N and D (taubin_terms()), and their gradients and Gauss–Newton Hessians over (apex, tilt e1,
+// tilt e2, cos²θ).
+struct TaubinDerivatives {
+  Vector6 grad_n, grad_d;
+  Matrix6 hess_n, hess_d;
+  double n = 0, d = 0;
+};
+
+TaubinDerivatives taubin_derivatives(const Gram& g, const ConeParameters& cone,
+                                     const TiltFrame& frame) {
+  const Eigen::Vector3d& u = cone.axis;
+  const Eigen::Vector3d &e1 = frame.e1, &e2 = frame.e2;
+  const Eigen::Matrix3d m = u * u.transpose() - cone.cos2 * Eigen::Matrix3d::Identity();
+  const Quadratic f = quadratic_form(m);
+  // ∂f / ∂(apex, tilt e1, tilt e2, cos²θ): linear in y for the apex, quadratic for the rest.
+  Eigen::Matrix3d by_apex;
+  for (int k = 0; k < 3; ++k) by_apex.col(k) = -2 * m.row(k).transpose();
+  Eigen::Matrix<double, 6, 3> by_shape;
+  by_shape.col(0) = quadratic_form(u * e1.transpose() + e1 * u.transpose());
+  by_shape.col(1) = quadratic_form(u * e2.transpose() + e2 * u.transpose());
+  by_shape.col(2) = quadratic_form(-Eigen::Matrix3d::Identity());
+  // Small fixed sizes: coefficient-wise products (lazyProduct) beat Eigen's blocked kernels.
+  const auto g01 = g.block<1, 3>(0, 1);
+  const auto g11 = linear_block(g);
+  const auto g12 = linear_quadratic_block(g);
+  const auto g22 = quadratic_block(g);
+  const Quadratic g22f = g22.lazyProduct(f);
+  TaubinDerivatives result;
+  result.grad_n.head<3>() = 2 * by_apex.transpose().lazyProduct(g12.lazyProduct(f));
+  result.grad_n.tail<3>() = 2 * by_shape.transpose().lazyProduct(g22f);
+  Matrix6& hess_n = result.hess_n;
+  hess_n.topLeftCorner<3, 3>() = 2 * by_apex.transpose().lazyProduct(g11.lazyProduct(by_apex));
+  hess_n.topRightCorner<3, 3>() = 2 * by_apex.transpose().lazyProduct(g12.lazyProduct(by_shape));
+  hess_n.bottomLeftCorner<3, 3>() = hess_n.topRightCorner<3, 3>().transpose();
+  hess_n.bottomRightCorner<3, 3>() =
+      2 * by_shape.transpose().lazyProduct(g22.lazyProduct(by_shape));
+  // (∇f)_i = 2 (My)_i is linear in y; its derivatives are constant for the apex and linear for
+  // the rest.
+  Vector6& grad_d = result.grad_d;
+  Matrix6& hess_d = result.hess_d;
+  grad_d.setZero();
+  hess_d.setZero();
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d gradient = 2 * m.row(i).transpose();
+    const Eigen::RowVector3d constant = -2 * m.row(i);
+    Eigen::Matrix3d linear;
+    linear.col(0) = 2 * (u(i) * e1 + e1(i) * u);
+    linear.col(1) = 2 * (u(i) * e2 + e2(i) * u);
+    linear.col(2) = -2 * Eigen::Vector3d::Unit(i);
+    const Eigen::Vector3d g_gradient = g11.lazyProduct(gradient);
+    const double g01_gradient = g01.dot(gradient);
+    grad_d.head<3>() += 2 * g01_gradient * constant.transpose();
+    grad_d.tail<3>() += 2 * linear.transpose().lazyProduct(g_gradient);
+    hess_d.topLeftCorner<3, 3>() += 2 * g(0, 0) * constant.transpose() * constant;
+    const Eigen::Matrix3d mixed = 2 * constant.transpose() * (g01.lazyProduct(linear));
+    hess_d.topRightCorner<3, 3>() += mixed;
+    hess_d.bottomLeftCorner<3, 3>() += mixed.transpose();
+    hess_d.bottomRightCorner<3, 3>() += 2 * linear.transpose().lazyProduct(g11.lazyProduct(linear));
+    result.d += gradient.dot(g_gradient);
+  }
+  result.n = f.dot(g22f);
+  return result;
+}
+
+// Where refine_cone() is: the cone, its ratio, the moments and Gram matrix about its apex, and
+// Levenberg–Marquardt's damping.
+struct ConeRefinement {
+  ConeParameters& cone;
+  double& ratio;
+  Moments& about_apex;
+  Gram g;
+  double lambda = 1e-3;
+};
+
+// Damped steps along the Newton direction of N − R D, the damping raised tenfold after each that
+// does not lower the ratio, until one does (then taken, and the damping lowered) or the damping
+// reaches 1e8. Returns whether a step was taken and the ratio fell by more than 1e-12 of itself.
+bool damped_step(const Moments& moments, double scale, const Vector6& gradient,
+                 const Matrix6& hessian, const TiltFrame& frame, ConeRefinement& state) {
+  while (state.lambda < 1e8) {
+    Matrix6 damped = hessian;
+    for (int k = 0; k < 6; ++k) damped(k, k) += state.lambda * std::abs(hessian(k, k)) + 1e-300;
+    // Not positive definite away from a minimum: the step is then checked like any other.
+    const Vector6 step = detail::solve_symmetric(damped, Vector6(-gradient));
+    if (!step.allFinite()) {
+      state.lambda *= 10;
+      continue;
+    }
+    ConeParameters next = state.cone;
+    next.apex += step.head<3>() / scale;
+    next.axis = (state.cone.axis + step(3) * frame.e1 + step(4) * frame.e2).normalized();
+    next.cos2 += step(5);
+    if (!(next.cos2 > 0 && next.cos2 < 1)) {
+      state.lambda *= 10;
+      continue;
+    }
+    Moments moved = moments.translated(next.apex);
+    const Gram next_gram = gram_of(moved, scale);
+    const auto [n, next_d] = taubin_terms(next_gram, next);
+    const double next_ratio = n / next_d;
+    if (next_ratio < state.ratio) {
+      const bool converged = state.ratio - next_ratio <= 1e-12 * state.ratio;
+      state.cone = next;
+      state.ratio = next_ratio;
+      state.about_apex = std::move(moved);
+      state.g = next_gram;
+      state.lambda = std::max(state.lambda / 10, 1e-9);
+      return !converged;
+    }
+    state.lambda *= 10;
+  }
+  return false;
+}
+
 // Levenberg–Marquardt on Taubin's ratio R = N / D over all six parameters at once (apex, axis
 // tilt, cos²θ): a minimum of R is a stationary point of N − R D at fixed R. Every term is a
 // polynomial of degree at most 2 in y, so the gradients and Gauss–Newton Hessians of N and D are
@@ -258,103 +387,15 @@ std::pair<double, double> taubin_terms(const Gram& g, const ConeParameters& cone
 // angle; the joint step does not.
 void refine_cone(const Moments& moments, double scale, ConeParameters& cone, double& ratio,
                  Moments& about_apex) {
-  using Vector6 = Eigen::Matrix<double, 6, 1>;
-  using Matrix6 = Eigen::Matrix<double, 6, 6>;
-  Gram g = gram_of(about_apex, scale);
-  double lambda = 1e-3;
+  ConeRefinement state{cone, ratio, about_apex, gram_of(about_apex, scale)};
   for (int iteration = 0; iteration < kConeRefinementSteps; ++iteration) {
-    const Eigen::Vector3d u = cone.axis;
-    Eigen::Index least;
-    u.cwiseAbs().minCoeff(&least);
-    const Eigen::Vector3d e1 = u.cross(Eigen::Vector3d::Unit(least)).normalized();
-    const Eigen::Vector3d e2 = u.cross(e1);
-    const Eigen::Matrix3d m = u * u.transpose() - cone.cos2 * Eigen::Matrix3d::Identity();
-    const Quadratic f = quadratic_form(m);
-    // ∂f / ∂(apex, tilt e1, tilt e2, cos²θ): linear in y for the apex, quadratic for the rest.
-    Eigen::Matrix3d by_apex;
-    for (int k = 0; k < 3; ++k) by_apex.col(k) = -2 * m.row(k).transpose();
-    Eigen::Matrix<double, 6, 3> by_shape;
-    by_shape.col(0) = quadratic_form(u * e1.transpose() + e1 * u.transpose());
-    by_shape.col(1) = quadratic_form(u * e2.transpose() + e2 * u.transpose());
-    by_shape.col(2) = quadratic_form(-Eigen::Matrix3d::Identity());
-    // Small fixed sizes: coefficient-wise products (lazyProduct) beat Eigen's blocked kernels.
-    const auto g01 = g.block<1, 3>(0, 1);
-    const auto g11 = linear_block(g);
-    const auto g12 = linear_quadratic_block(g);
-    const auto g22 = quadratic_block(g);
-    const Quadratic g22f = g22.lazyProduct(f);
-    Vector6 grad_n;
-    grad_n.head<3>() = 2 * by_apex.transpose().lazyProduct(g12.lazyProduct(f));
-    grad_n.tail<3>() = 2 * by_shape.transpose().lazyProduct(g22f);
-    Matrix6 hess_n;
-    hess_n.topLeftCorner<3, 3>() = 2 * by_apex.transpose().lazyProduct(g11.lazyProduct(by_apex));
-    hess_n.topRightCorner<3, 3>() = 2 * by_apex.transpose().lazyProduct(g12.lazyProduct(by_shape));
-    hess_n.bottomLeftCorner<3, 3>() = hess_n.topRightCorner<3, 3>().transpose();
-    hess_n.bottomRightCorner<3, 3>() =
-        2 * by_shape.transpose().lazyProduct(g22.lazyProduct(by_shape));
-    // (∇f)_i = 2 (My)_i is linear in y; its derivatives are constant for the apex and linear for
-    // the rest.
-    Vector6 grad_d = Vector6::Zero();
-    Matrix6 hess_d = Matrix6::Zero();
-    double d = 0;
-    for (int i = 0; i < 3; ++i) {
-      const Eigen::Vector3d gradient = 2 * m.row(i).transpose();
-      const Eigen::RowVector3d constant = -2 * m.row(i);
-      Eigen::Matrix3d linear;
-      linear.col(0) = 2 * (u(i) * e1 + e1(i) * u);
-      linear.col(1) = 2 * (u(i) * e2 + e2(i) * u);
-      linear.col(2) = -2 * Eigen::Vector3d::Unit(i);
-      const Eigen::Vector3d g_gradient = g11.lazyProduct(gradient);
-      const double g01_gradient = g01.dot(gradient);
-      grad_d.head<3>() += 2 * g01_gradient * constant.transpose();
-      grad_d.tail<3>() += 2 * linear.transpose().lazyProduct(g_gradient);
-      hess_d.topLeftCorner<3, 3>() += 2 * g(0, 0) * constant.transpose() * constant;
-      const Eigen::Matrix3d mixed = 2 * constant.transpose() * (g01.lazyProduct(linear));
-      hess_d.topRightCorner<3, 3>() += mixed;
-      hess_d.bottomLeftCorner<3, 3>() += mixed.transpose();
-      hess_d.bottomRightCorner<3, 3>() +=
-          2 * linear.transpose().lazyProduct(g11.lazyProduct(linear));
-      d += gradient.dot(g_gradient);
-    }
-    if (!(d > 0)) return;
-    const double r = f.dot(g22f) / d;
-    const Vector6 gradient = grad_n - r * grad_d;
-    const Matrix6 hessian = hess_n - r * hess_d;
-    bool accepted = false;
-    while (lambda < 1e8) {
-      Matrix6 damped = hessian;
-      for (int k = 0; k < 6; ++k) damped(k, k) += lambda * std::abs(hessian(k, k)) + 1e-300;
-      // Not positive definite away from a minimum: the step is then checked like any other.
-      const Vector6 step = detail::solve_symmetric(damped, Vector6(-gradient));
-      if (!step.allFinite()) {
-        lambda *= 10;
-        continue;
-      }
-      ConeParameters next = cone;
-      next.apex += step.head<3>() / scale;
-      next.axis = (u + step(3) * e1 + step(4) * e2).normalized();
-      next.cos2 += step(5);
-      if (!(next.cos2 > 0 && next.cos2 < 1)) {
-        lambda *= 10;
-        continue;
-      }
-      Moments moved = moments.translated(next.apex);
-      const Gram next_gram = gram_of(moved, scale);
-      const auto [n, next_d] = taubin_terms(next_gram, next);
-      const double next_ratio = n / next_d;
-      if (next_ratio < ratio) {
-        const bool converged = ratio - next_ratio <= 1e-12 * ratio;
-        cone = next;
-        ratio = next_ratio;
-        about_apex = std::move(moved);
-        g = next_gram;
-        lambda = std::max(lambda / 10, 1e-9);
-        accepted = !converged;
-        break;
-      }
-      lambda *= 10;
-    }
-    if (!accepted) return;
+    const TiltFrame frame = tilt_frame(cone.axis);
+    const TaubinDerivatives derivatives = taubin_derivatives(state.g, cone, frame);
+    if (!(derivatives.d > 0)) return;
+    const double r = derivatives.n / derivatives.d;
+    const Vector6 gradient = derivatives.grad_n - r * derivatives.grad_d;
+    const Matrix6 hessian = derivatives.hess_n - r * derivatives.hess_d;
+    if (!damped_step(moments, scale, gradient, hessian, frame, state)) return;
   }
 }
 

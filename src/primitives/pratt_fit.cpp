@@ -65,13 +65,73 @@ double adjugate_form(const Eigen::Matrix3d& m, const Eigen::Vector3d& t, double*
          2 * (a01 * t(0) * t(1) + a02 * t(0) * t(2) + a12 * t(1) * t(2));
 }
 
+// Whether the secular function g (pratt_fit()) is non-negative at x, for x below the smallest
+// eigenvalue of c: then c − xI is positive definite and g(x) det(c − xI) = (f − (s + 2x)²/w) det
+// − t·adj(c − xI) t, with no eigen-decomposition and no division.
+template <int D>
+bool secular_non_negative_at(const Eigen::Matrix<double, D, D>& c,
+                             const Eigen::Matrix<double, D, 1>& t, double f, double s, double w,
+                             double x) {
+  const Eigen::Matrix<double, D, D> shifted = c - Eigen::Matrix<double, D, D>::Identity() * x;
+  double det = 0;
+  const double form = adjugate_form(shifted, t, &det);
+  return (f - (s + 2 * x) * (s + 2 * x) / w) * det - form >= 0;
+}
+
+// The secular equation of pratt_fit() in the eigenbasis of c (eigenvalues λ ascending, τ = Uᵀ t)
+// as h(η) = (λ_0 − η) g(η), which has the same root on [0, λ_0) but no pole at λ_0 (Newton's
+// method on g itself keeps overshooting into the pole, and bisecting back, when the root is near
+// it).
+template <int D>
+struct SecularEquation {
+  Eigen::Matrix<double, D, 1> lambda, tau;
+  double f = 0, s = 0, w = 0;
+
+  double h(double eta, double* derivative) const {
+    double rest = f - (s + 2 * eta) * (s + 2 * eta) / w;
+    double rest_slope = -4 * (s + 2 * eta) / w;
+    for (int k = 1; k < D; ++k) {
+      const double gap = lambda(k) - eta;
+      rest -= tau(k) * tau(k) / gap;
+      rest_slope -= tau(k) * tau(k) / (gap * gap);
+    }
+    const double gap = lambda(0) - eta;
+    *derivative = gap * rest_slope - rest;
+    return gap * rest - tau(0) * tau(0);
+  }
+
+  // The root on [0, λ_0) (λ_0 > 0): Newton's method while it stays inside the bracket, bisection
+  // otherwise; 0 for an exact fit (round-off can make g(0) a hair negative).
+  double root() const {
+    double lo = 0, hi = lambda(0);
+    // Steps below this are round-off. (Relative to the whole bracket: relative to a shrinking
+    // one, a root at the round-off level of 0 would take every iteration bisecting towards it.)
+    const double resolution = 1e-15 * hi;
+    double eta = 0, slope = 0;
+    double value = h(eta, &slope);
+    if (!(value > 0)) return 0;
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      if (value > 0)
+        lo = eta;
+      else
+        hi = eta;
+      double next = eta - value / slope;
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (!(std::abs(next - eta) > resolution)) break;
+      eta = next;
+      value = h(eta, &slope);
+      if (value == 0) break;
+    }
+    return eta;
+  }
+};
+
 }  // namespace
 
 template <int D>
 PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to_beat,
                          double smallest_eigenvalue) {
   using Vector = Eigen::Matrix<double, D, 1>;
-  using Matrix = Eigen::Matrix<double, D, D>;
   PrattResult<D> result;
   const double w = moments.weight;
   const double spread2 = moments.second.trace() / w;
@@ -95,61 +155,21 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to
   if (std::isnan(smallest_eigenvalue)) smallest_eigenvalue = smallest_eigenvalue_of(moments.second);
   const double lambda_min = smallest_eigenvalue * scale2;
   if (!(lambda_min > 0)) return result;  // flat data: the plane itself
-  // g decreases: the root is at least x exactly when g(x) >= 0. For x below λ_min, c − xI is
-  // positive definite and g(x) det(c − xI) = (f − (s + 2x)²/w) det − t·adj(c − xI) t.
+  // g decreases: the root is at least x exactly when g(x) >= 0.
   const double beat = objective_to_beat * scale2;
-  if (beat > 0 && beat < lambda_min) {
-    const Matrix shifted = moments.second * scale2 - Matrix::Identity() * beat;
-    double det = 0;
-    const double form = adjugate_form(shifted, t, &det);
-    if ((f - (s + 2 * beat) * (s + 2 * beat) / w) * det - form >= 0) {
-      result.beaten = true;
-      result.objective_minimum = objective_to_beat;
-      return result;
-    }
+  if (beat > 0 && beat < lambda_min &&
+      secular_non_negative_at<D>(moments.second * scale2, t, f, s, w, beat)) {
+    result.beaten = true;
+    result.objective_minimum = objective_to_beat;
+    return result;
   }
 
   const Eigensystem<D> second = eigensystem_of(moments.second);
-  const Vector lambda = second.values * scale2;
-  const Vector tau = second.vectors.transpose() * t;
-  // h(η) = (λ_0 − η) g(η) has the same root on [0, λ_0) but no pole at λ_0 (Newton's method on g
-  // itself keeps overshooting into the pole, and bisecting back, when the root is near it).
-  auto h = [&](double eta, double* derivative) {
-    double rest = f - (s + 2 * eta) * (s + 2 * eta) / w;
-    double rest_slope = -4 * (s + 2 * eta) / w;
-    for (int k = 1; k < D; ++k) {
-      const double gap = lambda(k) - eta;
-      rest -= tau(k) * tau(k) / gap;
-      rest_slope -= tau(k) * tau(k) / (gap * gap);
-    }
-    const double gap = lambda(0) - eta;
-    *derivative = gap * rest_slope - rest;
-    return gap * rest - tau(0) * tau(0);
-  };
-  double lo = 0, hi = lambda(0);
-  if (!(hi > 0)) return result;  // round-off: flat data after all
-  // Steps below this are round-off. (Relative to the whole bracket: relative to a shrinking one,
-  // a root at the round-off level of 0 would take every iteration bisecting towards it.)
-  const double resolution = 1e-15 * hi;
-  double eta = 0, slope = 0;
-  double value = h(eta, &slope);
-  if (!(value > 0)) {
-    eta = 0;  // an exact fit (round-off can make g(0) a hair negative)
-  } else {
-    for (int iteration = 0; iteration < 100; ++iteration) {
-      if (value > 0)
-        lo = eta;
-      else
-        hi = eta;
-      // Newton while it stays inside the bracket, bisection otherwise.
-      double next = eta - value / slope;
-      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-      if (!(std::abs(next - eta) > resolution)) break;
-      eta = next;
-      value = h(eta, &slope);
-      if (value == 0) break;
-    }
-  }
+  const SecularEquation<D> secular{second.values * scale2, second.vectors.transpose() * t, f, s, w};
+  const Vector& lambda = secular.lambda;
+  const Vector& tau = secular.tau;
+  if (!(lambda(0) > 0)) return result;  // round-off: flat data after all
+  const double eta = secular.root();
   result.objective_minimum = std::max(0.0, eta) / scale2;
   const double gap_to_plane = lambda(0) - eta;
   if (!(gap_to_plane > 1e-12 * lambda(D - 1))) return result;
