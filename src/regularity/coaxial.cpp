@@ -144,95 +144,139 @@ struct FreeLineFit {
   std::vector<double> rms;  // per member, unweighted, at least kResolution × its radius
 };
 
+// The state of fit_free_line(): an axis line of free direction through a coaxial set, each
+// member keeping its own radius. Parameters: the tilt along u and v times `scale` (one unit in
+// every column), the line's shift along u and v, the radii. The line pivots where the points are
+// along it, so that a tilt hardly moves them on average.
+class FreeLine {
+ public:
+  FreeLine(const Eigen::Vector3d& direction, const CoaxialFit& start,
+           std::span<const std::size_t> clusters, const std::vector<std::vector<Vec3>>& points,
+           const std::vector<std::vector<double>>& weights)
+      : clusters_(clusters),
+        points_(points),
+        weights_(weights),
+        members_(static_cast<Eigen::Index>(clusters.size())),
+        direction_(direction),
+        radii_(start.radii),
+        scale_(*std::max_element(radii_.begin(), radii_.end())) {
+    std::tie(u_, v_) = orthonormal_pair(direction_);
+    pivot_ = start.centre.x() * u_ + start.centre.y() * v_;
+    recentre();
+  }
+
+  Eigen::Index parameters() const { return 4 + members_; }
+  double scale() const { return scale_; }
+  const Eigen::Vector3d& direction() const { return direction_; }
+  const Eigen::Vector3d& u() const { return u_; }
+  const Eigen::Vector3d& v() const { return v_; }
+  double radius(std::size_t k) const { return radii_[k]; }
+
+  // Residuals e = |Q(x − pivot)| − r, Q = I − d dᵀ: `visit(k, w, e, line)` gets each point of
+  // member k, its weight, its residual and its derivatives: `line` for the line's four
+  // parameters, −1 for its radius.
+  template <typename Visit>
+  void for_each_residual(const Visit& visit) const {
+    for (Eigen::Index k = 0; k < members_; ++k) {
+      const std::size_t c = clusters_[static_cast<std::size_t>(k)];
+      for (std::size_t i = 0; i < points_[c].size(); ++i) {
+        const Eigen::Vector3d d = to_eigen(points_[c][i]) - pivot_;
+        const double t = direction_.dot(d);
+        const Eigen::Vector3d radial = d - t * direction_;
+        const double length = radial.norm();
+        if (!(length > 0)) continue;
+        const Eigen::Vector3d normal = radial / length;
+        visit(k, weights_[c][i], length - radii_[static_cast<std::size_t>(k)],
+              Eigen::Vector4d(-t / scale_ * normal.dot(u_), -t / scale_ * normal.dot(v_),
+                              -normal.dot(u_), -normal.dot(v_)));
+      }
+    }
+  }
+
+  // Adds a residual's Jacobian row, times `weight`, to the (symmetric) normal matrix `matrix`:
+  // its upper part only, the lower filled by symmetric().
+  static void add_row(Eigen::MatrixXd& matrix, Eigen::Index k, double weight,
+                      const Eigen::Vector4d& line) {
+    matrix.topLeftCorner<4, 4>() += weight * line * line.transpose();
+    matrix.block<4, 1>(0, 4 + k) -= weight * line;
+    matrix(4 + k, 4 + k) += weight;
+  }
+  void symmetric(Eigen::MatrixXd& matrix) const {
+    matrix.bottomLeftCorner(members_, 4) = matrix.topRightCorner(4, members_).transpose();
+  }
+
+  // Takes a Gauss–Newton step; false when a radius ends non-positive.
+  bool move(const Eigen::VectorXd& delta) {
+    direction_ = (direction_ + delta(0) / scale_ * u_ + delta(1) / scale_ * v_).normalized();
+    pivot_ += delta(2) * u_ + delta(3) * v_;
+    for (Eigen::Index k = 0; k < members_; ++k) {
+      radii_[static_cast<std::size_t>(k)] += delta(4 + k);
+      if (!(radii_[static_cast<std::size_t>(k)] > 0)) return false;
+    }
+    std::tie(u_, v_) = orthonormal_pair(direction_);
+    recentre();
+    return true;
+  }
+
+ private:
+  void recentre() {
+    pivot_ += direction_ *
+              (middle_along(direction_, clusters_, points_, weights_) - direction_.dot(pivot_));
+  }
+
+  std::span<const std::size_t> clusters_;
+  const std::vector<std::vector<Vec3>>& points_;
+  const std::vector<std::vector<double>>& weights_;
+  Eigen::Index members_;
+  Eigen::Vector3d direction_, u_, v_, pivot_;
+  std::vector<double> radii_;
+  double scale_;
+};
+
 // A coaxial set's members fitted with one axis line whose direction is free too (Gauss–Newton
 // from `direction` and the set's joint fit with it, weighted steps as the joint fits take them),
 // as one item of its direction group: its direction, and how well all its points determine it
 // together (from the unweighted residuals, as oriented_cylinder()'s). Sharing the line ties the
 // members: two short steps of a shaft far apart fix the axis better than each does alone. Nothing
 // when the iteration does not settle or a radius ends non-positive.
-std::optional<FreeLineFit> fit_free_line(Eigen::Vector3d direction, const CoaxialFit& start,
+std::optional<FreeLineFit> fit_free_line(const Eigen::Vector3d& direction, const CoaxialFit& start,
                                          std::span<const std::size_t> clusters,
                                          const std::vector<std::vector<Vec3>>& points,
                                          const std::vector<std::vector<double>>& weights) {
-  const Eigen::Index members = static_cast<Eigen::Index>(clusters.size());
-  const Eigen::Index parameters = 4 + members;
-  std::vector<double> radii = start.radii;
-  const double scale = *std::max_element(radii.begin(), radii.end());
   std::size_t count = 0;
   for (const std::size_t c : clusters) count += points[c].size();
-  if (!(scale > 0) || count <= static_cast<std::size_t>(parameters)) return std::nullopt;
-  Eigen::Vector3d u, v;  // not a structured binding: the lambdas below capture them
-  std::tie(u, v) = orthonormal_pair(direction);
-  Eigen::Vector3d pivot = start.centre.x() * u + start.centre.y() * v;
-  // The tilt pivots where the points are along the line, so that it hardly moves them on average.
-  pivot += direction * (middle_along(direction, clusters, points, weights) - direction.dot(pivot));
-  // Parameters: the tilt along u and v times `scale` (one unit in every column), the line's shift
-  // along u and v, the radii. Residuals e = |Q(x − pivot)| − r, Q = I − d dᵀ; `visit(k, i, e,
-  // line)` gets point i of member k, its residual and its derivatives: `line` for the line's four
-  // parameters, −1 for its radius.
-  const auto for_each_residual = [&](const auto& visit) {
-    for (Eigen::Index k = 0; k < members; ++k) {
-      const std::size_t c = clusters[static_cast<std::size_t>(k)];
-      for (std::size_t i = 0; i < points[c].size(); ++i) {
-        const Eigen::Vector3d d = to_eigen(points[c][i]) - pivot;
-        const double t = direction.dot(d);
-        const Eigen::Vector3d radial = d - t * direction;
-        const double length = radial.norm();
-        if (!(length > 0)) continue;
-        const Eigen::Vector3d normal = radial / length;
-        visit(k, weights[c][i], length - radii[static_cast<std::size_t>(k)],
-              Eigen::Vector4d(-t / scale * normal.dot(u), -t / scale * normal.dot(v),
-                              -normal.dot(u), -normal.dot(v)));
-      }
-    }
-  };
-  // Adds a residual's Jacobian row, times `weight`, to the (symmetric) normal matrix `matrix`:
-  // its upper part only, the lower filled by symmetric().
-  const auto add_row = [](Eigen::MatrixXd& matrix, Eigen::Index k, double weight,
-                          const Eigen::Vector4d& line) {
-    matrix.topLeftCorner<4, 4>() += weight * line * line.transpose();
-    matrix.block<4, 1>(0, 4 + k) -= weight * line;
-    matrix(4 + k, 4 + k) += weight;
-  };
-  const auto symmetric = [members](Eigen::MatrixXd& matrix) {
-    matrix.bottomLeftCorner(members, 4) = matrix.topRightCorner(4, members).transpose();
-  };
+  const double largest = *std::max_element(start.radii.begin(), start.radii.end());
+  const Eigen::Index parameters = 4 + static_cast<Eigen::Index>(clusters.size());
+  if (!(largest > 0) || count <= static_cast<std::size_t>(parameters)) return std::nullopt;
+  FreeLine line(direction, start, clusters, points, weights);
   Eigen::MatrixXd weighted(parameters, parameters);
   Eigen::VectorXd gradient(parameters);
   constexpr int kMaxSteps = 30;
   for (int step = 0;; ++step) {
     weighted.setZero();
     gradient.setZero();
-    for_each_residual([&](Eigen::Index k, double w, double e, const Eigen::Vector4d& line) {
-      add_row(weighted, k, w, line);
-      gradient.head<4>() += w * e * line;
+    line.for_each_residual([&](Eigen::Index k, double w, double e, const Eigen::Vector4d& row) {
+      FreeLine::add_row(weighted, k, w, row);
+      gradient.head<4>() += w * e * row;
       gradient(4 + k) -= w * e;
     });
-    symmetric(weighted);
+    line.symmetric(weighted);
     const Eigen::VectorXd delta = -weighted.ldlt().solve(gradient);
     if (!delta.allFinite()) return std::nullopt;
-    if (delta.cwiseAbs().maxCoeff() <= 1e-12 * scale) break;
-    if (step == kMaxSteps) return std::nullopt;
-    direction = (direction + delta(0) / scale * u + delta(1) / scale * v).normalized();
-    pivot += delta(2) * u + delta(3) * v;
-    for (Eigen::Index k = 0; k < members; ++k) {
-      radii[static_cast<std::size_t>(k)] += delta(4 + k);
-      if (!(radii[static_cast<std::size_t>(k)] > 0)) return std::nullopt;
-    }
-    std::tie(u, v) = orthonormal_pair(direction);
-    pivot +=
-        direction * (middle_along(direction, clusters, points, weights) - direction.dot(pivot));
+    if (delta.cwiseAbs().maxCoeff() <= 1e-12 * line.scale()) break;
+    if (step == kMaxSteps || !line.move(delta)) return std::nullopt;
   }
   // At the solution: the unweighted information and each member's residual sum.
   Eigen::MatrixXd information = Eigen::MatrixXd::Zero(parameters, parameters);
   std::vector<double> member_squares(clusters.size(), 0);
   double squares = 0;
-  for_each_residual([&](Eigen::Index k, double, double e, const Eigen::Vector4d& line) {
-    add_row(information, k, 1, line);
+  line.for_each_residual([&](Eigen::Index k, double, double e, const Eigen::Vector4d& row) {
+    FreeLine::add_row(information, k, 1, row);
     member_squares[static_cast<std::size_t>(k)] += e * e;
   });
-  symmetric(information);
+  line.symmetric(information);
   for (const double own : member_squares) squares += own;
+  const double scale = line.scale();
   const double residual_variance =
       std::max(squares / double(count - static_cast<std::size_t>(parameters)),
                kResolution * kResolution * scale * scale);
@@ -241,15 +285,15 @@ std::optional<FreeLineFit> fit_free_line(Eigen::Vector3d direction, const Coaxia
   FreeLineFit fit;
   Oriented& item = fit.item;
   item.cluster = clusters[0];
-  item.direction = direction;
-  item.frame.col(0) = u;
-  item.frame.col(1) = v;
+  item.direction = line.direction();
+  item.frame.col(0) = line.u();
+  item.frame.col(1) = line.v();
   item.covariance = covariance.topLeftCorner<2, 2>() / (scale * scale);
   item.variance = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(item.covariance).eigenvalues()(1);
   if (!std::isfinite(item.variance) || !(item.variance > 0)) return std::nullopt;
   for (std::size_t k = 0; k < clusters.size(); ++k)
     fit.rms.push_back(std::max(std::sqrt(member_squares[k] / double(points[clusters[k]].size())),
-                               kResolution * radii[k]));
+                               kResolution * line.radius(k)));
   return fit;
 }
 

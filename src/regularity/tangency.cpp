@@ -596,6 +596,125 @@ void Tangency::write_plane_offsets() {
   }
 }
 
+// fit_held_line()'s iteration: y = (c, r₀, r₁, …), and N, the orthonormal basis of the null space
+// of the holds' rows linearised at y (y = y₀ + N z).
+class HeldLine {
+ public:
+  HeldLine(const Eigen::Vector3d& direction, const Eigen::Vector2d& centre,
+           std::span<const CoaxialMember> members, std::span<const LineHold> holds)
+      : members_(members),
+        holds_(holds),
+        size_(2 + static_cast<Eigen::Index>(members.size())),
+        free_(size_ - static_cast<Eigen::Index>(holds.size())),
+        curved_(std::any_of(holds.begin(), holds.end(),
+                            [](const LineHold& hold) { return hold.circle.has_value(); })),
+        y_(size_),
+        basis_(Eigen::MatrixXd::Identity(size_, size_)),
+        basis_rows_(basis_),
+        projected_(members.size()),
+        normal_(free_, free_),
+        gradient_(free_),
+        row_(free_) {
+    y_.head<2>() = centre;
+    for (Eigen::Index i = 2; i < size_; ++i)
+      y_(i) = members[static_cast<std::size_t>(i - 2)].radius;
+    const auto [u, v] = orthonormal_pair(direction);
+    for (std::size_t m = 0; m < members.size(); ++m)
+      for (const Vec3& p : members[m].points)
+        projected_[m].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
+  }
+
+  // Projects y onto the holds (linearised at y) and forms the basis of their null space; false
+  // when they are (nearly) dependent: their rows' Gram determinant, normalised (1 for orthogonal
+  // rows, 0 for dependent ones), at most 1e-12.
+  bool constrain() {
+    const Eigen::Index k = size_ - free_;
+    if (k == 0) return true;
+    Eigen::MatrixXd rows(size_, k);
+    Eigen::VectorXd excess(k);
+    double norms = 1;
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const LineHold hold = linearised(holds_[static_cast<std::size_t>(i)], y_);
+      rows.col(i) = hold.row;
+      excess(i) = hold.row.dot(y_) - hold.target;
+      norms *= hold.row.squaredNorm();
+    }
+    const Eigen::MatrixXd gram = rows.transpose() * rows;
+    if (!(gram.determinant() > 1e-12 * norms)) return false;
+    violation_ = excess.norm();
+    y_ -= rows * gram.ldlt().solve(excess);
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(rows);
+    basis_ = (qr.householderQ() * Eigen::MatrixXd::Identity(size_, size_)).rightCols(free_);
+    basis_rows_ = basis_.transpose();
+    return true;
+  }
+
+  // Gauss–Newton in z until the step is round-off and y is on the holds, a circle's hold
+  // linearised again and y projected onto it at every step; false when a projection fails, a step
+  // is not finite or 50 steps do not converge.
+  bool solve() {
+    bool converged = free_ == 0 && !curved_;
+    for (int step = 0; step < 50 && !converged; ++step) {
+      // A circle's hold linearised again, and y projected onto it: settled once y was on it.
+      const bool projected_again = curved_ && step > 0;
+      if (projected_again && !constrain()) return false;
+      const bool on_holds = !projected_again || !(violation_ > 1e-14 * y_.norm());
+      if (free_ == 0) {
+        converged = projected_again && on_holds;
+        continue;
+      }
+      linearise(true);
+      const Eigen::VectorXd delta = normal_.ldlt().solve(-gradient_);
+      if (!delta.allFinite()) return false;
+      const Eigen::VectorXd move = basis_ * delta;
+      y_ += move;
+      converged = !(move.norm() > 1e-14 * y_.norm()) && on_holds;
+    }
+    return converged;
+  }
+
+  // Σ w e² and its Gauss–Newton system in z (weighted or not); returns the unweighted Σ e².
+  double linearise(bool weighted) {
+    normal_.setZero();
+    gradient_.setZero();
+    double squares = 0;
+    for (std::size_t m = 0; m < members_.size(); ++m)
+      for (std::size_t i = 0; i < projected_[m].size(); ++i) {
+        const Eigen::Vector2d d = projected_[m][i] - y_.head<2>();
+        const double length = d.norm();
+        if (!(length > 0)) continue;
+        const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
+        const double e = length - y_(radius), w = weighted ? members_[m].weights[i] : 1.0;
+        row_.noalias() = -(d.x() / length) * basis_rows_.col(0) -
+                         (d.y() / length) * basis_rows_.col(1) - basis_rows_.col(radius);
+        normal_.noalias() += w * row_ * row_.transpose();
+        gradient_.noalias() += (w * e) * row_;
+        squares += e * e;
+      }
+    return squares;
+  }
+
+  const Eigen::VectorXd& y() const { return y_; }
+  Eigen::Index free() const { return free_; }
+  // The covariance of y for a residual variance of `variance`, from the last linearise().
+  Eigen::MatrixXd covariance(double variance) const {
+    return basis_ * normal_.inverse() * basis_.transpose() * variance;
+  }
+
+ private:
+  std::span<const CoaxialMember> members_;
+  std::span<const LineHold> holds_;
+  Eigen::Index size_, free_;
+  bool curved_;
+  Eigen::VectorXd y_;
+  Eigen::MatrixXd basis_, basis_rows_;
+  double violation_ = 0;  // how far y was from the holds, linearised, before their last projection
+  std::vector<std::vector<Eigen::Vector2d>> projected_;  // in orthonormal_pair(direction) coords
+  Eigen::MatrixXd normal_;
+  Eigen::VectorXd gradient_;
+  Eigen::VectorXd row_;  // a residual's derivative in z
+};
+
 }  // namespace
 
 std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
@@ -611,92 +730,19 @@ std::optional<HeldLineFit> fit_held_line(const Eigen::Vector3d& direction,
     largest_radius = std::max(largest_radius, member.radius);
   }
   if (k > size || count <= static_cast<std::size_t>(size - k)) return std::nullopt;
-  Eigen::VectorXd y(size);
-  y.head<2>() = centre;
-  for (Eigen::Index i = 2; i < size; ++i) y(i) = members[static_cast<std::size_t>(i - 2)].radius;
-  const bool curved = std::any_of(holds.begin(), holds.end(),
-                                  [](const LineHold& hold) { return hold.circle.has_value(); });
-  Eigen::MatrixXd basis = Eigen::MatrixXd::Identity(size, size), basis_rows = basis;
-  double violation = 0;  // how far y was from the holds, linearised, before their last projection
-  // Projects y onto the holds (linearised at y) and forms the basis of their null space; false
-  // when they are (nearly) dependent: their rows' Gram determinant, normalised (1 for orthogonal
-  // rows, 0 for dependent ones), at most 1e-12.
-  const auto constrain = [&] {
-    if (k == 0) return true;
-    Eigen::MatrixXd rows(size, k);
-    Eigen::VectorXd excess(k);
-    double norms = 1;
-    for (Eigen::Index i = 0; i < k; ++i) {
-      const LineHold hold = linearised(holds[static_cast<std::size_t>(i)], y);
-      rows.col(i) = hold.row;
-      excess(i) = hold.row.dot(y) - hold.target;
-      norms *= hold.row.squaredNorm();
-    }
-    const Eigen::MatrixXd gram = rows.transpose() * rows;
-    if (!(gram.determinant() > 1e-12 * norms)) return false;
-    violation = excess.norm();
-    y -= rows * gram.ldlt().solve(excess);
-    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(rows);
-    basis = (qr.householderQ() * Eigen::MatrixXd::Identity(size, size)).rightCols(size - k);
-    basis_rows = basis.transpose();
-    return true;
-  };
-  if (!constrain()) return std::nullopt;
-  const Eigen::Index free = size - k;
-  const auto [u, v] = orthonormal_pair(direction);
-  std::vector<std::vector<Eigen::Vector2d>> projected(members.size());
-  for (std::size_t m = 0; m < members.size(); ++m)
-    for (const Vec3& p : members[m].points)
-      projected[m].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)));
-  // Σ w e² and its Gauss–Newton system in z (weighted or not); returns the unweighted Σ e².
-  Eigen::MatrixXd normal(free, free);
-  Eigen::VectorXd gradient(free);
-  Eigen::VectorXd row(free);  // a residual's derivative in z
-  auto linearise = [&](bool weighted) {
-    normal.setZero();
-    gradient.setZero();
-    double squares = 0;
-    for (std::size_t m = 0; m < members.size(); ++m)
-      for (std::size_t i = 0; i < projected[m].size(); ++i) {
-        const Eigen::Vector2d d = projected[m][i] - y.head<2>();
-        const double length = d.norm();
-        if (!(length > 0)) continue;
-        const Eigen::Index radius = 2 + static_cast<Eigen::Index>(m);
-        const double e = length - y(radius), w = weighted ? members[m].weights[i] : 1.0;
-        row.noalias() = -(d.x() / length) * basis_rows.col(0) -
-                        (d.y() / length) * basis_rows.col(1) - basis_rows.col(radius);
-        normal.noalias() += w * row * row.transpose();
-        gradient.noalias() += (w * e) * row;
-        squares += e * e;
-      }
-    return squares;
-  };
-  bool converged = free == 0 && !curved;
-  for (int step = 0; step < 50 && !converged; ++step) {
-    // A circle's hold linearised again, and y projected onto it: settled once y was on it.
-    const bool projected_again = curved && step > 0;
-    if (projected_again && !constrain()) return std::nullopt;
-    const bool on_holds = !projected_again || !(violation > 1e-14 * y.norm());
-    if (free == 0) {
-      converged = projected_again && on_holds;
-      continue;
-    }
-    linearise(true);
-    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
-    if (!delta.allFinite()) return std::nullopt;
-    const Eigen::VectorXd move = basis * delta;
-    y += move;
-    converged = !(move.norm() > 1e-14 * y.norm()) && on_holds;
-  }
-  if (!converged || !y.allFinite() || !(y.tail(size - 2).minCoeff() > 0)) return std::nullopt;
-  const double squares = linearise(false);
+  HeldLine line(direction, centre, members, holds);
+  if (!line.constrain() || !line.solve()) return std::nullopt;
+  const Eigen::VectorXd& y = line.y();
+  if (!y.allFinite() || !(y.tail(size - 2).minCoeff() > 0)) return std::nullopt;
+  const double squares = line.linearise(false);
+  const Eigen::Index free = line.free();
   HeldLineFit fit{y, 0, static_cast<std::size_t>(free), count, Eigen::MatrixXd::Zero(size, size)};
   const double n = static_cast<double>(count);
   fit.rms = std::max(std::sqrt(squares / n), kResolution * largest_radius);
   if (free > 0) {
     const double variance = std::max(squares / (n - static_cast<double>(free)),
                                      kResolution * kResolution * largest_radius * largest_radius);
-    fit.covariance = basis * normal.inverse() * basis.transpose() * variance;
+    fit.covariance = line.covariance(variance);
     if (!fit.covariance.allFinite()) return std::nullopt;
   }
   return fit;
