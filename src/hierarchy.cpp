@@ -734,14 +734,21 @@ class HierarchyBuilder::Impl {
     merges_.push_back(record);
     max_cost_ = std::max(max_cost_, model.cost);
 
-    // The merged cluster lives in a's slot; b's is released.
+    keep_merged(slot_a, slot_b, edge_id, faces, triangles, node);
+    queue_candidates_of(slot_a, head);
+  }
+
+  // The merged cluster (node `node`, of `faces` faces and `triangles` triangles, its statistics in
+  // merged_) lives in slot_a; slot_b's is released. `edge_id` joined them.
+  void keep_merged(std::uint32_t slot_a, std::uint32_t slot_b, std::uint32_t edge_id,
+                   std::uint32_t faces, std::uint32_t triangles, std::uint32_t node) {
     release_stats(slot_b);
-    if (record.face_count == 2)
+    if (faces == 2)
       store_pair(slot_a, edge_id, triangles, std::move(merged_));
     else
       store_stats(slot_a, std::move(merged_));
     Slot& kept = slots_[slot_a];
-    kept.faces = record.face_count;
+    kept.faces = faces;
     kept.triangles += slots_[slot_b].triangles;
     kept.min_face = std::min(kept.min_face, slots_[slot_b].min_face);
     kept.node = node;
@@ -750,7 +757,10 @@ class HierarchyBuilder::Impl {
       next_face_[face_list_tail_[slot_a]] = face_list_head_[slot_b];
       face_list_tail_[slot_a] = face_list_tail_[slot_b];
     }
+  }
 
+  // The candidates of the cluster in `slot` (its adjacency list from `head`), after its merge.
+  void queue_candidates_of(std::uint32_t slot, std::uint32_t head) {
     // The new cluster's candidates: those under a bound that holds wait in the queue (a zero
     // bound would reach the top before the next merge anyway), the others are evaluated, on all
     // threads, and queued in list order.
@@ -766,7 +776,7 @@ class HierarchyBuilder::Impl {
     // The faces' corners, now that their triangles have arrived.
     for (const QueuedCandidate& queued : batch_) {
       const LiveEdge& e = edges_[queued.id];
-      const std::uint32_t other = e.a == slot_a ? e.b : e.a;
+      const std::uint32_t other = e.a == slot ? e.b : e.a;
       if (slots_[other].stats == kNone) graph_->prefetch_face_corners(other);
     }
     auto evaluate_batch = [&](std::size_t i, unsigned thread) {
@@ -776,10 +786,10 @@ class HierarchyBuilder::Impl {
     for (const QueuedCandidate& evaluated : batch_) queue_.prefetch_node(evaluated.id);
     bool zero_cost = false;
     for (const QueuedCandidate& evaluated : batch_) zero_cost = zero_cost || evaluated.cost == 0;
-    if (zero_cost) mark_neighbours(slot_a);
+    if (zero_cost) mark_neighbours(slot);
     for (QueuedCandidate& evaluated : batch_) {
       if (evaluated.cost == 0)
-        evaluated.set_degree(degree_with_marked(slot_a, other_end(edges_[evaluated.id], slot_a)));
+        evaluated.set_degree(degree_with_marked(slot, other_end(edges_[evaluated.id], slot)));
       requeue(evaluated);
     }
     evaluations_ += batch_.size();

@@ -3,6 +3,7 @@
 #include <limits>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "readers.hpp"
 #include "text_scanner.hpp"
@@ -38,12 +39,13 @@ std::int64_t read_count(TextScanner& in, const char* what) {
   return count;
 }
 
-}  // namespace
+// The counts of the header ("OFF", or an old file's bare counts), the cursor after its line; the
+// counts checked against what the file can hold.
+struct OffCounts {
+  std::int64_t vertices = 0, faces = 0;
+};
 
-Mesh read_off(std::span<const char> bytes, std::string_view file_name) {
-  TextScanner in(bytes, file_name, {.line_bounded = false, .comment = '#'});
-  if (in.at_end()) in.fail_at(in.cursor(), "file is empty");
-
+OffCounts read_off_header(TextScanner& in) {
   const char* header = in.cursor();
   bool dimension_follows = false;
   if (is_off_keyword(in.read_token(), dimension_follows)) {
@@ -78,14 +80,13 @@ Mesh read_off(std::span<const char> bytes, std::string_view file_name) {
   if (face_count == 0) {
     in.fail_at(counts, "mesh has no faces (the header declares 0 faces)", ErrorKind::InvalidInput);
   }
+  return {vertex_count, face_count};
+}
 
-  PolygonSoup soup;
-  soup.positions.resize(static_cast<std::size_t>(vertex_count));
-  soup.offsets.reserve(static_cast<std::size_t>(face_count) + 1);
-  soup.vertices.reserve(3 * static_cast<std::size_t>(face_count));
-
+void read_off_vertices(TextScanner& in, std::int64_t vertex_count, std::vector<Vec3>& positions) {
+  positions.resize(static_cast<std::size_t>(vertex_count));
   for (std::int64_t v = 0; v < vertex_count; ++v) {
-    Vec3& position = soup.positions[static_cast<std::size_t>(v)];
+    Vec3& position = positions[static_cast<std::size_t>(v)];
     for (double& coordinate : position) {
       if (!in.read_double(coordinate)) {
         in.fail_at_token("expected a coordinate of vertex " + std::to_string(v) + " of the " +
@@ -100,13 +101,17 @@ Mesh read_off(std::span<const char> bytes, std::string_view file_name) {
     }
     in.skip_line();  // Colour, normal or texture values of COFF/NOFF/STOFF.
   }
+}
 
-  const auto vertex_limit = static_cast<std::uint64_t>(vertex_count);
-  for (std::int64_t f = 0; f < face_count; ++f) {
+void read_off_faces(TextScanner& in, const OffCounts& counts, PolygonSoup& soup) {
+  soup.offsets.reserve(static_cast<std::size_t>(counts.faces) + 1);
+  soup.vertices.reserve(3 * static_cast<std::size_t>(counts.faces));
+  const auto vertex_limit = static_cast<std::uint64_t>(counts.vertices);
+  for (std::int64_t f = 0; f < counts.faces; ++f) {
     std::int64_t size = 0;
     if (!in.read_integer(size)) {
       in.fail_at_token("expected the vertex count of face " + std::to_string(f) + " of the " +
-                       std::to_string(face_count) + " the header declares");
+                       std::to_string(counts.faces) + " the header declares");
     }
     if (size < 3) {
       in.fail_at(in.last_token(), "face " + std::to_string(f) + " has " + std::to_string(size) +
@@ -126,17 +131,29 @@ Mesh read_off(std::span<const char> bytes, std::string_view file_name) {
       if (index < 0 || static_cast<std::uint64_t>(index) >= vertex_limit) {
         in.fail_at(in.last_token(), "face " + std::to_string(f) + " has vertex index " +
                                         std::to_string(index) + ", outside [0, " +
-                                        std::to_string(vertex_count) + ")");
+                                        std::to_string(counts.vertices) + ")");
       }
       soup.vertices.push_back(static_cast<std::uint32_t>(index));
     }
     soup.end_face();
     in.skip_line();  // Per-face colour.
   }
+}
+
+}  // namespace
+
+Mesh read_off(std::span<const char> bytes, std::string_view file_name) {
+  TextScanner in(bytes, file_name, {.line_bounded = false, .comment = '#'});
+  if (in.at_end()) in.fail_at(in.cursor(), "file is empty");
+  const OffCounts counts = read_off_header(in);
+  PolygonSoup soup;
+  read_off_vertices(in, counts.vertices, soup.positions);
+  read_off_faces(in, counts, soup);
   if (!in.at_end()) {
     in.read_token();
-    in.fail_at_token("expected the end of the file after the " + std::to_string(vertex_count) +
-                     " vertices and " + std::to_string(face_count) + " faces the header declares");
+    in.fail_at_token("expected the end of the file after the " + std::to_string(counts.vertices) +
+                     " vertices and " + std::to_string(counts.faces) +
+                     " faces the header declares");
   }
   return to_mesh(std::move(soup));
 }
