@@ -266,7 +266,8 @@ nlohmann::json append_relations(std::string& html, const Hierarchy& hierarchy,
   nlohmann::json kind_names = nlohmann::json::array();
   for (const auto kind : {ClusterRelation::Kind::Parallel, ClusterRelation::Kind::Coaxial,
                           ClusterRelation::Kind::Orthogonal, ClusterRelation::Kind::EqualRadius,
-                          ClusterRelation::Kind::Coplanar, ClusterRelation::Kind::Tangent})
+                          ClusterRelation::Kind::Coplanar, ClusterRelation::Kind::Tangent,
+                          ClusterRelation::Kind::Concentric})
     kind_names.push_back(to_string(kind));
   return {{"firstClusters", first},
           {"levels", level_count},

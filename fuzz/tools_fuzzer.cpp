@@ -429,6 +429,14 @@ void check_relations(const std::vector<Primitive>& primitives,
         if (!(off <= 1e-9 * scale)) fail((what + ": coplanar member off the plane").c_str(), off);
       }
     }
+    if (relation.kind == ClusterRelation::Kind::Concentric)
+      for (const std::uint32_t c : relation.clusters) {
+        if (primitives[c].type != PrimitiveType::Sphere)
+          fail((what + ": concentric surface is not a sphere").c_str(), c);
+        if (std::bit_cast<std::array<std::uint64_t, 3>>(primitives[c].point) !=
+            std::bit_cast<std::array<std::uint64_t, 3>>(primitives[relation.clusters[0]].point))
+          fail((what + ": concentric centres differ").c_str(), c);
+      }
     if (equal_radius)
       for (const std::uint32_t c : relation.clusters)
         if (std::bit_cast<std::uint64_t>(primitives[c].radius) !=

@@ -404,7 +404,7 @@ more centred on one line with no cylinder; "orthogonal": two directions at right
 "equal_radius": cylinders and spheres of one radius; "coplanar": planes of one plane, the
 fragments of one face; "tangent": a cylinder and a plane it borders, the cylinder tangent to it,
 as a fillet and the face it rounds, or two parallel cylinders that border each other, as a fillet
-and the boss it rounds) and clusters (their labels, increasing; for
+and the boss it rounds; "concentric": spheres of one centre, as a ball and its socket) and clusters (their labels, increasing; for
 "orthogonal", those of one direction, and orthogonal_to those of the other), and deviation: how
 far the clusters' own fits were from the relation (degrees for "parallel" and "orthogonal", input
 units otherwise), what a tolerance must reach for it to hold whatever the statistics.

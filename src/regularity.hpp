@@ -40,6 +40,9 @@ struct RegularityOptions {
   /// ball end, a hemispherical cap): one parameter along the line instead of three; and three
   /// spheres or more on one line of a direction made exact (a revolved profile's arcs).
   bool spheres_on_axes = true;
+  /// Give spheres on no line whose centres agree within the significance one centre, each
+  /// keeping its radius (a ball and its socket): 3 parameters for the set instead of 3 each.
+  bool concentric = true;
   /// Give cylinders and spheres whose radii agree within the significance one radius.
   bool equal_radii = true;
   /// ... never when the radii differ by more than this fraction of the larger, nor a radius
@@ -79,11 +82,13 @@ struct Relation {
 /// one parameter along it each, as are three spheres or more centred on one line of a direction
 /// made exact with no cylinder on it, and cylinders and spheres whose radii agree within the
 /// significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with the
-/// surfaces on their lines (each free sphere on its own centre). Returns the relations made
-/// exact: each direction group's members that were refitted with its direction, then its coplanar
-/// sets, then each coaxial set of its cylinders (spheres added when they join it), in that order,
-/// then the coaxial sets a sphere started with one cylinder, then the lines of spheres alone, then
-/// the classes of equal radii, then the right angles by their members. Last, cylinders whose
+/// surfaces on their lines (each free sphere on its own centre); before that, spheres on no line
+/// whose centres agree within the significance share one (RegularityOptions::concentric; such a
+/// sphere then joins no class of radii). Returns the relations made exact: each direction group's
+/// members that were refitted with its direction, then its coplanar sets, then each coaxial set of
+/// its cylinders (spheres added when they join it), in that order, then the coaxial sets a sphere
+/// started with one cylinder, then the lines of spheres alone, then the concentric sets, then the
+/// classes of equal radii, then the right angles by their members. Last, cylinders whose
 /// direction a right angle made exactly orthogonal to a plane's, that border the plane and whose
 /// axis is at their radius from it within the significance are refitted tangent to it
 /// (RegularityOptions::tangency; the cylinders of a coaxial set together, on their one line, not

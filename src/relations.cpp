@@ -37,6 +37,8 @@ std::string_view to_string(ClusterRelation::Kind kind) {
       return "coplanar";
     case ClusterRelation::Kind::Tangent:
       return "tangent";
+    case ClusterRelation::Kind::Concentric:
+      return "concentric";
   }
   return "unknown";
 }

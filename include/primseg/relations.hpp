@@ -59,6 +59,10 @@ struct ClusterRelation {
     /// into another) or the difference (a fillet inside a bore): the one with fewer vertices is
     /// refitted tangent to the other, which is held as the other relations left it.
     Tangent,
+    /// Spheres made one centre, each keeping its radius: a ball and its socket, the two sides of a
+    /// spherical shell, a sphere cut apart by the hierarchy. Not for spheres centred on a line
+    /// (Coaxial); its spheres are in no EqualRadius relation.
+    Concentric,
   };
   Kind kind = Kind::Parallel;
   /// Cluster labels, increasing; two or more (Orthogonal: one or more, its lowest below the
@@ -74,14 +78,15 @@ struct ClusterRelation {
   /// between a member of each side); input units for Coaxial (the largest distance of a member's
   /// own axis, at its point, or centre from the shared line), EqualRadius (the largest difference
   /// of two members' radii), Coplanar (the largest distance of a member's own centroid from the
-  /// shared plane) and Tangent (the cylinder's own gap: its axis's distance from the plane, at
+  /// shared plane), Tangent (the cylinder's own gap: its axis's distance from the plane, at
   /// its point, minus its radius, in absolute value; for two cylinders, the distance of the
   /// smaller one's axis, at its point, from the larger's, minus the sum or the difference of
-  /// their radii, whichever is nearer).
+  /// their radii, whichever is nearer); Concentric (the largest distance of a member's own centre
+  /// from the shared one).
   double deviation = 0;
 };
 
-/// "parallel", "coaxial", "orthogonal", "equal_radius", "coplanar" or "tangent".
+/// "parallel", "coaxial", "orthogonal", "equal_radius", "coplanar", "tangent" or "concentric".
 std::string_view to_string(ClusterRelation::Kind kind);
 
 /// Options of regularize_clusters().

@@ -410,6 +410,75 @@ std::optional<CoaxialFit> fit_alone(const Primitive& cylinder, const Eigen::Vect
   return fit_coaxial(direction, centre, {&alone, 1});
 }
 
+std::optional<ConcentricFit> fit_concentric(const Eigen::Vector3d& centre,
+                                            std::span<const CoaxialMember> members) {
+  const Eigen::Index size = 3 + static_cast<Eigen::Index>(members.size());
+  std::size_t count = 0;
+  for (const CoaxialMember& member : members) count += member.points.size();
+  if (count <= static_cast<std::size_t>(size)) return std::nullopt;
+  Eigen::VectorXd x(size);
+  x.head<3>() = centre;
+  for (std::size_t j = 0; j < members.size(); ++j)
+    x(3 + static_cast<Eigen::Index>(j)) = members[j].radius;
+  Eigen::MatrixXd normal(size, size);
+  Eigen::VectorXd gradient(size);
+  std::vector<double> member_squares(members.size());
+  // The normal equations at x, each residual |p − c| − rⱼ weighted or not; the unweighted Σ e².
+  const auto linearise = [&](bool weighted) {
+    normal.setZero();
+    gradient.setZero();
+    double squares = 0;
+    for (std::size_t j = 0; j < members.size(); ++j) {
+      const Eigen::Index q = 3 + static_cast<Eigen::Index>(j);
+      member_squares[j] = 0;
+      for (std::size_t i = 0; i < members[j].points.size(); ++i) {
+        const Eigen::Vector3d d = to_eigen(members[j].points[i]) - x.head<3>();
+        const double length = d.norm();
+        if (!(length > 0)) continue;
+        const double e = length - x(q), w = weighted ? members[j].weights[i] : 1.0;
+        const Eigen::Vector3d by_centre = -d / length;
+        normal.topLeftCorner<3, 3>() += w * by_centre * by_centre.transpose();
+        normal.block<3, 1>(0, q) -= w * by_centre;
+        normal(q, q) += w;
+        gradient.head<3>() += w * e * by_centre;
+        gradient(q) -= w * e;
+        squares += e * e;
+        member_squares[j] += e * e;
+      }
+    }
+    normal.bottomLeftCorner(size - 3, 3) = normal.topRightCorner(3, size - 3).transpose();
+    return squares;
+  };
+  bool converged = false;
+  for (int step = 0; step < 30 && !converged; ++step) {
+    linearise(true);
+    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
+    if (!delta.allFinite()) return std::nullopt;
+    x += delta;
+    converged = !(delta.norm() > 1e-14 * x.norm());
+  }
+  if (!converged || !x.allFinite() || !(x.tail(size - 3).minCoeff() > 0)) return std::nullopt;
+  const double squares = linearise(false);
+  const double largest_radius = x.tail(size - 3).maxCoeff();
+  const Eigen::MatrixXd covariance =
+      normal.inverse() *
+      std::max(squares / static_cast<double>(count - static_cast<std::size_t>(size)),
+               kResolution * kResolution * largest_radius * largest_radius);
+  if (!covariance.allFinite()) return std::nullopt;
+  ConcentricFit fit;
+  fit.centre = x.head<3>();
+  fit.centre_covariance = covariance.topLeftCorner<3, 3>();
+  for (std::size_t j = 0; j < members.size(); ++j) {
+    const Eigen::Index q = 3 + static_cast<Eigen::Index>(j);
+    fit.radii.push_back(x(q));
+    fit.radius_variances.push_back(covariance(q, q));
+    fit.rms.push_back(std::max(
+        std::sqrt(member_squares[j] / double(std::max<std::size_t>(members[j].points.size(), 1))),
+        kResolution * x(q)));
+  }
+  return fit;
+}
+
 double middle_along(const Eigen::Vector3d& direction, std::span<const std::size_t> clusters,
                     const std::vector<std::vector<Vec3>>& points,
                     const std::vector<std::vector<double>>& weights) {

@@ -3,6 +3,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -269,6 +270,116 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
 
 namespace {
 
+// Refits the spheres `set` (indices into settled.surfaces) with one centre; while a member's
+// residual sum rises by more than the significance, corrected for their number, allows, the worst
+// leaves. Writes the centre, the radii and the primitives back and appends the Concentric
+// relation, unless fewer than two stay.
+void settle_concentric(SettledSurfaces& settled, std::vector<std::size_t> set,
+                       const RegularityOptions& options, std::vector<Primitive>& primitives,
+                       const std::vector<std::vector<Vec3>>& points,
+                       const std::vector<std::vector<double>>& weights,
+                       std::vector<Relation>& relations) {
+  std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
+  std::optional<ConcentricFit> fit;
+  while (set.size() >= 2) {
+    PooledPosition<3> pooled;
+    std::vector<CoaxialMember> members;
+    for (const std::size_t k : set) {
+      const SettledSurfaces::Surface& sphere = surfaces[k];
+      pooled.add(settled.centres[sphere.centre], settled.centre_covariances[sphere.centre]);
+      members.push_back({points[sphere.cluster], weights[sphere.cluster], sphere.radius});
+    }
+    fit = fit_concentric(pooled.centre(), members);
+    if (!fit) return;
+    const double bound = family_significance(options.significance, set.size());
+    double worst_excess = 1;
+    std::size_t worst = set.size();
+    for (std::size_t j = 0; j < set.size(); ++j) {
+      const SettledSurfaces::Surface& sphere = surfaces[set[j]];
+      const double excess = residual_excess(sphere.rms, fit->rms[j], points[sphere.cluster].size(),
+                                            bound * bound, 4, options.length_tolerance);
+      if (excess > worst_excess) {
+        worst_excess = excess;
+        worst = j;
+      }
+    }
+    if (worst == set.size()) break;
+    set.erase(set.begin() + static_cast<std::ptrdiff_t>(worst));
+    fit.reset();
+  }
+  if (!fit) return;
+  const std::size_t shared = surfaces[set[0]].centre;
+  settled.centres[shared] = fit->centre;
+  Relation& relation = relations.emplace_back();
+  relation.kind = Relation::Kind::Concentric;
+  for (std::size_t j = 0; j < set.size(); ++j) {
+    SettledSurfaces::Surface& sphere = surfaces[set[j]];
+    sphere.centre = shared;
+    sphere.radius = fit->radii[j];
+    sphere.radius_variance = fit->radius_variances[j];
+    sphere.rms = fit->rms[j];
+    sphere.concentric = relations.size() - 1;
+    primitives[sphere.cluster].point = to_vec3(fit->centre);
+    primitives[sphere.cluster].radius = sphere.radius;
+    relation.members.push_back(sphere.cluster);
+  }
+  std::sort(relation.members.begin(), relation.members.end());
+}
+
+}  // namespace
+
+void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
+                     std::vector<Primitive>& primitives,
+                     const std::vector<std::vector<Vec3>>& points,
+                     const std::vector<std::vector<double>>& weights,
+                     std::vector<Relation>& relations) {
+  // A centre's offset is three normals: the bound they exceed as rarely as one the significance.
+  const double bound = chi_square_bound(options.significance, 3);
+  std::vector<std::size_t> placed;
+  for (std::size_t k = 0; k < settled.surfaces.size(); ++k) {
+    const SettledSurfaces::Surface& sphere = settled.surfaces[k];
+    if (!sphere.sphere || sphere.line != kNoLine) continue;
+    const Eigen::Matrix3d& covariance = settled.centre_covariances[sphere.centre];
+    const double largest =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance, Eigen::EigenvaluesOnly)
+            .eigenvalues()(2);
+    if (options.significance * std::sqrt(largest) <= options.max_radius_difference * sphere.radius)
+      placed.push_back(k);
+  }
+  const auto spread = [&](std::size_t k) {
+    return settled.centre_covariances[settled.surfaces[k].centre].trace();
+  };
+  std::stable_sort(placed.begin(), placed.end(),
+                   [&](std::size_t a, std::size_t b) { return spread(a) < spread(b); });
+  std::vector<std::vector<std::size_t>> sets;
+  std::vector<PooledPosition<3>> pooled;
+  for (const std::size_t k : placed) {
+    const SettledSurfaces::Surface& sphere = settled.surfaces[k];
+    const Eigen::Vector3d& centre = settled.centres[sphere.centre];
+    const Eigen::Matrix3d& covariance = settled.centre_covariances[sphere.centre];
+    std::size_t joined = sets.size();
+    for (std::size_t s = 0; s < sets.size() && joined == sets.size(); ++s) {
+      const Eigen::Vector3d offset = centre - pooled[s].centre();
+      if (!(offset.norm() <= options.max_radius_difference * sphere.radius)) continue;
+      const Eigen::Matrix3d combined = covariance + pooled[s].covariance();
+      if (offset.dot(combined.ldlt().solve(offset)) <= bound ||
+          within_tolerance(offset.norm(), options.length_tolerance))
+        joined = s;
+    }
+    if (joined == sets.size()) {
+      sets.emplace_back();
+      pooled.emplace_back();
+    }
+    sets[joined].push_back(k);
+    pooled[joined].add(centre, covariance);
+  }
+  for (const std::vector<std::size_t>& set : sets)
+    if (set.size() >= 2)
+      settle_concentric(settled, set, options, primitives, points, weights, relations);
+}
+
+namespace {
+
 // Classes of radii that are one radius within the significance: in increasing order of radius,
 // a class grows while its radii stay consistent with their information-weighted mean (their χ²
 // about it within chi_square_bound of its degrees of freedom) and its smallest within
@@ -292,7 +403,7 @@ std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surfa
   std::size_t members = 0;
   for (const std::size_t k : order) {
     const double r = surfaces[k].radius, variance = surfaces[k].radius_variance;
-    if (!(variance > 0) ||
+    if (surfaces[k].concentric != kNoRelation || !(variance > 0) ||
         options.significance * std::sqrt(variance) > options.max_radius_difference * r) {
       class_of[k] = classes++;  // a class of its own
       continue;

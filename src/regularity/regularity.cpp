@@ -90,6 +90,10 @@ double deviation(const ClusterRelation& related, std::span<const Primitive> own,
       const double distance = distance_across(point(c) - point(p), axis(p).normalized());
       return std::abs(nearest_circle_contact(distance, own[c].radius, own[p].radius).gap);
     }
+    case Kind::Concentric:
+      for (const std::uint32_t c : members)
+        largest = std::max(largest, (point(c) - to_eigen(shared[members[0]].point)).norm());
+      return largest;
   }
   return 0;
 }
@@ -267,12 +271,14 @@ std::vector<Relation> regularize(std::vector<Primitive>& primitives,
   const std::vector<std::vector<std::size_t>> refitted =
       align_groups(groups, constrained, coplanar, items, options, primitives, points, weights,
                    relations, settled);
-  if (options.equal_radii || options.spheres_on_axes) {
+  if (options.equal_radii || options.spheres_on_axes || options.concentric) {
     settle_the_others(items, primitives, points, weights, settled);
     if (options.spheres_on_axes) {
       centre_spheres_on_axes(settled, options, primitives, points, weights, relations);
       line_up_spheres(settled, groups, refitted, options, primitives, points, weights, relations);
     }
+    if (options.concentric)
+      make_concentric(settled, options, primitives, points, weights, relations);
     if (options.equal_radii)
       equalize_radii(settled, options, primitives, points, weights, relations);
   }

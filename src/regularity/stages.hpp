@@ -220,6 +220,22 @@ std::optional<JointFit> fit_cylinders_and_spheres(
 std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::Vector2d& centre,
                                       std::span<const CoaxialMember> members);
 
+/// Spheres sharing one centre, each with its own radius (fit_concentric()).
+struct ConcentricFit {
+  Eigen::Vector3d centre;
+  Eigen::Matrix3d centre_covariance = Eigen::Matrix3d::Zero();
+  std::vector<double> radii;
+  std::vector<double> rms;  // per member, unweighted, at least kResolution × its radius
+  std::vector<double> radius_variances;
+};
+
+/// The spheres `members` (their inliers, weights and radii; the CoaxialMember of a sphere) fitted
+/// with one centre by geometric least squares: Gauss–Newton from `centre` and their radii, weighted
+/// steps, the uncertainty from the unweighted residuals. Nothing when it does not converge in 30
+/// steps, a radius ends non-positive or the points do not outnumber the parameters (3 + members).
+std::optional<ConcentricFit> fit_concentric(const Eigen::Vector3d& centre,
+                                            std::span<const CoaxialMember> members);
+
 /// `cylinder` refitted alone on its inliers with the axis direction `direction`, from its own axis
 /// point and radius.
 std::optional<CoaxialFit> fit_alone(const Primitive& cylinder, const Eigen::Vector3d& direction,
@@ -236,19 +252,28 @@ double middle_along(const Eigen::Vector3d& direction, std::span<const std::size_
 void place_cylinder(Primitive& cylinder, const Eigen::Vector3d& direction,
                     const Eigen::Vector2d& centre, double radius);
 
-/// The information-weighted mean of axis positions: where a coaxial set's axis is, and how well.
-struct PooledCentre {
-  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d weighted = Eigen::Vector2d::Zero();  // Σ information × centre
+/// The information-weighted mean of positions of dimension D: where a set's common position is
+/// (an axis line's in the plane orthogonal to it, a sphere centre), and how well.
+template <int D>
+struct PooledPosition {
+  using Vector = Eigen::Matrix<double, D, 1>;
+  using Matrix = Eigen::Matrix<double, D, D>;
+  Matrix information = Matrix::Zero();
+  Vector weighted = Vector::Zero();  // Σ information × position
 
-  void add(const CoaxialFit& fit) { add(fit.centre, fit.centre_covariance); }
-  void add(const Eigen::Vector2d& centre, const Eigen::Matrix2d& covariance) {
-    const Eigen::Matrix2d own = covariance.inverse();
+  void add(const Vector& position, const Matrix& covariance) {
+    const Matrix own = covariance.inverse();
     information += own;
-    weighted += own * centre;
+    weighted += own * position;
   }
-  Eigen::Vector2d centre() const { return information.ldlt().solve(weighted); }
-  Eigen::Matrix2d covariance() const { return information.inverse(); }
+  Vector centre() const { return information.ldlt().solve(weighted); }
+  Matrix covariance() const { return information.inverse(); }
+};
+
+/// Where a coaxial set's axis is, and how well.
+struct PooledCentre : PooledPosition<2> {
+  using PooledPosition<2>::add;
+  void add(const CoaxialFit& fit) { add(fit.centre, fit.centre_covariance); }
 };
 
 // ---- Spheres on axis lines, and equal radii (radii.cpp)
@@ -273,8 +298,9 @@ struct SettledSurfaces {
     std::size_t cluster = 0;
     bool sphere = false;
     std::size_t line = 0;    // into `lines`: a cylinder's; a sphere's centre's, or kNoLine
-    std::size_t centre = 0;  // a sphere's, into `centres`
+    std::size_t centre = 0;  // a sphere's, into `centres` (one for a concentric set's)
     double radius = 0, radius_variance = 0, rms = 0;
+    std::size_t concentric = kNoRelation;  // a sphere's Concentric relation's index
   };
   std::vector<Line> lines;
   std::vector<Eigen::Vector3d> centres;
@@ -315,6 +341,21 @@ void centre_spheres_on_axes(SettledSurfaces& settled, const RegularityOptions& o
 void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>& groups,
                      const std::vector<std::vector<std::size_t>>& refitted,
                      const RegularityOptions& options, std::vector<Primitive>& primitives,
+                     const std::vector<std::vector<Vec3>>& points,
+                     const std::vector<std::vector<double>>& weights,
+                     std::vector<Relation>& relations);
+
+/// Spheres sharing one centre, each with its own radius: a ball and its socket, a spherical
+/// shell's two sides. Among the spheres on no line, best located first, each joins the first set
+/// whose pooled centre (information-weighted) it is within the significance of (Mahalanobis, with
+/// both covariances, against the χ² bound of three degrees of freedom) and within
+/// max_radius_difference of its radius; else it starts one. As for a line's spheres, a centre whose
+/// significance interval is wider than that joins none (the spheres of a freeform surface). Each
+/// set of two or more is refitted with one centre (fit_concentric()); while a member's residual
+/// sum rises by more than the significance corrected for their number allows, the worst leaves.
+/// Appends a Concentric relation per set kept; its spheres take part in no class of equal radii.
+void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
+                     std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights,
                      std::vector<Relation>& relations);

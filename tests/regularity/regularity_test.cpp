@@ -455,6 +455,18 @@ TEST(Regularity, SpheresShareTheRadiusOfEqualSpheresAndCylinders) {
   }
 }
 
+// The weighted least-squares objective of spheres: Σ w (distance to the centre − radius)².
+double spheres_objective(const std::vector<std::pair<Primitive, const Cluster*>>& spheres) {
+  double sum = 0;
+  for (const auto& [sphere, cluster] : spheres)
+    for (std::size_t i = 0; i < cluster->points.size(); ++i) {
+      const double e =
+          (to_eigen(cluster->points[i]) - to_eigen(sphere.point)).norm() - sphere.radius;
+      sum += cluster->weights[i] * e * e;
+    }
+  return sum;
+}
+
 // The weighted least-squares objective of a cylinder and spheres: Σ w (distance to the axis −
 // radius)² + Σ w (distance to the centre − radius)².
 double joint_objective(const Primitive& cylinder, const Cluster& shaft,
@@ -466,13 +478,7 @@ double joint_objective(const Primitive& cylinder, const Cluster& shaft,
     const double e = (d - d.dot(axis) * axis).norm() - cylinder.radius;
     sum += shaft.weights[i] * e * e;
   }
-  for (const auto& [sphere, cluster] : spheres)
-    for (std::size_t i = 0; i < cluster->points.size(); ++i) {
-      const double e =
-          (to_eigen(cluster->points[i]) - to_eigen(sphere.point)).norm() - sphere.radius;
-      sum += cluster->weights[i] * e * e;
-    }
-  return sum;
+  return sum + spheres_objective(spheres);
 }
 
 // A shaft of radius 0.3 with a ball end of radius 0.4 centred on its axis, and a seat of radius
@@ -527,6 +533,56 @@ TEST(Regularity, ABallEndIsCentredOnTheShaftAxis) {
     EXPECT_LE(axis_offset(shaft, true_ball),
               std::max(axis_offset(true_axis, own[1]), axis_offset(own[0], true_ball)));
   }
+}
+
+// A ball of radius 0.5 in its socket of radius 0.53 (a spherical joint: a cap of each about one
+// centre), and a third sphere whose centre is 2% of its radius from theirs (about 15 times its
+// uncertainty). The ball and the socket share one centre exactly, the least squares of both
+// (moving it or either radius only raises their residuals), nearer the truth over the draws than
+// either's own; each keeps its radius; the third keeps its own fit.
+TEST(Regularity, ABallAndItsSocketShareOneCentre) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ(), x = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d centre(0.2, -0.1, 0.3), off_centre = centre + Eigen::Vector3d(0, 0.006, 0);
+  double shared_squares = 0, ball_squares = 0, socket_squares = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{noisy_sphere_cap(centre, 0.5, z, 1.2, 0.002, rng),
+                                        noisy_sphere_cap(centre, 0.53, -z, 1.0, 0.002, rng),
+                                        noisy_sphere_cap(off_centre, 0.3, x, 1.2, 0.002, rng)};
+    std::vector<Primitive> primitives{fitted_sphere(clusters[0], centre, 0.5),
+                                      fitted_sphere(clusters[1], centre, 0.53),
+                                      fitted_sphere(clusters[2], off_centre, 0.3)};
+    const std::vector<Primitive> own = primitives;
+    ASSERT_EQ(regularize(primitives, clusters), (Relations{{Kind::Concentric, {0, 1}}}));
+    const Primitive &ball = primitives[0], &socket = primitives[1];
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(ball.point[i], socket.point[i]);
+      EXPECT_EQ(primitives[2].point[i], own[2].point[i]);
+    }
+    EXPECT_EQ(primitives[2].radius, own[2].radius);
+    EXPECT_NEAR(ball.radius, 0.5, 0.002);  // within the noise
+    EXPECT_NEAR(socket.radius, 0.53, 0.002);
+    const std::vector<std::pair<Primitive, const Cluster*>> both{{ball, &clusters[0]},
+                                                                 {socket, &clusters[1]}};
+    const double best = spheres_objective(both);
+    for (const double h : {-1e-4, 1e-4}) {
+      for (int axis = 0; axis < 3; ++axis) {
+        std::vector<std::pair<Primitive, const Cluster*>> moved = both;
+        for (auto& [sphere, unused] : moved) sphere.point[axis] += h;
+        EXPECT_GT(spheres_objective(moved), best);
+      }
+      for (int member = 0; member < 2; ++member) {
+        std::vector<std::pair<Primitive, const Cluster*>> wider = both;
+        wider[member].first.radius += h;
+        EXPECT_GT(spheres_objective(wider), best);
+      }
+    }
+    shared_squares += (to_eigen(ball.point) - centre).squaredNorm();
+    ball_squares += (to_eigen(own[0].point) - centre).squaredNorm();
+    socket_squares += (to_eigen(own[1].point) - centre).squaredNorm();
+  }
+  EXPECT_LT(shared_squares, std::min(ball_squares, socket_squares));
 }
 
 // The arcs of a revolved profile: three spheres centred on one line along the normal of a pair of

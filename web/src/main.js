@@ -541,6 +541,9 @@ class Viewer {
       row.dataset.index = String(i);
       let text = this.relationText(relation);
       if (relation.kind === 'equal_radius') text += `, r = ${format(this.primitiveOf(this.levelRelations[i].members[0]).radius)}`;
+      if (relation.kind === 'concentric') {
+        text += `, r = ${this.levelRelations[i].members.map((c) => format(this.primitiveOf(c).radius)).join(' and ')}`;
+      }
       if (relation.kind === 'tangent') {
         const radii = this.levelRelations[i].members.map((c) => this.primitiveOf(c))
           .filter((p) => TYPE_NAMES[p.type] === 'cylinder').map((p) => format(p.radius));

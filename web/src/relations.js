@@ -1,5 +1,5 @@
 // The relations of a page written by `primseg view --regularize`: for every level of up to a
-// number of clusters, the parallel, coaxial, orthogonal, equal-radius, coplanar and tangent sets
+// number of clusters, the parallel, coaxial, orthogonal, equal-radius, coplanar, tangent and concentric sets
 // `primseg cut --clusters K --regularize` finds, and the fits they make exact (layout in data.js).
 
 import { lowerBound } from './hierarchy.js';
@@ -12,6 +12,7 @@ export const RELATION_MEANINGS = {
   equal_radius: 'cylinders and spheres made one radius, each keeping its axis line or centre',
   coplanar: 'planes made one plane, each keeping its side: the fragments of one face',
   tangent: 'a cylinder made tangent to a plane or a parallel cylinder it borders: a fillet and a face or a boss it rounds',
+  concentric: 'spheres made one centre, each keeping its radius: a ball and its socket',
 };
 
 export class LevelRelations {
