@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -22,6 +24,7 @@
 #include "primseg/mesh_io.hpp"
 #include "primseg/refine.hpp"
 #include "primseg/shape_generator.hpp"
+#include "support/regularity_shapes.hpp"
 #include "support/test_support.hpp"
 
 namespace primseg {
@@ -438,6 +441,45 @@ TEST(Relations, TwoBearingSeatsFarApartShareTheirAxis) {
       "two bearing seats 12 apart: shared axis %.3g degrees from the truth (RMS), own %.3g\n",
       std::sqrt(shared_error), std::sqrt(own_error));
   EXPECT_LT(shared_error, own_error / 9);
+}
+
+// The bowl's two sides, fitted apart, are two spheres whose centres differ by their noise; made
+// concentric, they share one centre, exactly, nearer the truth over the draws than either's own,
+// and keep their radii.
+TEST(Relations, ABowlsTwoSidesShareOneCentre) {
+  const Eigen::Vector3d truth(testing::kBowlCentre[0], testing::kBowlCentre[1],
+                              testing::kBowlCentre[2]);
+  double shared_error = 0, outer_error = 0, inner_error = 0;
+  constexpr int kSeeds = 10;
+  for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    SCOPED_TRACE(seed);
+    const Hierarchy hierarchy = build_hierarchy(testing::spherical_bowl(0.002, seed));
+    const Segmentation cut = cut_by_count(hierarchy, 3);
+    const std::vector<ClusterReport> own = describe_clusters(hierarchy, cut);
+    std::vector<ClusterReport> reports = own;
+    const std::vector<ClusterRelation> relations = regularize_clusters(hierarchy, cut, reports);
+    std::vector<std::uint32_t> spheres;
+    for (std::uint32_t c = 0; c < 3; ++c)
+      if (reports[c].primitive.type == PrimitiveType::Sphere) spheres.push_back(c);
+    ASSERT_EQ(spheres.size(), 2u);
+    ASSERT_EQ(clusters_of(relations, ClusterRelation::Kind::Concentric), Groups{spheres});
+    // Label 0 is the larger, outer side.
+    const Primitive &outer = reports[spheres[0]].primitive, &inner = reports[spheres[1]].primitive;
+    EXPECT_EQ(outer.point, inner.point);
+    EXPECT_NEAR(outer.radius, 1.0, 0.002);
+    EXPECT_NEAR(inner.radius, 0.8, 0.002);
+    const auto error = [&](const Primitive& sphere) {
+      return (Eigen::Vector3d(sphere.point[0], sphere.point[1], sphere.point[2]) - truth)
+                 .squaredNorm() /
+             kSeeds;
+    };
+    shared_error += error(outer);
+    outer_error += error(own[spheres[0]].primitive);
+    inner_error += error(own[spheres[1]].primitive);
+  }
+  std::printf("bowl: shared centre %.3g from the truth (RMS), own %.3g (outer) and %.3g (inner)\n",
+              std::sqrt(shared_error), std::sqrt(outer_error), std::sqrt(inner_error));
+  EXPECT_LT(shared_error, std::min(outer_error, inner_error));
 }
 
 // A box's edge rounded by a fillet, swept along y over [0, 1]: in the xz profile its side x = 0

@@ -23,6 +23,7 @@
 #include "primseg/primitive.hpp"
 #include "primseg/relations.hpp"
 #include "primseg/shape_generator.hpp"
+#include "support/regularity_shapes.hpp"
 #include "support/test_support.hpp"
 
 namespace primseg {
@@ -1128,6 +1129,28 @@ TEST(Cli, ARelationLengthToleranceInPercentIsOfTheDiagonal) {
   // fandisk's fillet 7 needs about 1.1e-5 to be tangent to its face 4: 0.0014% is 2.0e-5.
   EXPECT_TRUE(tangent_4_7(in_percent.first));
   EXPECT_FALSE(tangent_4_7(relations("0.000005").first));
+}
+
+// A bowl's two sides (exact) come out as one centre: a "concentric" relation in the JSON and the
+// summary, and one center in both spheres' params, each keeping its radius.
+TEST(Cli, ABowlsTwoSidesAreConcentricInTheJson) {
+  TempDir dir("concentric");
+  write_mesh(dir / "bowl.off", testing::spherical_bowl(0, 1));
+  const CliRun r = run("segment " + dir.q("bowl.off") + " --clusters 3 --regularize --json " +
+                       dir.q("bowl.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("concentric: 0 1"), std::string::npos) << r.output;
+  const json j = read_json(dir / "bowl.json");
+  const json concentric{{"kind", "concentric"}, {"clusters", {0, 1}}};
+  EXPECT_TRUE(std::any_of(j["relations"].begin(), j["relations"].end(), [&](const json& relation) {
+    return relation["kind"] == concentric["kind"] && relation["clusters"] == concentric["clusters"];
+  })) << j["relations"].dump();
+  const json &outer = j["clusters"][0]["params"], &inner = j["clusters"][1]["params"];
+  EXPECT_EQ(outer["center"], inner["center"]);
+  for (int a = 0; a < 3; ++a)
+    EXPECT_NEAR(outer["center"][a].get<double>(), testing::kBowlCentre[a], 1e-9);
+  EXPECT_NEAR(outer["radius"].get<double>(), 1.0, 1e-9);
+  EXPECT_NEAR(inner["radius"].get<double>(), 0.8, 1e-9);
 }
 
 TEST(Cli, EvalScoresTheGeneratedShapes) {

@@ -61,6 +61,47 @@ Cluster noisy_sphere_cap(const Eigen::Vector3d& centre, double radius, const Eig
   return cluster;
 }
 
+Mesh spherical_bowl(double sigma, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  Noise noise{sigma};
+  std::vector<Vec3> positions;
+  std::vector<Triangle> triangles;
+  // One side: its pole, then ring i (1..kBowlRings) at polar angle (π/2) i / kBowlRings from the
+  // bottom.
+  const auto side = [&](double radius) {
+    const auto at = [&](double polar, double azimuth, double r) {
+      return Vec3{kBowlCentre[0] + r * std::sin(polar) * std::cos(azimuth),
+                  kBowlCentre[1] + r * std::sin(polar) * std::sin(azimuth),
+                  kBowlCentre[2] - r * std::cos(polar)};
+    };
+    const auto pole = static_cast<std::uint32_t>(positions.size());
+    positions.push_back(at(0, 0, radius + noise(rng)));
+    for (int i = 1; i <= kBowlRings; ++i)
+      for (int j = 0; j < kBowlAround; ++j)
+        positions.push_back(at(std::numbers::pi / 2 * i / kBowlRings,
+                               2 * std::numbers::pi * j / kBowlAround,
+                               radius + (i < kBowlRings ? noise(rng) : 0.0)));
+    const auto vertex = [pole](int i, int j) {
+      return pole + 1 + static_cast<std::uint32_t>((i - 1) * kBowlAround + (j % kBowlAround));
+    };
+    for (int j = 0; j < kBowlAround; ++j)
+      triangles.push_back({pole, vertex(1, j + 1), vertex(1, j)});
+    for (int i = 1; i < kBowlRings; ++i)
+      for (int j = 0; j < kBowlAround; ++j) {
+        triangles.push_back({vertex(i, j), vertex(i, j + 1), vertex(i + 1, j + 1)});
+        triangles.push_back({vertex(i, j), vertex(i + 1, j + 1), vertex(i + 1, j)});
+      }
+    return vertex;
+  };
+  const auto outer = side(1.0);
+  const auto inner = side(0.8);
+  for (int j = 0; j < kBowlAround; ++j) {
+    triangles.push_back({outer(kBowlRings, j), inner(kBowlRings, j), inner(kBowlRings, j + 1)});
+    triangles.push_back({outer(kBowlRings, j), inner(kBowlRings, j + 1), outer(kBowlRings, j + 1)});
+  }
+  return Mesh::from_triangles(std::move(positions), std::move(triangles));
+}
+
 Primitive fitted_plane(const Cluster& cluster) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const Vec3& p : cluster.points) centroid += to_eigen(p);

@@ -4,11 +4,14 @@
 // and tests/regularity/tangency_test.cpp.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <random>
 #include <utility>
 #include <vector>
 
+#include "primseg/mesh.hpp"
 #include "primseg/primitive.hpp"
 #include "regularity.hpp"
 
@@ -42,6 +45,15 @@ Cluster noisy_cylinder(const Eigen::Vector3d& axis, const Eigen::Vector3d& centr
 /// `sigma` (0: exact).
 Cluster noisy_sphere_cap(const Eigen::Vector3d& centre, double radius, const Eigen::Vector3d& pole,
                          double polar_angle, double sigma, std::mt19937_64& rng);
+
+/// A hemispherical bowl: the outer side a hemisphere of radius 1 about kBowlCentre below its
+/// equator, the inner side one of radius 0.8 about the same centre, joined by the flat rim between
+/// them (kBowlRings rings of kBowlAround vertices on each side): a closed shell of three surfaces,
+/// 2,304 triangles. Each sphere vertex is moved along its radius by Gaussian noise of deviation
+/// `sigma` (0: exact); the rim's vertices stay on the rim.
+inline constexpr std::array<double, 3> kBowlCentre{0.3, -0.2, 0.5};
+inline constexpr int kBowlRings = 12, kBowlAround = 48;
+Mesh spherical_bowl(double sigma, std::uint64_t seed);
 
 /// A profile in the xz-plane, swept along y by swept_profile(): a point and its unit normal.
 struct ProfilePoint {
