@@ -425,6 +425,44 @@ def test_sphere_radius_and_centre():
     assert np.allclose(clusters[0]["params"]["center"], [10, 20, 30], atol=1e-9)
 
 
+def bowl(noise, seed=1, rings=12, around=48):
+    """A hemispherical shell about (0.3, -0.2, 0.5): outer radius 1, inner 0.8, a flat rim between
+    them; each sphere vertex moved along its radius by Gaussian noise of deviation `noise`."""
+    rng = np.random.default_rng(seed)
+    centre = np.array([0.3, -0.2, 0.5])
+    V, F = [], []
+    for radius in (1.0, 0.8):
+        pole = len(V)
+        polar = np.repeat(np.pi / 2 * np.arange(1, rings + 1) / rings, around)
+        azimuth = np.tile(2 * np.pi * np.arange(around) / around, rings)
+        r = radius + rng.normal(0, noise, rings * around) * (polar < np.pi / 2)
+        V += [centre + [0, 0, -radius - rng.normal(0, noise)]]
+        V += list(centre + r[:, None] * np.stack([np.sin(polar) * np.cos(azimuth),
+                                                  np.sin(polar) * np.sin(azimuth), -np.cos(polar)], -1))
+        def vertex(i, j, pole=pole):
+            return pole + 1 + (i - 1) * around + j % around
+        F += [[pole, vertex(1, j + 1), vertex(1, j)] for j in range(around)]
+        F += [t for i in range(1, rings) for j in range(around)
+              for t in ([vertex(i, j), vertex(i, j + 1), vertex(i + 1, j + 1)],
+                        [vertex(i, j), vertex(i + 1, j + 1), vertex(i + 1, j)])]
+    rim_outer, rim_inner = 1 + (rings - 1) * around, len(V) - around
+    F += [t for j in range(around)
+          for t in ([rim_outer + j, rim_inner + j, rim_inner + (j + 1) % around],
+                    [rim_outer + j, rim_inner + (j + 1) % around, rim_outer + (j + 1) % around])]
+    return np.array(V), np.array(F)
+
+
+def test_a_bowls_two_sides_are_concentric():
+    tree = primseg.segment(*bowl(noise=0.002))
+    assert {"kind": "concentric", "clusters": [0, 1], "deviation": pytest.approx(0, abs=0.002)} in tree.relations(3)
+    outer, inner, rim = tree.clusters(3, regularize=True)
+    assert (outer["type"], inner["type"], rim["type"]) == ("sphere", "sphere", "plane")
+    assert outer["params"]["center"] == inner["params"]["center"]
+    assert np.allclose(outer["params"]["center"], [0.3, -0.2, 0.5], atol=0.002)
+    assert outer["params"]["radius"] == pytest.approx(1.0, abs=0.002)
+    assert inner["params"]["radius"] == pytest.approx(0.8, abs=0.002)
+
+
 def test_tolerance_levels(fandisk_tree):
     diagonal = fandisk_tree.mesh.bounding_box_diagonal
     np.testing.assert_array_equal(fandisk_tree.cut(relative_tolerance=0.002),
