@@ -83,23 +83,23 @@ struct Relation {
 /// made exact with no cylinder on it, and cylinders and spheres whose radii agree within the
 /// significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with the
 /// surfaces on their lines (each free sphere on its own centre); before that, spheres on no line
-/// whose centres agree within the significance share one (RegularityOptions::concentric; such a
-/// sphere then joins no class of radii). Returns the relations made exact: each direction group's
-/// members that were refitted with its direction, then its coplanar sets, then each coaxial set of
-/// its cylinders (spheres added when they join it), in that order, then the coaxial sets a sphere
-/// started with one cylinder, then the lines of spheres alone, then the concentric sets, then the
-/// classes of equal radii, then the right angles by their members. Last, cylinders whose
-/// direction a right angle made exactly orthogonal to a plane's, that border the plane and whose
-/// axis is at their radius from it within the significance are refitted tangent to it
-/// (RegularityOptions::tangency; the cylinders of a coaxial set together, on their one line, not
-/// a line with spheres on it; one of a class of equal radii with members off its line keeps that
-/// radius), each on its points away from the band about the contact line where the two surfaces
-/// are within the noise (the plane's offset refitted so, unless it is a coplanar set's): each
-/// pair is a Tangent relation, by line. Direction groups the right angles made one direction are
-/// merged first. Every test "within the significance" also passes a difference within the angle or
-/// length tolerance (RegularityOptions::angle_tolerance, length_tolerance), and every check that a
-/// joint fit explains a member as its own did also passes a rise of its mean square residual within
-/// the length tolerance's square.
+/// whose centres agree within the significance share one (RegularityOptions::concentric; those
+/// of them whose radii agree share one radius, and join no other class of radii). Returns the
+/// relations made exact: each direction group's members that were refitted with its direction, then
+/// its coplanar sets, then each coaxial set of its cylinders (spheres added when they join it), in
+/// that order, then the coaxial sets a sphere started with one cylinder, then the lines of spheres
+/// alone, then the concentric sets, then the classes of equal radii, then the right angles by their
+/// members. Last, cylinders whose direction a right angle made exactly orthogonal to a plane's,
+/// that border the plane and whose axis is at their radius from it within the significance are
+/// refitted tangent to it (RegularityOptions::tangency; the cylinders of a coaxial set together, on
+/// their one line, not a line with spheres on it; one of a class of equal radii with members off
+/// its line keeps that radius), each on its points away from the band about the contact line where
+/// the two surfaces are within the noise (the plane's offset refitted so, unless it is a coplanar
+/// set's): each pair is a Tangent relation, by line. Direction groups the right angles made one
+/// direction are merged first. Every test "within the significance" also passes a difference within
+/// the angle or length tolerance (RegularityOptions::angle_tolerance, length_tolerance), and every
+/// check that a joint fit explains a member as its own did also passes a rise of its mean square
+/// residual within the length tolerance's square.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,

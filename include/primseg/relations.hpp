@@ -61,7 +61,8 @@ struct ClusterRelation {
     Tangent,
     /// Spheres made one centre, each keeping its radius: a ball and its socket, the two sides of a
     /// spherical shell, a sphere cut apart by the hierarchy. Not for spheres centred on a line
-    /// (Coaxial); its spheres are in no EqualRadius relation.
+    /// (Coaxial). Its spheres whose radii agree (fragments of one sphere) are an EqualRadius
+    /// relation too, and are in no other.
     Concentric,
   };
   Kind kind = Kind::Parallel;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <span>
 #include <utility>
@@ -411,15 +412,20 @@ std::optional<CoaxialFit> fit_alone(const Primitive& cylinder, const Eigen::Vect
 }
 
 std::optional<ConcentricFit> fit_concentric(const Eigen::Vector3d& centre,
-                                            std::span<const CoaxialMember> members) {
-  const Eigen::Index size = 3 + static_cast<Eigen::Index>(members.size());
+                                            std::span<const CoaxialMember> members,
+                                            std::span<const std::size_t> radius_of) {
+  const auto radius_index = [&](std::size_t j) {
+    return 3 + static_cast<Eigen::Index>(radius_of.empty() ? j : radius_of[j]);
+  };
+  Eigen::Index size = 3;
+  for (std::size_t j = 0; j < members.size(); ++j) size = std::max(size, radius_index(j) + 1);
   std::size_t count = 0;
   for (const CoaxialMember& member : members) count += member.points.size();
   if (count <= static_cast<std::size_t>(size)) return std::nullopt;
-  Eigen::VectorXd x(size);
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(size, std::numeric_limits<double>::quiet_NaN());
   x.head<3>() = centre;
-  for (std::size_t j = 0; j < members.size(); ++j)
-    x(3 + static_cast<Eigen::Index>(j)) = members[j].radius;
+  for (std::size_t j = members.size(); j-- > 0;) x(radius_index(j)) = members[j].radius;
+  if (!x.allFinite()) return std::nullopt;  // a radius no member has
   Eigen::MatrixXd normal(size, size);
   Eigen::VectorXd gradient(size);
   std::vector<double> member_squares(members.size());
@@ -429,7 +435,7 @@ std::optional<ConcentricFit> fit_concentric(const Eigen::Vector3d& centre,
     gradient.setZero();
     double squares = 0;
     for (std::size_t j = 0; j < members.size(); ++j) {
-      const Eigen::Index q = 3 + static_cast<Eigen::Index>(j);
+      const Eigen::Index q = radius_index(j);
       member_squares[j] = 0;
       for (std::size_t i = 0; i < members[j].points.size(); ++i) {
         const Eigen::Vector3d d = to_eigen(members[j].points[i]) - x.head<3>();
@@ -469,7 +475,7 @@ std::optional<ConcentricFit> fit_concentric(const Eigen::Vector3d& centre,
   fit.centre = x.head<3>();
   fit.centre_covariance = covariance.topLeftCorner<3, 3>();
   for (std::size_t j = 0; j < members.size(); ++j) {
-    const Eigen::Index q = 3 + static_cast<Eigen::Index>(j);
+    const Eigen::Index q = radius_index(j);
     fit.radii.push_back(x(q));
     fit.radius_variances.push_back(covariance(q, q));
     fit.rms.push_back(std::max(

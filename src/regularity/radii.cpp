@@ -270,60 +270,155 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
 
 namespace {
 
-// Refits the spheres `set` (indices into settled.surfaces) with one centre; while a member's
-// residual sum rises by more than the significance, corrected for their number, allows, the worst
-// leaves. Writes the centre, the radii and the primitives back and appends the Concentric
-// relation, unless fewer than two stay.
+std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surface>& surfaces,
+                                        const RegularityOptions& options);
+
+// The spheres `set` (indices into settled.surfaces) as members of a joint fit.
+std::vector<CoaxialMember> sphere_members(const SettledSurfaces& settled,
+                                          const std::vector<std::size_t>& set,
+                                          const std::vector<std::vector<Vec3>>& points,
+                                          const std::vector<std::vector<double>>& weights) {
+  std::vector<CoaxialMember> members;
+  for (const std::size_t k : set) {
+    const SettledSurfaces::Surface& sphere = settled.surfaces[k];
+    members.push_back({points[sphere.cluster], weights[sphere.cluster], sphere.radius});
+  }
+  return members;
+}
+
+// The member of `set` that `fit` explains worse than its own fit beyond the significance
+// corrected for the number of members `tested` (among those `tested_member` accepts), or
+// set.size() for none.
+template <typename Tested>
+std::size_t worst_sphere(const SettledSurfaces& settled, const std::vector<std::size_t>& set,
+                         const ConcentricFit& fit, std::size_t tested, const Tested& tested_member,
+                         const RegularityOptions& options,
+                         const std::vector<std::vector<Vec3>>& points) {
+  const double bound = family_significance(options.significance, tested);
+  double worst_excess = 1;
+  std::size_t worst = set.size();
+  for (std::size_t j = 0; j < set.size(); ++j) {
+    if (!tested_member(j)) continue;
+    const SettledSurfaces::Surface& sphere = settled.surfaces[set[j]];
+    // A sphere's own fit has 4 parameters.
+    const double excess = residual_excess(sphere.rms, fit.rms[j], points[sphere.cluster].size(),
+                                          bound * bound, 4, options.length_tolerance);
+    if (excess > worst_excess) {
+      worst_excess = excess;
+      worst = j;
+    }
+  }
+  return worst;
+}
+
+// The spheres `set` refitted with one centre; while a member's residual sum rises by more than
+// the significance, corrected for their number, allows, the worst leaves `set`. Nothing when
+// fewer than two stay or a fit fails.
+std::optional<ConcentricFit> one_centre(const SettledSurfaces& settled,
+                                        std::vector<std::size_t>& set,
+                                        const RegularityOptions& options,
+                                        const std::vector<std::vector<Vec3>>& points,
+                                        const std::vector<std::vector<double>>& weights) {
+  while (set.size() >= 2) {
+    PooledPosition<3> pooled;
+    for (const std::size_t k : set) {
+      const std::size_t centre = settled.surfaces[k].centre;
+      pooled.add(settled.centres[centre], settled.centre_covariances[centre]);
+    }
+    std::optional<ConcentricFit> fit =
+        fit_concentric(pooled.centre(), sphere_members(settled, set, points, weights));
+    if (!fit) return std::nullopt;
+    const std::size_t worst = worst_sphere(
+        settled, set, *fit, set.size(), [](std::size_t) { return true; }, options, points);
+    if (worst == set.size()) return fit;
+    set.erase(set.begin() + static_cast<std::ptrdiff_t>(worst));
+  }
+  return std::nullopt;
+}
+
+// Concentric spheres whose radii (as `fit` measured them) agree within the significance are one
+// sphere cut apart: each class of them (radius_classes) takes one radius, refitted with the
+// centre; as for the classes of equal radii, while a member's residual sum rises by more than the
+// significance allows, the worst takes a radius of its own. Returns each member's radius index
+// (empty: none shared), and replaces `fit` with the refit.
+std::vector<std::size_t> share_radii(const SettledSurfaces& settled,
+                                     const std::vector<std::size_t>& set, ConcentricFit& fit,
+                                     const RegularityOptions& options,
+                                     const std::vector<std::vector<Vec3>>& points,
+                                     const std::vector<std::vector<double>>& weights) {
+  std::vector<SettledSurfaces::Surface> measured;
+  for (std::size_t j = 0; j < set.size(); ++j) {
+    SettledSurfaces::Surface& sphere = measured.emplace_back(settled.surfaces[set[j]]);
+    sphere.radius = fit.radii[j];
+    sphere.radius_variance = fit.radius_variances[j];
+    sphere.concentric = kNoRelation;
+  }
+  std::vector<std::size_t> class_of = radius_classes(measured, options);
+  while (true) {
+    std::vector<std::size_t> class_size(set.size(), 0);
+    for (const std::size_t q : class_of) ++class_size[q];
+    const std::size_t tested = static_cast<std::size_t>(std::count_if(
+        class_of.begin(), class_of.end(), [&](std::size_t q) { return class_size[q] >= 2; }));
+    if (tested == 0) return {};
+    // Radii numbered from 0 in order of first use.
+    std::vector<std::size_t> number(set.size(), set.size()), radius_of;
+    std::size_t radii = 0;
+    for (const std::size_t q : class_of) {
+      if (number[q] == set.size()) number[q] = radii++;
+      radius_of.push_back(number[q]);
+    }
+    const std::optional<ConcentricFit> shared =
+        fit_concentric(fit.centre, sphere_members(settled, set, points, weights), radius_of);
+    if (!shared) return {};
+    const std::size_t worst = worst_sphere(
+        settled, set, *shared, tested, [&](std::size_t j) { return class_size[class_of[j]] >= 2; },
+        options, points);
+    if (worst == set.size()) {
+      fit = *shared;
+      return radius_of;
+    }
+    const auto free_class = std::find(class_size.begin(), class_size.end(), 0);
+    class_of[worst] = static_cast<std::size_t>(free_class - class_size.begin());
+  }
+}
+
+// Refits the spheres `set` (indices into settled.surfaces) with one centre (one_centre()), and
+// those of one radius with one radius (share_radii()). Writes the centre, the radii and the
+// primitives back and appends the Concentric relation, and an EqualRadius relation per radius
+// shared, unless fewer than two stay.
 void settle_concentric(SettledSurfaces& settled, std::vector<std::size_t> set,
                        const RegularityOptions& options, std::vector<Primitive>& primitives,
                        const std::vector<std::vector<Vec3>>& points,
                        const std::vector<std::vector<double>>& weights,
                        std::vector<Relation>& relations) {
-  std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
-  std::optional<ConcentricFit> fit;
-  while (set.size() >= 2) {
-    PooledPosition<3> pooled;
-    std::vector<CoaxialMember> members;
-    for (const std::size_t k : set) {
-      const SettledSurfaces::Surface& sphere = surfaces[k];
-      pooled.add(settled.centres[sphere.centre], settled.centre_covariances[sphere.centre]);
-      members.push_back({points[sphere.cluster], weights[sphere.cluster], sphere.radius});
-    }
-    fit = fit_concentric(pooled.centre(), members);
-    if (!fit) return;
-    const double bound = family_significance(options.significance, set.size());
-    double worst_excess = 1;
-    std::size_t worst = set.size();
-    for (std::size_t j = 0; j < set.size(); ++j) {
-      const SettledSurfaces::Surface& sphere = surfaces[set[j]];
-      const double excess = residual_excess(sphere.rms, fit->rms[j], points[sphere.cluster].size(),
-                                            bound * bound, 4, options.length_tolerance);
-      if (excess > worst_excess) {
-        worst_excess = excess;
-        worst = j;
-      }
-    }
-    if (worst == set.size()) break;
-    set.erase(set.begin() + static_cast<std::ptrdiff_t>(worst));
-    fit.reset();
-  }
+  std::optional<ConcentricFit> fit = one_centre(settled, set, options, points, weights);
   if (!fit) return;
+  const std::vector<std::size_t> radius_of =
+      share_radii(settled, set, *fit, options, points, weights);
+  std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
   const std::size_t shared = surfaces[set[0]].centre;
   settled.centres[shared] = fit->centre;
-  Relation& relation = relations.emplace_back();
-  relation.kind = Relation::Kind::Concentric;
+  const std::size_t concentric = relations.size();
+  relations.push_back({Relation::Kind::Concentric, {}, {}});
+  std::map<std::size_t, std::vector<std::size_t>> of_radius;
   for (std::size_t j = 0; j < set.size(); ++j) {
     SettledSurfaces::Surface& sphere = surfaces[set[j]];
     sphere.centre = shared;
     sphere.radius = fit->radii[j];
     sphere.radius_variance = fit->radius_variances[j];
     sphere.rms = fit->rms[j];
-    sphere.concentric = relations.size() - 1;
+    sphere.concentric = concentric;
     primitives[sphere.cluster].point = to_vec3(fit->centre);
     primitives[sphere.cluster].radius = sphere.radius;
-    relation.members.push_back(sphere.cluster);
+    relations[concentric].members.push_back(sphere.cluster);
+    if (!radius_of.empty()) of_radius[radius_of[j]].push_back(sphere.cluster);
   }
-  std::sort(relation.members.begin(), relation.members.end());
+  std::sort(relations[concentric].members.begin(), relations[concentric].members.end());
+  for (auto& [unused, members] : of_radius)
+    if (members.size() >= 2) {
+      std::sort(members.begin(), members.end());
+      relations.push_back({Relation::Kind::EqualRadius, std::move(members), {}});
+    }
 }
 
 }  // namespace

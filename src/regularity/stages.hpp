@@ -220,21 +220,24 @@ std::optional<JointFit> fit_cylinders_and_spheres(
 std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::Vector2d& centre,
                                       std::span<const CoaxialMember> members);
 
-/// Spheres sharing one centre, each with its own radius (fit_concentric()).
+/// Spheres sharing one centre, each with its own radius or one of a class (fit_concentric()).
 struct ConcentricFit {
   Eigen::Vector3d centre;
   Eigen::Matrix3d centre_covariance = Eigen::Matrix3d::Zero();
-  std::vector<double> radii;
-  std::vector<double> rms;  // per member, unweighted, at least kResolution × its radius
-  std::vector<double> radius_variances;
+  // Per member: its radius, its variance, its residuals' RMS (unweighted, at least kResolution ×
+  // its radius).
+  std::vector<double> radii, radius_variances, rms;
 };
 
 /// The spheres `members` (their inliers, weights and radii; the CoaxialMember of a sphere) fitted
 /// with one centre by geometric least squares: Gauss–Newton from `centre` and their radii, weighted
-/// steps, the uncertainty from the unweighted residuals. Nothing when it does not converge in 30
-/// steps, a radius ends non-positive or the points do not outnumber the parameters (3 + members).
+/// steps, the uncertainty from the unweighted residuals. Member j has radius radius_of[j] (radii
+/// numbered from 0, each started from its first member's; empty: a radius each). Nothing when it
+/// does not converge in 30 steps, a radius ends non-positive or the points do not outnumber the
+/// parameters (3 + the radii).
 std::optional<ConcentricFit> fit_concentric(const Eigen::Vector3d& centre,
-                                            std::span<const CoaxialMember> members);
+                                            std::span<const CoaxialMember> members,
+                                            std::span<const std::size_t> radius_of = {});
 
 /// `cylinder` refitted alone on its inliers with the axis direction `direction`, from its own axis
 /// point and radius.
@@ -352,8 +355,10 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
 /// max_radius_difference of its radius; else it starts one. As for a line's spheres, a centre whose
 /// significance interval is wider than that joins none (the spheres of a freeform surface). Each
 /// set of two or more is refitted with one centre (fit_concentric()); while a member's residual
-/// sum rises by more than the significance corrected for their number allows, the worst leaves.
-/// Appends a Concentric relation per set kept; its spheres take part in no class of equal radii.
+/// sum rises by more than the significance corrected for their number allows, the worst leaves;
+/// then its members whose radii agree (radius_classes) take one radius, with the classes' guard.
+/// Appends a Concentric relation per set kept and an EqualRadius relation per radius its members
+/// share; its spheres take part in no other class of equal radii.
 void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
                      std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,

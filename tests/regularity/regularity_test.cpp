@@ -585,6 +585,43 @@ TEST(Regularity, ABallAndItsSocketShareOneCentre) {
   EXPECT_LT(shared_squares, std::min(ball_squares, socket_squares));
 }
 
+// Two fragments of one sphere (the hierarchy cut it apart: two caps of radius 0.5 about one
+// centre, facing apart) are one sphere again: one centre and one radius, exactly, the radius nearer
+// the truth over the draws than either fragment's own. Each test refuses a true relation at the
+// significance's rarity: of 1,000 draws 989 are one sphere, 7 concentric with a radius each and 4
+// of one radius with a centre each.
+TEST(Regularity, TwoFragmentsOfOneSphereBecomeOneSphere) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ(), x = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d centre(-0.4, 0.1, 0.2);
+  const Relations one_sphere{{Kind::Concentric, {0, 1}}, {Kind::EqualRadius, {0, 1}}};
+  double shared_squares = 0, own_squares = 0;
+  int joined = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{noisy_sphere_cap(centre, 0.5, z, 0.9, 0.002, rng),
+                                        noisy_sphere_cap(centre, 0.5, x, 0.9, 0.002, rng)};
+    std::vector<Primitive> primitives{fitted_sphere(clusters[0], centre, 0.5),
+                                      fitted_sphere(clusters[1], centre, 0.5)};
+    const std::vector<Primitive> own = primitives;
+    const Relations relations = regularize(primitives, clusters);
+    ASSERT_TRUE(relations == one_sphere || relations == Relations{one_sphere[0]} ||
+                relations == Relations{one_sphere[1]});
+    if (relations.front() == one_sphere[0]) {
+      EXPECT_EQ(primitives[0].point, primitives[1].point);
+    }
+    if (relations.back() == one_sphere[1]) {
+      EXPECT_EQ(primitives[0].radius, primitives[1].radius);
+    }
+    joined += relations == one_sphere ? 1 : 0;
+    shared_squares +=
+        (std::pow(primitives[0].radius - 0.5, 2) + std::pow(primitives[1].radius - 0.5, 2)) / 2;
+    own_squares += (std::pow(own[0].radius - 0.5, 2) + std::pow(own[1].radius - 0.5, 2)) / 2;
+  }
+  EXPECT_GE(joined, 19);
+  EXPECT_LT(shared_squares, own_squares);
+}
+
 // The arcs of a revolved profile: three spheres centred on one line along the normal of a pair of
 // parallel faces, with no cylinder on it, and a fourth whose centre is 4% of its radius off the
 // line (about 20 times its uncertainty). The three are one coaxial set, their centres on one line
