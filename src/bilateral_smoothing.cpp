@@ -34,8 +34,8 @@ std::vector<std::vector<std::uint32_t>> face_neighbourhoods(const Mesh& mesh,
   return rings;
 }
 
-// The triangles' centroids, unit normals (zero for a degenerate triangle) and areas at
-// `positions`, each normal on the side the dual graph oriented its triangle to (`flipped`).
+// The triangles' centroids, unit normals (zero for a degenerate triangle) and areas, each normal
+// on the side the dual graph oriented its triangle to (`flipped`).
 struct FaceGeometry {
   std::vector<Eigen::Vector3d> centroids, normals;
   std::vector<double> areas;

@@ -165,7 +165,6 @@ class FreeLine {
     recentre();
   }
 
-  Eigen::Index parameters() const { return 4 + members_; }
   double scale() const { return scale_; }
   const Eigen::Vector3d& direction() const { return direction_; }
   const Eigen::Vector3d& u() const { return u_; }
@@ -245,10 +244,10 @@ std::optional<FreeLineFit> fit_free_line(const Eigen::Vector3d& direction, const
                                          const std::vector<std::vector<double>>& weights) {
   std::size_t count = 0;
   for (const std::size_t c : clusters) count += points[c].size();
-  const double largest = *std::max_element(start.radii.begin(), start.radii.end());
   const Eigen::Index parameters = 4 + static_cast<Eigen::Index>(clusters.size());
-  if (!(largest > 0) || count <= static_cast<std::size_t>(parameters)) return std::nullopt;
+  if (count <= static_cast<std::size_t>(parameters)) return std::nullopt;
   FreeLine line(direction, start, clusters, points, weights);
+  if (!(line.scale() > 0)) return std::nullopt;
   Eigen::MatrixXd weighted(parameters, parameters);
   Eigen::VectorXd gradient(parameters);
   constexpr int kMaxSteps = 30;

@@ -270,8 +270,57 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
 
 namespace {
 
+// Classes of radii that are one radius within the significance: in increasing order of radius,
+// a class grows while its radii stay consistent with their information-weighted mean (their χ²
+// about it within chi_square_bound of its degrees of freedom) and its smallest within
+// max_radius_difference of its largest (relative to the largest). A radius whose significance
+// interval is wider than that bound joins none: any two such radii within the bound would pass, so
+// the bound and not the data would decide (cylinder patches of a freeform surface; a nearly flat
+// cylinder). Returns each surface's class.
 std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surface>& surfaces,
-                                        const RegularityOptions& options);
+                                        const RegularityOptions& options) {
+  const std::size_t n = surfaces.size();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return surfaces[a].radius < surfaces[b].radius;
+  });
+  std::vector<std::size_t> class_of(n);
+  std::size_t classes = 0, open = 0;
+  // The open class: its first radius, and Σ 1/σ², Σ d/σ², Σ d²/σ² of its radii's differences d
+  // from that first one (differences keep the sums exact on CAD radii known to 1e-9).
+  double first = 0, information = 0, moment = 0, square = 0;
+  std::size_t members = 0;
+  for (const std::size_t k : order) {
+    const double r = surfaces[k].radius, variance = surfaces[k].radius_variance;
+    if (surfaces[k].concentric != kNoRelation || !(variance > 0) ||
+        options.significance * std::sqrt(variance) > options.max_radius_difference * r) {
+      class_of[k] = classes++;  // a class of its own
+      continue;
+    }
+    const double d = r - first;
+    const double joined_information = information + 1 / variance,
+                 joined_moment = moment + d / variance, joined_square = square + d * d / variance;
+    const double spread = joined_square - joined_moment * joined_moment / joined_information;
+    if (members == 0 || r - first > options.max_radius_difference * r ||
+        (spread > chi_square_bound(options.significance, members) &&
+         !within_tolerance(r - first, options.length_tolerance))) {
+      first = r;
+      information = 1 / variance;
+      moment = square = 0;
+      members = 1;
+      open = classes++;
+      class_of[k] = open;
+      continue;
+    }
+    information = joined_information;
+    moment = joined_moment;
+    square = joined_square;
+    ++members;
+    class_of[k] = open;
+  }
+  return class_of;
+}
 
 // The spheres `set` (indices into settled.surfaces) as members of a joint fit.
 std::vector<CoaxialMember> sphere_members(const SettledSurfaces& settled,
@@ -286,14 +335,15 @@ std::vector<CoaxialMember> sphere_members(const SettledSurfaces& settled,
   return members;
 }
 
-// The member of `set` that `fit` explains worse than its own fit beyond the significance
-// corrected for the number of members `tested` (among those `tested_member` accepts), or
-// set.size() for none.
+// Among the members of `set` that `tested_member` accepts, the one that `fit` explains worse than
+// its own fit beyond the significance corrected for their number, or set.size() for none.
 template <typename Tested>
 std::size_t worst_sphere(const SettledSurfaces& settled, const std::vector<std::size_t>& set,
-                         const ConcentricFit& fit, std::size_t tested, const Tested& tested_member,
+                         const ConcentricFit& fit, const Tested& tested_member,
                          const RegularityOptions& options,
                          const std::vector<std::vector<Vec3>>& points) {
+  std::size_t tested = 0;
+  for (std::size_t j = 0; j < set.size(); ++j) tested += tested_member(j) ? 1 : 0;
   const double bound = family_significance(options.significance, tested);
   double worst_excess = 1;
   std::size_t worst = set.size();
@@ -329,7 +379,7 @@ std::optional<ConcentricFit> one_centre(const SettledSurfaces& settled,
         fit_concentric(pooled.centre(), sphere_members(settled, set, points, weights));
     if (!fit) return std::nullopt;
     const std::size_t worst = worst_sphere(
-        settled, set, *fit, set.size(), [](std::size_t) { return true; }, options, points);
+        settled, set, *fit, [](std::size_t) { return true; }, options, points);
     if (worst == set.size()) return fit;
     set.erase(set.begin() + static_cast<std::ptrdiff_t>(worst));
   }
@@ -351,15 +401,15 @@ std::vector<std::size_t> share_radii(const SettledSurfaces& settled,
     SettledSurfaces::Surface& sphere = measured.emplace_back(settled.surfaces[set[j]]);
     sphere.radius = fit.radii[j];
     sphere.radius_variance = fit.radius_variances[j];
-    sphere.concentric = kNoRelation;
   }
   std::vector<std::size_t> class_of = radius_classes(measured, options);
   while (true) {
     std::vector<std::size_t> class_size(set.size(), 0);
     for (const std::size_t q : class_of) ++class_size[q];
-    const std::size_t tested = static_cast<std::size_t>(std::count_if(
-        class_of.begin(), class_of.end(), [&](std::size_t q) { return class_size[q] >= 2; }));
-    if (tested == 0) return {};
+    const auto shares = [&](std::size_t j) { return class_size[class_of[j]] >= 2; };
+    if (std::none_of(class_of.begin(), class_of.end(),
+                     [&](std::size_t q) { return class_size[q] >= 2; }))
+      return {};
     // Radii numbered from 0 in order of first use.
     std::vector<std::size_t> number(set.size(), set.size()), radius_of;
     std::size_t radii = 0;
@@ -370,9 +420,7 @@ std::vector<std::size_t> share_radii(const SettledSurfaces& settled,
     const std::optional<ConcentricFit> shared =
         fit_concentric(fit.centre, sphere_members(settled, set, points, weights), radius_of);
     if (!shared) return {};
-    const std::size_t worst = worst_sphere(
-        settled, set, *shared, tested, [&](std::size_t j) { return class_size[class_of[j]] >= 2; },
-        options, points);
+    const std::size_t worst = worst_sphere(settled, set, *shared, shares, options, points);
     if (worst == set.size()) {
       fit = *shared;
       return radius_of;
@@ -472,62 +520,6 @@ void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
     if (set.size() >= 2)
       settle_concentric(settled, set, options, primitives, points, weights, relations);
 }
-
-namespace {
-
-// Classes of radii that are one radius within the significance: in increasing order of radius,
-// a class grows while its radii stay consistent with their information-weighted mean (their χ²
-// about it within chi_square_bound of its degrees of freedom) and its smallest within
-// max_radius_difference of its largest (relative to the largest). A radius whose significance
-// interval is wider than that bound joins none: any two such radii within the bound would pass, so
-// the bound and not the data would decide (cylinder patches of a freeform surface; a nearly flat
-// cylinder). Returns each surface's class.
-std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surface>& surfaces,
-                                        const RegularityOptions& options) {
-  const std::size_t n = surfaces.size();
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return surfaces[a].radius < surfaces[b].radius;
-  });
-  std::vector<std::size_t> class_of(n);
-  std::size_t classes = 0, open = 0;
-  // The open class: its first radius, and Σ 1/σ², Σ d/σ², Σ d²/σ² of its radii's differences d
-  // from that first one (differences keep the sums exact on CAD radii known to 1e-9).
-  double first = 0, information = 0, moment = 0, square = 0;
-  std::size_t members = 0;
-  for (const std::size_t k : order) {
-    const double r = surfaces[k].radius, variance = surfaces[k].radius_variance;
-    if (surfaces[k].concentric != kNoRelation || !(variance > 0) ||
-        options.significance * std::sqrt(variance) > options.max_radius_difference * r) {
-      class_of[k] = classes++;  // a class of its own
-      continue;
-    }
-    const double d = r - first;
-    const double joined_information = information + 1 / variance,
-                 joined_moment = moment + d / variance, joined_square = square + d * d / variance;
-    const double spread = joined_square - joined_moment * joined_moment / joined_information;
-    if (members == 0 || r - first > options.max_radius_difference * r ||
-        (spread > chi_square_bound(options.significance, members) &&
-         !within_tolerance(r - first, options.length_tolerance))) {
-      first = r;
-      information = 1 / variance;
-      moment = square = 0;
-      members = 1;
-      open = classes++;
-      class_of[k] = open;
-      continue;
-    }
-    information = joined_information;
-    moment = joined_moment;
-    square = joined_square;
-    ++members;
-    class_of[k] = open;
-  }
-  return class_of;
-}
-
-}  // namespace
 
 namespace {
 
