@@ -182,14 +182,14 @@ void add_fit_options(CLI::App& command, LevelOptions& options) {
                   "cluster whose primitive fits them better (0: none)")
       ->check(CLI::Range(0u, 1000u))
       ->capture_default_str();
-  command.add_flag(
-      "--regularize", options.regularize,
-      "Make the fits' design intent exact: plane normals and cylinder axes that "
-      "agree within their uncertainty share one direction, directions at right "
-      "angles become orthogonal, fragments of one face share one plane, cylinders "
-      "share one axis line and spheres are centred on it, cylinders and spheres "
-      "share one radius, and fillets become tangent to the faces and parallel cylinders "
-      "they border (listed as \"relations\" in the JSON)");
+  command.add_flag("--regularize", options.regularize,
+                   "Make the fits' design intent exact: plane normals and cylinder axes that "
+                   "agree within their uncertainty share one direction, directions at right "
+                   "angles become orthogonal, fragments of one face share one plane, cylinders "
+                   "share one axis line and spheres are centred on it, spheres of one centre "
+                   "share it, cylinders and spheres share one radius, and fillets become tangent "
+                   "to the faces and parallel cylinders they border (listed as \"relations\" in "
+                   "the JSON)");
   add_relation_options(command, options.relations);
 }
 

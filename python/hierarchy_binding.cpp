@@ -60,8 +60,10 @@ const char* kRefineArgument =
 const char* kRegularizeArgument =
     R"(regularize: make the fits' relations exact (the CLI's --regularize): plane normals and
   cylinder axes that agree within their uncertainty share one direction, cylinders one axis line
-  (with the spheres centred on it), directions at right angles within it are made orthogonal,
-  and cylinders and spheres of one radius share it; Hierarchy.relations() lists them.)";
+  (with the spheres centred on it), spheres of one centre share it, directions at right angles
+  within it are made orthogonal, fragments of one face share one plane, cylinders and spheres of
+  one radius share it, and fillets become tangent to the faces and cylinders they border;
+  Hierarchy.relations() lists them.)";
 
 const char* kRelationArguments =
     R"(relation_significance, max_relation_angle, max_radius_difference: the CLI's options of the

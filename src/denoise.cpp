@@ -438,7 +438,8 @@ std::vector<ClusterRelation> Denoiser::regularize(const std::vector<std::vector<
   // fragments: the automatic levels of NumPy draws of fandisk and couplingdown moved by -0.4% to
   // 0%, but the C++ fandisk table's plain K = 40 by +1.6% and its Taubin K = 60 by +2.2%, so each
   // plane keeps its own offset. Spheres centred on axes do lower it (-0.1% to -1.2% on the same
-  // runs where one was found, none worse), and stay.
+  // runs where one was found, none worse), and stay; so do concentric spheres (couplingdown's
+  // automatic level 1.6104e-3 → 1.6099e-3), each with its own radius.
   // Nor do tangent fillets (docs/method.md): -0.6% to +1.6% on the same automatic levels, and
   // the C++ fandisk table's K = 40 from 3.61x to 3.45x.
   regularity.equal_radii = false;

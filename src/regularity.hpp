@@ -42,8 +42,10 @@ struct RegularityOptions {
   bool spheres_on_axes = true;
   /// Give spheres on no line whose centres agree within the significance one centre, each
   /// keeping its radius (a ball and its socket): 3 parameters for the set instead of 3 each.
+  /// With equal_radii, those whose radii agree too take one radius (fragments of one sphere).
   bool concentric = true;
-  /// Give cylinders and spheres whose radii agree within the significance one radius.
+  /// Give cylinders and spheres whose radii agree within the significance one radius, concentric
+  /// spheres included.
   bool equal_radii = true;
   /// ... never when the radii differ by more than this fraction of the larger, nor a radius
   /// whose significance interval is wider than this fraction of it; likewise a sphere's centre's

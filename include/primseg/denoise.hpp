@@ -86,10 +86,11 @@ struct DenoiseOptions {
   /// (one direction, estimated from all of them), directions at right angles become orthogonal,
   /// cylinders of one direction whose axes are one line become coaxial (each keeps its radius; a
   /// member whose fit the shared axis worsens beyond the same significance stays alone), and
-  /// spheres centred on such a line are centred on it. The members are refitted on their inliers
-  /// (regularize_clusters() does the same for a level's fits, and also gives cylinders and
-  /// spheres of equal radius one radius, and the fragments of one face one plane, which do not
-  /// lower a snap's error and are left out here). A relation of the part (opposite faces of a box,
+  /// spheres centred on such a line are centred on it, and spheres whose centres agree share one
+  /// (each keeps its radius). The members are refitted on their inliers (regularize_clusters()
+  /// does the same for a level's fits, and also gives cylinders and spheres of equal radius one
+  /// radius, the fragments of one face one plane and fillets tangency, which do not lower a
+  /// snap's error and are left out here). A relation of the part (opposite faces of a box,
   /// a cylinder and its caps, a stepped shaft, a ball end, a box's corner) then costs one direction
   /// or one axis instead of one per primitive, which lowers what the fits leave of the noise: the
   /// generated noisy box and capped cylinder on their true regions (edges 2% of the diagonal) 12.0x

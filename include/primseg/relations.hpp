@@ -6,7 +6,8 @@
 /// cylinders that share an axis line and spheres centred on it (a stepped shaft, the fragments of
 /// one bore, a ball end, a hole's spherical seat) and cylinders and spheres of one radius (a bolt
 /// circle's holes), and cylinders tangent to the planes they border (a fillet, a slot's round end)
-/// or to the parallel cylinders they border (a fillet around a boss or in a bore).
+/// or to the parallel cylinders they border (a fillet around a boss or in a bore), and spheres
+/// of one centre (a ball and its socket, a spherical shell's two sides).
 /// Making these relations exact is what reverse engineering wants of a scanned part's fits: a box
 /// with parallel faces, a flange face in one plane, a shaft with one axis, a fillet tangent to its
 /// faces (after GlobFit, Li et al. 2011).

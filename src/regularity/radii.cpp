@@ -430,10 +430,10 @@ std::vector<std::size_t> share_radii(const SettledSurfaces& settled,
   }
 }
 
-// Refits the spheres `set` (indices into settled.surfaces) with one centre (one_centre()), and
-// those of one radius with one radius (share_radii()). Writes the centre, the radii and the
-// primitives back and appends the Concentric relation, and an EqualRadius relation per radius
-// shared, unless fewer than two stay.
+// Refits the spheres `set` (indices into settled.surfaces) with one centre (one_centre()), and,
+// with options.equal_radii, those of one radius with one radius (share_radii()). Writes the centre,
+// the radii and the primitives back and appends the Concentric relation, and an EqualRadius
+// relation per radius shared, unless fewer than two stay.
 void settle_concentric(SettledSurfaces& settled, std::vector<std::size_t> set,
                        const RegularityOptions& options, std::vector<Primitive>& primitives,
                        const std::vector<std::vector<Vec3>>& points,
@@ -442,7 +442,8 @@ void settle_concentric(SettledSurfaces& settled, std::vector<std::size_t> set,
   std::optional<ConcentricFit> fit = one_centre(settled, set, options, points, weights);
   if (!fit) return;
   const std::vector<std::size_t> radius_of =
-      share_radii(settled, set, *fit, options, points, weights);
+      options.equal_radii ? share_radii(settled, set, *fit, options, points, weights)
+                          : std::vector<std::size_t>{};
   std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
   const std::size_t shared = surfaces[set[0]].centre;
   settled.centres[shared] = fit->centre;

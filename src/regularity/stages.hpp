@@ -356,9 +356,9 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
 /// significance interval is wider than that joins none (the spheres of a freeform surface). Each
 /// set of two or more is refitted with one centre (fit_concentric()); while a member's residual
 /// sum rises by more than the significance corrected for their number allows, the worst leaves;
-/// then its members whose radii agree (radius_classes) take one radius, with the classes' guard.
-/// Appends a Concentric relation per set kept and an EqualRadius relation per radius its members
-/// share; its spheres take part in no other class of equal radii.
+/// then, with options.equal_radii, its members whose radii agree (radius_classes) take one radius,
+/// with the classes' guard. Appends a Concentric relation per set kept and an EqualRadius relation
+/// per radius its members share; its spheres take part in no other class of equal radii.
 void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
                      std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,

@@ -590,19 +590,30 @@ TEST(Regularity, ABallAndItsSocketShareOneCentre) {
 // the truth over the draws than either fragment's own. Each test refuses a true relation at the
 // significance's rarity: of 1,000 draws 989 are one sphere, 7 concentric with a radius each and 4
 // of one radius with a centre each.
-TEST(Regularity, TwoFragmentsOfOneSphereBecomeOneSphere) {
-  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ(), x = Eigen::Vector3d::UnitX();
+struct SphereFragments {
+  std::vector<Cluster> clusters;
+  std::vector<Primitive> primitives;  // each fragment's own fit
+};
+
+SphereFragments two_fragments_of_a_sphere(std::uint64_t seed) {
   const Eigen::Vector3d centre(-0.4, 0.1, 0.2);
+  std::mt19937_64 rng(seed);
+  SphereFragments fragments;
+  const Eigen::Vector3d facings[] = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()};
+  for (const Eigen::Vector3d& facing : facings) {
+    fragments.clusters.push_back(noisy_sphere_cap(centre, 0.5, facing, 0.9, 0.002, rng));
+    fragments.primitives.push_back(fitted_sphere(fragments.clusters.back(), centre, 0.5));
+  }
+  return fragments;
+}
+
+TEST(Regularity, TwoFragmentsOfOneSphereBecomeOneSphere) {
   const Relations one_sphere{{Kind::Concentric, {0, 1}}, {Kind::EqualRadius, {0, 1}}};
   double shared_squares = 0, own_squares = 0;
   int joined = 0;
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     SCOPED_TRACE(seed);
-    std::mt19937_64 rng(seed);
-    const std::vector<Cluster> clusters{noisy_sphere_cap(centre, 0.5, z, 0.9, 0.002, rng),
-                                        noisy_sphere_cap(centre, 0.5, x, 0.9, 0.002, rng)};
-    std::vector<Primitive> primitives{fitted_sphere(clusters[0], centre, 0.5),
-                                      fitted_sphere(clusters[1], centre, 0.5)};
+    auto [clusters, primitives] = two_fragments_of_a_sphere(seed);
     const std::vector<Primitive> own = primitives;
     const Relations relations = regularize(primitives, clusters);
     ASSERT_TRUE(relations == one_sphere || relations == Relations{one_sphere[0]} ||
@@ -620,6 +631,28 @@ TEST(Regularity, TwoFragmentsOfOneSphereBecomeOneSphere) {
   }
   EXPECT_GE(joined, 19);
   EXPECT_LT(shared_squares, own_squares);
+}
+
+// Without equal radii (the denoiser's choice) the same fragments share their centre only: no
+// radius is made one, whatever their agreement.
+TEST(Regularity, WithoutEqualRadiiConcentricFragmentsKeepTheirOwnRadii) {
+  detail::RegularityOptions options;
+  options.equal_radii = false;
+  int concentric = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE(seed);
+    auto [clusters, primitives] = two_fragments_of_a_sphere(seed);
+    const Relations relations = regularize(primitives, clusters, options);
+    const Relations concentric_only{{Kind::Concentric, {0, 1}}};
+    ASSERT_TRUE(relations.empty() || relations == concentric_only);
+    if (relations.empty()) continue;
+    ++concentric;
+    EXPECT_EQ(primitives[0].point, primitives[1].point);
+    EXPECT_NE(primitives[0].radius, primitives[1].radius);
+    EXPECT_NEAR(primitives[0].radius, 0.5, 0.002);
+    EXPECT_NEAR(primitives[1].radius, 0.5, 0.002);
+  }
+  EXPECT_GE(concentric, 9);
 }
 
 // The arcs of a revolved profile: three spheres centred on one line along the normal of a pair of
