@@ -407,8 +407,8 @@ std::vector<std::size_t> share_radii(const SettledSurfaces& settled,
     std::vector<std::size_t> class_size(set.size(), 0);
     for (const std::size_t q : class_of) ++class_size[q];
     const auto shares = [&](std::size_t j) { return class_size[class_of[j]] >= 2; };
-    if (std::none_of(class_of.begin(), class_of.end(),
-                     [&](std::size_t q) { return class_size[q] >= 2; }))
+    if (std::none_of(class_size.begin(), class_size.end(),
+                     [](std::size_t size) { return size >= 2; }))
       return {};
     // Radii numbered from 0 in order of first use.
     std::vector<std::size_t> number(set.size(), set.size()), radius_of;
