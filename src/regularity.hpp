@@ -41,8 +41,10 @@ struct RegularityOptions {
   /// spheres or more on one line of a direction made exact (a revolved profile's arcs).
   bool spheres_on_axes = true;
   /// Give spheres on no line whose centres agree within the significance one centre, each
-  /// keeping its radius (a ball and its socket): 3 parameters for the set instead of 3 each.
-  /// With equal_radii, those whose radii agree too take one radius (fragments of one sphere).
+  /// keeping its radius (a ball and its socket): 3 parameters for the set instead of 3 each; and
+  /// spheres on one line whose places along it agree one place (a ball and its socket on a
+  /// shaft's axis). With equal_radii, those whose radii agree too take one radius (fragments of
+  /// one sphere).
   bool concentric = true;
   /// Give cylinders and spheres whose radii agree within the significance one radius, concentric
   /// spheres included.
@@ -84,24 +86,25 @@ struct Relation {
 /// one parameter along it each, as are three spheres or more centred on one line of a direction
 /// made exact with no cylinder on it, and cylinders and spheres whose radii agree within the
 /// significance (RegularityOptions::equal_radii) are refitted with one radius, jointly with the
-/// surfaces on their lines (each free sphere on its own centre); before that, spheres on no line
-/// whose centres agree within the significance share one (RegularityOptions::concentric; those
-/// of them whose radii agree share one radius, and join no other class of radii). Returns the
-/// relations made exact: each direction group's members that were refitted with its direction, then
-/// its coplanar sets, then each coaxial set of its cylinders (spheres added when they join it), in
-/// that order, then the coaxial sets a sphere started with one cylinder, then the lines of spheres
-/// alone, then the concentric sets, then the classes of equal radii, then the right angles by their
-/// members. Last, cylinders whose direction a right angle made exactly orthogonal to a plane's,
-/// that border the plane and whose axis is at their radius from it within the significance are
-/// refitted tangent to it (RegularityOptions::tangency; the cylinders of a coaxial set together, on
-/// their one line, not a line with spheres on it; one of a class of equal radii with members off
-/// its line keeps that radius), each on its points away from the band about the contact line where
-/// the two surfaces are within the noise (the plane's offset refitted so, unless it is a coplanar
-/// set's): each pair is a Tangent relation, by line. Direction groups the right angles made one
-/// direction are merged first. Every test "within the significance" also passes a difference within
-/// the angle or length tolerance (RegularityOptions::angle_tolerance, length_tolerance), and every
-/// check that a joint fit explains a member as its own did also passes a rise of its mean square
-/// residual within the length tolerance's square.
+/// surfaces on their lines and centres; before that, spheres on no line whose centres agree within
+/// the significance share one, and spheres on one line whose places along it agree share one
+/// (RegularityOptions::concentric), which they keep when their radii join classes (a sphere cut
+/// apart: its fragments then share both). Returns the relations made exact: each direction group's
+/// members that were refitted with its direction, then its coplanar sets, then each coaxial set of
+/// its cylinders (spheres added when they join it), in that order, then the coaxial sets a sphere
+/// started with one cylinder, then the lines of spheres alone, then the concentric sets (off
+/// lines, then on them), then the classes of equal radii, then the right angles by their members.
+/// Last, cylinders whose direction a right angle made exactly orthogonal to a plane's, that border
+/// the plane and whose axis is at their radius from it within the significance are refitted tangent
+/// to it (RegularityOptions::tangency; the cylinders of a coaxial set together, on their one line,
+/// not a line with spheres on it; one of a class of equal radii with members off its line keeps
+/// that radius), each on its points away from the band about the contact line where the two
+/// surfaces are within the noise (the plane's offset refitted so, unless it is a coplanar set's):
+/// each pair is a Tangent relation, by line. Direction groups the right angles made one direction
+/// are merged first. Every test "within the significance" also passes a difference within the angle
+/// or length tolerance (RegularityOptions::angle_tolerance, length_tolerance), and every check that
+/// a joint fit explains a member as its own did also passes a rise of its mean square residual
+/// within the length tolerance's square.
 std::vector<Relation> regularize(std::vector<Primitive>& primitives,
                                  const std::vector<std::vector<Vec3>>& points,
                                  const std::vector<std::vector<double>>& weights,

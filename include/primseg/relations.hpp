@@ -30,7 +30,9 @@ struct ClusterRelation {
     /// of a box, a cylinder and its caps.
     Parallel,
     /// Cylinders of one direction made one axis line, each keeping its radius, and spheres
-    /// centred on that line, each keeping its radius and its place along it: a stepped shaft, the
+    /// centred on that line, each keeping its radius and its place along it (spheres of one place,
+    /// a ball and its socket on a shaft's axis, are also a Concentric relation): a stepped shaft,
+    /// the
     /// fragments of one cylinder, a shaft's ball end, the hemisphere closing a cylinder, a hole's
     /// spherical seat. Two or more cylinders are also part of a Parallel relation. A set without
     /// a cylinder has three spheres or more, centred on a line of a direction of the part (one a
@@ -61,9 +63,10 @@ struct ClusterRelation {
     /// refitted tangent to the other, which is held as the other relations left it.
     Tangent,
     /// Spheres made one centre, each keeping its radius: a ball and its socket, the two sides of a
-    /// spherical shell, a sphere cut apart by the hierarchy. Not for spheres centred on a line
-    /// (Coaxial). Its spheres whose radii agree (fragments of one sphere) are an EqualRadius
-    /// relation too, and are in no other.
+    /// spherical shell, a sphere cut apart by the hierarchy. Spheres centred on a line (Coaxial)
+    /// are concentric when they share their place along it. Its spheres whose radii agree
+    /// (fragments of one sphere) are in an EqualRadius relation too, with any other cylinders and
+    /// spheres of that radius.
     Concentric,
   };
   Kind kind = Kind::Parallel;

@@ -30,10 +30,11 @@ void place_cylinder(Primitive& cylinder, const Eigen::Vector3d& direction,
 namespace {
 
 // The normal equations of fit_cylinders_and_spheres() at x = (line centres 2 each, free sphere
-// centres 3 each, positions of the spheres on a line along it, radii), by blocks: each line's
-// own 2x2, each term's coupling of its line and its radius, each radius's diagonal (radii never
-// couple with each other, lines never with lines). A sphere's 3x3 block is over its centre, or
-// over its line's centre and its position along it.
+// centres 3 each, positions of the sphere centres on a line along it, radii), by blocks: each
+// line's own 2x2, each term's coupling of its line and its radius, each radius's diagonal (radii
+// never couple with each other, lines never with lines). A sphere centre's 3x3 block is over its
+// position, or over its line's centre and its position along it; each of its spheres couples it
+// with that sphere's radius.
 class JointSystem {
  public:
   JointSystem(std::span<const Eigen::Vector3d> directions, std::span<const Eigen::Vector2d> centres,
@@ -54,34 +55,38 @@ class JointSystem {
   std::size_t count = 0;  // points with a residual, at the last linearise()
 
  private:
-  // The radii's Schur complement S = D − Σ Bₗᵀ Aₗ⁻¹ Bₗ, then each line's and sphere's position.
+  // The radii's Schur complement S = D − Σ Bₗᵀ Aₗ⁻¹ Bₗ, then each line's and centre's position.
   Eigen::VectorXd step_by_blocks();
 
   std::span<const Eigen::Vector3d> directions_;
   std::span<const CylinderTerm> terms_;
   std::span<const SphereTerm> spheres_;
   Eigen::Index lines_, radius_count_, first_radius_, size_;
-  std::vector<Eigen::Index> sphere_offset_;
+  // Per sphere centre: its line (kNoLine: free), its first parameter, its spheres.
+  std::vector<std::size_t> centre_line_;
+  std::vector<Eigen::Index> centre_offset_;
+  std::vector<std::vector<std::size_t>> spheres_of_centre_;
   // The points in the plane orthogonal to their line's direction, once for every iteration; a
-  // sphere's on a line in its frame (u, v, direction).
+  // sphere's with its centre on a line in the line's frame (u, v, direction).
   std::vector<std::vector<Eigen::Vector2d>> projected_;
   std::vector<std::vector<Eigen::Vector3d>> sphere_local_;
-  std::vector<std::vector<std::size_t>> terms_on_line_, spheres_on_line_;
+  std::vector<std::vector<std::size_t>> terms_on_line_, centres_on_line_;
   std::vector<Eigen::Matrix2d> line_block_;
   std::vector<Eigen::Vector2d> coupling_, line_gradient_;
-  std::vector<Eigen::Matrix3d> sphere_block_;
-  std::vector<Eigen::Vector3d> sphere_coupling_, sphere_gradient_;
+  std::vector<Eigen::Matrix3d> centre_block_;  // per centre
+  std::vector<Eigen::Vector3d> centre_gradient_;
+  std::vector<Eigen::Vector3d> sphere_coupling_;  // per sphere, with its radius
   Eigen::VectorXd radius_diagonal_, radius_gradient_;
   // Per cylinder term, then per sphere.
   std::vector<double> term_squares_;
   std::vector<std::size_t> term_count_;
-  // step_by_blocks()'s: per line, with the positions of its spheres along it eliminated, its
+  // step_by_blocks()'s: per line, with the positions of its centres along it eliminated, its
   // block's inverse, its gradient, and the coupling of each of its terms (cylinders, then
-  // spheres) with that term's radius; per free sphere, its block's inverse.
+  // spheres) with that term's radius; per free centre, its block's inverse.
   std::vector<Eigen::Matrix2d> inverse_;
   std::vector<Eigen::Vector2d> reduced_gradient_;
   std::vector<std::vector<std::pair<Eigen::Index, Eigen::Vector2d>>> reduced_coupling_;
-  std::vector<Eigen::Matrix3d> sphere_inverse_;
+  std::vector<Eigen::Matrix3d> centre_inverse_;
 };
 
 JointSystem::JointSystem(std::span<const Eigen::Vector3d> directions,
@@ -94,17 +99,19 @@ JointSystem::JointSystem(std::span<const Eigen::Vector3d> directions,
       spheres_(spheres),
       lines_(static_cast<Eigen::Index>(centres.size())),
       radius_count_(static_cast<Eigen::Index>(radii.size())),
-      sphere_offset_(spheres.size()),
+      centre_line_(sphere_centres.size(), kNoLine),
+      centre_offset_(sphere_centres.size()),
+      spheres_of_centre_(sphere_centres.size()),
       projected_(terms.size()),
       sphere_local_(spheres.size()),
       terms_on_line_(centres.size()),
-      spheres_on_line_(centres.size()),
+      centres_on_line_(centres.size()),
       line_block_(centres.size()),
       coupling_(terms.size()),
       line_gradient_(centres.size()),
-      sphere_block_(spheres.size()),
+      centre_block_(sphere_centres.size()),
+      centre_gradient_(sphere_centres.size()),
       sphere_coupling_(spheres.size()),
-      sphere_gradient_(spheres.size()),
       radius_diagonal_(radius_count_),
       radius_gradient_(radius_count_),
       term_squares_(terms.size() + spheres.size()),
@@ -112,22 +119,27 @@ JointSystem::JointSystem(std::span<const Eigen::Vector3d> directions,
       inverse_(centres.size()),
       reduced_gradient_(centres.size()),
       reduced_coupling_(centres.size()),
-      sphere_inverse_(spheres.size()) {
-  const Eigen::Index free_spheres = std::count_if(
-      spheres.begin(), spheres.end(), [](const SphereTerm& s) { return s.line == kNoLine; });
-  Eigen::Index next_free = 2 * lines_, next_on_line = 2 * lines_ + 3 * free_spheres;
-  for (std::size_t s = 0; s < spheres.size(); ++s)
-    sphere_offset_[s] =
-        spheres[s].line == kNoLine ? std::exchange(next_free, next_free + 3) : next_on_line++;
+      centre_inverse_(sphere_centres.size()) {
+  for (std::size_t s = 0; s < spheres.size(); ++s) {
+    centre_line_[spheres[s].centre] = spheres[s].line;
+    spheres_of_centre_[spheres[s].centre].push_back(s);
+  }
+  const Eigen::Index free_centres = std::count(centre_line_.begin(), centre_line_.end(), kNoLine);
+  Eigen::Index next_free = 2 * lines_, next_on_line = 2 * lines_ + 3 * free_centres;
+  for (std::size_t c = 0; c < sphere_centres.size(); ++c) {
+    const std::size_t l = centre_line_[c];
+    centre_offset_[c] = l == kNoLine ? std::exchange(next_free, next_free + 3) : next_on_line++;
+    if (l != kNoLine) centres_on_line_[l].push_back(c);
+  }
   first_radius_ = next_on_line;
   size_ = first_radius_ + radius_count_;
   x.resize(size_);
   for (Eigen::Index l = 0; l < lines_; ++l) x.segment<2>(2 * l) = centres[l];
-  for (std::size_t s = 0; s < spheres.size(); ++s) {
-    if (spheres[s].line == kNoLine)
-      x.segment<3>(sphere_offset_[s]) = sphere_centres[s];
+  for (std::size_t c = 0; c < sphere_centres.size(); ++c) {
+    if (centre_line_[c] == kNoLine)
+      x.segment<3>(centre_offset_[c]) = sphere_centres[c];
     else
-      x(sphere_offset_[s]) = directions[spheres[s].line].dot(sphere_centres[s]);
+      x(centre_offset_[c]) = directions[centre_line_[c]].dot(sphere_centres[c]);
   }
   for (Eigen::Index q = 0; q < radius_count_; ++q) x(first_radius_ + q) = radii[q];
   for (std::size_t k = 0; k < terms.size(); ++k) {
@@ -144,7 +156,6 @@ JointSystem::JointSystem(std::span<const Eigen::Vector3d> directions,
     for (const Vec3& p : spheres[s].points)
       sphere_local_[s].emplace_back(u.dot(to_eigen(p)), v.dot(to_eigen(p)),
                                     direction.dot(to_eigen(p)));
-    spheres_on_line_[l].push_back(s);
   }
 }
 
@@ -152,9 +163,9 @@ double JointSystem::linearise(bool weighted) {
   std::fill(line_block_.begin(), line_block_.end(), Eigen::Matrix2d::Zero());
   std::fill(coupling_.begin(), coupling_.end(), Eigen::Vector2d::Zero());
   std::fill(line_gradient_.begin(), line_gradient_.end(), Eigen::Vector2d::Zero());
-  std::fill(sphere_block_.begin(), sphere_block_.end(), Eigen::Matrix3d::Zero());
+  std::fill(centre_block_.begin(), centre_block_.end(), Eigen::Matrix3d::Zero());
+  std::fill(centre_gradient_.begin(), centre_gradient_.end(), Eigen::Vector3d::Zero());
   std::fill(sphere_coupling_.begin(), sphere_coupling_.end(), Eigen::Vector3d::Zero());
-  std::fill(sphere_gradient_.begin(), sphere_gradient_.end(), Eigen::Vector3d::Zero());
   radius_diagonal_.setZero();
   radius_gradient_.setZero();
   double squares = 0;
@@ -190,7 +201,8 @@ double JointSystem::linearise(bool weighted) {
   }
   for (std::size_t s = 0; s < spheres_.size(); ++s) {
     const Eigen::Index q = static_cast<Eigen::Index>(spheres_[s].radius);
-    const Eigen::Index offset = sphere_offset_[s];
+    const std::size_t c = spheres_[s].centre;
+    const Eigen::Index offset = centre_offset_[c];
     const double radius = x(first_radius_ + q);
     const std::size_t k = terms_.size() + s;
     term_squares_[k] = 0;
@@ -199,15 +211,15 @@ double JointSystem::linearise(bool weighted) {
       const Eigen::Vector3d centre = x.segment<3>(offset);
       for (std::size_t i = 0; i < spheres_[s].points.size(); ++i)
         add_point((to_eigen(spheres_[s].points[i]) - centre).eval(), radius,
-                  weighted ? spheres_[s].weights[i] : 1.0, sphere_block_[s], sphere_coupling_[s],
-                  sphere_gradient_[s], q, k);
+                  weighted ? spheres_[s].weights[i] : 1.0, centre_block_[c], sphere_coupling_[s],
+                  centre_gradient_[c], q, k);
     } else {
       const Eigen::Index l = 2 * static_cast<Eigen::Index>(spheres_[s].line);
       const Eigen::Vector3d centre(x(l), x(l + 1), x(offset));
       for (std::size_t i = 0; i < sphere_local_[s].size(); ++i)
         add_point((sphere_local_[s][i] - centre).eval(), radius,
-                  weighted ? spheres_[s].weights[i] : 1.0, sphere_block_[s], sphere_coupling_[s],
-                  sphere_gradient_[s], q, k);
+                  weighted ? spheres_[s].weights[i] : 1.0, centre_block_[c], sphere_coupling_[s],
+                  centre_gradient_[c], q, k);
     }
   }
   return squares;
@@ -223,24 +235,29 @@ void JointSystem::whole_system(Eigen::MatrixXd& normal, Eigen::VectorXd& gradien
   for (std::size_t k = 0; k < terms_.size(); ++k)
     normal.block<2, 1>(2 * static_cast<Eigen::Index>(terms_[k].line),
                        first_radius_ + static_cast<Eigen::Index>(terms_[k].radius)) += coupling_[k];
-  for (std::size_t s = 0; s < spheres_.size(); ++s) {
-    const Eigen::Index o = sphere_offset_[s];
-    const Eigen::Index q = first_radius_ + static_cast<Eigen::Index>(spheres_[s].radius);
-    if (spheres_[s].line == kNoLine) {
-      normal.block<3, 3>(o, o) = sphere_block_[s];
-      gradient.segment<3>(o) = sphere_gradient_[s];
-      normal.block<3, 1>(o, q) += sphere_coupling_[s];
+  for (std::size_t c = 0; c < centre_line_.size(); ++c) {
+    const Eigen::Index o = centre_offset_[c];
+    const Eigen::Matrix3d& block = centre_block_[c];
+    if (centre_line_[c] == kNoLine) {
+      normal.block<3, 3>(o, o) = block;
+      gradient.segment<3>(o) = centre_gradient_[c];
+      for (const std::size_t s : spheres_of_centre_[c])
+        normal.block<3, 1>(o, first_radius_ + static_cast<Eigen::Index>(spheres_[s].radius)) +=
+            sphere_coupling_[s];
       continue;
     }
-    const Eigen::Index l = 2 * static_cast<Eigen::Index>(spheres_[s].line);
-    normal.block<2, 2>(l, l) += sphere_block_[s].topLeftCorner<2, 2>();
-    normal.block<2, 1>(l, o) = sphere_block_[s].block<2, 1>(0, 2);
-    normal.block<1, 2>(o, l) = sphere_block_[s].block<1, 2>(2, 0);
-    normal(o, o) = sphere_block_[s](2, 2);
-    gradient.segment<2>(l) += sphere_gradient_[s].head<2>();
-    gradient(o) = sphere_gradient_[s](2);
-    normal.block<2, 1>(l, q) += sphere_coupling_[s].head<2>();
-    normal(o, q) += sphere_coupling_[s](2);
+    const Eigen::Index l = 2 * static_cast<Eigen::Index>(centre_line_[c]);
+    normal.block<2, 2>(l, l) += block.topLeftCorner<2, 2>();
+    normal.block<2, 1>(l, o) = block.block<2, 1>(0, 2);
+    normal.block<1, 2>(o, l) = block.block<1, 2>(2, 0);
+    normal(o, o) = block(2, 2);
+    gradient.segment<2>(l) += centre_gradient_[c].head<2>();
+    gradient(o) = centre_gradient_[c](2);
+    for (const std::size_t s : spheres_of_centre_[c]) {
+      const Eigen::Index q = first_radius_ + static_cast<Eigen::Index>(spheres_[s].radius);
+      normal.block<2, 1>(l, q) += sphere_coupling_[s].head<2>();
+      normal(o, q) += sphere_coupling_[s](2);
+    }
   }
   normal.diagonal().tail(radius_count_) = radius_diagonal_;
   gradient.tail(radius_count_) = radius_gradient_;
@@ -262,6 +279,9 @@ Eigen::VectorXd JointSystem::step_by_blocks() {
   Eigen::VectorXd delta(size_);
   Eigen::MatrixXd schur = radius_diagonal_.asDiagonal();
   Eigen::VectorXd right = -radius_gradient_;
+  const auto radius_of = [&](std::size_t s) {
+    return static_cast<Eigen::Index>(spheres_[s].radius);
+  };
   for (std::size_t l = 0; l < line_block_.size(); ++l) {
     Eigen::Matrix2d block = line_block_[l];
     reduced_gradient_[l] = line_gradient_[l];
@@ -269,19 +289,22 @@ Eigen::VectorXd JointSystem::step_by_blocks() {
     couplings.clear();
     for (const std::size_t a : terms_on_line_[l])
       couplings.emplace_back(static_cast<Eigen::Index>(terms_[a].radius), coupling_[a]);
-    // A sphere's position t along the line couples with the line's centre (b), its radius (c)
-    // and nothing else: t = (−g_t − bᵀ δ_line − c δ_radius) / a, substituted.
-    for (const std::size_t s : spheres_on_line_[l]) {
-      const Eigen::Matrix3d& own = sphere_block_[s];
-      const double along = own(2, 2), radius_along = sphere_coupling_[s](2),
-                   gradient_along = sphere_gradient_[s](2);
+    // A centre's position t along the line couples with the line's centre (b) and its spheres'
+    // radii (cₛ), and nothing else: t = (−g_t − bᵀ δ_line − Σ cₛ δ_radius) / a, substituted.
+    for (const std::size_t c : centres_on_line_[l]) {
+      const Eigen::Matrix3d& own = centre_block_[c];
+      const double along = own(2, 2), gradient_along = centre_gradient_[c](2);
       const Eigen::Vector2d cross = own.block<2, 1>(0, 2);
-      const Eigen::Index q = static_cast<Eigen::Index>(spheres_[s].radius);
       block += own.topLeftCorner<2, 2>() - cross * cross.transpose() / along;
-      reduced_gradient_[l] += sphere_gradient_[s].head<2>() - cross * (gradient_along / along);
-      couplings.emplace_back(q, sphere_coupling_[s].head<2>() - cross * (radius_along / along));
-      schur(q, q) -= radius_along * radius_along / along;
-      right(q) += radius_along * gradient_along / along;
+      reduced_gradient_[l] += centre_gradient_[c].head<2>() - cross * (gradient_along / along);
+      for (const std::size_t a : spheres_of_centre_[c]) {
+        const double radius_along = sphere_coupling_[a](2);
+        couplings.emplace_back(radius_of(a),
+                               sphere_coupling_[a].head<2>() - cross * (radius_along / along));
+        right(radius_of(a)) += radius_along * gradient_along / along;
+        for (const std::size_t b : spheres_of_centre_[c])
+          schur(radius_of(a), radius_of(b)) -= radius_along * sphere_coupling_[b](2) / along;
+      }
     }
     inverse_[l] = block.inverse();
     for (const auto& [qa, ca] : couplings) {
@@ -290,13 +313,15 @@ Eigen::VectorXd JointSystem::step_by_blocks() {
       for (const auto& [qb, cb] : couplings) schur(qa, qb) -= spread.dot(cb);
     }
   }
-  for (std::size_t s = 0; s < spheres_.size(); ++s) {
-    if (spheres_[s].line != kNoLine) continue;
-    sphere_inverse_[s] = sphere_block_[s].inverse();
-    const Eigen::Vector3d spread = sphere_inverse_[s] * sphere_coupling_[s];
-    const Eigen::Index q = static_cast<Eigen::Index>(spheres_[s].radius);
-    right(q) += spread.dot(sphere_gradient_[s]);
-    schur(q, q) -= spread.dot(sphere_coupling_[s]);
+  for (std::size_t c = 0; c < centre_line_.size(); ++c) {
+    if (centre_line_[c] != kNoLine) continue;
+    centre_inverse_[c] = centre_block_[c].inverse();
+    for (const std::size_t a : spheres_of_centre_[c]) {
+      const Eigen::Vector3d spread = centre_inverse_[c] * sphere_coupling_[a];
+      right(radius_of(a)) += spread.dot(centre_gradient_[c]);
+      for (const std::size_t b : spheres_of_centre_[c])
+        schur(radius_of(a), radius_of(b)) -= spread.dot(sphere_coupling_[b]);
+    }
   }
   delta.tail(radius_count_) = schur.ldlt().solve(right);
   for (std::size_t l = 0; l < line_block_.size(); ++l) {
@@ -304,19 +329,20 @@ Eigen::VectorXd JointSystem::step_by_blocks() {
     for (const auto& [q, c] : reduced_coupling_[l]) rest -= c * delta(first_radius_ + q);
     delta.segment<2>(2 * static_cast<Eigen::Index>(l)) = inverse_[l] * rest;
   }
-  for (std::size_t s = 0; s < spheres_.size(); ++s) {
-    const double radius_step = delta(first_radius_ + static_cast<Eigen::Index>(spheres_[s].radius));
-    if (spheres_[s].line == kNoLine) {
-      const Eigen::Vector3d rest = -sphere_gradient_[s] - sphere_coupling_[s] * radius_step;
-      delta.segment<3>(sphere_offset_[s]) = sphere_inverse_[s] * rest;
-    } else {
-      const Eigen::Vector2d line_step =
-          delta.segment<2>(2 * static_cast<Eigen::Index>(spheres_[s].line));
-      delta(sphere_offset_[s]) =
-          (-sphere_gradient_[s](2) - sphere_block_[s].block<2, 1>(0, 2).dot(line_step) -
-           sphere_coupling_[s](2) * radius_step) /
-          sphere_block_[s](2, 2);
+  for (std::size_t c = 0; c < centre_line_.size(); ++c) {
+    if (centre_line_[c] == kNoLine) {
+      Eigen::Vector3d rest = -centre_gradient_[c];
+      for (const std::size_t s : spheres_of_centre_[c])
+        rest -= sphere_coupling_[s] * delta(first_radius_ + radius_of(s));
+      delta.segment<3>(centre_offset_[c]) = centre_inverse_[c] * rest;
+      continue;
     }
+    const Eigen::Vector2d line_step =
+        delta.segment<2>(2 * static_cast<Eigen::Index>(centre_line_[c]));
+    double rest = -centre_gradient_[c](2) - centre_block_[c].block<2, 1>(0, 2).dot(line_step);
+    for (const std::size_t s : spheres_of_centre_[c])
+      rest -= sphere_coupling_[s](2) * delta(first_radius_ + radius_of(s));
+    delta(centre_offset_[c]) = rest / centre_block_[c](2, 2);
   }
   return delta;
 }
@@ -325,16 +351,16 @@ std::optional<JointFit> JointSystem::result(double squares, bool with_covariance
   const auto fitted_radii = x.tail(radius_count_);
   JointFit fit;
   for (Eigen::Index l = 0; l < lines_; ++l) fit.centres.emplace_back(x.segment<2>(2 * l));
-  for (std::size_t s = 0; s < spheres_.size(); ++s) {
-    if (spheres_[s].line == kNoLine) {
-      fit.sphere_centres.emplace_back(x.segment<3>(sphere_offset_[s]));
+  for (std::size_t c = 0; c < centre_line_.size(); ++c) {
+    if (centre_line_[c] == kNoLine) {
+      fit.sphere_centres.emplace_back(x.segment<3>(centre_offset_[c]));
       continue;
     }
-    const Eigen::Vector3d& direction = directions_[spheres_[s].line];
+    const Eigen::Vector3d& direction = directions_[centre_line_[c]];
     const auto [u, v] = orthonormal_pair(direction);
-    const Eigen::Vector2d& centre = fit.centres[spheres_[s].line];
+    const Eigen::Vector2d& centre = fit.centres[centre_line_[c]];
     fit.sphere_centres.emplace_back(centre.x() * u + centre.y() * v +
-                                    x(sphere_offset_[s]) * direction);
+                                    x(centre_offset_[c]) * direction);
   }
   fit.radii.assign(fitted_radii.data(), fitted_radii.data() + fitted_radii.size());
   for (std::size_t k = 0; k < terms_.size() + spheres_.size(); ++k)
@@ -365,6 +391,16 @@ std::optional<JointFit> fit_cylinders_and_spheres(std::span<const Eigen::Vector3
                                                   std::span<const CylinderTerm> terms,
                                                   std::span<const SphereTerm> spheres,
                                                   bool with_covariance) {
+  // Every centre has spheres, and they put it on one line or none.
+  std::vector<std::optional<std::size_t>> centre_line(sphere_centres.size());
+  for (const SphereTerm& sphere : spheres) {
+    std::optional<std::size_t>& line = centre_line[sphere.centre];
+    if (line && *line != sphere.line) return std::nullopt;
+    line = sphere.line;
+  }
+  if (!std::all_of(centre_line.begin(), centre_line.end(),
+                   [](const std::optional<std::size_t>& line) { return line.has_value(); }))
+    return std::nullopt;
   JointSystem system(directions, centres, sphere_centres, radii, terms, spheres);
   for (int step = 0; step < 30; ++step) {
     system.linearise(true);
@@ -412,76 +448,23 @@ std::optional<CoaxialFit> fit_alone(const Primitive& cylinder, const Eigen::Vect
 }
 
 std::optional<ConcentricFit> fit_concentric(const Eigen::Vector3d& centre,
-                                            std::span<const CoaxialMember> members,
-                                            std::span<const std::size_t> radius_of) {
-  const auto radius_index = [&](std::size_t j) {
-    return 3 + static_cast<Eigen::Index>(radius_of.empty() ? j : radius_of[j]);
-  };
-  Eigen::Index size = 3;
-  for (std::size_t j = 0; j < members.size(); ++j) size = std::max(size, radius_index(j) + 1);
-  std::size_t count = 0;
-  for (const CoaxialMember& member : members) count += member.points.size();
-  if (count <= static_cast<std::size_t>(size)) return std::nullopt;
-  Eigen::VectorXd x = Eigen::VectorXd::Constant(size, std::numeric_limits<double>::quiet_NaN());
-  x.head<3>() = centre;
-  for (std::size_t j = members.size(); j-- > 0;) x(radius_index(j)) = members[j].radius;
-  if (!x.allFinite()) return std::nullopt;  // a radius no member has
-  Eigen::MatrixXd normal(size, size);
-  Eigen::VectorXd gradient(size);
-  std::vector<double> member_squares(members.size());
-  // The normal equations at x, each residual |p − c| − rⱼ weighted or not; the unweighted Σ e².
-  const auto linearise = [&](bool weighted) {
-    normal.setZero();
-    gradient.setZero();
-    double squares = 0;
-    for (std::size_t j = 0; j < members.size(); ++j) {
-      const Eigen::Index q = radius_index(j);
-      member_squares[j] = 0;
-      for (std::size_t i = 0; i < members[j].points.size(); ++i) {
-        const Eigen::Vector3d d = to_eigen(members[j].points[i]) - x.head<3>();
-        const double length = d.norm();
-        if (!(length > 0)) continue;
-        const double e = length - x(q), w = weighted ? members[j].weights[i] : 1.0;
-        const Eigen::Vector3d by_centre = -d / length;
-        normal.topLeftCorner<3, 3>() += w * by_centre * by_centre.transpose();
-        normal.block<3, 1>(0, q) -= w * by_centre;
-        normal(q, q) += w;
-        gradient.head<3>() += w * e * by_centre;
-        gradient(q) -= w * e;
-        squares += e * e;
-        member_squares[j] += e * e;
-      }
-    }
-    normal.bottomLeftCorner(size - 3, 3) = normal.topRightCorner(3, size - 3).transpose();
-    return squares;
-  };
-  bool converged = false;
-  for (int step = 0; step < 30 && !converged; ++step) {
-    linearise(true);
-    const Eigen::VectorXd delta = normal.ldlt().solve(-gradient);
-    if (!delta.allFinite()) return std::nullopt;
-    x += delta;
-    converged = !(delta.norm() > 1e-14 * x.norm());
-  }
-  if (!converged || !x.allFinite() || !(x.tail(size - 3).minCoeff() > 0)) return std::nullopt;
-  const double squares = linearise(false);
-  const double largest_radius = x.tail(size - 3).maxCoeff();
-  const Eigen::MatrixXd covariance =
-      normal.inverse() *
-      std::max(squares / static_cast<double>(count - static_cast<std::size_t>(size)),
-               kResolution * kResolution * largest_radius * largest_radius);
-  if (!covariance.allFinite()) return std::nullopt;
-  ConcentricFit fit;
-  fit.centre = x.head<3>();
-  fit.centre_covariance = covariance.topLeftCorner<3, 3>();
+                                            std::span<const CoaxialMember> members) {
+  std::vector<SphereTerm> spheres;
+  std::vector<double> radii;
   for (std::size_t j = 0; j < members.size(); ++j) {
-    const Eigen::Index q = radius_index(j);
-    fit.radii.push_back(x(q));
-    fit.radius_variances.push_back(covariance(q, q));
-    fit.rms.push_back(std::max(
-        std::sqrt(member_squares[j] / double(std::max<std::size_t>(members[j].points.size(), 1))),
-        kResolution * x(q)));
+    spheres.push_back({members[j].points, members[j].weights, j, kNoLine, 0});
+    radii.push_back(members[j].radius);
   }
+  const std::optional<JointFit> joint =
+      fit_cylinders_and_spheres({}, {}, {&centre, 1}, radii, {}, spheres, true);
+  if (!joint) return std::nullopt;
+  ConcentricFit fit;
+  fit.centre = joint->sphere_centres[0];
+  fit.centre_covariance = joint->covariance.topLeftCorner<3, 3>();
+  fit.radii = joint->radii;
+  fit.rms = joint->rms;
+  for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(members.size()); ++j)
+    fit.radius_variances.push_back(joint->covariance(3 + j, 3 + j));
   return fit;
 }
 

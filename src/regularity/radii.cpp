@@ -11,6 +11,7 @@
 #include <map>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -28,6 +29,59 @@ bool known_within(const Eigen::Matrix2d& covariance, double significance, double
   const double largest =
       (covariance(0, 0) + covariance(1, 1)) / 2 + std::hypot(half_difference, covariance(0, 1));
   return significance * std::sqrt(largest) <= bound;
+}
+
+// The spheres `spheres` (indices into settled.surfaces) grouped by their places along
+// `direction`: best located first, each joins the first group whose pooled place
+// (information-weighted) it is within the significance of (the χ² bound of one degree of freedom,
+// with both variances, each sphere's that of its own fit's centre along the direction) and within
+// max_radius_difference of its radius. A place whose significance interval is wider than that
+// (the interval rule of the centres) is a group of its own. Returns every group, in the order
+// they formed, those of one place known less well last.
+std::vector<std::vector<std::size_t>> places_along(const SettledSurfaces& settled,
+                                                   std::span<const std::size_t> spheres,
+                                                   const Eigen::Vector3d& direction,
+                                                   const RegularityOptions& options) {
+  const double bound = chi_square_bound(options.significance, 1);
+  struct Placed {
+    std::size_t surface = 0;
+    double place = 0, variance = 0;
+  };
+  std::vector<Placed> placed;
+  std::vector<std::vector<std::size_t>> unplaced;
+  for (const std::size_t k : spheres) {
+    const SettledSurfaces::Surface& sphere = settled.surfaces[k];
+    const double variance = direction.dot(settled.centre_covariances[sphere.centre] * direction);
+    if (options.significance * std::sqrt(variance) <= options.max_radius_difference * sphere.radius)
+      placed.push_back({k, direction.dot(settled.centres[sphere.centre]), variance});
+    else
+      unplaced.push_back({k});
+  }
+  std::stable_sort(placed.begin(), placed.end(),
+                   [](const Placed& a, const Placed& b) { return a.variance < b.variance; });
+  std::vector<std::vector<std::size_t>> groups;
+  std::vector<PooledPosition<1>> pooled;
+  for (const Placed& sphere : placed) {
+    const double largest_offset =
+        options.max_radius_difference * settled.surfaces[sphere.surface].radius;
+    std::size_t joined = groups.size();
+    for (std::size_t g = 0; g < groups.size() && joined == groups.size(); ++g) {
+      const double offset = sphere.place - pooled[g].centre()(0);
+      if (!(std::abs(offset) <= largest_offset)) continue;
+      if (offset * offset <= bound * (sphere.variance + pooled[g].covariance()(0, 0)) ||
+          within_tolerance(std::abs(offset), options.length_tolerance))
+        joined = g;
+    }
+    if (joined == groups.size()) {
+      groups.emplace_back();
+      pooled.emplace_back();
+    }
+    groups[joined].push_back(sphere.surface);
+    pooled[joined].add(Eigen::Matrix<double, 1, 1>(sphere.place),
+                       Eigen::Matrix<double, 1, 1>(sphere.variance));
+  }
+  groups.insert(groups.end(), unplaced.begin(), unplaced.end());
+  return groups;
 }
 
 // Refits line l with its cylinders and the spheres `spheres` (indices into settled.surfaces) on
@@ -59,7 +113,7 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
     }
     for (const std::size_t k : spheres) {
       const std::size_t c = surfaces[k].cluster;
-      sphere_terms.push_back({points[c], weights[c], radii.size(), 0});
+      sphere_terms.push_back({points[c], weights[c], radii.size(), 0, sphere_terms.size()});
       radii.push_back(surfaces[k].radius);
       centres.push_back(settled.centres[surfaces[k].centre]);
     }
@@ -256,7 +310,11 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
       sets[joined].pooled.add(sphere.position, sphere.covariance);
     }
     for (Set& set : sets) {
-      if (set.surfaces.size() < kFewestSpheresOnALine) continue;
+      // Three places along the line at least: spheres of one place (fragments of one sphere, a
+      // ball and its socket) are on a line of any direction, and concentric instead.
+      if (set.surfaces.size() < kFewestSpheresOnALine ||
+          places_along(settled, set.surfaces, direction, options).size() < kFewestSpheresOnALine)
+        continue;
       std::vector<std::size_t> clusters;
       for (const std::size_t k : set.surfaces) clusters.push_back(settled.surfaces[k].cluster);
       settled.lines.push_back({direction, set.pooled.centre(), set.pooled.covariance(), kNoRelation,
@@ -293,7 +351,7 @@ std::vector<std::size_t> radius_classes(const std::vector<SettledSurfaces::Surfa
   std::size_t members = 0;
   for (const std::size_t k : order) {
     const double r = surfaces[k].radius, variance = surfaces[k].radius_variance;
-    if (surfaces[k].concentric != kNoRelation || !(variance > 0) ||
+    if (!(variance > 0) ||
         options.significance * std::sqrt(variance) > options.max_radius_difference * r) {
       class_of[k] = classes++;  // a class of its own
       continue;
@@ -335,20 +393,15 @@ std::vector<CoaxialMember> sphere_members(const SettledSurfaces& settled,
   return members;
 }
 
-// Among the members of `set` that `tested_member` accepts, the one that `fit` explains worse than
-// its own fit beyond the significance corrected for their number, or set.size() for none.
-template <typename Tested>
+// The member of `set` that `fit` explains worse than its own fit beyond the significance
+// corrected for their number, or set.size() for none.
 std::size_t worst_sphere(const SettledSurfaces& settled, const std::vector<std::size_t>& set,
-                         const ConcentricFit& fit, const Tested& tested_member,
-                         const RegularityOptions& options,
+                         const ConcentricFit& fit, const RegularityOptions& options,
                          const std::vector<std::vector<Vec3>>& points) {
-  std::size_t tested = 0;
-  for (std::size_t j = 0; j < set.size(); ++j) tested += tested_member(j) ? 1 : 0;
-  const double bound = family_significance(options.significance, tested);
+  const double bound = family_significance(options.significance, set.size());
   double worst_excess = 1;
   std::size_t worst = set.size();
   for (std::size_t j = 0; j < set.size(); ++j) {
-    if (!tested_member(j)) continue;
     const SettledSurfaces::Surface& sphere = settled.surfaces[set[j]];
     // A sphere's own fit has 4 parameters.
     const double excess = residual_excess(sphere.rms, fit.rms[j], points[sphere.cluster].size(),
@@ -378,96 +431,136 @@ std::optional<ConcentricFit> one_centre(const SettledSurfaces& settled,
     std::optional<ConcentricFit> fit =
         fit_concentric(pooled.centre(), sphere_members(settled, set, points, weights));
     if (!fit) return std::nullopt;
-    const std::size_t worst = worst_sphere(
-        settled, set, *fit, [](std::size_t) { return true; }, options, points);
+    const std::size_t worst = worst_sphere(settled, set, *fit, options, points);
     if (worst == set.size()) return fit;
     set.erase(set.begin() + static_cast<std::ptrdiff_t>(worst));
   }
   return std::nullopt;
 }
 
-// Concentric spheres whose radii (as `fit` measured them) agree within the significance are one
-// sphere cut apart: each class of them (radius_classes) takes one radius, refitted with the
-// centre; as for the classes of equal radii, while a member's residual sum rises by more than the
-// significance allows, the worst takes a radius of its own. Returns each member's radius index
-// (empty: none shared), and replaces `fit` with the refit.
-std::vector<std::size_t> share_radii(const SettledSurfaces& settled,
-                                     const std::vector<std::size_t>& set, ConcentricFit& fit,
-                                     const RegularityOptions& options,
-                                     const std::vector<std::vector<Vec3>>& points,
-                                     const std::vector<std::vector<double>>& weights) {
-  std::vector<SettledSurfaces::Surface> measured;
-  for (std::size_t j = 0; j < set.size(); ++j) {
-    SettledSurfaces::Surface& sphere = measured.emplace_back(settled.surfaces[set[j]]);
-    sphere.radius = fit.radii[j];
-    sphere.radius_variance = fit.radius_variances[j];
-  }
-  std::vector<std::size_t> class_of = radius_classes(measured, options);
-  while (true) {
-    std::vector<std::size_t> class_size(set.size(), 0);
-    for (const std::size_t q : class_of) ++class_size[q];
-    const auto shares = [&](std::size_t j) { return class_size[class_of[j]] >= 2; };
-    if (std::none_of(class_size.begin(), class_size.end(),
-                     [](std::size_t size) { return size >= 2; }))
-      return {};
-    // Radii numbered from 0 in order of first use.
-    std::vector<std::size_t> number(set.size(), set.size()), radius_of;
-    std::size_t radii = 0;
-    for (const std::size_t q : class_of) {
-      if (number[q] == set.size()) number[q] = radii++;
-      radius_of.push_back(number[q]);
-    }
-    const std::optional<ConcentricFit> shared =
-        fit_concentric(fit.centre, sphere_members(settled, set, points, weights), radius_of);
-    if (!shared) return {};
-    const std::size_t worst = worst_sphere(settled, set, *shared, shares, options, points);
-    if (worst == set.size()) {
-      fit = *shared;
-      return radius_of;
-    }
-    const auto free_class = std::find(class_size.begin(), class_size.end(), 0);
-    class_of[worst] = static_cast<std::size_t>(free_class - class_size.begin());
-  }
-}
-
-// Refits the spheres `set` (indices into settled.surfaces) with one centre (one_centre()), and,
-// with options.equal_radii, those of one radius with one radius (share_radii()). Writes the centre,
-// the radii and the primitives back and appends the Concentric relation, and an EqualRadius
-// relation per radius shared, unless fewer than two stay.
+// Refits the spheres `set` (indices into settled.surfaces) with one centre (one_centre()). Writes
+// the centre, the radii and the primitives back and appends the Concentric relation, unless fewer
+// than two stay.
 void settle_concentric(SettledSurfaces& settled, std::vector<std::size_t> set,
                        const RegularityOptions& options, std::vector<Primitive>& primitives,
                        const std::vector<std::vector<Vec3>>& points,
                        const std::vector<std::vector<double>>& weights,
                        std::vector<Relation>& relations) {
-  std::optional<ConcentricFit> fit = one_centre(settled, set, options, points, weights);
+  const std::optional<ConcentricFit> fit = one_centre(settled, set, options, points, weights);
   if (!fit) return;
-  const std::vector<std::size_t> radius_of =
-      options.equal_radii ? share_radii(settled, set, *fit, options, points, weights)
-                          : std::vector<std::size_t>{};
   std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
   const std::size_t shared = surfaces[set[0]].centre;
   settled.centres[shared] = fit->centre;
-  const std::size_t concentric = relations.size();
-  relations.push_back({Relation::Kind::Concentric, {}, {}});
-  std::map<std::size_t, std::vector<std::size_t>> of_radius;
+  Relation& concentric = relations.emplace_back(Relation{Relation::Kind::Concentric, {}, {}});
   for (std::size_t j = 0; j < set.size(); ++j) {
     SettledSurfaces::Surface& sphere = surfaces[set[j]];
     sphere.centre = shared;
     sphere.radius = fit->radii[j];
     sphere.radius_variance = fit->radius_variances[j];
     sphere.rms = fit->rms[j];
-    sphere.concentric = concentric;
     primitives[sphere.cluster].point = to_vec3(fit->centre);
     primitives[sphere.cluster].radius = sphere.radius;
-    relations[concentric].members.push_back(sphere.cluster);
-    if (!radius_of.empty()) of_radius[radius_of[j]].push_back(sphere.cluster);
+    concentric.members.push_back(sphere.cluster);
   }
-  std::sort(relations[concentric].members.begin(), relations[concentric].members.end());
-  for (auto& [unused, members] : of_radius)
-    if (members.size() >= 2) {
-      std::sort(members.begin(), members.end());
-      relations.push_back({Relation::Kind::EqualRadius, std::move(members), {}});
+  std::sort(concentric.members.begin(), concentric.members.end());
+}
+
+// Line l refitted with its cylinders and spheres, the spheres of each of `sets` on one centre:
+// while a member's residual sum rises by more than the significance, corrected for the number of
+// members, allows, the worst sphere of a set leaves it (a set left with one member dissolves).
+// Writes the line, its members and their primitives back and appends a Concentric relation per
+// set, unless no set stays.
+void share_centres_on_line(SettledSurfaces& settled, std::size_t l,
+                           std::vector<std::vector<std::size_t>> sets,
+                           const RegularityOptions& options, std::vector<Primitive>& primitives,
+                           const std::vector<std::vector<Vec3>>& points,
+                           const std::vector<std::vector<double>>& weights,
+                           std::vector<Relation>& relations) {
+  std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
+  SettledSurfaces::Line& line = settled.lines[l];
+  std::vector<std::size_t> members;  // the line's cylinders, then its spheres
+  for (const bool sphere : {false, true})
+    for (std::size_t k = 0; k < surfaces.size(); ++k)
+      if (surfaces[k].line == l && surfaces[k].sphere == sphere) members.push_back(k);
+  std::vector<CylinderTerm> terms;
+  std::vector<SphereTerm> spheres;
+  std::optional<JointFit> fit;
+  while (true) {
+    std::erase_if(sets, [](const std::vector<std::size_t>& set) { return set.size() < 2; });
+    if (sets.empty()) return;
+    terms.clear();
+    spheres.clear();
+    std::vector<double> radii;
+    std::vector<Eigen::Vector3d> centres;
+    std::map<std::size_t, std::size_t> centre_of;  // a set's surfaces: their shared centre's index
+    for (const std::vector<std::size_t>& set : sets) {
+      for (const std::size_t k : set) centre_of[k] = centres.size();
+      centres.push_back(settled.centres[surfaces[set[0]].centre]);
     }
+    for (const std::size_t k : members) {
+      const std::size_t c = surfaces[k].cluster;
+      if (surfaces[k].sphere) {
+        const auto shared = centre_of.find(k);
+        std::size_t centre = centres.size();
+        if (shared != centre_of.end())
+          centre = shared->second;
+        else
+          centres.push_back(settled.centres[surfaces[k].centre]);
+        spheres.push_back({points[c], weights[c], radii.size(), 0, centre});
+      } else {
+        terms.push_back({points[c], weights[c], 0, radii.size()});
+      }
+      radii.push_back(surfaces[k].radius);
+    }
+    fit = fit_cylinders_and_spheres({&line.direction, 1}, {&line.centre, 1}, centres, radii, terms,
+                                    spheres, true);
+    if (!fit) return;
+    const double bound = family_significance(options.significance, members.size());
+    double worst_excess = 1, worst_shared_excess = -std::numeric_limits<double>::infinity();
+    std::size_t worst = 0;
+    for (std::size_t j = 0; j < members.size(); ++j) {
+      const SettledSurfaces::Surface& surface = surfaces[members[j]];
+      // On the line a sphere has 2 parameters of its own, a cylinder 3 (as worst_member counts).
+      const double excess =
+          residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(), bound * bound,
+                          surface.sphere ? 2 : 3, options.length_tolerance);
+      worst_excess = std::max(worst_excess, excess);
+      if (centre_of.contains(members[j]) && excess > worst_shared_excess) {
+        worst_shared_excess = excess;
+        worst = members[j];
+      }
+    }
+    if (!(worst_excess > 1)) break;
+    for (std::vector<std::size_t>& set : sets) std::erase(set, worst);
+  }
+  // Written back: the line, its cylinders and its spheres, with their radii's variances.
+  const Eigen::Index first_radius = 2 + static_cast<Eigen::Index>(fit->sphere_centres.size());
+  line.centre = fit->centres[0];
+  line.covariance = fit->covariance.topLeftCorner<2, 2>();
+  for (std::size_t j = 0; j < members.size(); ++j) {
+    SettledSurfaces::Surface& surface = surfaces[members[j]];
+    const Eigen::Index q = static_cast<Eigen::Index>(j);
+    surface.radius = fit->radii[j];
+    surface.radius_variance = fit->covariance(first_radius + q, first_radius + q);
+    surface.rms = fit->rms[j];
+    Primitive& primitive = primitives[surface.cluster];
+    if (!surface.sphere) {
+      place_cylinder(primitive, line.direction, line.centre, surface.radius);
+      continue;
+    }
+    const SphereTerm& term = spheres[j - terms.size()];
+    settled.centres[surface.centre] = fit->sphere_centres[term.centre];
+    primitive.point = to_vec3(settled.centres[surface.centre]);
+    primitive.radius = surface.radius;
+  }
+  for (const std::vector<std::size_t>& set : sets) {
+    Relation& concentric = relations.emplace_back(Relation{Relation::Kind::Concentric, {}, {}});
+    for (const std::size_t k : set) {
+      surfaces[k].centre = surfaces[set[0]].centre;
+      concentric.members.push_back(surfaces[k].cluster);
+    }
+    std::sort(concentric.members.begin(), concentric.members.end());
+  }
 }
 
 }  // namespace
@@ -520,12 +613,25 @@ void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
   for (const std::vector<std::size_t>& set : sets)
     if (set.size() >= 2)
       settle_concentric(settled, set, options, primitives, points, weights, relations);
+  std::vector<std::vector<std::size_t>> spheres_on(settled.lines.size());
+  for (std::size_t k = 0; k < settled.surfaces.size(); ++k)
+    if (settled.surfaces[k].sphere && settled.surfaces[k].line != kNoLine)
+      spheres_on[settled.surfaces[k].line].push_back(k);
+  for (std::size_t l = 0; l < settled.lines.size(); ++l) {
+    std::vector<std::vector<std::size_t>> places =
+        places_along(settled, spheres_on[l], settled.lines[l].direction, options);
+    std::erase_if(places, [](const std::vector<std::size_t>& place) { return place.size() < 2; });
+    if (!places.empty())
+      share_centres_on_line(settled, l, std::move(places), options, primitives, points, weights,
+                            relations);
+  }
 }
 
 namespace {
 
-// The surfaces linked by a class of radii (`class_of`) or by an axis line, by union-find: each
-// component's surfaces in increasing order, at the index of its root (the others empty).
+// The surfaces linked by a class of radii (`class_of`), by an axis line or by a sphere centre,
+// by union-find: each component's surfaces in increasing order, at the index of its root (the
+// others empty).
 std::vector<std::vector<std::size_t>> linked_components(const SettledSurfaces& settled,
                                                         const std::vector<std::size_t>& class_of) {
   const std::size_t n = settled.surfaces.size();
@@ -543,19 +649,23 @@ std::vector<std::vector<std::size_t>> linked_components(const SettledSurfaces& s
     else
       parent[root(k)] = root(first);
   };
-  std::vector<std::size_t> first_of_class(n, n), first_on_line(settled.lines.size(), n);
+  std::vector<std::size_t> first_of_class(n, n), first_on_line(settled.lines.size(), n),
+      first_of_centre(settled.centres.size(), n);
   for (std::size_t k = 0; k < n; ++k) {
+    const SettledSurfaces::Surface& surface = settled.surfaces[k];
     join(first_of_class[class_of[k]], k);
-    if (settled.surfaces[k].line != kNoLine) join(first_on_line[settled.surfaces[k].line], k);
+    if (surface.line != kNoLine) join(first_on_line[surface.line], k);
+    if (surface.sphere) join(first_of_centre[surface.centre], k);
   }
   std::vector<std::vector<std::size_t>> components(n);
   for (std::size_t k = 0; k < n; ++k) components[root(k)].push_back(k);
   return components;
 }
 
-// A component's joint fit, as fit_cylinders_and_spheres() takes it: its lines, spheres and radii
-// (a class of two or more has one radius, started from its first member's), and each member's
-// term, its index among the cylinder terms or among the spheres.
+// A component's joint fit, as fit_cylinders_and_spheres() takes it: its lines, spheres, sphere
+// centres (concentric spheres share one) and radii (a class of two or more has one radius, started
+// from its first member's), and each member's term, its index among the cylinder terms or among
+// the spheres.
 struct RadiusProblem {
   std::vector<CylinderTerm> terms;
   std::vector<SphereTerm> spheres;
@@ -565,40 +675,54 @@ struct RadiusProblem {
   std::vector<std::size_t> term_of;
 };
 
-// `line_index` and `radius_of_class` number the component's lines and radii in the joint fit;
-// only its own entries are reset, so that many small components cost no more than one large one.
-RadiusProblem radius_problem(
-    const SettledSurfaces& settled, const std::vector<std::size_t>& component,
-    const std::vector<std::size_t>& class_of, const std::vector<std::size_t>& class_size,
-    const std::vector<std::vector<Vec3>>& points, const std::vector<std::vector<double>>& weights,
-    std::vector<std::size_t>& line_index, std::vector<std::size_t>& radius_of_class) {
+// The numbers a component's lines, sphere centres and radii (by class) take in its joint fit,
+// n (the number of surfaces) for none yet; radius_problem() resets only the component's own
+// entries, so that many small components cost no more than one large one.
+struct JointNumbering {
+  std::vector<std::size_t> line, centre, radius_of_class;
+};
+
+RadiusProblem radius_problem(const SettledSurfaces& settled,
+                             const std::vector<std::size_t>& component,
+                             const std::vector<std::size_t>& class_of,
+                             const std::vector<std::size_t>& class_size,
+                             const std::vector<std::vector<Vec3>>& points,
+                             const std::vector<std::vector<double>>& weights,
+                             JointNumbering& numbering) {
   const std::size_t n = settled.surfaces.size();
   RadiusProblem problem;
   problem.term_of.resize(component.size());
   for (const std::size_t k : component) {
-    if (settled.surfaces[k].line != kNoLine) line_index[settled.surfaces[k].line] = n;
-    radius_of_class[class_of[k]] = n;
+    const SettledSurfaces::Surface& surface = settled.surfaces[k];
+    if (surface.line != kNoLine) numbering.line[surface.line] = n;
+    if (surface.sphere) numbering.centre[surface.centre] = n;
+    numbering.radius_of_class[class_of[k]] = n;
   }
   for (std::size_t j = 0; j < component.size(); ++j) {
     const SettledSurfaces::Surface& surface = settled.surfaces[component[j]];
-    std::size_t& radius = radius_of_class[class_of[component[j]]];
+    std::size_t& radius = numbering.radius_of_class[class_of[component[j]]];
     if (radius == n || class_size[class_of[component[j]]] < 2) {
       radius = problem.radii.size();
       problem.radii.push_back(surface.radius);
     }
     std::size_t line = kNoLine;
     if (surface.line != kNoLine) {
-      line = line_index[surface.line];
+      line = numbering.line[surface.line];
       if (line == n) {
-        line = line_index[surface.line] = problem.directions.size();
+        line = numbering.line[surface.line] = problem.directions.size();
         problem.directions.push_back(settled.lines[surface.line].direction);
         problem.centres.push_back(settled.lines[surface.line].centre);
       }
     }
     if (surface.sphere) {
+      std::size_t& centre = numbering.centre[surface.centre];
+      if (centre == n) {
+        centre = problem.sphere_centres.size();
+        problem.sphere_centres.push_back(settled.centres[surface.centre]);
+      }
       problem.term_of[j] = problem.spheres.size();
-      problem.spheres.push_back({points[surface.cluster], weights[surface.cluster], radius, line});
-      problem.sphere_centres.push_back(settled.centres[surface.centre]);
+      problem.spheres.push_back(
+          {points[surface.cluster], weights[surface.cluster], radius, line, centre});
       continue;
     }
     problem.term_of[j] = problem.terms.size();
@@ -640,26 +764,33 @@ std::size_t worst_member(const SettledSurfaces& settled, const std::vector<std::
 }
 
 // Writes the joint `fit` back: the members of classes of two or more, and the surfaces on their
-// lines; appends each class of two or more as an EqualRadius relation.
+// lines and the spheres on their centres; appends each class of two or more as an EqualRadius
+// relation.
 void write_equal_radii(const SettledSurfaces& settled, const std::vector<std::size_t>& component,
                        const std::vector<std::size_t>& class_of,
                        const std::vector<std::size_t>& class_size, const RadiusProblem& problem,
                        const JointFit& fit, std::vector<Primitive>& primitives,
                        std::vector<Relation>& relations) {
   const std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
-  std::vector<bool> moved_line(settled.lines.size(), false);
-  for (const std::size_t k : component)
-    if (class_size[class_of[k]] >= 2 && surfaces[k].line != kNoLine)
-      moved_line[surfaces[k].line] = true;
+  std::vector<bool> moved_line(settled.lines.size(), false),
+      moved_centre(settled.centres.size(), false);
+  for (const std::size_t k : component) {
+    if (class_size[class_of[k]] < 2) continue;
+    if (surfaces[k].line != kNoLine) moved_line[surfaces[k].line] = true;
+    if (surfaces[k].sphere) moved_centre[surfaces[k].centre] = true;
+  }
   std::map<std::size_t, std::vector<std::size_t>> members_of_class;
   for (std::size_t j = 0; j < component.size(); ++j) {
     const SettledSurfaces::Surface& surface = surfaces[component[j]];
     const bool member = class_size[class_of[component[j]]] >= 2;
     Primitive& primitive = primitives[surface.cluster];
     if (surface.sphere) {
-      if (!member && (surface.line == kNoLine || !moved_line[surface.line])) continue;
-      primitive.point = to_vec3(fit.sphere_centres[problem.term_of[j]]);
-      primitive.radius = fit.radii[problem.spheres[problem.term_of[j]].radius];
+      if (!member && !moved_centre[surface.centre] &&
+          (surface.line == kNoLine || !moved_line[surface.line]))
+        continue;
+      const SphereTerm& term = problem.spheres[problem.term_of[j]];
+      primitive.point = to_vec3(fit.sphere_centres[term.centre]);
+      primitive.radius = fit.radii[term.radius];
     } else {
       if (!moved_line[surface.line]) continue;
       const CylinderTerm& term = problem.terms[problem.term_of[j]];
@@ -687,7 +818,9 @@ void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& opt
   std::vector<std::size_t> class_of = radius_classes(settled.surfaces, options);
   std::vector<std::size_t> class_size(n, 0);
   for (const std::size_t q : class_of) ++class_size[q];
-  std::vector<std::size_t> line_index(settled.lines.size(), n), radius_of_class(n, n);
+  JointNumbering numbering{std::vector<std::size_t>(settled.lines.size(), n),
+                           std::vector<std::size_t>(settled.centres.size(), n),
+                           std::vector<std::size_t>(n, n)};
   for (const std::vector<std::size_t>& component : linked_components(settled, class_of)) {
     if (std::none_of(component.begin(), component.end(),
                      [&](std::size_t k) { return class_size[class_of[k]] >= 2; }))
@@ -695,8 +828,8 @@ void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& opt
     // While the joint fit explains a member worse than its own beyond the significance, the
     // worst takes a class of its own, under any unused number.
     while (true) {
-      const RadiusProblem problem = radius_problem(settled, component, class_of, class_size, points,
-                                                   weights, line_index, radius_of_class);
+      const RadiusProblem problem =
+          radius_problem(settled, component, class_of, class_size, points, weights, numbering);
       const std::optional<JointFit> fit =
           fit_cylinders_and_spheres(problem.directions, problem.centres, problem.sphere_centres,
                                     problem.radii, problem.terms, problem.spheres, false);

@@ -159,13 +159,15 @@ struct CylinderTerm {
 /// No line: the `line` of a sphere (a joint fit's term, a settled surface) whose centre is its own.
 inline constexpr std::size_t kNoLine = std::numeric_limits<std::size_t>::max();
 
-/// A sphere's points: sphere s of a joint fit has one of its radii, and its own centre, or its
-/// centre on one of its lines (one parameter along it).
+/// A sphere's points: sphere s of a joint fit has one of its radii and one of its centres, free or
+/// on one of its lines (one parameter along it). Spheres of one centre are concentric, and give
+/// it the same line (or none).
 struct SphereTerm {
   std::span<const Vec3> points;
   std::span<const double> weights;
   std::size_t radius = 0;
   std::size_t line = kNoLine;
+  std::size_t centre = 0;
 };
 
 /// Axis lines of fixed directions, sphere centres and radii fitted together by geometric least
@@ -175,11 +177,11 @@ struct SphereTerm {
 /// spheres) of equal radius.
 struct JointFit {
   std::vector<Eigen::Vector2d> centres;  // per line, in orthonormal_pair(direction) coordinates
-  std::vector<Eigen::Vector3d> sphere_centres;
+  std::vector<Eigen::Vector3d> sphere_centres;  // per sphere centre
   std::vector<double> radii;
   // Per cylinder term, then per sphere; unweighted, at least kResolution × the radius.
   std::vector<double> rms;
-  // Of (line centres, free sphere centres, the positions along their lines of the spheres on
+  // Of (line centres, free sphere centres, the positions along their lines of the centres on
   // one, radii), from the unweighted residuals (if asked).
   Eigen::MatrixXd covariance;
 };
@@ -202,13 +204,14 @@ struct CoaxialFit {
   Eigen::Matrix2d centre_covariance = Eigen::Matrix2d::Zero();
 };
 
-/// Gauss–Newton from `centres`, `sphere_centres` and `radii` (weighted steps; the uncertainty,
-/// when asked for, from the unweighted residuals at the solution); a sphere on a line starts from
-/// its centre's projection onto it. Nothing when it diverges, a radius ends non-positive or the
-/// points do not outnumber the parameters. A step of one line and no sphere solves the normal
-/// equations whole; otherwise it eliminates each line's and each free sphere's position first (a
-/// 2x2 or 3x3 block that couples only to its own terms' radii; a sphere on a line, its position
-/// along it before the line's), so that a plate of n holes of one radius costs O(n), not O(n³).
+/// Gauss–Newton from `centres`, `sphere_centres` and `radii` (weighted steps, at most 30; the
+/// uncertainty, when asked for, from the unweighted residuals at the solution); a sphere centre on
+/// a line starts from its projection onto it. Nothing when it diverges, a radius ends non-positive,
+/// the points do not outnumber the parameters, a sphere centre has no sphere or its spheres put it
+/// on different lines. A step of one line and no sphere solves the normal equations whole;
+/// otherwise it eliminates each line's and each free centre's position first (a 2x2 or 3x3 block
+/// that couples only to its own terms' radii; a centre on a line, its position along it before the
+/// line's), so that a plate of n holes of one radius costs O(n), not O(n³).
 std::optional<JointFit> fit_cylinders_and_spheres(
     std::span<const Eigen::Vector3d> directions, std::span<const Eigen::Vector2d> centres,
     std::span<const Eigen::Vector3d> sphere_centres, std::span<const double> radii,
@@ -220,7 +223,7 @@ std::optional<JointFit> fit_cylinders_and_spheres(
 std::optional<CoaxialFit> fit_coaxial(const Eigen::Vector3d& axis, const Eigen::Vector2d& centre,
                                       std::span<const CoaxialMember> members);
 
-/// Spheres sharing one centre, each with its own radius or one of a class (fit_concentric()).
+/// Spheres sharing one centre, each with its own radius (fit_concentric()).
 struct ConcentricFit {
   Eigen::Vector3d centre;
   Eigen::Matrix3d centre_covariance = Eigen::Matrix3d::Zero();
@@ -230,14 +233,10 @@ struct ConcentricFit {
 };
 
 /// The spheres `members` (their inliers, weights and radii; the CoaxialMember of a sphere) fitted
-/// with one centre by geometric least squares: Gauss–Newton from `centre` and their radii, weighted
-/// steps, the uncertainty from the unweighted residuals. Member j has radius radius_of[j] (radii
-/// numbered from 0, each started from its first member's; empty: a radius each). Nothing when it
-/// does not converge in 30 steps, a radius ends non-positive or the points do not outnumber the
-/// parameters (3 + the radii).
+/// with one centre, each keeping its own radius: fit_cylinders_and_spheres() from `centre` and
+/// their radii, with its covariance.
 std::optional<ConcentricFit> fit_concentric(const Eigen::Vector3d& centre,
-                                            std::span<const CoaxialMember> members,
-                                            std::span<const std::size_t> radius_of = {});
+                                            std::span<const CoaxialMember> members);
 
 /// `cylinder` refitted alone on its inliers with the axis direction `direction`, from its own axis
 /// point and radius.
@@ -303,7 +302,6 @@ struct SettledSurfaces {
     std::size_t line = 0;    // into `lines`: a cylinder's; a sphere's centre's, or kNoLine
     std::size_t centre = 0;  // a sphere's, into `centres` (one for a concentric set's)
     double radius = 0, radius_variance = 0, rms = 0;
-    std::size_t concentric = kNoRelation;  // a sphere's Concentric relation's index
   };
   std::vector<Line> lines;
   std::vector<Eigen::Vector3d> centres;
@@ -339,7 +337,8 @@ void centre_spheres_on_axes(SettledSurfaces& settled, const RegularityOptions& o
 /// the direction they are within the significance of (the χ² bound of two degrees of freedom, with
 /// the covariances of the centre, of the pooled position and of the direction's tilt times the
 /// height between them) and within max_radius_difference of their radius; a centre known less well
-/// than that joins none. A set of kFewestSpheresOnALine or more becomes a line of its own, refitted
+/// than that joins none. A set of kFewestSpheresOnALine or more, at as many places along the
+/// direction (spheres of one place are concentric instead), becomes a line of its own, refitted
 /// with its spheres (settle_on_line, as many staying), and a coaxial relation of them.
 void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>& groups,
                      const std::vector<std::vector<std::size_t>>& refitted,
@@ -355,10 +354,11 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
 /// max_radius_difference of its radius; else it starts one. As for a line's spheres, a centre whose
 /// significance interval is wider than that joins none (the spheres of a freeform surface). Each
 /// set of two or more is refitted with one centre (fit_concentric()); while a member's residual
-/// sum rises by more than the significance corrected for their number allows, the worst leaves;
-/// then, with options.equal_radii, its members whose radii agree (radius_classes) take one radius,
-/// with the classes' guard. Appends a Concentric relation per set kept and an EqualRadius relation
-/// per radius its members share; its spheres take part in no other class of equal radii.
+/// sum rises by more than the significance corrected for their number allows, the worst leaves.
+/// Then on each line, its spheres whose places along it agree (places_along) are refitted
+/// with the line, one place per set, with the same guard. Appends a Concentric relation per set
+/// kept, and gives its members one centre in `settled`: equalize_radii() keeps it shared
+/// (fragments of one sphere, whose radii agree, are made one there).
 void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
                      std::vector<Primitive>& primitives,
                      const std::vector<std::vector<Vec3>>& points,
@@ -366,11 +366,11 @@ void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
                      std::vector<Relation>& relations);
 
 /// Cylinders and spheres of equal radius within the significance (radius_classes) share one
-/// radius: each component of surfaces joined by a class or by an axis line (a coaxial set) is
-/// refitted by one joint least squares over its lines' positions, its spheres' centres and its
-/// radii, the directions kept. As for a coaxial set, a member the joint fit explains worse than
-/// its own by more than the significance leaves its class, the worst first. Appends the classes
-/// of two or more to `relations`.
+/// radius: each component of surfaces joined by a class, by an axis line (a coaxial set) or by a
+/// sphere centre (a concentric set) is refitted by one joint least squares over its lines'
+/// positions, its spheres' centres and its radii, the directions kept. As for a coaxial set, a
+/// member the joint fit explains worse than its own by more than the significance leaves its class,
+/// the worst first. Appends the classes of two or more to `relations`.
 void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& options,
                     std::vector<Primitive>& primitives,
                     const std::vector<std::vector<Vec3>>& points,

@@ -494,7 +494,7 @@ TEST(Regularity, ABallEndIsCentredOnTheShaftAxis) {
     std::mt19937_64 rng(seed);
     const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.3, 1, 0.002, rng),
                                         noisy_sphere_cap(ball_centre, 0.4, z, 2.2, 0.002, rng),
-                                        noisy_sphere_cap(seat_centre, 0.25, -z, 1.2, 0.0005, rng)};
+                                        noisy_sphere_cap(seat_centre, 0.27, -z, 1.2, 0.002, rng)};
     std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.3),
                                       fitted_sphere(clusters[1], ball_centre, 0.4),
                                       fitted_sphere(clusters[2], seat_centre, 0.25)};
@@ -585,6 +585,61 @@ TEST(Regularity, ABallAndItsSocketShareOneCentre) {
   EXPECT_LT(shared_squares, std::min(ball_squares, socket_squares));
 }
 
+// A spherical joint on a shaft: a shaft of radius 0.3 along z, a ball of radius 0.4 at its end
+// and the socket around it, of radius 0.45, both centred on the shaft's axis at z = 0.5, and a cap
+// of radius 0.27 closing the other end, centred on the axis at z = −0.5. The spheres the line
+// takes are centred on it; when it takes the ball and the socket, they also share their place
+// along it, exactly, by the least squares of both (moving it along the axis only raises their
+// residuals), and keep their radii; the cap keeps its own place. Of 400 draws, the line took both
+// on 389, and each time they shared their centre; on 11 its guard left one of them off.
+TEST(Regularity, ABallAndItsSocketOnAShaftAxisShareOneCentreOnIt) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d centre(0, 0, 0.5), cap_centre(0, 0, -0.5);
+  const Relations::value_type pair{Kind::Concentric, {1, 2}};
+  int shared = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.3, 1, 0.002, rng),
+                                        noisy_sphere_cap(centre, 0.4, z, 1.2, 0.002, rng),
+                                        noisy_sphere_cap(centre, 0.45, -z, 1.0, 0.002, rng),
+                                        noisy_sphere_cap(cap_centre, 0.27, -z, 1.2, 0.002, rng)};
+    std::vector<Primitive> primitives{
+        fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.3), fitted_sphere(clusters[1], centre, 0.4),
+        fitted_sphere(clusters[2], centre, 0.45), fitted_sphere(clusters[3], cap_centre, 0.27)};
+    const Relations relations = regularize(primitives, clusters);
+    ASSERT_FALSE(relations.empty());
+    const auto& [kind, line] = relations[0];
+    ASSERT_EQ(kind, Kind::Coaxial);
+    const auto on_line = [&](std::size_t k) { return std::ranges::count(line, k) == 1; };
+    for (const std::size_t k : line) {
+      if (k == 0) continue;  // the shaft
+      EXPECT_LT(axis_offset(primitives[0], {PrimitiveType::Sphere, primitives[k].point, {0, 0, 1}}),
+                1e-14);
+    }
+    if (!on_line(1) || !on_line(2)) {
+      EXPECT_EQ(relations.size(), 1);
+      continue;
+    }
+    ASSERT_EQ(relations, (Relations{relations[0], pair}));
+    ++shared;
+    EXPECT_EQ(primitives[1].point, primitives[2].point);
+    EXPECT_NE(primitives[1].point, primitives[3].point);
+    EXPECT_NEAR(primitives[1].radius, 0.4, 0.002);
+    EXPECT_NEAR(primitives[2].radius, 0.45, 0.002);
+    EXPECT_NEAR(primitives[1].point[2], 0.5, 0.002);
+    const std::vector<std::pair<Primitive, const Cluster*>> both{{primitives[1], &clusters[1]},
+                                                                 {primitives[2], &clusters[2]}};
+    const double best = spheres_objective(both);
+    for (const double h : {-1e-4, 1e-4}) {
+      std::vector<std::pair<Primitive, const Cluster*>> moved = both;
+      for (auto& [sphere, unused] : moved) sphere.point[2] += h;
+      EXPECT_GT(spheres_objective(moved), best);
+    }
+  }
+  EXPECT_GE(shared, 9);
+}
+
 // Two caps of radius 0.5 about one centre, facing apart, with noise 0.002, and their own fits.
 struct SphereFragments {
   std::vector<Cluster> clusters;
@@ -606,7 +661,7 @@ SphereFragments two_fragments_of_a_sphere(std::uint64_t seed) {
 // Two fragments of one sphere (the hierarchy cut it apart: two caps of radius 0.5 about one
 // centre, facing apart) are one sphere again: one centre and one radius, exactly, the radius nearer
 // the truth over the draws than either fragment's own. Each test refuses a true relation at the
-// significance's rarity: of 1,000 draws 989 are one sphere, 7 concentric with a radius each and 4
+// significance's rarity: of 1,000 draws 994 are one sphere, 2 concentric with a radius each and 4
 // of one radius with a centre each.
 TEST(Regularity, TwoFragmentsOfOneSphereBecomeOneSphere) {
   const Relations one_sphere{{Kind::Concentric, {0, 1}}, {Kind::EqualRadius, {0, 1}}};
@@ -654,6 +709,47 @@ TEST(Regularity, WithoutEqualRadiiConcentricFragmentsKeepTheirOwnRadii) {
     EXPECT_NEAR(primitives[1].radius, 0.5, 0.002);
   }
   EXPECT_GE(concentric, 9);
+}
+
+// A ball of radius 0.5 in its socket of radius 0.53, and a hole of the socket's radius elsewhere
+// (a cylinder along x). The socket and the hole share one radius, and the ball keeps the centre
+// it shares with the socket: the joint fit of the radius moves that centre for both, exactly, to
+// the least squares of both caps. (Until session 40 a concentric set joined no class of radii.)
+TEST(Regularity, AConcentricSetSharesARadiusWithASurfaceOutsideIt) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ(), x = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d centre(0.2, -0.1, 0.3), hole_point(0, 2, 0);
+  const Relations expected{{Kind::Concentric, {0, 1}}, {Kind::EqualRadius, {1, 2}}};
+  int shared = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Cluster> clusters{noisy_sphere_cap(centre, 0.5, z, 1.2, 0.002, rng),
+                                        noisy_sphere_cap(centre, 0.53, -z, 1.0, 0.002, rng),
+                                        noisy_cylinder(x, hole_point, 0.53, 1, 0.002, rng)};
+    std::vector<Primitive> primitives{fitted_sphere(clusters[0], centre, 0.5),
+                                      fitted_sphere(clusters[1], centre, 0.53),
+                                      fitted_cylinder(clusters[2], x, hole_point, 0.53)};
+    const Relations relations = regularize(primitives, clusters);
+    ASSERT_TRUE(relations == expected || relations == Relations{expected[0]});
+    EXPECT_EQ(primitives[0].point, primitives[1].point);
+    if (relations != expected) continue;
+    ++shared;
+    EXPECT_EQ(primitives[1].radius, primitives[2].radius);
+    EXPECT_NE(primitives[0].radius, primitives[1].radius);
+    EXPECT_NEAR(primitives[1].radius, 0.53, 0.002);
+    EXPECT_LT((to_eigen(primitives[0].point) - centre).norm(), 0.002);
+    // The shared centre is the least squares of both caps: moving it only raises their residuals.
+    const std::vector<std::pair<Primitive, const Cluster*>> both{{primitives[0], &clusters[0]},
+                                                                 {primitives[1], &clusters[1]}};
+    const double best = spheres_objective(both);
+    for (const double h : {-1e-4, 1e-4})
+      for (int axis = 0; axis < 3; ++axis) {
+        std::vector<std::pair<Primitive, const Cluster*>> moved = both;
+        for (auto& [sphere, unused] : moved) sphere.point[axis] += h;
+        EXPECT_GT(spheres_objective(moved), best);
+      }
+  }
+  EXPECT_GE(shared, 9);
 }
 
 // The arcs of a revolved profile: three spheres centred on one line along the normal of a pair of

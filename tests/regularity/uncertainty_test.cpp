@@ -150,6 +150,68 @@ TEST(RegularityUncertainty, ASphereOnALineIsCalibratedAlongItAndInItsRadius) {
   expect_calibrated(sum, 5, "cylinder and sphere on its line");
 }
 
+TEST(RegularityUncertainty, ConcentricSpheresOnALineAreCalibrated) {
+  // A shaft closed by a ball end, and a socket around the ball with its centre: one position along
+  // the line for both spheres (x = (line, the centre's position along it, radii)).
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, 2, 2).normalized();
+  const auto [u, v] = detail::orthonormal_pair(axis);
+  std::mt19937_64 rng(17);
+  double sum = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Cluster shaft = noisy_cylinder(axis, Eigen::Vector3d::Zero(), 0.4, 2, 0.004, rng, 10);
+    const Cluster ball = noisy_sphere_cap(axis, 0.5, axis, 1.2, 0.004, rng);
+    const Cluster socket = noisy_sphere_cap(axis, 0.7, -axis, 0.8, 0.004, rng);
+    const Eigen::Vector2d line(0.005, -0.005);
+    const Eigen::Vector3d centre = 1.01 * axis;
+    const double radii[] = {0.41, 0.49, 0.72};
+    const detail::CylinderTerm terms[] = {{shaft.points, shaft.weights, 0, 0}};
+    const detail::SphereTerm spheres[] = {{ball.points, ball.weights, 1, 0, 0},
+                                          {socket.points, socket.weights, 2, 0, 0}};
+    const std::optional<detail::JointFit> fit = detail::fit_cylinders_and_spheres(
+        {&axis, 1}, {&line, 1}, {&centre, 1}, radii, terms, spheres, true);
+    ASSERT_TRUE(fit);
+    ASSERT_EQ(fit->covariance.rows(), 6);
+    ASSERT_EQ(fit->sphere_centres.size(), 1);
+    Eigen::Matrix<double, 6, 1> error;
+    error << fit->centres[0].x(), fit->centres[0].y(), fit->sphere_centres[0].dot(axis) - 1,
+        fit->radii[0] - 0.4, fit->radii[1] - 0.5, fit->radii[2] - 0.7;
+    sum += error.dot(fit->covariance.inverse() * error);
+    // The shared centre is on the line.
+    EXPECT_NEAR(u.dot(fit->sphere_centres[0]), fit->centres[0].x(), 1e-12);
+    EXPECT_NEAR(v.dot(fit->sphere_centres[0]), fit->centres[0].y(), 1e-12);
+  }
+  expect_calibrated(sum, 6, "concentric spheres on a cylinder's line");
+}
+
+TEST(RegularityUncertainty, SpheresOfOneCentreNeedOneLine) {
+  std::mt19937_64 rng(18);
+  const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  const Cluster shaft = noisy_cylinder(axis, Eigen::Vector3d::Zero(), 0.4, 2, 0, rng, 10);
+  const Cluster ball = noisy_sphere_cap(axis, 0.5, axis, 1.2, 0, rng);
+  const Cluster socket = noisy_sphere_cap(axis, 0.7, -axis, 0.8, 0, rng);
+  const Eigen::Vector2d line(0, 0);
+  const Eigen::Vector3d centres[] = {axis, axis};
+  const double radii[] = {0.4, 0.5, 0.7};
+  const detail::CylinderTerm terms[] = {{shaft.points, shaft.weights, 0, 0}};
+  // One centre, one sphere on the line and one free: no fit.
+  const detail::SphereTerm mixed[] = {{ball.points, ball.weights, 1, 0, 0},
+                                      {socket.points, socket.weights, 2, detail::kNoLine, 0}};
+  EXPECT_FALSE(detail::fit_cylinders_and_spheres({&axis, 1}, {&line, 1}, {centres, 1}, radii, terms,
+                                                 mixed, false));
+  // A centre no sphere has: no fit.
+  const detail::SphereTerm one_centre[] = {{ball.points, ball.weights, 1, 0, 0},
+                                           {socket.points, socket.weights, 2, 0, 0}};
+  EXPECT_FALSE(detail::fit_cylinders_and_spheres({&axis, 1}, {&line, 1}, centres, radii, terms,
+                                                 one_centre, false));
+  // On exact points, the shared centre and the radii are exact.
+  const std::optional<detail::JointFit> fit = detail::fit_cylinders_and_spheres(
+      {&axis, 1}, {&line, 1}, {centres, 1}, radii, terms, one_centre, false);
+  ASSERT_TRUE(fit);
+  EXPECT_LT((fit->sphere_centres[0] - axis).norm(), 1e-12);
+  EXPECT_NEAR(fit->radii[1], 0.5, 1e-12);
+  EXPECT_NEAR(fit->radii[2], 0.7, 1e-12);
+}
+
 TEST(RegularityUncertainty, JointFitsAreExactOnExactPoints) {
   // Three holes of one radius on three lines and a free sphere of that radius: one radius.
   const Eigen::Vector3d axis = Eigen::Vector3d(0, 1, 1).normalized();
