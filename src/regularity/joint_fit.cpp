@@ -394,6 +394,7 @@ std::optional<JointFit> fit_cylinders_and_spheres(std::span<const Eigen::Vector3
   // Every centre has spheres, and they put it on one line or none.
   std::vector<std::optional<std::size_t>> centre_line(sphere_centres.size());
   for (const SphereTerm& sphere : spheres) {
+    if (sphere.centre >= centre_line.size()) return std::nullopt;
     std::optional<std::size_t>& line = centre_line[sphere.centre];
     if (line && *line != sphere.line) return std::nullopt;
     line = sphere.line;

@@ -207,11 +207,12 @@ struct CoaxialFit {
 /// Gauss–Newton from `centres`, `sphere_centres` and `radii` (weighted steps, at most 30; the
 /// uncertainty, when asked for, from the unweighted residuals at the solution); a sphere centre on
 /// a line starts from its projection onto it. Nothing when it diverges, a radius ends non-positive,
-/// the points do not outnumber the parameters, a sphere centre has no sphere or its spheres put it
-/// on different lines. A step of one line and no sphere solves the normal equations whole;
-/// otherwise it eliminates each line's and each free centre's position first (a 2x2 or 3x3 block
-/// that couples only to its own terms' radii; a centre on a line, its position along it before the
-/// line's), so that a plate of n holes of one radius costs O(n), not O(n³).
+/// the points do not outnumber the parameters, a sphere names no centre of `sphere_centres`, or a
+/// centre has no sphere or its spheres put it on different lines. A step of one line and no sphere
+/// solves the normal equations whole; otherwise it eliminates each line's and each free centre's
+/// position first (a 2x2 or 3x3 block that couples only to its own terms' radii; a centre on a
+/// line, its position along it before the line's), so that a plate of n holes of one radius costs
+/// O(n), not O(n³).
 std::optional<JointFit> fit_cylinders_and_spheres(
     std::span<const Eigen::Vector3d> directions, std::span<const Eigen::Vector2d> centres,
     std::span<const Eigen::Vector3d> sphere_centres, std::span<const double> radii,

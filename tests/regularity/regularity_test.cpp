@@ -609,8 +609,8 @@ TEST(Regularity, ABallAndItsSocketOnAShaftAxisShareOneCentreOnIt) {
         fitted_sphere(clusters[2], centre, 0.45), fitted_sphere(clusters[3], cap_centre, 0.27)};
     const Relations relations = regularize(primitives, clusters);
     ASSERT_FALSE(relations.empty());
-    const auto& [kind, line] = relations[0];
-    ASSERT_EQ(kind, Kind::Coaxial);
+    ASSERT_EQ(relations[0].first, Kind::Coaxial);
+    const std::vector<std::size_t>& line = relations[0].second;
     const auto on_line = [&](std::size_t k) { return std::ranges::count(line, k) == 1; };
     for (const std::size_t k : line) {
       if (k == 0) continue;  // the shaft

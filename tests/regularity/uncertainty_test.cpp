@@ -198,6 +198,10 @@ TEST(RegularityUncertainty, SpheresOfOneCentreNeedOneLine) {
                                       {socket.points, socket.weights, 2, detail::kNoLine, 0}};
   EXPECT_FALSE(detail::fit_cylinders_and_spheres({&axis, 1}, {&line, 1}, {centres, 1}, radii, terms,
                                                  mixed, false));
+  // A centre that is not there: no fit.
+  const detail::SphereTerm beyond[] = {{ball.points, ball.weights, 1, 0, 1}};
+  EXPECT_FALSE(detail::fit_cylinders_and_spheres({&axis, 1}, {&line, 1}, {centres, 1}, radii, terms,
+                                                 beyond, false));
   // A centre no sphere has: no fit.
   const detail::SphereTerm one_centre[] = {{ball.points, ball.weights, 1, 0, 0},
                                            {socket.points, socket.weights, 2, 0, 0}};
