@@ -84,6 +84,63 @@ std::vector<std::vector<std::size_t>> places_along(const SettledSurfaces& settle
   return groups;
 }
 
+// Line l fitted with the surfaces `cylinders` and `spheres` on it (indices into
+// settled.surfaces), each with its own radius, sphere j on centre centre_of[j], started from
+// centres[centre_of[j]]: fit_cylinders_and_spheres() with its covariance.
+std::optional<JointFit> fit_line(const SettledSurfaces& settled, std::size_t l,
+                                 std::span<const std::size_t> cylinders,
+                                 std::span<const std::size_t> spheres,
+                                 std::span<const std::size_t> centre_of,
+                                 std::span<const Eigen::Vector3d> centres,
+                                 const std::vector<std::vector<Vec3>>& points,
+                                 const std::vector<std::vector<double>>& weights) {
+  std::vector<CylinderTerm> terms;
+  std::vector<SphereTerm> sphere_terms;
+  std::vector<double> radii;
+  for (const std::size_t k : cylinders) {
+    const std::size_t c = settled.surfaces[k].cluster;
+    terms.push_back({points[c], weights[c], 0, radii.size()});
+    radii.push_back(settled.surfaces[k].radius);
+  }
+  for (std::size_t j = 0; j < spheres.size(); ++j) {
+    const std::size_t c = settled.surfaces[spheres[j]].cluster;
+    sphere_terms.push_back({points[c], weights[c], radii.size(), 0, centre_of[j]});
+    radii.push_back(settled.surfaces[spheres[j]].radius);
+  }
+  const SettledSurfaces::Line& line = settled.lines[l];
+  return fit_cylinders_and_spheres({&line.direction, 1}, {&line.centre, 1}, centres, radii, terms,
+                                   sphere_terms, true);
+}
+
+// Writes fit_line()'s `fit` back: the line, its cylinders and its spheres (each then on line l),
+// with their radii's variances, and their primitives.
+void write_line(SettledSurfaces& settled, std::size_t l, std::span<const std::size_t> cylinders,
+                std::span<const std::size_t> spheres, std::span<const std::size_t> centre_of,
+                const JointFit& fit, std::vector<Primitive>& primitives) {
+  SettledSurfaces::Line& line = settled.lines[l];
+  const Eigen::Index first_radius = 2 + static_cast<Eigen::Index>(fit.sphere_centres.size());
+  line.centre = fit.centres[0];
+  line.covariance = fit.covariance.topLeftCorner<2, 2>();
+  for (std::size_t j = 0; j < cylinders.size() + spheres.size(); ++j) {
+    const bool is_sphere = j >= cylinders.size();
+    SettledSurfaces::Surface& surface =
+        settled.surfaces[is_sphere ? spheres[j - cylinders.size()] : cylinders[j]];
+    const Eigen::Index q = static_cast<Eigen::Index>(j);
+    surface.radius = fit.radii[j];
+    surface.radius_variance = fit.covariance(first_radius + q, first_radius + q);
+    surface.rms = fit.rms[j];
+    Primitive& primitive = primitives[surface.cluster];
+    if (is_sphere) {
+      surface.line = l;
+      settled.centres[surface.centre] = fit.sphere_centres[centre_of[j - cylinders.size()]];
+      primitive.point = to_vec3(settled.centres[surface.centre]);
+      primitive.radius = surface.radius;
+    } else {
+      place_cylinder(primitive, line.direction, line.centre, surface.radius);
+    }
+  }
+}
+
 // Refits line l with its cylinders and the spheres `spheres` (indices into settled.surfaces) on
 // it, each sphere one parameter along it: while any member's residual sum rises by more than the
 // significance, corrected for the number of members, allows, the sphere whose rise is largest
@@ -97,28 +154,15 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
                     const std::vector<std::vector<double>>& weights,
                     std::vector<Relation>& relations, std::size_t fewest = 1) {
   std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
-  SettledSurfaces::Line& line = settled.lines[l];
   std::optional<JointFit> fit;
-  std::vector<CylinderTerm> terms;
-  std::vector<SphereTerm> sphere_terms;
+  std::vector<std::size_t> own_centre;  // a centre each
   while (spheres.size() >= fewest) {
-    terms.clear();
-    sphere_terms.clear();
-    std::vector<double> radii;
     std::vector<Eigen::Vector3d> centres;
-    for (const std::size_t k : cylinders) {
-      const std::size_t c = surfaces[k].cluster;
-      terms.push_back({points[c], weights[c], 0, radii.size()});
-      radii.push_back(surfaces[k].radius);
-    }
-    for (const std::size_t k : spheres) {
-      const std::size_t c = surfaces[k].cluster;
-      sphere_terms.push_back({points[c], weights[c], radii.size(), 0, sphere_terms.size()});
-      radii.push_back(surfaces[k].radius);
-      centres.push_back(settled.centres[surfaces[k].centre]);
-    }
-    fit = fit_cylinders_and_spheres({&line.direction, 1}, {&line.centre, 1}, centres, radii, terms,
-                                    sphere_terms, true);
+    centres.reserve(spheres.size());
+    for (const std::size_t k : spheres) centres.push_back(settled.centres[surfaces[k].centre]);
+    own_centre.resize(spheres.size());
+    std::iota(own_centre.begin(), own_centre.end(), 0);
+    fit = fit_line(settled, l, cylinders, spheres, own_centre, centres, points, weights);
     const std::size_t members = cylinders.size() + spheres.size();
     const double bound = family_significance(options.significance, members);
     double worst_excess = 1, worst_sphere_excess = -std::numeric_limits<double>::infinity();
@@ -143,30 +187,12 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
     fit.reset();
   }
   if (!fit) return false;
-  // Written back: the line, its cylinders and its spheres, with their radii's variances.
-  const Eigen::Index first_radius = 2 + static_cast<Eigen::Index>(spheres.size());
-  line.centre = fit->centres[0];
-  line.covariance = fit->covariance.topLeftCorner<2, 2>();
+  write_line(settled, l, cylinders, spheres, own_centre, *fit, primitives);
   std::vector<std::size_t> members;
-  for (std::size_t j = 0; j < cylinders.size() + spheres.size(); ++j) {
-    const bool is_sphere = j >= cylinders.size();
-    SettledSurfaces::Surface& surface =
-        surfaces[is_sphere ? spheres[j - cylinders.size()] : cylinders[j]];
-    const Eigen::Index q = static_cast<Eigen::Index>(j);
-    surface.radius = fit->radii[j];
-    surface.radius_variance = fit->covariance(first_radius + q, first_radius + q);
-    surface.rms = fit->rms[j];
-    Primitive& primitive = primitives[surface.cluster];
-    if (is_sphere) {
-      surface.line = l;
-      settled.centres[surface.centre] = fit->sphere_centres[j - cylinders.size()];
-      primitive.point = to_vec3(settled.centres[surface.centre]);
-      primitive.radius = surface.radius;
-    } else {
-      place_cylinder(primitive, line.direction, line.centre, surface.radius);
-    }
-    members.push_back(surface.cluster);
-  }
+  members.reserve(cylinders.size() + spheres.size());
+  for (const std::size_t k : cylinders) members.push_back(surfaces[k].cluster);
+  for (const std::size_t k : spheres) members.push_back(surfaces[k].cluster);
+  SettledSurfaces::Line& line = settled.lines[l];
   if (line.coaxial == kNoRelation) {
     line.coaxial = relations.size();
     relations.push_back({Relation::Kind::Coaxial, {}, {}});
@@ -477,82 +503,51 @@ void share_centres_on_line(SettledSurfaces& settled, std::size_t l,
                            const std::vector<std::vector<double>>& weights,
                            std::vector<Relation>& relations) {
   std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
-  SettledSurfaces::Line& line = settled.lines[l];
-  std::vector<std::size_t> members;  // the line's cylinders, then its spheres
-  for (const bool sphere : {false, true})
-    for (std::size_t k = 0; k < surfaces.size(); ++k)
-      if (surfaces[k].line == l && surfaces[k].sphere == sphere) members.push_back(k);
-  std::vector<CylinderTerm> terms;
-  std::vector<SphereTerm> spheres;
+  std::vector<std::size_t> cylinders, spheres;
+  for (std::size_t k = 0; k < surfaces.size(); ++k)
+    if (surfaces[k].line == l) (surfaces[k].sphere ? spheres : cylinders).push_back(k);
   std::optional<JointFit> fit;
+  std::vector<std::size_t> centre_of(spheres.size());
   while (true) {
     std::erase_if(sets, [](const std::vector<std::size_t>& set) { return set.size() < 2; });
     if (sets.empty()) return;
-    terms.clear();
-    spheres.clear();
-    std::vector<double> radii;
+    // The sets' centres first, started from their first members', then one per other sphere.
     std::vector<Eigen::Vector3d> centres;
-    std::map<std::size_t, std::size_t> centre_of;  // a set's surfaces: their shared centre's index
+    std::map<std::size_t, std::size_t> set_centre;  // a set's surfaces: their centre's index
     for (const std::vector<std::size_t>& set : sets) {
-      for (const std::size_t k : set) centre_of[k] = centres.size();
+      for (const std::size_t k : set) set_centre[k] = centres.size();
       centres.push_back(settled.centres[surfaces[set[0]].centre]);
     }
-    for (const std::size_t k : members) {
-      const std::size_t c = surfaces[k].cluster;
-      if (surfaces[k].sphere) {
-        const auto shared = centre_of.find(k);
-        std::size_t centre = centres.size();
-        if (shared != centre_of.end())
-          centre = shared->second;
-        else
-          centres.push_back(settled.centres[surfaces[k].centre]);
-        spheres.push_back({points[c], weights[c], radii.size(), 0, centre});
-      } else {
-        terms.push_back({points[c], weights[c], 0, radii.size()});
-      }
-      radii.push_back(surfaces[k].radius);
+    for (std::size_t j = 0; j < spheres.size(); ++j) {
+      const auto shared = set_centre.find(spheres[j]);
+      centre_of[j] = shared != set_centre.end() ? shared->second : centres.size();
+      if (shared == set_centre.end())
+        centres.push_back(settled.centres[surfaces[spheres[j]].centre]);
     }
-    fit = fit_cylinders_and_spheres({&line.direction, 1}, {&line.centre, 1}, centres, radii, terms,
-                                    spheres, true);
+    fit = fit_line(settled, l, cylinders, spheres, centre_of, centres, points, weights);
     if (!fit) return;
-    const double bound = family_significance(options.significance, members.size());
+    const std::size_t members = cylinders.size() + spheres.size();
+    const double bound = family_significance(options.significance, members);
     double worst_excess = 1, worst_shared_excess = -std::numeric_limits<double>::infinity();
     std::size_t worst = 0;
-    for (std::size_t j = 0; j < members.size(); ++j) {
-      const SettledSurfaces::Surface& surface = surfaces[members[j]];
+    for (std::size_t j = 0; j < members; ++j) {
+      const bool is_sphere = j >= cylinders.size();
+      const std::size_t k = is_sphere ? spheres[j - cylinders.size()] : cylinders[j];
+      const SettledSurfaces::Surface& surface = surfaces[k];
       // On the line a sphere has 2 parameters of its own, a cylinder 3 (as worst_member counts).
       const double excess =
           residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(), bound * bound,
-                          surface.sphere ? 2 : 3, options.length_tolerance);
+                          is_sphere ? 2 : 3, options.length_tolerance);
       worst_excess = std::max(worst_excess, excess);
-      if (centre_of.contains(members[j]) && excess > worst_shared_excess) {
+      if (set_centre.contains(k) && excess > worst_shared_excess) {
         worst_shared_excess = excess;
-        worst = members[j];
+        worst = k;
       }
     }
     if (!(worst_excess > 1)) break;
     for (std::vector<std::size_t>& set : sets) std::erase(set, worst);
   }
-  // Written back: the line, its cylinders and its spheres, with their radii's variances.
-  const Eigen::Index first_radius = 2 + static_cast<Eigen::Index>(fit->sphere_centres.size());
-  line.centre = fit->centres[0];
-  line.covariance = fit->covariance.topLeftCorner<2, 2>();
-  for (std::size_t j = 0; j < members.size(); ++j) {
-    SettledSurfaces::Surface& surface = surfaces[members[j]];
-    const Eigen::Index q = static_cast<Eigen::Index>(j);
-    surface.radius = fit->radii[j];
-    surface.radius_variance = fit->covariance(first_radius + q, first_radius + q);
-    surface.rms = fit->rms[j];
-    Primitive& primitive = primitives[surface.cluster];
-    if (!surface.sphere) {
-      place_cylinder(primitive, line.direction, line.centre, surface.radius);
-      continue;
-    }
-    const SphereTerm& term = spheres[j - terms.size()];
-    settled.centres[surface.centre] = fit->sphere_centres[term.centre];
-    primitive.point = to_vec3(settled.centres[surface.centre]);
-    primitive.radius = surface.radius;
-  }
+  write_line(settled, l, cylinders, spheres, centre_of, *fit, primitives);
   for (const std::vector<std::size_t>& set : sets) {
     Relation& concentric = relations.emplace_back(Relation{Relation::Kind::Concentric, {}, {}});
     for (const std::size_t k : set) {
