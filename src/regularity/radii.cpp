@@ -22,65 +22,127 @@ namespace primseg::detail {
 
 namespace {
 
-// Whether a 2D position of covariance `covariance` is known to within `bound` at the
-// significance, in its worst direction (the interval rule of the spheres' centres).
-bool known_within(const Eigen::Matrix2d& covariance, double significance, double bound) {
-  const double half_difference = (covariance(0, 0) - covariance(1, 1)) / 2;
-  const double largest =
-      (covariance(0, 0) + covariance(1, 1)) / 2 + std::hypot(half_difference, covariance(0, 1));
-  return significance * std::sqrt(largest) <= bound;
+// The largest variance of a position of covariance `covariance`: in its worst direction.
+template <int D>
+double largest_variance(const Eigen::Matrix<double, D, D>& covariance) {
+  if constexpr (D == 1) {
+    return covariance(0, 0);
+  } else if constexpr (D == 2) {
+    const double half_difference = (covariance(0, 0) - covariance(1, 1)) / 2;
+    return (covariance(0, 0) + covariance(1, 1)) / 2 +
+           std::hypot(half_difference, covariance(0, 1));
+  } else {
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>>(covariance,
+                                                                      Eigen::EigenvaluesOnly)
+        .eigenvalues()(D - 1);
+  }
+}
+
+// Whether a position of covariance `covariance` is known to within `bound` at the significance,
+// in its worst direction (the interval rule of the spheres' centres).
+template <int D>
+bool known_within(const Eigen::Matrix<double, D, D>& covariance, double significance,
+                  double bound) {
+  return significance * std::sqrt(largest_variance(covariance)) <= bound;
+}
+
+// Whether the offset `offset` of covariance `covariance` is within the χ² bound `bound`.
+template <int D>
+bool within_chi_square(const Eigen::Matrix<double, D, 1>& offset,
+                       const Eigen::Matrix<double, D, D>& covariance, double bound) {
+  if constexpr (D == 1)
+    return offset(0) * offset(0) <= bound * covariance(0, 0);
+  else
+    return offset.dot(covariance.ldlt().solve(offset)) <= bound;
+}
+
+// A sphere's centre in D coordinates (along a line, across one, in space), for pool_centres().
+template <int D>
+struct PlacedCentre {
+  std::size_t surface = 0;  // index into settled.surfaces
+  Eigen::Matrix<double, D, 1> position;
+  Eigen::Matrix<double, D, D> covariance;
+};
+
+// A set of spheres whose centres agree, and their information-weighted position.
+template <int D>
+struct CentreSet {
+  std::vector<std::size_t> surfaces;  // indices into settled.surfaces, the first best located
+  PooledPosition<D> pooled;
+};
+
+// The spheres `placed` in sets whose centres are one position within the significance. Best
+// located first (the least trace of covariance), each joins the first set whose pooled position
+// it is within max_radius_difference of its radius of and, with the covariance of both plus
+// `extra(first, k)` (first the set's first surface, k its own), within the χ² bound of D degrees
+// of freedom, or within the length tolerance. A centre whose significance interval is wider than
+// that radius bound (the interval rule of the centres) is a set of its own. Returns every set, in
+// the order they formed, those of one centre known less well last.
+template <int D, class ExtraCovariance>
+std::vector<CentreSet<D>> pool_centres(const SettledSurfaces& settled,
+                                       std::vector<PlacedCentre<D>> placed,
+                                       const RegularityOptions& options,
+                                       const ExtraCovariance& extra) {
+  const double bound = chi_square_bound(options.significance, D);
+  const auto largest_offset = [&](std::size_t k) {
+    return options.max_radius_difference * settled.surfaces[k].radius;
+  };
+  std::vector<CentreSet<D>> unplaced;
+  std::erase_if(placed, [&](const PlacedCentre<D>& sphere) {
+    if (known_within(sphere.covariance, options.significance, largest_offset(sphere.surface)))
+      return false;
+    unplaced.emplace_back().surfaces.push_back(sphere.surface);
+    return true;
+  });
+  std::stable_sort(placed.begin(), placed.end(),
+                   [](const PlacedCentre<D>& a, const PlacedCentre<D>& b) {
+                     return a.covariance.trace() < b.covariance.trace();
+                   });
+  std::vector<CentreSet<D>> sets;
+  for (const PlacedCentre<D>& sphere : placed) {
+    std::size_t joined = sets.size();
+    for (std::size_t s = 0; s < sets.size() && joined == sets.size(); ++s) {
+      const Eigen::Matrix<double, D, 1> offset = sphere.position - sets[s].pooled.centre();
+      // Most pairs end here, before any covariance.
+      if (!(offset.norm() <= largest_offset(sphere.surface))) continue;
+      const Eigen::Matrix<double, D, D> combined = sphere.covariance + sets[s].pooled.covariance() +
+                                                   extra(sets[s].surfaces[0], sphere.surface);
+      if (within_chi_square(offset, combined, bound) ||
+          within_tolerance(offset.norm(), options.length_tolerance))
+        joined = s;
+    }
+    if (joined == sets.size()) sets.emplace_back();
+    sets[joined].surfaces.push_back(sphere.surface);
+    sets[joined].pooled.add(sphere.position, sphere.covariance);
+  }
+  sets.insert(sets.end(), unplaced.begin(), unplaced.end());
+  return sets;
+}
+
+// No covariance beyond the centres' own.
+template <int D>
+auto no_extra_covariance() {
+  return [](std::size_t, std::size_t) { return Eigen::Matrix<double, D, D>::Zero().eval(); };
 }
 
 // The spheres `spheres` (indices into settled.surfaces) grouped by their places along
-// `direction`: best located first, each joins the first group whose pooled place
-// (information-weighted) it is within the significance of (the χ² bound of one degree of freedom,
-// with both variances, each sphere's that of its own fit's centre along the direction) and within
-// max_radius_difference of its radius. A place whose significance interval is wider than that
-// (the interval rule of the centres) is a group of its own. Returns every group, in the order
-// they formed, those of one place known less well last.
+// `direction` (pool_centres() of one degree of freedom, each place's variance that of its own
+// fit's centre along the direction).
 std::vector<std::vector<std::size_t>> places_along(const SettledSurfaces& settled,
                                                    std::span<const std::size_t> spheres,
                                                    const Eigen::Vector3d& direction,
                                                    const RegularityOptions& options) {
-  const double bound = chi_square_bound(options.significance, 1);
-  struct Placed {
-    std::size_t surface = 0;
-    double place = 0, variance = 0;
-  };
-  std::vector<Placed> placed;
-  std::vector<std::vector<std::size_t>> unplaced;
+  std::vector<PlacedCentre<1>> placed;
   for (const std::size_t k : spheres) {
-    const SettledSurfaces::Surface& sphere = settled.surfaces[k];
-    const double variance = direction.dot(settled.centre_covariances[sphere.centre] * direction);
-    if (options.significance * std::sqrt(variance) <= options.max_radius_difference * sphere.radius)
-      placed.push_back({k, direction.dot(settled.centres[sphere.centre]), variance});
-    else
-      unplaced.push_back({k});
+    const std::size_t centre = settled.surfaces[k].centre;
+    placed.push_back({k, Eigen::Matrix<double, 1, 1>(direction.dot(settled.centres[centre])),
+                      Eigen::Matrix<double, 1, 1>(
+                          direction.dot(settled.centre_covariances[centre] * direction))});
   }
-  std::stable_sort(placed.begin(), placed.end(),
-                   [](const Placed& a, const Placed& b) { return a.variance < b.variance; });
   std::vector<std::vector<std::size_t>> groups;
-  std::vector<PooledPosition<1>> pooled;
-  for (const Placed& sphere : placed) {
-    const double largest_offset =
-        options.max_radius_difference * settled.surfaces[sphere.surface].radius;
-    std::size_t joined = groups.size();
-    for (std::size_t g = 0; g < groups.size() && joined == groups.size(); ++g) {
-      const double offset = sphere.place - pooled[g].centre()(0);
-      if (!(std::abs(offset) <= largest_offset)) continue;
-      if (offset * offset <= bound * (sphere.variance + pooled[g].covariance()(0, 0)) ||
-          within_tolerance(std::abs(offset), options.length_tolerance))
-        joined = g;
-    }
-    if (joined == groups.size()) {
-      groups.emplace_back();
-      pooled.emplace_back();
-    }
-    groups[joined].push_back(sphere.surface);
-    pooled[joined].add(Eigen::Matrix<double, 1, 1>(sphere.place),
-                       Eigen::Matrix<double, 1, 1>(sphere.variance));
-  }
-  groups.insert(groups.end(), unplaced.begin(), unplaced.end());
+  for (CentreSet<1>& set :
+       pool_centres(settled, std::move(placed), options, no_extra_covariance<1>()))
+    groups.push_back(std::move(set.surfaces));
   return groups;
 }
 
@@ -282,18 +344,6 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights,
                      std::vector<Relation>& relations) {
-  const double bound = chi_square_bound(options.significance, 2);
-  struct Placed {
-    std::size_t surface = 0;
-    Eigen::Vector2d position;
-    Eigen::Matrix2d covariance;
-    double height = 0;
-  };
-  struct Set {
-    std::vector<std::size_t> surfaces;
-    double height = 0;  // its first member's
-    PooledCentre pooled;
-  };
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (refitted[g].empty()) continue;
     const Eigen::Vector3d& direction = groups[g].direction;
@@ -301,41 +351,22 @@ void line_up_spheres(SettledSurfaces& settled, const std::vector<DirectionGroup>
     Eigen::Matrix<double, 2, 3> frame;
     frame << u.transpose(), v.transpose();
     const Eigen::Matrix2d tilt = tilt_in_frame(direction, groups[g].covariance);
-    std::vector<Placed> placed;
+    std::vector<PlacedCentre<2>> placed;
     for (std::size_t k = 0; k < settled.surfaces.size(); ++k) {
       const SettledSurfaces::Surface& sphere = settled.surfaces[k];
       if (!sphere.sphere || sphere.line != kNoLine) continue;
-      const Eigen::Vector3d& centre = settled.centres[sphere.centre];
-      const Eigen::Matrix2d covariance =
-          frame * settled.centre_covariances[sphere.centre] * frame.transpose();
-      if (!known_within(covariance, options.significance,
-                        options.max_radius_difference * sphere.radius))
-        continue;
-      placed.push_back({k, frame * centre, covariance, direction.dot(centre)});
+      placed.push_back({k, frame * settled.centres[sphere.centre],
+                        frame * settled.centre_covariances[sphere.centre] * frame.transpose()});
     }
-    std::stable_sort(placed.begin(), placed.end(), [](const Placed& a, const Placed& b) {
-      return a.covariance.trace() < b.covariance.trace();
-    });
-    std::vector<Set> sets;
-    for (const Placed& sphere : placed) {
-      const double largest_offset =
-          options.max_radius_difference * settled.surfaces[sphere.surface].radius;
-      std::size_t joined = sets.size();
-      for (std::size_t s = 0; s < sets.size() && joined == sets.size(); ++s) {
-        const Eigen::Vector2d offset = sphere.position - sets[s].pooled.centre();
-        if (!(offset.norm() <= largest_offset)) continue;  // most pairs, before any covariance
-        const double height = sphere.height - sets[s].height;
-        const Eigen::Matrix2d combined =
-            sphere.covariance + sets[s].pooled.covariance() + height * height * tilt;
-        if (offset.dot(combined.ldlt().solve(offset)) <= bound ||
-            within_tolerance(offset.norm(), options.length_tolerance))
-          joined = s;
-      }
-      if (joined == sets.size()) sets.emplace_back().height = sphere.height;
-      sets[joined].surfaces.push_back(sphere.surface);
-      sets[joined].pooled.add(sphere.position, sphere.covariance);
-    }
-    for (Set& set : sets) {
+    const auto height = [&](std::size_t k) {
+      return direction.dot(settled.centres[settled.surfaces[k].centre]);
+    };
+    // The direction's tilt over the distance along it from the set's first member.
+    const auto tilted = [&](std::size_t first, std::size_t k) -> Eigen::Matrix2d {
+      const double apart = height(k) - height(first);
+      return apart * apart * tilt;
+    };
+    for (const CentreSet<2>& set : pool_centres(settled, std::move(placed), options, tilted)) {
       // Three places along the line at least: spheres of one place (fragments of one sphere, a
       // ball and its socket) are on a line of any direction, and concentric instead.
       if (set.surfaces.size() < kFewestSpheresOnALine ||
@@ -565,49 +596,17 @@ void make_concentric(SettledSurfaces& settled, const RegularityOptions& options,
                      const std::vector<std::vector<Vec3>>& points,
                      const std::vector<std::vector<double>>& weights,
                      std::vector<Relation>& relations) {
-  // A centre's offset is three normals: the bound they exceed as rarely as one the significance.
-  const double bound = chi_square_bound(options.significance, 3);
-  std::vector<std::size_t> placed;
+  std::vector<PlacedCentre<3>> placed;
   for (std::size_t k = 0; k < settled.surfaces.size(); ++k) {
     const SettledSurfaces::Surface& sphere = settled.surfaces[k];
-    if (!sphere.sphere || sphere.line != kNoLine) continue;
-    const Eigen::Matrix3d& covariance = settled.centre_covariances[sphere.centre];
-    const double largest =
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance, Eigen::EigenvaluesOnly)
-            .eigenvalues()(2);
-    if (options.significance * std::sqrt(largest) <= options.max_radius_difference * sphere.radius)
-      placed.push_back(k);
+    if (sphere.sphere && sphere.line == kNoLine)
+      placed.push_back(
+          {k, settled.centres[sphere.centre], settled.centre_covariances[sphere.centre]});
   }
-  const auto spread = [&](std::size_t k) {
-    return settled.centre_covariances[settled.surfaces[k].centre].trace();
-  };
-  std::stable_sort(placed.begin(), placed.end(),
-                   [&](std::size_t a, std::size_t b) { return spread(a) < spread(b); });
-  std::vector<std::vector<std::size_t>> sets;
-  std::vector<PooledPosition<3>> pooled;
-  for (const std::size_t k : placed) {
-    const SettledSurfaces::Surface& sphere = settled.surfaces[k];
-    const Eigen::Vector3d& centre = settled.centres[sphere.centre];
-    const Eigen::Matrix3d& covariance = settled.centre_covariances[sphere.centre];
-    std::size_t joined = sets.size();
-    for (std::size_t s = 0; s < sets.size() && joined == sets.size(); ++s) {
-      const Eigen::Vector3d offset = centre - pooled[s].centre();
-      if (!(offset.norm() <= options.max_radius_difference * sphere.radius)) continue;
-      const Eigen::Matrix3d combined = covariance + pooled[s].covariance();
-      if (offset.dot(combined.ldlt().solve(offset)) <= bound ||
-          within_tolerance(offset.norm(), options.length_tolerance))
-        joined = s;
-    }
-    if (joined == sets.size()) {
-      sets.emplace_back();
-      pooled.emplace_back();
-    }
-    sets[joined].push_back(k);
-    pooled[joined].add(centre, covariance);
-  }
-  for (const std::vector<std::size_t>& set : sets)
-    if (set.size() >= 2)
-      settle_concentric(settled, set, options, primitives, points, weights, relations);
+  for (const CentreSet<3>& set :
+       pool_centres(settled, std::move(placed), options, no_extra_covariance<3>()))
+    if (set.surfaces.size() >= 2)
+      settle_concentric(settled, set.surfaces, options, primitives, points, weights, relations);
   std::vector<std::vector<std::size_t>> spheres_on(settled.lines.size());
   for (std::size_t k = 0; k < settled.surfaces.size(); ++k)
     if (settled.surfaces[k].sphere && settled.surfaces[k].line != kNoLine)

@@ -269,7 +269,13 @@ struct PooledPosition {
     information += own;
     weighted += own * position;
   }
-  Vector centre() const { return information.ldlt().solve(weighted); }
+  Vector centre() const {
+    // One dimension divides: g++ 12 takes Eigen's 1x1 LDLT for an out-of-bounds access.
+    if constexpr (D == 1)
+      return weighted / information(0, 0);
+    else
+      return information.ldlt().solve(weighted);
+  }
   Matrix covariance() const { return information.inverse(); }
 };
 
