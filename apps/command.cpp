@@ -263,8 +263,8 @@ void add_relation_options(CLI::App& command, RelationChoice& choice) {
                   "an axis farther than this fraction of its radius from it, or known less well, "
                   "nor a cylinder made tangent to a plane (a parallel cylinder) when its axis's "
                   "distance from it differs from its radius (their radii's sum or difference) by "
-                  "more (in (0, 1); lower it for fewer chance "
-                  "relations on freeform parts)")
+                  "more, or when the tangent refit moves its radius by more (in (0, 1); lower it "
+                  "for fewer chance relations on freeform parts)")
       ->check(number_range(0, 1, "a fraction in (0, 1) of the larger radius"))
       ->capture_default_str();
 }

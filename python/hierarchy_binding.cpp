@@ -71,7 +71,8 @@ const char* kRelationArguments =
   within relation_significance standard deviations (> 0), never beyond max_relation_angle degrees
   (in (0, 90)) or radii more than max_radius_difference apart (in (0, 1); a sphere's centre is
   put on an axis no farther than that fraction of its radius from it, and a cylinder made tangent
-  to a plane or a parallel cylinder no farther than that fraction of its radius from tangent).
+  to a plane or a parallel cylinder no farther than that fraction of its radius from tangent,
+  nor its radius moved by more by the tangent refit).
   relation_angle_tolerance (degrees, at least 0 and below max_relation_angle) and
   relation_length_tolerance (input units, >= 0, or a string "L%": L percent of the bounding-box
   diagonal, as the CLI's --relation-length-tolerance L%; RelationOptions angle_tolerance_degrees,

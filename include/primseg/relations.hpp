@@ -122,7 +122,8 @@ struct RelationOptions {
   /// radius bounds its centre's distance from a cylinder's axis, and how well that distance must
   /// be known, for the sphere to be centred on the axis; and of a cylinder's radius, the gap
   /// between it and its axis's distance from a plane (or from a parallel cylinder's axis, against
-  /// the sum or the difference of their radii), for the cylinder to be made tangent to it.
+  /// the sum or the difference of their radii), for the cylinder to be made tangent to it, and
+  /// how far the tangent refit may move each radius on the cylinder's line.
   double max_radius_difference = 0.05;
   /// The directions and the refits use each cluster's inlier vertices: those within this many
   /// robust deviations (1.4826 × the median distance) of its primitive. > 0.
