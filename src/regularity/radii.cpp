@@ -203,6 +203,42 @@ void write_line(SettledSurfaces& settled, std::size_t l, std::span<const std::si
   }
 }
 
+// How line l's fit `fit` (none: it failed) explains its members, `cylinders` then `spheres`
+// (indices into settled.surfaces), against their own fits: the largest residual_excess() at the
+// significance corrected for their number (at least 1; infinite without a fit), a cylinder's own
+// fit having 3 parameters and a sphere's `sphere_parameters`, and which sphere (an index into
+// `spheres`) of those `may_leave` accepts has the largest.
+struct LineExcess {
+  double worst = 1;
+  std::size_t worst_sphere = 0;
+};
+template <class MayLeave>
+LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size_t> cylinders,
+                       std::span<const std::size_t> spheres, const JointFit* fit,
+                       int sphere_parameters, const RegularityOptions& options,
+                       const std::vector<std::vector<Vec3>>& points, const MayLeave& may_leave) {
+  const std::size_t members = cylinders.size() + spheres.size();
+  const double bound = family_significance(options.significance, members);
+  LineExcess result;
+  double worst_sphere_excess = -std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < members; ++j) {
+    const bool is_sphere = j >= cylinders.size();
+    const SettledSurfaces::Surface& surface =
+        settled.surfaces[is_sphere ? spheres[j - cylinders.size()] : cylinders[j]];
+    const double excess =
+        fit ? residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(),
+                              bound * bound, is_sphere ? sphere_parameters : 3,
+                              options.length_tolerance)
+            : std::numeric_limits<double>::infinity();
+    result.worst = std::max(result.worst, excess);
+    if (is_sphere && may_leave(j - cylinders.size()) && excess > worst_sphere_excess) {
+      worst_sphere_excess = excess;
+      result.worst_sphere = j - cylinders.size();
+    }
+  }
+  return result;
+}
+
 // Refits line l with its cylinders and the spheres `spheres` (indices into settled.surfaces) on
 // it, each sphere one parameter along it: while any member's residual sum rises by more than the
 // significance, corrected for the number of members, allows, the sphere whose rise is largest
@@ -225,27 +261,11 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
     own_centre.resize(spheres.size());
     std::iota(own_centre.begin(), own_centre.end(), 0);
     fit = fit_line(settled, l, cylinders, spheres, own_centre, centres, points, weights);
-    const std::size_t members = cylinders.size() + spheres.size();
-    const double bound = family_significance(options.significance, members);
-    double worst_excess = 1, worst_sphere_excess = -std::numeric_limits<double>::infinity();
-    std::size_t worst_sphere = 0;
-    for (std::size_t j = 0; j < members; ++j) {
-      const bool is_sphere = j >= cylinders.size();
-      const SettledSurfaces::Surface& surface =
-          surfaces[is_sphere ? spheres[j - cylinders.size()] : cylinders[j]];
-      // A sphere's own fit has 4 parameters, a cylinder's (on its direction) 3.
-      const double excess =
-          fit ? residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(),
-                                bound * bound, is_sphere ? 4 : 3, options.length_tolerance)
-              : std::numeric_limits<double>::infinity();
-      worst_excess = std::max(worst_excess, excess);
-      if (is_sphere && excess > worst_sphere_excess) {
-        worst_sphere_excess = excess;
-        worst_sphere = j - cylinders.size();
-      }
-    }
-    if (!(worst_excess > 1)) break;
-    spheres.erase(spheres.begin() + static_cast<std::ptrdiff_t>(worst_sphere));
+    // A sphere's own fit has 4 parameters; any may leave.
+    const LineExcess excess = line_excess(settled, cylinders, spheres, fit ? &*fit : nullptr, 4,
+                                          options, points, [](std::size_t) { return true; });
+    if (!(excess.worst > 1)) break;
+    spheres.erase(spheres.begin() + static_cast<std::ptrdiff_t>(excess.worst_sphere));
     fit.reset();
   }
   if (!fit) return false;
@@ -557,26 +577,13 @@ void share_centres_on_line(SettledSurfaces& settled, std::size_t l,
     }
     fit = fit_line(settled, l, cylinders, spheres, centre_of, centres, points, weights);
     if (!fit) return;
-    const std::size_t members = cylinders.size() + spheres.size();
-    const double bound = family_significance(options.significance, members);
-    double worst_excess = 1, worst_shared_excess = -std::numeric_limits<double>::infinity();
-    std::size_t worst = 0;
-    for (std::size_t j = 0; j < members; ++j) {
-      const bool is_sphere = j >= cylinders.size();
-      const std::size_t k = is_sphere ? spheres[j - cylinders.size()] : cylinders[j];
-      const SettledSurfaces::Surface& surface = surfaces[k];
-      // On the line a sphere has 2 parameters of its own, a cylinder 3 (as worst_member counts).
-      const double excess =
-          residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(), bound * bound,
-                          is_sphere ? 2 : 3, options.length_tolerance);
-      worst_excess = std::max(worst_excess, excess);
-      if (set_centre.contains(k) && excess > worst_shared_excess) {
-        worst_shared_excess = excess;
-        worst = k;
-      }
-    }
-    if (!(worst_excess > 1)) break;
-    for (std::vector<std::size_t>& set : sets) std::erase(set, worst);
+    // On the line a sphere has 2 parameters of its own (as worst_member counts); only a sphere of
+    // a set may leave.
+    const LineExcess excess =
+        line_excess(settled, cylinders, spheres, &*fit, 2, options, points,
+                    [&](std::size_t j) { return set_centre.contains(spheres[j]); });
+    if (!(excess.worst > 1)) break;
+    for (std::vector<std::size_t>& set : sets) std::erase(set, spheres[excess.worst_sphere]);
   }
   write_line(settled, l, cylinders, spheres, centre_of, *fit, primitives);
   for (const std::vector<std::size_t>& set : sets) {

@@ -151,15 +151,13 @@ Eigen::Index radius_index(std::size_t m) {
   return 2 + static_cast<Eigen::Index>(m);
 }
 
-// Whether every radius of `held` (of `count` members) is within `fraction` of `own`'s, relative
-// to the larger. A small arc held tangent to a plane can flatten into it, its radius running off
-// to 1e15 while its residuals stay within the noise (fandisk_large at a significance of 3.44),
-// and the relation is then no design intent but a plane given as a cylinder whose distances lose
-// every digit.
-bool radii_within(const HeldLineFit& own, const HeldLineFit& held, std::size_t count,
-                  double fraction) {
-  for (std::size_t m = 0; m < count; ++m) {
-    const double before = own.y(radius_index(m)), after = held.y(radius_index(m));
+// Whether every radius of `held` is within `fraction` of `own`'s, relative to the larger. A small
+// arc held tangent to a plane can flatten into it, its radius running off to 1e15 while its
+// residuals stay within the noise (fandisk_large at a significance of 3.44), and the relation is
+// then no design intent but a plane given as a cylinder whose distances lose every digit.
+bool radii_within(const HeldLineFit& own, const HeldLineFit& held, double fraction) {
+  for (Eigen::Index r = radius_index(0); r < own.y.size(); ++r) {
+    const double before = own.y(r), after = held.y(r);
     if (!(std::abs(after - before) <= fraction * std::max(before, after))) return false;
   }
   return true;
@@ -576,7 +574,7 @@ void Tangency::hold_tangent(const TangentLine& line, std::vector<Relation>& tang
     std::optional<HeldLineFit> trial =
         fit_held_line(direction, own->y.head<2>(), sides.members, holds);
     const std::size_t conditions = holds.size() - own_holds;
-    if (trial && radii_within(*own, *trial, cylinders.size(), options_.max_radius_difference) &&
+    if (trial && radii_within(*own, *trial, options_.max_radius_difference) &&
         residual_excess(own->rms, trial->rms, own->count,
                         chi_square_bound(options_.significance, conditions),
                         static_cast<int>(own->free), options_.length_tolerance) <= 1) {
