@@ -355,14 +355,17 @@ nlohmann::json level_summary(const LevelOptions& options, const ChosenLevel& lev
   nlohmann::json summary = {{"clusters", clusters}};
   if (level.automatic) {
     summary["requested_clusters"] = "auto";
-    summary["rule"] = level.by_noise ? "noise" : to_string(level.automatic->rule);
+    const bool by_noise = level.noise && level.noise->level_by_noise;
+    summary["rule"] = by_noise ? "noise" : to_string(level.automatic->rule);
     nlohmann::json candidates = nlohmann::json::array();
     for (const LevelCandidate& c : level.automatic->candidates)
       candidates.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
     summary["candidates"] = std::move(candidates);
-    if (level.by_noise) {
-      summary["noise_estimate"] = level.by_noise->noise;
-      summary["noise_tolerance"] = level.by_noise->tolerance;
+    if (level.noise) {
+      summary["noise_estimate"] = level.noise->estimate;
+      summary["noise_tolerance"] = level.noise->tolerance;
+      if (level.automatic->rule == AutoLevelRule::Jump)
+        summary["jump_worst_rms"] = level.noise->jump_worst_rms;
     }
   } else if (options.level.clusters) {
     summary["requested_clusters"] = *parse_cluster_count(*options.level.clusters);

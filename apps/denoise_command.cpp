@@ -48,11 +48,13 @@ DenoiseOptions denoise_options(const DenoiseCommandOptions& o) {
 // The level a round snaps onto: with --clusters auto, denoising's own automatic level (under
 // noise, a multiple of the noise), else the cut the level options ask for.
 ChosenLevel round_level(const Denoiser& denoiser, const Hierarchy& hierarchy,
-                        const LevelChoice& choice) {
+                        const LevelChoice& choice, bool stylize) {
   if (!choice.clusters || parse_cluster_count(*choice.clusters)) return cut(hierarchy, choice);
   DenoiseLevel chosen = denoiser.automatic_level(hierarchy);
   ChosenLevel level{std::move(chosen.segmentation), std::move(chosen.automatic), std::nullopt};
-  if (chosen.by_noise) level.by_noise = {chosen.noise, chosen.tolerance};
+  // Stylization keeps the segmentation's level and estimates no noise.
+  if (!stylize)
+    level.noise = {chosen.noise, chosen.tolerance, chosen.jump_worst_rms, chosen.by_noise};
   return level;
 }
 
@@ -64,12 +66,31 @@ nlohmann::json round_json(const SnapReport& r) {
           {"mean_move", r.mean_move}, {"max_move", r.max_move}};
 }
 
-void print_round(int round, const ChosenLevel& level, const SnapReport& r) {
-  if (level.by_noise)
-    std::printf(
-        "round %d: no jump in the error curve; level by noise: estimate %.6g, clusters within "
-        "RMS %.6g\n",
-        round, level.by_noise->noise, level.by_noise->tolerance);
+// `diagonal`: the input's bounding-box diagonal, which the noise is given as a percentage of too.
+void print_round(int round, const ChosenLevel& level, const SnapReport& r, double diagonal) {
+  if (level.noise) {
+    const ChosenLevel::Noise& noise = *level.noise;
+    const bool jump = level.automatic->rule == AutoLevelRule::Jump;
+    if (jump) {
+      std::printf("round %d: the error curve jumps at %u clusters, the worst with RMS %.6g", round,
+                  level.automatic->clusters, noise.jump_worst_rms);
+      // A noise-free mesh can estimate no noise at all: its tolerance is 0.
+      if (noise.tolerance > 0)
+        std::printf(" (%.3g tolerances)", noise.jump_worst_rms / noise.tolerance);
+      if (noise.level_by_noise)
+        std::printf(": beyond %g noise tolerances, a surface left out\n",
+                    kMaxJumpClusterRmsInTolerances);
+      else
+        std::printf(": kept\n");
+    }
+    std::printf("round %d: noise estimate %.6g (%.3g%% of the diagonal), tolerance %.6g%s\n", round,
+                noise.estimate, diagonal > 0 ? 100 * noise.estimate / diagonal : 0.0,
+                noise.tolerance,
+                !noise.level_by_noise ? ""
+                : jump                ? "; level by noise: the clusters within it"
+                                      : "; no jump in the error curve, level by noise: the "
+                                        "clusters within it");
+  }
   std::printf(
       "round %d: %s, %s snapped (%u on cluster borders, %u onto fewer primitives), %u moved, %u "
       "blocked; mean move %.6g, max %.6g\n",
@@ -86,6 +107,7 @@ void run_denoise(DenoiseCommandOptions& o) {
   const auto start = Clock::now();
   Mesh mesh = read_geometry_within(o.mesh_path, o.limits, o.level.files.png ? kPictureBytes : 0);
   validate_level(o.level.level, mesh.face_count());
+  const double diagonal = bounding_box_diagonal(mesh);
   Denoiser denoiser(std::move(mesh), options);
   std::unique_ptr<Hierarchy> hierarchy;
   ChosenLevel level;
@@ -93,10 +115,10 @@ void run_denoise(DenoiseCommandOptions& o) {
   for (int i = 0; i < o.iterations; ++i) {
     hierarchy =
         std::make_unique<Hierarchy>(build_hierarchy(denoiser.segmented_mesh(), options.hierarchy));
-    level = round_level(denoiser, *hierarchy, o.level.level);
+    level = round_level(denoiser, *hierarchy, o.level.level, o.stylize);
     const SnapReport report = denoiser.snap(*hierarchy, level.segmentation);
     rounds.push_back(round_json(report));
-    if (!o.level.quiet) print_round(i + 1, level, report);
+    if (!o.level.quiet) print_round(i + 1, level, report, diagonal);
   }
   write_mesh(o.output_path, denoiser.mesh());
   nlohmann::json summary;

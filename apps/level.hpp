@@ -29,12 +29,15 @@ void validate_level(const LevelChoice& level, std::uint32_t face_count);
 struct ChosenLevel {
   Segmentation segmentation;
   std::optional<AutoLevel> automatic;
-  // denoise --clusters auto without a jump: the level is the tolerance cut at a multiple of the
-  // noise estimate (Denoiser::automatic_level), both in input units.
-  struct ByNoise {
-    double noise = 0, tolerance = 0;
+  // denoise --clusters auto (Denoiser::automatic_level): the noise estimate and the tolerance
+  // at a multiple of it, the worst cluster RMS of the curve's jump (0 without one), all in input
+  // units, and whether the level is the tolerance cut (no jump, or one beyond
+  // kMaxJumpClusterRmsInTolerances).
+  struct Noise {
+    double estimate = 0, tolerance = 0, jump_worst_rms = 0;
+    bool level_by_noise = false;
   };
-  std::optional<ByNoise> by_noise;
+  std::optional<Noise> noise;
 };
 
 /// The segmentation for a level choice; with neither option, the default tolerance below.

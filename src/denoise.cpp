@@ -132,19 +132,6 @@ std::optional<Primitive> fit_plane(std::span<const Vec3> points, std::span<const
   return plane;
 }
 
-// A jump of the error curve is kept as the denoising level only while each of its clusters fits
-// its primitive within this many noise tolerances (RMS): a cluster that fits several times worse
-// than the noise allows straddles two surfaces, and snapping onto its primitive moves vertices
-// off both. Measured on the 13 generated shapes with 0.2% and 0.4% noise, 2 seeds, as they are
-// and with a bilateral copy (96 jump levels): the worst cluster of a jump at the true number of
-// surfaces is within 3.8 tolerances but once (5.6, where the jump and the noise level denoise
-// alike); the 6 jumps with a cluster beyond 4.5 tolerances had left a region out and took the
-// RMS distance to the clean shape above the noisy input's (0.14x to 0.46x; 1.4x to 4.0x at the
-// noise level). A chamfer that resampling left on a noise-free part is systematic, not noise,
-// and stays below it: the marching-tetrahedra box's worst plane is at 4.0 tolerances on its
-// bilateral copy, 2.1 as it is.
-constexpr double kMaxJumpClusterRmsInTolerances = 4.5;
-
 // The largest RMS distance estimate of a segmentation's clusters (input units).
 double worst_cluster_rms(const Hierarchy& hierarchy, const Segmentation& segmentation) {
   double worst = 0;
@@ -357,8 +344,17 @@ DenoiseLevel Denoiser::automatic_level(const Hierarchy& hierarchy) const {
   // Only here: the estimate smooths the whole mesh, once more unless the segmented copy is its.
   level.noise = noise_from(mesh_, *estimate_copy());
   level.tolerance = noise_tolerance_factor() * level.noise;
-  level.by_noise = !jump || worst_cluster_rms(hierarchy, level.segmentation) >
-                                kMaxJumpClusterRmsInTolerances * level.tolerance;
+  // A cluster that fits several times worse than the noise allows straddles two surfaces, and
+  // snapping onto its primitive moves vertices off both. Measured on the 13 generated shapes with
+  // 0.2% and 0.4% noise, 2 seeds, as they are and with a bilateral copy (96 jump levels): the worst
+  // cluster of a jump at the true number of surfaces is within 3.8 tolerances but once (5.6, where
+  // the jump and the noise level denoise alike); the 6 jumps with a cluster beyond 4.5 tolerances
+  // had left a region out and took the RMS distance to the clean shape above the noisy input's
+  // (0.14x to 0.46x; 1.4x to 4.0x at the noise level). A chamfer that resampling left on a
+  // noise-free part is systematic, not noise, and stays below it: the marching-tetrahedra box's
+  // worst plane is at 4.0 tolerances on its bilateral copy, 2.1 as it is.
+  if (jump) level.jump_worst_rms = worst_cluster_rms(hierarchy, level.segmentation);
+  level.by_noise = !jump || level.jump_worst_rms > kMaxJumpClusterRmsInTolerances * level.tolerance;
   if (level.by_noise) level.segmentation = cut_by_tolerance(hierarchy, level.tolerance);
   return level;
 }

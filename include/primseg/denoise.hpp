@@ -127,17 +127,26 @@ LevelSelector level_by_tolerance(double tolerance);
 /// smoothing does to its edges and is small. Throws InvalidInputError as bilateral_smooth().
 double estimate_noise(const Mesh& mesh, const BilateralSmoothingOptions& options = {});
 
+/// A jump of the error curve is the automatic level of a denoising round only when each of its
+/// clusters fits its primitive within this many noise tolerances (RMS estimates): a cluster that
+/// fits worse straddles two surfaces (Denoiser::automatic_level).
+inline constexpr double kMaxJumpClusterRmsInTolerances = 4.5;
+
 /// The automatic level of a denoising round (Denoiser::automatic_level), and how it was chosen.
 struct DenoiseLevel {
   Segmentation segmentation;
   /// choose_level() on the hierarchy: its Jump level is kept when its clusters fit the noise.
   AutoLevel automatic;
   /// True when the noise rule chose (no significant jump, or one whose clusters do not fit
-  /// within 4.5 tolerances): the tolerance cut below.
+  /// within kMaxJumpClusterRmsInTolerances): the tolerance cut below.
   bool by_noise = false;
   /// estimate_noise() of the mesh being denoised, input units (0 in NearestIncident mode).
   double noise = 0;
   double tolerance = 0;  ///< noise × the tolerance factor, input units (0 in NearestIncident mode)
+  /// With a Jump level (and not NearestIncident): the largest RMS distance estimate of its
+  /// clusters (Hierarchy::rms_estimate), input units: the jump is kept when it is within
+  /// kMaxJumpClusterRmsInTolerances × `tolerance`. 0 without a jump.
+  double jump_worst_rms = 0;
 };
 
 /// What one snapping pass did.

@@ -85,6 +85,50 @@ TEST(CliDenoise, DenoisesABoxKeepingVertexAndFaceOrder) {
               1e-9);
 }
 
+// --clusters auto says how it chose: the noise estimate and tolerance, and the jump of the curve
+// with its worst cluster, both on the console and in the JSON's level.
+TEST(CliDenoise, AutomaticLevelReportsTheNoiseAndTheJump) {
+  const Files f = noisy_box();
+  std::string output;
+  ASSERT_EQ(primseg({"denoise", q(f.noisy), "--clusters auto -o", q(f.dir / "a.off"), "--json",
+                     q(f.dir / "a.json")},
+                    &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("round 1: the error curve jumps at 6 clusters, the worst with RMS "),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("tolerances): kept\nround 1: noise estimate "), std::string::npos)
+      << output;
+  std::ifstream json_file(f.dir / "a.json");
+  const nlohmann::json summary = nlohmann::json::parse(json_file);
+  const nlohmann::json& level = summary["level"];
+  EXPECT_EQ(level["rule"], "jump");
+  EXPECT_EQ(level["clusters"], 6);
+  // Noise of 0.4% of the diagonal along the normals, estimated within a few percent; the multiple
+  // for the mesh as it is; and the six faces fit within the tolerance the jump is judged by.
+  const double sigma = 0.004 * bounding_box_diagonal(read_mesh(f.clean));
+  const double noise = level["noise_estimate"].get<double>();
+  EXPECT_NEAR(noise, sigma, 0.1 * sigma);
+  EXPECT_DOUBLE_EQ(level["noise_tolerance"].get<double>(), 1.2 * noise);
+  EXPECT_GT(level["jump_worst_rms"].get<double>(), 0.5 * noise);
+  EXPECT_LE(level["jump_worst_rms"].get<double>(),
+            kMaxJumpClusterRmsInTolerances * level["noise_tolerance"].get<double>());
+
+  // Stylization keeps the segmentation's automatic level and estimates no noise.
+  ASSERT_EQ(primseg({"denoise", q(f.noisy), "--clusters auto --stylize -o", q(f.dir / "s.off"),
+                     "--json", q(f.dir / "s.json")},
+                    &output),
+            0)
+      << output;
+  EXPECT_EQ(output.find("noise estimate"), std::string::npos) << output;
+  std::ifstream stylized_file(f.dir / "s.json");
+  const nlohmann::json stylized = nlohmann::json::parse(stylized_file)["level"];
+  EXPECT_EQ(stylized["requested_clusters"], "auto");
+  EXPECT_FALSE(stylized.contains("noise_estimate"));
+  EXPECT_FALSE(stylized.contains("jump_worst_rms"));
+}
+
 TEST(CliDenoise, StylizeToleranceIterationsAndLevelOutputs) {
   const Files f = noisy_box();
   std::string output;

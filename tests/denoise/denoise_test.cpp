@@ -412,6 +412,10 @@ TEST(Denoise, AutomaticLevelKeepsAJumpOfTheErrorCurve) {
   EXPECT_FALSE(level.by_noise);
   EXPECT_EQ(level.automatic.rule, AutoLevelRule::Jump);
   EXPECT_EQ(level.segmentation.cluster_count(), 6u);
+  // Each face fits about as well as the noise, which is estimated within a few percent.
+  EXPECT_NEAR(level.noise, box.sigma, 0.1 * box.sigma);
+  EXPECT_GT(level.jump_worst_rms, 0.5 * level.noise);
+  EXPECT_LE(level.jump_worst_rms, kMaxJumpClusterRmsInTolerances * level.tolerance);
   EXPECT_EQ(denoiser.mesh().positions, denoise(box.noisy.mesh, level_by_count(6)).positions);
   EXPECT_EQ(denoiser.noise_tolerance_factor(), 1.2);  // the mesh segmented as it is
 }
@@ -454,6 +458,7 @@ TEST(Denoise, AutomaticLevelRefusesAJumpWhoseClustersDoNotFitTheNoise) {
   EXPECT_EQ(level.automatic.rule, AutoLevelRule::Jump);
   EXPECT_LT(jump, dome.clean.regions.size());
   EXPECT_TRUE(level.by_noise);
+  EXPECT_GT(level.jump_worst_rms, kMaxJumpClusterRmsInTolerances * level.tolerance);
   const double before = mesh_distance(dome.noisy.mesh, dome.clean.mesh, measure_options()).rms;
   const double after = mesh_distance(denoiser.mesh(), dome.clean.mesh, measure_options()).rms;
   const Mesh at_jump = denoise(dome.noisy.mesh, level_by_count(jump), options);

@@ -102,6 +102,7 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
                 chosen.tolerance);
     EXPECT_TRUE(chosen.by_noise);
     EXPECT_EQ(chosen.automatic.rule, AutoLevelRule::Knee);
+    EXPECT_EQ(chosen.jump_worst_rms, 0);   // no jump to judge
     EXPECT_GE(chosen.noise, 0.9 * sigma);  // measured 0.98 sigma
     EXPECT_LE(chosen.noise, 1.05 * sigma);
     EXPECT_EQ(chosen.tolerance, 0.4 * chosen.noise);
