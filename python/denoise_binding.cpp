@@ -17,6 +17,7 @@
 #include "binding_support.hpp"
 #include "bindings.hpp"
 #include "doxygen_docstrings.hpp"
+#include "primseg/auto_level.hpp"
 #include "primseg/bilateral_smoothing.hpp"
 #include "primseg/borders.hpp"
 #include "primseg/cut.hpp"
@@ -57,7 +58,10 @@ max_move). With return_level=True it returns (V, level), or (V, rounds, level) w
 last round's snap (Denoiser::snapped_level) as a dict of "labels" (int32 (F,), the CLI's
 --labels), "clusters", "borders" and "relations" (the CLI's --json entries: the clusters after
 relabelling with the primitives the vertices went onto, their borders on the denoised mesh, and
-the groups of clusters made parallel or coaxial, {kind, clusters}).
+the groups of clusters made parallel or coaxial, {kind, clusters}); with k="auto" also how the
+level was chosen, as the CLI's --json "level" says it: "rule" ("jump", "knee", ... or "noise"
+for the tolerance cut) and, without stylize, "noise_estimate" and "noise_tolerance" (input
+units) and, when the curve jumps, "jump_worst_rms" (its worst cluster's RMS).
 The input is a Mesh, arrays V and F (as segment takes them), or a Hierarchy: its first round
 then snaps onto that tree's level without building it again (smoothing_steps must be 0, and the
 later rounds use its primitives and weights).
@@ -125,6 +129,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         std::vector<Vec3> positions;
         SnappedLevel snapped;
         std::vector<ClusterBorder> borders;
+        DenoiseLevel chosen;  // the last round's, with k="auto"
         without_gil([&] {
           Denoiser denoiser(*mesh, options);
           // k="auto": denoising's own automatic level, as `primseg denoise --clusters auto`.
@@ -140,9 +145,9 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
                     : std::make_shared<const Hierarchy>(
                           HierarchyBuilder(denoiser.segmented_mesh(), options.hierarchy)
                               .finish(report_round));
+            if (automatic) chosen = denoiser.automatic_level(*hierarchy);
             reports.push_back(denoiser.snap(
-                *hierarchy, automatic ? denoiser.automatic_level(*hierarchy).segmentation
-                                      : cut_level(*hierarchy, level)));
+                *hierarchy, automatic ? chosen.segmentation : cut_level(*hierarchy, level)));
           }
           if (return_level) {
             snapped = denoiser.snapped_level();
@@ -171,6 +176,17 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
           snapped_dict["clusters"] = clusters;
           snapped_dict["borders"] = border_list;
           snapped_dict["relations"] = relations_list(snapped.relations);
+          // How k="auto" chose, with the keys and values of the CLI's --json "level".
+          if (level.k && std::holds_alternative<std::string>(*level.k)) {
+            snapped_dict["rule"] =
+                chosen.by_noise ? "noise" : std::string(to_string(chosen.automatic.rule));
+            if (!stylize) {
+              snapped_dict["noise_estimate"] = chosen.noise;
+              snapped_dict["noise_tolerance"] = chosen.tolerance;
+              if (chosen.automatic.rule == AutoLevelRule::Jump)
+                snapped_dict["jump_worst_rms"] = chosen.jump_worst_rms;
+            }
+          }
           result.append(snapped_dict);
         }
         return py::tuple(result);

@@ -74,6 +74,10 @@ def test_denoise_matches_the_cli(cli, noisy_fandisk, tmp_path, cli_options, pyth
     assert level["relations"] == summary["relations"]
     assert json.loads(json.dumps(level["borders"])) == summary["borders"]
     assert len(level["clusters"]) == summary["level"]["clusters"] == rounds[-1]["clusters"]
+    # With k="auto", how the level was chosen: the same keys and values.
+    for key in ("rule", "noise_estimate", "noise_tolerance", "jump_worst_rms"):
+        assert level.get(key) == summary["level"].get(key), key
+    assert ("noise_estimate" in level) == (python_options.get("k") == "auto")
     np.testing.assert_array_equal(primseg.denoise(mesh, **python_options, return_level=True)[0], V)
 
 
