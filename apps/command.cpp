@@ -311,6 +311,27 @@ void validate_level_outputs(LevelOptions& options) {
   if (writes_to_standard_output(options.files)) options.quiet = true;
 }
 
+// The console's line on how --clusters auto chose the level.
+static void print_automatic_level(const AutoLevel& level) {
+  switch (level.rule) {
+    case AutoLevelRule::Jump: {
+      double score = 0;
+      for (const LevelCandidate& c : level.candidates)
+        if (c.clusters == level.clusters) score = c.score;
+      std::printf("automatic level: %u clusters, where the error curve jumps (score %.3g)\n",
+                  level.clusters, score);
+      break;
+    }
+    case AutoLevelRule::Knee:
+      std::printf("automatic level: %u clusters, the knee of the error curve (no jump)\n",
+                  level.clusters);
+      break;
+    case AutoLevelRule::Components:
+      std::printf("automatic level: one cluster per component (no jump)\n");
+      break;
+  }
+}
+
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
                   Clock::time_point cut_start) {
   report_level(hierarchy, options, cut(hierarchy, options.level), std::move(summary), cut_start);
@@ -347,7 +368,10 @@ void report_level(const Hierarchy& hierarchy, const LevelOptions& options, Chose
   write_level_outputs(hierarchy, hierarchy.mesh(), segmentation.labels, reports, options.files,
                       summary);
   if (options.files.tree) write_output(*options.files.tree, serialize_tree(hierarchy));
-  if (!options.quiet) print_summary(reports, relations);
+  if (!options.quiet) {
+    if (level.automatic) print_automatic_level(*level.automatic);
+    print_summary(reports, relations);
+  }
 }
 
 nlohmann::json level_summary(const LevelOptions& options, const ChosenLevel& level,

@@ -950,10 +950,17 @@ TEST(Cli, ClustersAutoFindsTheRegionsAndReportsCandidatesAndTheCurve) {
   EXPECT_LE(rms_at_7, 1e-9 * bounding_box_diagonal(shape.mesh)) << "exact regions at K = 7";
   EXPECT_GT(rms_at_6, 1e-3 * bounding_box_diagonal(shape.mesh)) << "a jump after it";
 
-  // cut makes the same choice from the saved tree.
+  // cut makes the same choice from the saved tree, and both say how on the console.
   ASSERT_EXIT_OK(
       run("cut " + dir.q("t.tree") + " --quiet --clusters auto --json " + dir.q("c.json")));
   EXPECT_EQ(read_json(dir / "c.json")["clusters"], j["clusters"]);
+  for (const std::string& command : {"segment " + dir.q("in.off"), "cut " + dir.q("t.tree")}) {
+    const CliRun r = run(command + " --clusters auto");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("automatic level: 7 clusters, where the error curve jumps (score "),
+              std::string::npos)
+        << r.output;
+  }
 }
 
 TEST(Cli, RefineReportsItsPassesAndKeepsEveryFaceLabelled) {
