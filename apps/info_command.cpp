@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "limits.hpp"
+#include "primseg/denoise.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_info.hpp"
 #include "primseg/mesh_io.hpp"
@@ -16,6 +17,7 @@ Command add_info_command(CLI::App& app) {
   struct Options {
     std::string path;
     std::optional<std::string> json;
+    bool noise = false;
     ResourceLimits limits;
   };
   auto o = std::make_shared<Options>();
@@ -23,10 +25,15 @@ Command add_info_command(CLI::App& app) {
   info->add_option("MESH", o->path, "Input mesh (- for standard input)")->required();
   info->add_option("--json", o->json,
                    "Write the counts as JSON (- for standard output, instead of the text)");
+  info->add_flag("--noise", o->noise,
+                 "Also estimate the noise along the normals (what bilateral smoothing moves the "
+                 "vertices, RMS; on coarse meshes curvature counts too), for --tolerance");
   add_limit_options(*info, o->limits, kMeshBytesPerFace);
 
   return {info, [o] {
             std::uint64_t file_bytes = 0;
+            // The estimate smooths a copy of the mesh, with each face's neighbourhood.
+            if (o->noise) o->limits.bytes_per_face = kNoiseEstimateBytesPerFace;
             const Mesh mesh = read_input_mesh(o->path, &file_bytes, o->limits.max_memory);
             check_mesh_limits({&mesh}, file_bytes, o->limits);
             const MeshInfo i = describe_mesh(mesh);
@@ -37,9 +44,12 @@ Command add_info_command(CLI::App& app) {
             } catch (const InvalidInputError& error) {
               out_of_range = error.what();
             }
+            // Not for coordinates out of range, which no fit takes either.
+            std::optional<double> noise;
+            if (o->noise && !out_of_range) noise = estimate_noise(mesh);
             if (o->json) {
               // The keys and values of the Python module's Mesh.info().
-              const nlohmann::json json = {
+              nlohmann::json json = {
                   {"vertices", i.vertices},
                   {"isolated_vertices", i.isolated_vertices},
                   {"faces", i.faces},
@@ -56,6 +66,7 @@ Command add_info_command(CLI::App& app) {
                   {"bbox_max", i.bbox_max},
                   {"bbox_diagonal", i.bbox_diagonal},
                   {"out_of_range", out_of_range ? nlohmann::json(*out_of_range) : nullptr}};
+              if (o->noise) json["noise_estimate"] = noise ? nlohmann::json(*noise) : nullptr;
               write_output(*o->json, json.dump(2) + "\n");
               if (*o->json == kStandardOutput) return;
             }
@@ -81,6 +92,9 @@ Command add_info_command(CLI::App& app) {
                         i.bbox_min[0], i.bbox_min[1], i.bbox_min[2], i.bbox_max[0], i.bbox_max[1],
                         i.bbox_max[2], i.bbox_diagonal);
             if (out_of_range) std::printf("  out of range        %s\n", out_of_range->c_str());
+            if (noise)
+              std::printf("  noise estimate      %g (%.3g%% of the diagonal)\n", *noise,
+                          i.bbox_diagonal > 0 ? 100 * *noise / i.bbox_diagonal : 0.0);
           }};
 }
 

@@ -36,6 +36,9 @@ inline constexpr std::uint64_t kDenoiseBytesPerFace = 1536;
 /// and its adjacency, search tree, skinning weights or level: 222 to 633 bytes per face, 130 to
 /// 400 per face of distance's two meshes, 339 to 748 for cut (its tree file has 154 per face).
 inline constexpr std::uint64_t kMeshBytesPerFace = 512;
+/// info --noise: a smoothed copy of the mesh, each face's neighbourhood, normals and centroids:
+/// 433 to 810 bytes per face (bunny00 midpoint-subdivided to 1.2M faces, fandisk).
+inline constexpr std::uint64_t kNoiseEstimateBytesPerFace = 1024;
 
 struct ResourceLimits {
   std::optional<std::uint32_t> max_faces;  ///< refuse meshes with more input faces

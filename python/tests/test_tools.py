@@ -102,6 +102,25 @@ def test_denoise_auto_level_is_a_multiple_of_the_estimated_noise(cli, noisy_fand
     assert finer["clusters"] > default["clusters"]  # a smaller tolerance cuts finer
 
 
+def test_info_estimates_the_noise_as_denoise_does(cli, noisy_fandisk, tmp_path):
+    """info --noise and Mesh.info(noise=True): the estimate denoise(k="auto") judges by, to pick
+    a tolerance; nothing of it without the option."""
+    mesh = primseg.read_mesh(noisy_fandisk)
+    info = mesh.info(noise=True)
+    assert "noise_estimate" not in mesh.info()
+    assert {k: v for k, v in info.items() if k != "noise_estimate"} == mesh.info()
+    assert json.loads(run_cli(cli, "info", noisy_fandisk, "--noise", "--json", "-")) == info
+    # Isotropic noise of 0.1% of the diagonal: about that much along the normals.
+    assert 0.7e-3 * mesh.bounding_box_diagonal < info["noise_estimate"] < 1.5e-3 * mesh.bounding_box_diagonal
+    run_cli(cli, "denoise", noisy_fandisk, "--clusters", "auto", "-o", tmp_path / "out.off",
+            "--json", tmp_path / "summary.json", "--quiet")
+    level = json.loads((tmp_path / "summary.json").read_text())["level"]
+    assert level["noise_estimate"] == info["noise_estimate"]
+    printed = run_cli(cli, "info", noisy_fandisk, "--noise").splitlines()[-1].split()
+    assert printed[:2] == ["noise", "estimate"] and float(printed[2]) == pytest.approx(
+        info["noise_estimate"], rel=1e-5)
+
+
 def test_denoise_from_arrays_and_from_a_hierarchy(noisy_fandisk):
     mesh = primseg.read_mesh(noisy_fandisk)
     reference = primseg.denoise(mesh, k=30)

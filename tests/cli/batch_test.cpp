@@ -404,6 +404,7 @@ TEST(Limits, EveryCommandThatReadsAMeshHasThemAndItsEstimateBoundsItsPeak) {
       {{"view", mesh, "--skeleton", "-q", "-o", out("v.html")}, 1280, mesh_bytes, 1, buffers},
       {{"distance", mesh, mesh, "-q", "--json", out("distance.json")}, 512, 2 * mesh_bytes, 2},
       {{"info", mesh, "--json", out("info.json")}, 512, mesh_bytes},
+      {{"info", mesh, "--noise", "--json", out("noise.json")}, 1024, mesh_bytes},
       {{"deform", mesh, out("skeleton.json"), out("pose.json"), "-q", "-o", out("posed.ply"),
         "--png", out("posed.png")},
        512,

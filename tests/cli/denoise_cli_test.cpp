@@ -114,6 +114,9 @@ TEST(CliDenoise, AutomaticLevelReportsTheNoiseAndTheJump) {
   EXPECT_GT(level["jump_worst_rms"].get<double>(), 0.5 * noise);
   EXPECT_LE(level["jump_worst_rms"].get<double>(),
             kMaxJumpClusterRmsInTolerances * level["noise_tolerance"].get<double>());
+  // info --noise gives the same estimate before any denoising, to pick a tolerance by.
+  ASSERT_EQ(primseg({"info", q(f.noisy), "--noise --json -"}, &output), 0) << output;
+  EXPECT_EQ(nlohmann::json::parse(output)["noise_estimate"].get<double>(), noise);
 
   // Stylization keeps the segmentation's automatic level and estimates no noise.
   ASSERT_EQ(primseg({"denoise", q(f.noisy), "--clusters auto --stylize -o", q(f.dir / "s.off"),
