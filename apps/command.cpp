@@ -311,8 +311,10 @@ void validate_level_outputs(LevelOptions& options) {
   if (writes_to_standard_output(options.files)) options.quiet = true;
 }
 
+namespace {
+
 // The console's line on how --clusters auto chose the level.
-static void print_automatic_level(const AutoLevel& level) {
+void print_automatic_level(const AutoLevel& level) {
   switch (level.rule) {
     case AutoLevelRule::Jump: {
       double score = 0;
@@ -331,6 +333,8 @@ static void print_automatic_level(const AutoLevel& level) {
       break;
   }
 }
+
+}  // namespace
 
 void report_level(const Hierarchy& hierarchy, const LevelOptions& options, nlohmann::json summary,
                   Clock::time_point cut_start) {
