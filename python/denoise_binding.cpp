@@ -129,11 +129,11 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         std::vector<Vec3> positions;
         SnappedLevel snapped;
         std::vector<ClusterBorder> borders;
-        DenoiseLevel chosen;  // the last round's, with k="auto"
+        // k="auto": denoising's own automatic level, as `primseg denoise --clusters auto`.
+        const bool automatic = level.k && std::holds_alternative<std::string>(*level.k);
+        DenoiseLevel chosen;  // the last round's, when automatic
         without_gil([&] {
           Denoiser denoiser(*mesh, options);
-          // k="auto": denoising's own automatic level, as `primseg denoise --clusters auto`.
-          const bool automatic = level.k && std::holds_alternative<std::string>(*level.k);
           for (int round = 0; round < iterations; ++round) {
             // As `primseg denoise`: each round segments the previous round's result.
             const auto report_round = [&](double fraction) {
@@ -177,7 +177,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
           snapped_dict["borders"] = border_list;
           snapped_dict["relations"] = relations_list(snapped.relations);
           // How k="auto" chose, with the keys and values of the CLI's --json "level".
-          if (level.k && std::holds_alternative<std::string>(*level.k)) {
+          if (automatic) {
             snapped_dict["rule"] =
                 chosen.by_noise ? "noise" : std::string(to_string(chosen.automatic.rule));
             if (!stylize) {
