@@ -203,19 +203,43 @@ void write_line(SettledSurfaces& settled, std::size_t l, std::span<const std::si
   }
 }
 
+// The factor by which the bound of sphere k's residual rise on line l is scaled, for the line's
+// held direction. At the height h of the sphere's centre along the line, from where its cylinders
+// are, the line is misplaced by the direction's tilt times h, of covariance h² T, which its joint
+// fit cannot correct: a centre held on it rises by tr(C⁻¹ h² T) σ² more on average than the 2σ²
+// of the two coordinates it loses, C the covariance of the sphere's own centre across the line.
+// The bound is scaled by that mean, 1 + tr(C⁻¹ h² T) / 2, at most 2: beyond, the tilt would place
+// the line less well than the sphere's own centre is known, and the held direction rather than
+// the sphere would decide. 1 when C is singular.
+double tilt_allowance(const SettledSurfaces& settled, std::size_t l, std::size_t k) {
+  const SettledSurfaces::Line& line = settled.lines[l];
+  const std::size_t centre = settled.surfaces[k].centre;
+  const auto [u, v] = orthonormal_pair(line.direction);
+  Eigen::Matrix<double, 2, 3> frame;
+  frame << u.transpose(), v.transpose();
+  const Eigen::Matrix2d across = frame * settled.centre_covariances[centre] * frame.transpose();
+  const double height = line.direction.dot(settled.centres[centre]) - line.middle;
+  const Eigen::LDLT<Eigen::Matrix2d> solver(across);
+  if (solver.info() != Eigen::Success || !(solver.vectorD().minCoeff() > 0)) return 1;
+  const double added = (solver.solve(height * height * line.tilt)).trace();
+  return std::isfinite(added) ? 1 + std::clamp(added, 0.0, 2.0) / 2 : 1;
+}
+
 // How line l's fit `fit` (none: it failed) explains its members, `cylinders` then `spheres`
 // (indices into settled.surfaces), against their own fits: the largest residual_excess() at the
 // significance corrected for their number (at least 1; infinite without a fit), a cylinder's own
-// fit having 3 parameters and a sphere's `sphere_parameters`, and which sphere (an index into
-// `spheres`) of those `may_leave` accepts has the largest.
+// fit having 3 parameters and a sphere's `sphere_parameters`, sphere j's bound scaled by
+// allowance(j), and which sphere (an index into `spheres`) of those `may_leave` accepts has the
+// largest.
 struct LineExcess {
   double worst = 1;
   std::size_t worst_sphere = 0;
 };
-template <class MayLeave>
+template <class Allowance, class MayLeave>
 LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size_t> cylinders,
                        std::span<const std::size_t> spheres, const JointFit* fit,
-                       int sphere_parameters, const RegularityOptions& options,
+                       int sphere_parameters, const Allowance& allowance,
+                       const RegularityOptions& options,
                        const std::vector<std::vector<Vec3>>& points, const MayLeave& may_leave) {
   const std::size_t members = cylinders.size() + spheres.size();
   const double bound = family_significance(options.significance, members);
@@ -227,8 +251,8 @@ LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size
         settled.surfaces[is_sphere ? spheres[j - cylinders.size()] : cylinders[j]];
     const double excess =
         fit ? residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(),
-                              bound * bound, is_sphere ? sphere_parameters : 3,
-                              options.length_tolerance)
+                              bound * bound * (is_sphere ? allowance(j - cylinders.size()) : 1),
+                              is_sphere ? sphere_parameters : 3, options.length_tolerance)
             : std::numeric_limits<double>::infinity();
     result.worst = std::max(result.worst, excess);
     if (is_sphere && may_leave(j - cylinders.size()) && excess > worst_sphere_excess) {
@@ -262,8 +286,10 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
     std::iota(own_centre.begin(), own_centre.end(), 0);
     fit = fit_line(settled, l, cylinders, spheres, own_centre, centres, points, weights);
     // A sphere's own fit has 4 parameters; any may leave.
-    const LineExcess excess = line_excess(settled, cylinders, spheres, fit ? &*fit : nullptr, 4,
-                                          options, points, [](std::size_t) { return true; });
+    const LineExcess excess = line_excess(
+        settled, cylinders, spheres, fit ? &*fit : nullptr, 4,
+        [&](std::size_t j) { return tilt_allowance(settled, l, spheres[j]); }, options, points,
+        [](std::size_t) { return true; });
     if (!(excess.worst > 1)) break;
     spheres.erase(spheres.begin() + static_cast<std::ptrdiff_t>(excess.worst_sphere));
     fit.reset();
@@ -579,9 +605,9 @@ void share_centres_on_line(SettledSurfaces& settled, std::size_t l,
     if (!fit) return;
     // On the line a sphere has 2 parameters of its own (as worst_member counts); only a sphere of
     // a set may leave.
-    const LineExcess excess =
-        line_excess(settled, cylinders, spheres, &*fit, 2, options, points,
-                    [&](std::size_t j) { return set_centre.contains(spheres[j]); });
+    const LineExcess excess = line_excess(
+        settled, cylinders, spheres, &*fit, 2, [](std::size_t) { return 1.0; }, options, points,
+        [&](std::size_t j) { return set_centre.contains(spheres[j]); });
     if (!(excess.worst > 1)) break;
     for (std::vector<std::size_t>& set : sets) std::erase(set, spheres[excess.worst_sphere]);
   }

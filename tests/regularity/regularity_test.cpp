@@ -481,6 +481,35 @@ double joint_objective(const Primitive& cylinder, const Cluster& shaft,
   return sum + spheres_objective(spheres);
 }
 
+// A noisy shaft along z (radius 0.3, length 1, about the origin) as cluster 0 and two noisy
+// spherical caps as clusters 1 and 2, all with noise 0.002, each fitted on its own.
+struct CapOnAShaft {
+  Eigen::Vector3d centre;
+  double radius;
+  Eigen::Vector3d pole;
+  double polar_angle;
+  double start_radius;  // where its own fit starts
+};
+struct ShaftAndCaps {
+  std::vector<Cluster> clusters;
+  std::vector<Primitive> primitives;
+};
+ShaftAndCaps shaft_with_caps(std::uint64_t seed, const CapOnAShaft& first,
+                             const CapOnAShaft& second) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  std::mt19937_64 rng(seed);
+  ShaftAndCaps shape;
+  shape.clusters.push_back(noisy_cylinder(z, {0, 0, 0}, 0.3, 1, 0.002, rng));
+  shape.primitives.push_back(fitted_cylinder(shape.clusters[0], z, {0, 0, 0}, 0.3));
+  for (const CapOnAShaft* cap : {&first, &second}) {
+    shape.clusters.push_back(
+        noisy_sphere_cap(cap->centre, cap->radius, cap->pole, cap->polar_angle, 0.002, rng));
+    shape.primitives.push_back(
+        fitted_sphere(shape.clusters.back(), cap->centre, cap->start_radius));
+  }
+  return shape;
+}
+
 // A shaft of radius 0.3 with a ball end of radius 0.4 centred on its axis, and a seat of radius
 // 0.25 whose centre is 2% of its radius off the axis (about 40 times its uncertainty): the ball is
 // centred on the shaft's axis, exactly, by the least squares of both (moving the shared line, the
@@ -491,13 +520,8 @@ TEST(Regularity, ABallEndIsCentredOnTheShaftAxis) {
   const Eigen::Vector3d ball_centre(0, 0, 0.5), seat_centre(0.005, 0, -0.8);
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
     SCOPED_TRACE(seed);
-    std::mt19937_64 rng(seed);
-    const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.3, 1, 0.002, rng),
-                                        noisy_sphere_cap(ball_centre, 0.4, z, 2.2, 0.002, rng),
-                                        noisy_sphere_cap(seat_centre, 0.27, -z, 1.2, 0.002, rng)};
-    std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.3),
-                                      fitted_sphere(clusters[1], ball_centre, 0.4),
-                                      fitted_sphere(clusters[2], seat_centre, 0.25)};
+    auto [clusters, primitives] =
+        shaft_with_caps(seed, {ball_centre, 0.4, z, 2.2, 0.4}, {seat_centre, 0.27, -z, 1.2, 0.25});
     const std::vector<Primitive> own = primitives;
     ASSERT_EQ(regularize(primitives, clusters), (Relations{{Kind::Coaxial, {0, 1}}}));
     const Primitive &shaft = primitives[0], &ball = primitives[1];
@@ -533,6 +557,35 @@ TEST(Regularity, ABallEndIsCentredOnTheShaftAxis) {
     EXPECT_LE(axis_offset(shaft, true_ball),
               std::max(axis_offset(true_axis, own[1]), axis_offset(own[0], true_ball)));
   }
+}
+
+// A shaft of radius 0.3 and length 1 closed by a cap of radius 0.27 at each end, all with noise
+// 0.002, in 200 draws. The line is held at the shaft's own direction, which the shaft knows to
+// about 4.5e-4 radians: at its ends, half a length from its middle, that places the line to within
+// about a third of the caps' own centres' variance. The caps are true spheres on the axis, so each
+// must stay on it as often as the significance promises (a few in a thousand): all 400 do; 8 left
+// it when the test of their residuals ignored the direction's tilt.
+TEST(Regularity, CapsAtAShaftsEndsStayOnItsAxisAsOftenAsTheSignificancePromises) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d top(0, 0, 0.5), bottom(0, 0, -0.5);
+  int on_axis = 0;
+  for (std::uint64_t seed = 1; seed <= 200; ++seed) {
+    SCOPED_TRACE(seed);
+    auto [clusters, primitives] =
+        shaft_with_caps(seed, {top, 0.27, z, 1.2, 0.27}, {bottom, 0.27, -z, 1.2, 0.27});
+    detail::RegularityOptions options;
+    options.equal_radii = false;  // the caps' radii are one: only their centres are tested here
+    const Relations relations = regularize(primitives, clusters, options);
+    for (const auto& [kind, members] : relations) {
+      if (kind != Kind::Coaxial) continue;
+      for (const std::size_t k : {1, 2}) {
+        if (std::ranges::count(members, k) == 0) continue;
+        ++on_axis;
+        EXPECT_LT(axis_offset(primitives[0], primitives[k]), 1e-14);
+      }
+    }
+  }
+  EXPECT_GE(on_axis, 396);
 }
 
 // A ball of radius 0.5 in its socket of radius 0.53 (a spherical joint: a cap of each about one
@@ -591,7 +644,8 @@ TEST(Regularity, ABallAndItsSocketShareOneCentre) {
 // takes are centred on it; when it takes the ball and the socket, they also share their place
 // along it, exactly, by the least squares of both (moving it along the axis only raises their
 // residuals), and keep their radii; the cap keeps its own place. Of 400 draws, the line took both
-// on 389, and each time they shared their centre; on 11 its guard left one of them off.
+// on 397, and each time they shared their centre; on 3 the test of its position left one of them
+// off (on 11 before the test of the residuals allowed for the line's tilt).
 TEST(Regularity, ABallAndItsSocketOnAShaftAxisShareOneCentreOnIt) {
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d centre(0, 0, 0.5), cap_centre(0, 0, -0.5);
