@@ -561,8 +561,8 @@ TEST(Regularity, ABallEndIsCentredOnTheShaftAxis) {
 
 // A shaft of radius 0.3 and length 1 closed by a cap of radius 0.27 at each end, all with noise
 // 0.002, in 200 draws. The line is held at the shaft's own direction, which the shaft knows to
-// about 4.5e-4 radians: at its ends, half a length from its middle, that places the line to within
-// about a third of the caps' own centres' variance. The caps are true spheres on the axis, so each
+// about 4.3e-4 radians: at its ends, half a length from its middle, that places the line to within
+// about half the caps' own centres' variance. The caps are true spheres on the axis, so each
 // must stay on it as often as the significance promises (a few in a thousand): all 400 do; 8 left
 // it when the test of their residuals ignored the direction's tilt.
 TEST(Regularity, CapsAtAShaftsEndsStayOnItsAxisAsOftenAsTheSignificancePromises) {
