@@ -214,10 +214,7 @@ void write_line(SettledSurfaces& settled, std::size_t l, std::span<const std::si
 double tilt_allowance(const SettledSurfaces& settled, std::size_t l, std::size_t k) {
   const SettledSurfaces::Line& line = settled.lines[l];
   const std::size_t centre = settled.surfaces[k].centre;
-  const auto [u, v] = orthonormal_pair(line.direction);
-  Eigen::Matrix<double, 2, 3> frame;
-  frame << u.transpose(), v.transpose();
-  const Eigen::Matrix2d across = frame * settled.centre_covariances[centre] * frame.transpose();
+  const Eigen::Matrix2d across = tilt_in_frame(line.direction, settled.centre_covariances[centre]);
   const double height = line.direction.dot(settled.centres[centre]) - line.middle;
   const Eigen::LDLT<Eigen::Matrix2d> solver(across);
   if (solver.info() != Eigen::Success || !(solver.vectorD().minCoeff() > 0)) return 1;
