@@ -18,7 +18,9 @@ namespace primseg::detail {
 
 struct RegularityOptions {
   /// A direction joins a group when its tilt from the group's direction is within this many
-  /// standard deviations (Mahalanobis, with both estimates' covariances). > 0.
+  /// standard deviations: its squared Mahalanobis distance (both estimates' covariances) within
+  /// chi_square_bound() of 2 degrees of freedom. Every test takes the bound of its degrees of
+  /// freedom, a true relation failing each as rarely as a normal deviate beyond this. > 0.
   double significance = 3;
   /// ... and never farther than this, whatever the uncertainty (degrees); the same bounds make
   /// two directions orthogonal.

@@ -616,11 +616,19 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
   EXPECT_GE(orthogonal_pairs(relations).size(), 3u);
   expect_orthogonal(after, relations);
   const double diagonal = bounding_box_diagonal(mesh);
+  // Each fit's RMS before, or for a member of a coaxial set its members' largest: the fragments of
+  // one fillet share its line, and a fragment of 16 faces fitted closer than the tessellation's
+  // chords elsewhere on it (1.9e-5 against 9.5e-5) ends at 2.8e-5.
+  std::vector<double> own_rms(before.size());
+  for (std::size_t c = 0; c < before.size(); ++c) own_rms[c] = before[c].rms;
+  for (const auto& set : coaxial)
+    for (const std::uint32_t c : set)
+      for (const std::uint32_t other : set) own_rms[c] = std::max(own_rms[c], before[other].rms);
   for (const auto& group : parallel) {
     expect_one_direction(after, group);
     for (const std::uint32_t c : group) {
       EXPECT_TRUE(has_direction(after[c].primitive));
-      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
+      EXPECT_LE(after[c].rms, 1.25 * own_rms[c] + 1e-9 * diagonal) << c;
       EXPECT_LT(angle_between_lines_degrees(after[c].primitive.axis, before[c].primitive.axis), 1.0)
           << c;
     }
@@ -628,7 +636,7 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
   for (const auto& set : clusters_of(relations, ClusterRelation::Kind::EqualRadius))
     for (const std::uint32_t c : set) {
       EXPECT_TRUE(testing::same_bits(after[c].primitive.radius, after[set[0]].primitive.radius));
-      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
+      EXPECT_LE(after[c].rms, 1.25 * own_rms[c] + 1e-9 * diagonal) << c;
     }
   for (const auto& set : coaxial) {
     // The cylinders of a coaxial set are one line and, when several, within a parallel group;
@@ -647,7 +655,7 @@ TEST(Relations, FandiskRelationsAreExactAndCheap) {
       ASSERT_TRUE(after[c].primitive.type == PrimitiveType::Cylinder ||
                   after[c].primitive.type == PrimitiveType::Sphere);
       EXPECT_LT(distance_from_axis(after[c].primitive.point, line), 1e-12 * diagonal);
-      EXPECT_LE(after[c].rms, 1.25 * before[c].rms + 1e-9 * diagonal) << c;
+      EXPECT_LE(after[c].rms, 1.25 * own_rms[c] + 1e-9 * diagonal) << c;
     }
   }
   const Groups tangent = clusters_of(relations, ClusterRelation::Kind::Tangent);
@@ -752,13 +760,18 @@ TEST(Relations, ALengthToleranceMakesFandisksFilletTangentToItsFace) {
   // its gap on this exact tessellation (the face's offset and its normal's tilt at the contact
   // counted; 4.2 with the fillet's fit alone), but refitted tangent the fillet's residual sum
   // rises too much, so refused. Within a length tolerance of 2e-5 it is tangent, exactly, and its
-  // deviation says how far it was: its own gap.
+  // deviation says how far it was: its own gap. It stays tangent to the cylinder it also rounds
+  // (cluster 2): it now shares its line with a fragment of it (cluster 33), which moves the line
+  // 2.5e-5 from tangent to the cylinder, but once held tangent to the face the line is within the
+  // tolerance of it again, and the contact is tested again there.
   const RegularizedPart statistical = regularized_part("fandisk.off");
   EXPECT_EQ(tangent_pair(statistical.relations, 4, 7), nullptr);
+  ASSERT_NE(tangent_pair(statistical.relations, 2, 7), nullptr);
   const RegularizedPart part = regularized_part("fandisk.off", with_length_tolerance(2e-5));
   const Groups tangent = clusters_of(part.relations, ClusterRelation::Kind::Tangent);
   EXPECT_EQ(tangent.size(),
             clusters_of(statistical.relations, ClusterRelation::Kind::Tangent).size() + 1);
+  EXPECT_NE(tangent_pair(part.relations, 2, 7), nullptr);
   const ClusterRelation* fillet = tangent_pair(part.relations, 4, 7);
   ASSERT_NE(fillet, nullptr);
   expect_exactly_tangent(part.level.reports, part.after, tangent,
@@ -810,17 +823,16 @@ TEST(Relations, FandisksFilletIsTangentToTheCylinderItRounds) {
 }
 
 TEST(Relations, AFilletHeldTangentKeepsItsRadius) {
-  // At a significance of 3.44, fandisk_large's cylinder 119 (17 faces, a small arc of radius
-  // 0.114) joined the direction group of its neighbour 125 and was held tangent to it: the fit ran
-  // along the valley of arcs that match a flat patch, to a radius of 1e15, and since its residuals
-  // stayed within the noise the likelihood-ratio test kept it, a plane given as a cylinder whose
-  // distances lose every digit (its RMS 0.256 against 0.001). A hold now leaves every radius on its
-  // line within max_radius_difference of the line's own fit: on all 143 libcgal-demo meshes at the
-  // default significance, 54 holds were tried, 48 moved no radius by more than 5% and 6 by 15% to
-  // 24%.
-  RelationOptions options;
-  options.significance = 3.44;
-  const RegularizedPart part = regularized_part("fandisk_large.off", options);
+  // At the default significance (at 3.44 until the direction test's χ² bound of a tilt's 2 degrees
+  // of freedom was 3.44² rather than the 11.8 of 3), fandisk_large's cylinder 119 (17 faces, a
+  // small arc of radius 0.114) joins the direction group of its neighbour 125 and is held tangent
+  // to it: the fit ran along the valley of arcs that match a flat patch, to a radius of 1e15, and
+  // since its residuals stayed within the noise the likelihood-ratio test kept it, a plane given as
+  // a cylinder whose distances lose every digit (its RMS 0.256 against 0.001). A hold now leaves
+  // every radius on its line within max_radius_difference of the line's own fit: on the 137
+  // libcgal-demo meshes under 3 MB at the default significance, 50 holds were tried, 41 moved no
+  // radius by more than 5%, 8 by 5.4% to 24%, and this one by all of it.
+  const RegularizedPart part = regularized_part("fandisk_large.off");
   const Groups tangent = clusters_of(part.relations, ClusterRelation::Kind::Tangent);
   ASSERT_FALSE(tangent.empty());
   const double diagonal = bounding_box_diagonal(part.hierarchy.mesh());

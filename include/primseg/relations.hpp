@@ -97,7 +97,11 @@ std::string_view to_string(ClusterRelation::Kind kind);
 /// Options of regularize_clusters().
 struct RelationOptions {
   /// A direction joins a group when its tilt from the group's direction is within this many
-  /// standard deviations of the two estimates (Mahalanobis). Larger joins more. > 0.
+  /// standard deviations of the two estimates: its squared Mahalanobis distance (both estimates'
+  /// covariances) at most the χ² bound that a tilt's two degrees of freedom exceed as rarely as
+  /// one normal deviate exceeds this (11.8 at 3). Every test of a relation is calibrated so, by
+  /// its degrees of freedom: a true relation is refused with the two-sided normal tail of this
+  /// (0.27% at 3). Larger joins more. > 0.
   double significance = 3.0;
   /// ... and never when the tilt is larger than this, whatever the uncertainty (degrees, in
   /// (0, 90)).

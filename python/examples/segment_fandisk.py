@@ -160,12 +160,6 @@ def check_tangent(pairs, fits):
 tangent = [r["clusters"] for r in relations if r["kind"] == "tangent"]
 assert tangent
 check_tangent(tangent, exact)
-# At the automatic level (34 clusters) a fillet also rounds the edge between a face and a large
-# cylinder of its direction, and is made tangent to the cylinder.
-automatic = [r["clusters"] for r in tree.relations("auto") if r["kind"] == "tangent"]
-automatic_fits = tree.clusters("auto", regularize=True)
-assert any(all(automatic_fits[c]["type"] == "cylinder" for c in pair) for pair in automatic)
-check_tangent(automatic, automatic_fits)
 
 # %% [markdown]
 # ## A CAD part's tolerances
@@ -181,6 +175,17 @@ tangent_within = [r["clusters"] for r in tolerant if r["kind"] == "tangent"]
 print(f"tangent pairs: {len(tangent)} by the statistics, {len(tangent_within)} within the"
       f" tolerances: {tangent_within}")
 assert len(tangent_within) > len(tangent)
+# At the automatic level (34 clusters) a fillet rounds the edge between a face and a large
+# cylinder of its direction: within the tolerances it is tangent to both, as drawn.
+automatic = [r["clusters"] for r in tree.relations("auto", **tolerances) if r["kind"] == "tangent"]
+automatic_fits = tree.clusters("auto", regularize=True, **tolerances)
+fillet_between = [pair for pair in automatic
+                  if all(automatic_fits[c]["type"] == "cylinder" for c in pair)]
+assert fillet_between
+fillet = next(c for c in fillet_between[0] if automatic_fits[c]["params"]["radius"] < 1)
+assert any(fillet in pair and any(automatic_fits[c]["type"] == "plane" for c in pair)
+           for pair in automatic)
+check_tangent(automatic, automatic_fits)
 
 # %% [markdown]
 # ## The design intent of many levels at once

@@ -34,13 +34,14 @@ std::optional<AlignedCylinder> aligned_cylinder(std::size_t c, const Primitive& 
 namespace {
 
 // Sets of cylinders (indices into `cylinders`, sorted best-located first) whose axes are one line
-// within the significance: each joins the first set whose information-weighted axis it is near,
+// within `bound` (the χ² of the 2 coordinates of an axis's offset): each joins the first set whose
+// information-weighted axis it is near,
 // counting the direction's tilt (`tilt`, radians², orthonormal_pair(direction) coordinates) over
 // the distance along it from the set's first member, as the coplanar sets do; or within the length
 // tolerance of it. An axis known less well than the radius (a nearly flat cylinder) joins none.
 std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCylinder>& cylinders,
-                                                   const Eigen::Matrix2d& tilt,
-                                                   double significance2, double length_tolerance) {
+                                                   const Eigen::Matrix2d& tilt, double bound,
+                                                   double length_tolerance) {
   std::vector<std::vector<std::size_t>> sets;
   std::vector<PooledCentre> pooled;
   for (std::size_t k = 0; k < cylinders.size(); ++k) {
@@ -52,7 +53,7 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
       const Eigen::Vector2d delta = fit.centre - covariance * pooled[s].weighted;
       const double apart = cylinders[k].middle - cylinders[sets[s][0]].middle;
       const Eigen::Matrix2d combined = fit.centre_covariance + covariance + apart * apart * tilt;
-      if (delta.dot(combined.ldlt().solve(delta)) <= significance2 ||
+      if (delta.dot(combined.ldlt().solve(delta)) <= bound ||
           within_tolerance(delta.norm(), length_tolerance)) {
         joined = s;
         break;
@@ -73,8 +74,8 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
 // fit (none for a lone cylinder): coaxial_sets(), then the joint fit `fit_set(set)` (an optional
 // fit whose `rms` are its members', in the set's order) must explain each member as its own fit
 // did, within the significance corrected for the number of members: a member whose residual sum
-// rises by more than its square times its residual variance (it has 2 degrees of freedom fewer)
-// leaves the set, the worst first, and starts one of its own.
+// rises by more than guard_bound() of the 2 degrees of freedom it loses times its residual
+// variance leaves the set, the worst first, and starts one of its own.
 template <class FitSet>
 auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& direction_covariance,
                       std::vector<AlignedCylinder>& cylinders, const RegularityOptions& options,
@@ -87,20 +88,21 @@ auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& d
                    });
   std::vector<std::vector<std::size_t>> sets =
       coaxial_sets(cylinders, tilt_in_frame(direction, direction_covariance),
-                   significance * significance, options.length_tolerance);
+                   chi_square_bound(significance, 2), options.length_tolerance);
   std::vector<std::pair<std::vector<std::size_t>, Fit>> fitted;
   for (std::size_t s = 0; s < sets.size(); ++s) {
     Fit joint;
     while (sets[s].size() > 1) {
       Fit fit = fit_set(sets[s]);
-      const double bound = family_significance(significance, sets[s].size());
+      // A member gives up its own axis line: 2 degrees of freedom.
+      const double bound = guard_bound(significance, sets[s].size(), 2);
       std::size_t worst = sets[s].size();
       double worst_excess = 1;
       for (std::size_t j = 0; j < sets[s].size(); ++j) {
         const AlignedCylinder& member = cylinders[sets[s][j]];
         const double excess =
             fit ? residual_excess(member.fit.rms[0], fit->rms[j], points[member.cluster].size(),
-                                  bound * bound, 3, options.length_tolerance)
+                                  bound, 3, options.length_tolerance)
                 : std::numeric_limits<double>::infinity();
         if (excess > worst_excess) {
           worst_excess = excess;

@@ -141,7 +141,9 @@ std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
   for (const std::size_t i : order) {
     const Oriented& item = items[i];
     std::size_t best = groups.size();
-    double best_score = options.significance * options.significance;
+    // A tilt has 2 degrees of freedom.
+    const double bound = chi_square_bound(options.significance, 2);
+    double best_score = bound;
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const double angle = angle_between_lines(item.direction, groups[g].direction);
       if (angle > max_angle) continue;
@@ -151,8 +153,7 @@ std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
       const Eigen::Matrix2d combined =
           item.covariance + item.frame.transpose() * groups[g].covariance * item.frame;
       const double score =
-          tolerated(delta.dot(combined.ldlt().solve(delta)),
-                    options.significance * options.significance, angle, options.angle_tolerance);
+          tolerated(delta.dot(combined.ldlt().solve(delta)), bound, angle, options.angle_tolerance);
       if (score <= best_score) {
         best_score = score;
         best = g;
@@ -258,10 +259,10 @@ bool moves_within(const std::vector<std::size_t>& component,
                   const std::vector<Eigen::Vector3d>& moved,
                   const std::vector<Eigen::Vector3d>& measured,
                   const std::vector<DirectionGroup>& groups, const RegularityOptions& options) {
-  const double significance2 = options.significance * options.significance;
+  const double bound = chi_square_bound(options.significance, 2);  // a tilt's
   for (std::size_t k = 0; k < component.size(); ++k) {
     const Eigen::Vector3d tilt = moved[k] - measured[component[k]];
-    if (!(tilt.dot(groups[component[k]].information * tilt) <= significance2 ||
+    if (!(tilt.dot(groups[component[k]].information * tilt) <= bound ||
           within_tolerance(angle_between_lines(moved[k], measured[component[k]]),
                            options.angle_tolerance)))
       return false;

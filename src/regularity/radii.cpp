@@ -225,9 +225,10 @@ double tilt_allowance(const SettledSurfaces& settled, std::size_t l, std::size_t
 // How line l's fit `fit` (none: it failed) explains its members, `cylinders` then `spheres`
 // (indices into settled.surfaces), against their own fits: the largest residual_excess() at the
 // significance corrected for their number (at least 1; infinite without a fit), a cylinder's own
-// fit having 3 parameters and a sphere's `sphere_parameters`, sphere j's bound scaled by
-// allowance(j), and which sphere (an index into `spheres`) of those `may_leave` accepts has the
-// largest.
+// fit having 3 parameters and a sphere's `sphere_parameters`, of which the line takes
+// `sphere_lost` (the cylinders, already on it, are held to one degree of freedom), sphere j's
+// bound scaled by allowance(j), and which sphere (an index into `spheres`) of those `may_leave`
+// accepts has the largest.
 struct LineExcess {
   double worst = 1;
   std::size_t worst_sphere = 0;
@@ -235,11 +236,12 @@ struct LineExcess {
 template <class Allowance, class MayLeave>
 LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size_t> cylinders,
                        std::span<const std::size_t> spheres, const JointFit* fit,
-                       int sphere_parameters, const Allowance& allowance,
+                       int sphere_parameters, std::size_t sphere_lost, const Allowance& allowance,
                        const RegularityOptions& options,
                        const std::vector<std::vector<Vec3>>& points, const MayLeave& may_leave) {
   const std::size_t members = cylinders.size() + spheres.size();
-  const double bound = family_significance(options.significance, members);
+  const double cylinder_bound = guard_bound(options.significance, members, 1);
+  const double sphere_bound = guard_bound(options.significance, members, sphere_lost);
   LineExcess result;
   double worst_sphere_excess = -std::numeric_limits<double>::infinity();
   for (std::size_t j = 0; j < members; ++j) {
@@ -247,9 +249,10 @@ LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size
     const SettledSurfaces::Surface& surface =
         settled.surfaces[is_sphere ? spheres[j - cylinders.size()] : cylinders[j]];
     const double excess =
-        fit ? residual_excess(surface.rms, fit->rms[j], points[surface.cluster].size(),
-                              bound * bound * (is_sphere ? allowance(j - cylinders.size()) : 1),
-                              is_sphere ? sphere_parameters : 3, options.length_tolerance)
+        fit ? residual_excess(
+                  surface.rms, fit->rms[j], points[surface.cluster].size(),
+                  is_sphere ? sphere_bound * allowance(j - cylinders.size()) : cylinder_bound,
+                  is_sphere ? sphere_parameters : 3, options.length_tolerance)
             : std::numeric_limits<double>::infinity();
     result.worst = std::max(result.worst, excess);
     if (is_sphere && may_leave(j - cylinders.size()) && excess > worst_sphere_excess) {
@@ -282,9 +285,9 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
     own_centre.resize(spheres.size());
     std::iota(own_centre.begin(), own_centre.end(), 0);
     fit = fit_line(settled, l, cylinders, spheres, own_centre, centres, points, weights);
-    // A sphere's own fit has 4 parameters; any may leave.
+    // A sphere's own fit has 4 parameters, 2 of which the line takes; any may leave.
     const LineExcess excess = line_excess(
-        settled, cylinders, spheres, fit ? &*fit : nullptr, 4,
+        settled, cylinders, spheres, fit ? &*fit : nullptr, 4, 2,
         [&](std::size_t j) { return tilt_allowance(settled, l, spheres[j]); }, options, points,
         [](std::size_t) { return true; });
     if (!(excess.worst > 1)) break;
@@ -498,14 +501,15 @@ std::vector<CoaxialMember> sphere_members(const SettledSurfaces& settled,
 std::size_t worst_sphere(const SettledSurfaces& settled, const std::vector<std::size_t>& set,
                          const ConcentricFit& fit, const RegularityOptions& options,
                          const std::vector<std::vector<Vec3>>& points) {
-  const double bound = family_significance(options.significance, set.size());
+  // A sphere gives up its centre: 3 degrees of freedom.
+  const double bound = guard_bound(options.significance, set.size(), 3);
   double worst_excess = 1;
   std::size_t worst = set.size();
   for (std::size_t j = 0; j < set.size(); ++j) {
     const SettledSurfaces::Surface& sphere = settled.surfaces[set[j]];
     // A sphere's own fit has 4 parameters.
     const double excess = residual_excess(sphere.rms, fit.rms[j], points[sphere.cluster].size(),
-                                          bound * bound, 4, options.length_tolerance);
+                                          bound, 4, options.length_tolerance);
     if (excess > worst_excess) {
       worst_excess = excess;
       worst = j;
@@ -600,10 +604,10 @@ void share_centres_on_line(SettledSurfaces& settled, std::size_t l,
     }
     fit = fit_line(settled, l, cylinders, spheres, centre_of, centres, points, weights);
     if (!fit) return;
-    // On the line a sphere has 2 parameters of its own (as worst_member counts); only a sphere of
-    // a set may leave.
+    // On the line a sphere has 2 parameters of its own (as worst_member counts), and a set shares
+    // its place; only a sphere of a set may leave.
     const LineExcess excess = line_excess(
-        settled, cylinders, spheres, &*fit, 2, [](std::size_t) { return 1.0; }, options, points,
+        settled, cylinders, spheres, &*fit, 2, 1, [](std::size_t) { return 1.0; }, options, points,
         [&](std::size_t j) { return set_centre.contains(spheres[j]); });
     if (!(excess.worst > 1)) break;
     for (std::vector<std::size_t>& set : sets) std::erase(set, spheres[excess.worst_sphere]);
@@ -767,7 +771,8 @@ std::size_t worst_member(const SettledSurfaces& settled, const std::vector<std::
   const std::size_t tested = static_cast<std::size_t>(
       std::count_if(component.begin(), component.end(),
                     [&](std::size_t k) { return class_size[class_of[k]] >= 2; }));
-  const double bound = family_significance(options.significance, tested);
+  // A member of a class gives up its radius: 1 degree of freedom.
+  const double bound = guard_bound(options.significance, tested, 1);
   std::size_t worst = component.size();
   double worst_excess = 1;
   for (std::size_t j = 0; j < component.size(); ++j) {
@@ -777,8 +782,8 @@ std::size_t worst_member(const SettledSurfaces& settled, const std::vector<std::
         fit.rms[surface.sphere ? problem.terms.size() + problem.term_of[j] : problem.term_of[j]];
     // A sphere's own fit has 4 parameters (2 on a line), a cylinder's (on its direction) 3.
     const int parameters = !surface.sphere ? 3 : surface.line == kNoLine ? 4 : 2;
-    const double excess = residual_excess(surface.rms, rms, points[surface.cluster].size(),
-                                          bound * bound, parameters, options.length_tolerance);
+    const double excess = residual_excess(surface.rms, rms, points[surface.cluster].size(), bound,
+                                          parameters, options.length_tolerance);
     if (excess > worst_excess) {
       worst_excess = excess;
       worst = j;

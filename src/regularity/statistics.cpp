@@ -68,4 +68,8 @@ double family_significance(double significance, std::size_t tests) {
       std::erfc(significance / std::numbers::sqrt2) / static_cast<double>(tests), significance);
 }
 
+double guard_bound(double significance, std::size_t tests, std::size_t lost) {
+  return chi_square_bound(family_significance(significance, tests), lost);
+}
+
 }  // namespace primseg::detail

@@ -133,6 +133,7 @@ struct TestedContact {
   double score = 0;
   std::size_t other = 0, member = 0;
   LineHold hold;
+  const Contact* contact = nullptr;
 };
 
 // x in the frame (u, v) of the plane orthogonal to a line's direction.
@@ -526,7 +527,7 @@ std::vector<TestedContact> Tangency::tested_contacts(const TangentLine& line,
          within_tolerance(std::abs(gap), options_.length_tolerance)))
       tested.push_back(
           {tolerated(gap * gap / variance, significance2, std::abs(gap), options_.length_tolerance),
-           contact->other, m, hold});
+           contact->other, m, hold, contact});
   }
   std::sort(tested.begin(), tested.end(), [](const TestedContact& a, const TestedContact& b) {
     return std::tie(a.score, a.other, a.member) < std::tie(b.score, b.other, b.member);
@@ -552,14 +553,14 @@ void Tangency::hold_tangent(const TangentLine& line, std::vector<Relation>& tang
       in_frame(orthonormal_pair(direction), to_eigen(primitives_[line.first].point));
   const std::optional<HeldLineFit> own = fit_held_line(direction, start, sides.members, holds);
   if (!own || own->free == 0) return;
-  const std::vector<TestedContact> tested = tested_contacts(line, bordered, *own);
+  std::vector<TestedContact> tested = tested_contacts(line, bordered, *own);
   // Each trial starts from the own fit.
   for (std::size_t m = 0; m < cylinders.size(); ++m)
     sides.members[m].radius = own->y(radius_index(m));
   const std::size_t own_holds = holds.size();
   std::vector<std::pair<std::size_t, std::size_t>> kept;  // (cylinder, other)
   std::optional<HeldLineFit> fit;
-  for (const TestedContact& candidate : tested) {
+  const auto try_hold = [&](const TestedContact& candidate) {
     // A condition the kept ones imply (a fragment's second face, once the line and the other
     // fragments are held) holds to round-off or not at all: it adds no freedom to test.
     const Eigen::VectorXd& at = fit ? fit->y : own->y;
@@ -568,7 +569,7 @@ void Tangency::hold_tangent(const TangentLine& line, std::vector<Relation>& tang
       if (fit && std::abs(there.row.dot(fit->y) - there.target) <=
                      kImplied * fit->y(radius_index(candidate.member)))
         kept.emplace_back(cylinders[candidate.member], candidate.other);
-      continue;
+      return;
     }
     holds.push_back(candidate.hold);
     std::optional<HeldLineFit> trial =
@@ -583,6 +584,19 @@ void Tangency::hold_tangent(const TangentLine& line, std::vector<Relation>& tang
     } else {
       holds.pop_back();
     }
+  };
+  std::vector<const Contact*> untried = bordered;
+  for (std::size_t kept_before = 0;;) {
+    for (const TestedContact& candidate : tested) {
+      std::erase(untried, candidate.contact);
+      try_hold(candidate);
+    }
+    // Kept holds move the line and its radii: a fillet's radius, off alike at both faces it
+    // rounds (an exact tessellation's chords), is set by the first. A contact whose gap the own
+    // fit put beyond the significance is tested again at the held fit while holds are added.
+    if (!fit || kept.size() == kept_before || untried.empty()) break;
+    kept_before = kept.size();
+    tested = tested_contacts(line, untried, *fit);
   }
   if (!fit) return;
   for (std::size_t m = 0; m < cylinders.size(); ++m) {
