@@ -34,11 +34,11 @@ std::optional<AlignedCylinder> aligned_cylinder(std::size_t c, const Primitive& 
 namespace {
 
 // Sets of cylinders (indices into `cylinders`, sorted best-located first) whose axes are one line
-// within `bound` (the χ² of the 2 coordinates of an axis's offset): each joins the first set whose
-// information-weighted axis it is near,
-// counting the direction's tilt (`tilt`, radians², orthonormal_pair(direction) coordinates) over
-// the distance along it from the set's first member, as the coplanar sets do; or within the length
-// tolerance of it. An axis known less well than the radius (a nearly flat cylinder) joins none.
+// within `bound` (a χ² bound of the 2 coordinates of an axis's offset): each joins the first set
+// whose information-weighted axis it is near, counting the direction's tilt (`tilt`, radians²,
+// orthonormal_pair(direction) coordinates) over the distance along it from the set's first
+// member, as the coplanar sets do; or within the length tolerance of it. An axis known less well
+// than the radius (a nearly flat cylinder) joins none.
 std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCylinder>& cylinders,
                                                    const Eigen::Matrix2d& tilt, double bound,
                                                    double length_tolerance) {

@@ -138,11 +138,10 @@ std::vector<DirectionGroup> group_directions(const std::vector<Oriented>& items,
   });
   const double max_angle = options.max_angle_degrees * std::numbers::pi / 180;
   std::vector<DirectionGroup> groups;
+  const double bound = chi_square_bound(options.significance, 2);  // a tilt's 2 coordinates
   for (const std::size_t i : order) {
     const Oriented& item = items[i];
     std::size_t best = groups.size();
-    // A tilt has 2 degrees of freedom.
-    const double bound = chi_square_bound(options.significance, 2);
     double best_score = bound;
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const double angle = angle_between_lines(item.direction, groups[g].direction);

@@ -49,11 +49,11 @@ double tolerated(double score, double bound, double size, double tolerance);
 double chi_square_bound(double significance, std::size_t freedom);
 
 /// How far a joint fit explains a member worse than its own fit did: the rise of its residual sum
-/// over `significance2` (a χ² bound: guard_bound()) times its residual variance (estimated with
-/// the degrees of freedom of the
-/// member's own fit, of `parameters` parameters), or, when lower, the rise of its mean square
-/// against the square of the length tolerance. Above 1, it does not belong.
-double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2,
+/// over `bound` (a χ² bound, guard_bound()) times its residual variance (estimated with the
+/// degrees of freedom of the member's own fit, of `parameters` parameters), or, when lower, the
+/// rise of its mean square against the square of the length tolerance. Above 1, it does not
+/// belong.
+double residual_excess(double own_rms, double joint_rms, std::size_t count, double bound,
                        int parameters, double length_tolerance);
 
 /// The covariance of a direction's tilt (radians², 3x3) in orthonormal_pair(direction)
@@ -65,7 +65,7 @@ Eigen::Matrix2d tilt_in_frame(const Eigen::Vector3d& direction, const Eigen::Mat
 /// their number).
 double family_significance(double significance, std::size_t tests);
 
-/// The `significance2` of residual_excess() for each of `tests` members of a joint fit that takes
+/// The `bound` of residual_excess() for each of `tests` members of a joint fit that takes
 /// `lost` degrees of freedom from each: the χ² bound of those degrees of freedom at the family
 /// significance, so that a true member's residual sum, which rises by about its residual variance
 /// times a χ² of `lost` degrees of freedom, is sent away as rarely as the significance promises.

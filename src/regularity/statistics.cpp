@@ -48,11 +48,11 @@ double chi_square_bound(double significance, std::size_t freedom) {
   return k * std::pow(1 - spread + z * std::sqrt(spread), 3);
 }
 
-double residual_excess(double own_rms, double joint_rms, std::size_t count, double significance2,
+double residual_excess(double own_rms, double joint_rms, std::size_t count, double bound,
                        int parameters, double length_tolerance) {
   const double n = static_cast<double>(count);
   const double rise = n * (joint_rms * joint_rms - own_rms * own_rms);
-  return tolerated(rise / (significance2 * own_rms * own_rms * n / (n - parameters)), 1,
+  return tolerated(rise / (bound * own_rms * own_rms * n / (n - parameters)), 1,
                    std::sqrt(std::max(rise / n, 0.0)), length_tolerance);
 }
 

@@ -127,13 +127,13 @@ struct RadiusHolds {
   std::vector<std::size_t> tied;
 };
 
-// A tangency that passed its test, ranked by `score`: member `member` of the line (an index into
-// its cylinders) against `other`, a plane or a held cylinder, as `hold`.
+// A tangency that passed its test, ranked by `score`: `contact`, of member `member` of the line (an
+// index into its cylinders) against a plane or a held cylinder, as `hold`.
 struct TestedContact {
   double score = 0;
-  std::size_t other = 0, member = 0;
-  LineHold hold;
   const Contact* contact = nullptr;
+  std::size_t member = 0;
+  LineHold hold;
 };
 
 // x in the frame (u, v) of the plane orthogonal to a line's direction.
@@ -527,10 +527,11 @@ std::vector<TestedContact> Tangency::tested_contacts(const TangentLine& line,
          within_tolerance(std::abs(gap), options_.length_tolerance)))
       tested.push_back(
           {tolerated(gap * gap / variance, significance2, std::abs(gap), options_.length_tolerance),
-           contact->other, m, hold, contact});
+           contact, m, hold});
   }
   std::sort(tested.begin(), tested.end(), [](const TestedContact& a, const TestedContact& b) {
-    return std::tie(a.score, a.other, a.member) < std::tie(b.score, b.other, b.member);
+    return std::tie(a.score, a.contact->other, a.member) <
+           std::tie(b.score, b.contact->other, b.member);
   });
   return tested;
 }
@@ -568,7 +569,7 @@ void Tangency::hold_tangent(const TangentLine& line, std::vector<Relation>& tang
     if (implied_by(holds, there.row, at)) {
       if (fit && std::abs(there.row.dot(fit->y) - there.target) <=
                      kImplied * fit->y(radius_index(candidate.member)))
-        kept.emplace_back(cylinders[candidate.member], candidate.other);
+        kept.emplace_back(cylinders[candidate.member], candidate.contact->other);
       return;
     }
     holds.push_back(candidate.hold);
@@ -580,7 +581,7 @@ void Tangency::hold_tangent(const TangentLine& line, std::vector<Relation>& tang
                         chi_square_bound(options_.significance, conditions),
                         static_cast<int>(own->free), options_.length_tolerance) <= 1) {
       fit = trial;
-      kept.emplace_back(cylinders[candidate.member], candidate.other);
+      kept.emplace_back(cylinders[candidate.member], candidate.contact->other);
     } else {
       holds.pop_back();
     }
