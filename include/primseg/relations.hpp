@@ -101,7 +101,9 @@ struct RelationOptions {
   /// covariances) at most the χ² bound that a tilt's two degrees of freedom exceed as rarely as
   /// one normal deviate exceeds this (11.8 at 3). Every test of a relation is calibrated so, by
   /// its degrees of freedom: a true relation is refused with the two-sided normal tail of this
-  /// (0.27% at 3). Larger joins more. > 0.
+  /// (0.27% at 3), for clusters of a hundred points or more; smaller ones more often, as their
+  /// noise is estimated from their own points (a plane of 16 points: 1.35%). Larger joins more.
+  /// > 0.
   double significance = 3.0;
   /// ... and never when the tilt is larger than this, whatever the uncertainty (degrees, in
   /// (0, 90)).

@@ -366,8 +366,8 @@ TEST(Regularity, AShaftsStepsFarApartFixTheirAxisTogether) {
 // for their χ² bound of two degrees of freedom, and the guard the bound of one for the two a step
 // loses; 9 against 11.8 fails a true relation four times as often, and 18 and 20 of the 400 draws
 // lost the steps' line. Now 4 and 8 do: 4 a step's direction, 4 more the axis lines' test 8
-// apart (scores 12 to 14), both tests calibrated (tests/regularity/uncertainty_test.cpp; docs/
-// method.md, "Every test at the rarity of its significance").
+// apart (scores 12 to 14), both tests calibrated (tests/regularity/uncertainty_test.cpp and
+// docs/method.md, "Every test at the rarity of its significance").
 TEST(Regularity, ShaftStepsFarApartShareTheirLineAsOftenAsTheSignificancePromises) {
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
   for (const double apart : {1.0, 8.0}) {
