@@ -24,6 +24,7 @@ struct SkeletonCommandOptions {
   SkeletonPicture picture;
   LevelChoice level;
   double band = SkinningOptions{}.band;
+  std::string joints{to_string(SkeletonOptions{}.joints)};
   unsigned threads = 0;
   bool quiet = false;
   ResourceLimits limits;
@@ -37,6 +38,7 @@ void run_skeleton(const SkeletonCommandOptions& o) {
   validate(options);
   if (!(std::isfinite(o.band) && o.band >= 0))
     throw InvalidInputError("--band: must be a finite number >= 0");
+  const SkeletonOptions skeleton_choice = skeleton_options(o.joints);
   auto mesh = std::make_shared<const Mesh>(
       read_geometry_within(o.mesh_path, o.limits, o.picture.png ? kPictureBytes : 0));
   validate_level(o.level, mesh->face_count());
@@ -45,12 +47,14 @@ void run_skeleton(const SkeletonCommandOptions& o) {
   const Hierarchy hierarchy = builder.finish(Progress("hierarchy", o.quiet));
   const double build_seconds = seconds_since(build_start);
   const auto skeleton_start = Clock::now();
-  const Skeleton skeleton = extract_skeleton(hierarchy, cut(hierarchy, o.level).segmentation);
+  const Skeleton skeleton =
+      extract_skeleton(hierarchy, cut(hierarchy, o.level).segmentation, skeleton_choice);
   const double skeleton_seconds = seconds_since(skeleton_start);
 
   nlohmann::json json;
   json["mesh"] = mesh_summary(o.mesh_path, hierarchy);
   json["primitives"] = o.primitives;
+  json["joint_rule"] = o.joints;
   const std::optional<std::uint32_t> requested = parse_cluster_count(*o.level.clusters);
   if (requested)
     json["requested_clusters"] = *requested;
@@ -111,6 +115,7 @@ Command add_skeleton_command(CLI::App& app) {
                    "4 for engines that take four)")
       ->capture_default_str()
       ->needs(gltf_option);
+  add_joints_option(*command, o->joints);
   command
       ->add_option("--band", o->band,
                    "Skinning blend half-width on each side of a boundary, in bone radii")

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "primseg/error.hpp"
 #include "primseg/skeleton_render.hpp"
 
 namespace primseg::cli {
@@ -20,6 +21,23 @@ std::string skin_weights_text(const SkinWeights& weights) {
     text += '\n';
   }
   return text;
+}
+
+void add_joints_option(CLI::App& command, std::string& joints, const std::string& help_prefix) {
+  command
+      .add_option("--joints", joints,
+                  help_prefix +
+                      "Joint rule: paper (touching boundaries merge into locked hubs) or limbs (a "
+                      "protruding part also turns where it is attached)")
+      ->capture_default_str();
+}
+
+SkeletonOptions skeleton_options(const std::string& joints) {
+  SkeletonOptions options;
+  const std::optional<JointRule> rule = joint_rule_from_string(joints);
+  if (!rule) throw InvalidInputError("--joints: '" + joints + "' is not paper or limbs");
+  options.joints = *rule;
+  return options;
 }
 
 void SkeletonPicture::add_options(CLI::App& command, const std::string& what) {

@@ -1,6 +1,6 @@
 #pragma once
 // What `primseg skeleton` and `primseg deform` share besides the skeleton and pose files
-// (primseg/skeleton_io.hpp): the skin weights file and the picture options.
+// (primseg/skeleton_io.hpp): the skin weights file, the joint rule and the picture options.
 
 #include <CLI/CLI.hpp>
 #include <array>
@@ -17,6 +17,12 @@ namespace primseg::cli {
 /// Text, one line per vertex: "bone weight bone weight ..." (bones increasing, weights summing
 /// to 1, 17 significant digits); an unused vertex has an empty line.
 std::string skin_weights_text(const SkinWeights& weights);
+
+/// --joints paper|limbs (SkeletonOptions::joints) into `joints`, its help starting with
+/// `help_prefix`.
+void add_joints_option(CLI::App& command, std::string& joints, const std::string& help_prefix = "");
+/// The options --joints names; throws InvalidInputError for an unknown rule.
+SkeletonOptions skeleton_options(const std::string& joints);
 
 /// --png FILE, --view X,Y,Z and --up X,Y,Z: a picture of the skeleton over the mesh.
 struct SkeletonPicture {

@@ -27,6 +27,7 @@
 #include "primseg/skeleton.hpp"
 #include "primseg/skinning.hpp"
 #include "primseg/tree_io.hpp"
+#include "skeleton_outputs.hpp"
 #include "viewer_bundle.hpp"
 
 namespace primseg::cli {
@@ -418,6 +419,7 @@ struct ViewCommandOptions {
   std::optional<std::uint32_t> regularize_clusters;  // default: kRelationClusters
   RelationChoice relations;
   double band = SkinningOptions{}.band;
+  std::string joints{to_string(SkeletonOptions{}.joints)};
   unsigned threads = 0;
   bool quiet = false;
   ResourceLimits limits;
@@ -454,7 +456,7 @@ PageSkeleton page_skeleton(const ViewCommandOptions& o, const Mesh& mesh,
                                  : opening_level;
   SkinningOptions skinning;
   skinning.band = o.band;
-  Skeleton extracted = extract_skeleton(hierarchy, bones);
+  Skeleton extracted = extract_skeleton(hierarchy, bones, skeleton_options(o.joints));
   SkinWeights weights = compute_skin_weights(mesh, extracted, skinning);
   return PageSkeleton{std::move(extracted), std::move(weights), o.band};
 }
@@ -473,6 +475,7 @@ void run_view(const ViewCommandOptions& o) {
       std::make_shared<const Mesh>(read_geometry_within(o.mesh_path, o.limits, kViewerPageBytes));
   if (!(std::isfinite(o.band) && o.band >= 0))
     throw InvalidInputError("--band: must be a finite number >= 0");
+  skeleton_options(o.joints);  // before the hierarchy: a misspelt rule fails at once
   if (o.clusters) validate_level({o.clusters, std::nullopt}, mesh->face_count());
   if (o.skeleton_clusters) validate_level({o.skeleton_clusters, std::nullopt}, mesh->face_count());
   const auto build_start = Clock::now();
@@ -538,6 +541,7 @@ Command add_view_command(CLI::App& app) {
                    "--skeleton: skinning blend half-width on each side of a boundary, in bone "
                    "radii")
       ->capture_default_str();
+  add_joints_option(*view, o->joints, "--skeleton: ");
   view->add_flag("--regularize", o->regularize,
                  "List the relations cut --regularize finds (parallel, orthogonal, coaxial, "
                  "equal radius, coplanar, tangent) at every level of up to --regularize-clusters "

@@ -576,6 +576,10 @@ Results run(const std::shared_ptr<const Mesh>& mesh, const Settings& settings) {
   results.skin = compute_skin_weights(*mesh, results.skeleton);
   check_skeleton(*mesh, results.level, results.skeleton, results.skin);
   check_glb(skinned_glb(*mesh, results.skeleton, results.skin), mesh->vertex_count());
+  SkeletonOptions limbs;
+  limbs.joints = JointRule::Limbs;
+  const Skeleton limb_skeleton = extract_skeleton(hierarchy, results.level, limbs);
+  check_skeleton(*mesh, results.level, limb_skeleton, compute_skin_weights(*mesh, limb_skeleton));
 
   Denoiser denoiser(*mesh, settings.denoise);
   const SnapReport report = settings.automatic_level ? denoiser.iterate([&](const Hierarchy& h) {

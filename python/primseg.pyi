@@ -308,6 +308,7 @@ def skeleton(
     relative_tolerance: float | None = None,
     primitives: _Primitives | None = None,
     weights: _Weights | None = None,
+    joints: Literal["paper", "limbs"] = "paper",
     threads: int = 0,
     progress: _Progress = None,
 ) -> Skeleton: ...

@@ -405,13 +405,18 @@ the CLI's --max-influences (0 keeps every weight).)",
       "skeleton",
       [](const py::object& first, const py::object& faces, ClusterCount k,
          std::optional<double> tolerance, std::optional<double> relative_tolerance,
-         const py::object& primitives, const py::object& weights, unsigned threads,
-         const py::object& progress) {
+         const py::object& primitives, const py::object& weights, const std::string& joints,
+         unsigned threads, const py::object& progress) {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
         if (given && !faces.is_none())
           throw InvalidInputError("skeleton(hierarchy) takes no F (give the level as k=...)");
+        SkeletonOptions skeleton_options;
+        const std::optional<JointRule> rule = joint_rule_from_string(joints);
+        if (!rule)
+          throw InvalidInputError("skeleton: joints='" + joints + "' is not 'paper' or 'limbs'");
+        skeleton_options.joints = *rule;
         const HierarchyOptions options = tool_hierarchy_options(
             "skeleton", given, primitives, weights, threads, py::make_tuple("cylinder"));
         const std::shared_ptr<const Mesh> mesh =
@@ -426,16 +431,17 @@ the CLI's --max-influences (0 keeps every weight).)",
           PySkeleton skeleton;
           skeleton.mesh = mesh;
           skeleton.skeleton = std::make_shared<const Skeleton>(
-              extract_skeleton(*hierarchy, cut_level(*hierarchy, level)));
+              extract_skeleton(*hierarchy, cut_level(*hierarchy, level), skeleton_options));
           return skeleton;
         });
       },
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(), py::arg("k") = py::none(),
       py::arg("tolerance") = py::none(), py::arg("relative_tolerance") = py::none(),
-      py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
+      py::arg("primitives") = py::none(), py::arg("weights") = py::none(),
+      py::arg("joints") = std::string(to_string(SkeletonOptions{}.joints)), py::arg("threads") = 0u,
       py::arg("progress") = py::none(),
       join_docs(
-          {R"(skeleton(mesh, *, k=None, tolerance=None, relative_tolerance=None, primitives=None, weights=None, threads=0, progress=None) -> Skeleton
+          {R"(skeleton(mesh, *, k=None, tolerance=None, relative_tolerance=None, primitives=None, weights=None, joints="paper", threads=0, progress=None) -> Skeleton
 skeleton(V, F, *, ...) -> Skeleton
 skeleton(hierarchy, *, ...) -> Skeleton
 
@@ -443,7 +449,8 @@ skeleton(hierarchy, *, ...) -> Skeleton
 Mesh, arrays V and F, or a Hierarchy (its tree, not built again). Level: k (count or "auto"),
 tolerance or relative_tolerance as in Hierarchy.cut (the CLI asks for --clusters K|auto).
 primitives: cylinders only by default, as the CLI (and the paper) do; weights: "area" by
-default. The GIL is released while it works; Ctrl-C (KeyboardInterrupt) stops the hierarchy's
+default. joints: "paper" (touching boundaries merge into locked hubs) or "limbs" (a protruding
+part also turns where it is attached), as the CLI's --joints. The GIL is released while it works; Ctrl-C (KeyboardInterrupt) stops the hierarchy's
 build, and progress, if given, is called during it with the fraction done, as in segment.)",
            cpp_doc("skeleton.hpp", doc::skeleton__file)})
           .c_str());

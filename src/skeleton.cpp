@@ -8,6 +8,7 @@
 #include <map>
 #include <numeric>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "no_index.hpp"
@@ -31,6 +32,16 @@ std::string_view to_string(JointKind kind) {
 std::optional<JointKind> joint_kind_from_string(std::string_view name) {
   for (const JointKind kind : {JointKind::Sensitive, JointKind::Locked, JointKind::Virtual})
     if (to_string(kind) == name) return kind;
+  return std::nullopt;
+}
+
+std::string_view to_string(JointRule rule) {
+  return rule == JointRule::Limbs ? "limbs" : "paper";
+}
+
+std::optional<JointRule> joint_rule_from_string(std::string_view name) {
+  for (const JointRule rule : {JointRule::Paper, JointRule::Limbs})
+    if (to_string(rule) == name) return rule;
   return std::nullopt;
 }
 
@@ -183,14 +194,16 @@ std::vector<std::vector<std::uint32_t>> vertices_of_clusters(
   return cluster_vertices;
 }
 
-// The groups of pair boundaries that touch (share a vertex: union-find over pairs), each a joint,
-// in the order of their lowest boundary vertex.
+// The groups of pair boundaries that touch (share a vertex: union-find over pairs), leaving out
+// the pairs marked in `taken`; each group is a joint.
 std::vector<std::vector<std::uint32_t>> touching_boundaries(
-    const Mesh& mesh, const std::vector<ClusterPairBoundary>& pairs) {
+    const Mesh& mesh, const std::vector<ClusterPairBoundary>& pairs,
+    const std::vector<bool>& taken) {
   std::vector<std::uint32_t> pair_parent(pairs.size());
   std::iota(pair_parent.begin(), pair_parent.end(), 0u);
   std::vector<std::uint32_t> vertex_pair(mesh.vertex_count(), kNone);  // a pair at the vertex
-  for (std::uint32_t p = 0; p < pairs.size(); ++p)
+  for (std::uint32_t p = 0; p < pairs.size(); ++p) {
+    if (taken[p]) continue;
     for (const std::uint32_t v : pairs[p].vertices) {
       if (vertex_pair[v] == kNone) {
         vertex_pair[v] = p;
@@ -199,19 +212,171 @@ std::vector<std::vector<std::uint32_t>> touching_boundaries(
       const std::uint32_t a = find_root(pair_parent, vertex_pair[v]), b = find_root(pair_parent, p);
       if (a != b) pair_parent[std::max(a, b)] = std::min(a, b);
     }
-  std::map<std::uint32_t, std::vector<std::uint32_t>> groups;  // root pair -> pairs
-  for (std::uint32_t p = 0; p < pairs.size(); ++p) groups[find_root(pair_parent, p)].push_back(p);
-  std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> ordered;
-  for (auto& [root, members] : groups) {
-    std::uint32_t lowest = kNone;
-    for (const std::uint32_t p : members) lowest = std::min(lowest, pairs[p].vertices.front());
-    ordered.emplace_back(lowest, std::move(members));
   }
-  std::sort(ordered.begin(), ordered.end());
+  std::map<std::uint32_t, std::vector<std::uint32_t>> groups;  // root pair -> pairs
+  for (std::uint32_t p = 0; p < pairs.size(); ++p)
+    if (!taken[p]) groups[find_root(pair_parent, p)].push_back(p);
   std::vector<std::vector<std::uint32_t>> joints;
-  joints.reserve(ordered.size());
-  for (auto& [lowest, members] : ordered) joints.push_back(std::move(members));
+  joints.reserve(groups.size());
+  for (auto& [root, members] : groups) joints.push_back(std::move(members));
   return joints;
+}
+
+// The cluster on the other side of a pair boundary from c.
+std::uint32_t across(const ClusterPairBoundary& pair, std::uint32_t c) {
+  return pair.first == c ? pair.second : pair.first;
+}
+
+// A limb of JointRule::Limbs: a cluster that its attachment loop (some of its pair boundaries)
+// frees, with everything beyond its other loops, from the root bone's side.
+struct Limb {
+  std::uint32_t cluster = 0;
+  std::vector<std::uint32_t> loop;  ///< pairs, increasing
+  double protrusion = 0;            ///< farthest own vertex from the loop's plane / loop radius
+};
+
+// The loops of one cluster: its pair boundaries grouped by shared vertices.
+std::vector<std::vector<std::uint32_t>> boundary_loops(
+    const std::vector<ClusterPairBoundary>& pairs, const std::vector<std::uint32_t>& own) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> vertex_of;  // (vertex, index in own)
+  for (std::uint32_t i = 0; i < own.size(); ++i)
+    for (const std::uint32_t v : pairs[own[i]].vertices) vertex_of.emplace_back(v, i);
+  std::sort(vertex_of.begin(), vertex_of.end());
+  std::vector<std::uint32_t> parent(own.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  for (std::size_t i = 1; i < vertex_of.size(); ++i)
+    if (vertex_of[i].first == vertex_of[i - 1].first) {
+      const std::uint32_t a = find_root(parent, vertex_of[i].second);
+      const std::uint32_t b = find_root(parent, vertex_of[i - 1].second);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::map<std::uint32_t, std::vector<std::uint32_t>> loops;
+  for (std::uint32_t i = 0; i < own.size(); ++i) loops[find_root(parent, i)].push_back(own[i]);
+  std::vector<std::vector<std::uint32_t>> result;
+  result.reserve(loops.size());
+  for (auto& [root, members] : loops) result.push_back(std::move(members));
+  return result;
+}
+
+// How far `vertices` reach from the plane of the loop made of `loop`'s pair boundaries, in
+// units of the loop's mean radius; 0 for a loop of no extent.
+double protrusion(const Mesh& mesh, const std::vector<ClusterPairBoundary>& pairs,
+                  const std::vector<std::uint32_t>& loop,
+                  const std::vector<std::uint32_t>& vertices) {
+  std::vector<std::uint32_t> loop_vertices;
+  for (const std::uint32_t p : loop)
+    loop_vertices.insert(loop_vertices.end(), pairs[p].vertices.begin(), pairs[p].vertices.end());
+  std::sort(loop_vertices.begin(), loop_vertices.end());
+  loop_vertices.erase(std::unique(loop_vertices.begin(), loop_vertices.end()), loop_vertices.end());
+  Vec3 centre{0, 0, 0};
+  for (const std::uint32_t v : loop_vertices) centre = centre + mesh.positions[v];
+  centre = (1.0 / static_cast<double>(loop_vertices.size())) * centre;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  double radius = 0;
+  for (const std::uint32_t v : loop_vertices) {
+    const Vec3 d = mesh.positions[v] - centre;
+    const Eigen::Vector3d e(d[0], d[1], d[2]);
+    scatter += e * e.transpose();
+    radius += norm(d);
+  }
+  radius /= static_cast<double>(loop_vertices.size());
+  if (!(radius > 0)) return 0;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  const Eigen::Vector3d smallest = solver.eigenvectors().col(0);
+  const Vec3 normal{smallest[0], smallest[1], smallest[2]};
+  double reach = 0;
+  for (const std::uint32_t v : vertices)
+    reach = std::max(reach, std::abs(dot(mesh.positions[v] - centre, normal)));
+  return reach / radius;
+}
+
+// The limbs of JointRule::Limbs, by decreasing protrusion; a limb whose loop shares a pair with
+// one before it is left out.
+std::vector<Limb> find_limbs(const Mesh& mesh, const std::vector<ClusterPairBoundary>& pairs,
+                             const std::vector<std::vector<std::uint32_t>>& cluster_vertices,
+                             double min_protrusion) {
+  const std::size_t k = cluster_vertices.size();
+  std::vector<std::vector<std::uint32_t>> own(k);  // pairs of each cluster
+  for (std::uint32_t p = 0; p < pairs.size(); ++p) {
+    own[pairs[p].first].push_back(p);
+    own[pairs[p].second].push_back(p);
+  }
+  const auto other = [&](std::uint32_t p, std::uint32_t c) { return across(pairs[p], c); };
+  // Depth-first search from the lowest cluster of each part of the adjacency graph (where the
+  // skinning's tree starts it), for what that part falls into without one cluster c (Hopcroft
+  // and Tarjan's articulation points): each child subtree of c that no edge leads out of above
+  // c, and the rest, which holds the start.
+  std::vector<std::uint32_t> found(k, kNone), subtree_end(k), low(k), parent(k, kNone);
+  std::vector<std::vector<std::uint32_t>> children(k);
+  std::vector<std::pair<std::uint32_t, std::size_t>> stack;  // cluster, next of its pairs
+  std::uint32_t time = 0;
+  for (std::uint32_t start = 0; start < k; ++start) {
+    if (found[start] != kNone) continue;
+    found[start] = low[start] = time++;
+    stack.assign(1, {start, 0});
+    while (!stack.empty()) {
+      const std::uint32_t c = stack.back().first;
+      if (stack.back().second < own[c].size()) {
+        const std::uint32_t next = other(own[c][stack.back().second++], c);
+        if (found[next] == kNone) {
+          parent[next] = c;
+          children[c].push_back(next);
+          found[next] = low[next] = time++;
+          stack.emplace_back(next, 0);
+        } else if (next != parent[c]) {
+          low[c] = std::min(low[c], found[next]);
+        }
+        continue;
+      }
+      subtree_end[c] = time;
+      stack.pop_back();
+      if (parent[c] != kNone) low[parent[c]] = std::min(low[parent[c]], low[c]);
+    }
+  }
+  // The part of the graph without c that holds its neighbour x: a child of c that roots it, or
+  // c itself for the part with the start.
+  const auto part_of = [&](std::uint32_t c, std::uint32_t x) {
+    if (found[x] <= found[c] || found[x] >= subtree_end[c]) return c;  // not below c
+    const std::vector<std::uint32_t>& below = children[c];
+    const std::uint32_t child = *(std::upper_bound(below.begin(), below.end(), found[x],
+                                                   [&](std::uint32_t time_of_x, std::uint32_t b) {
+                                                     return time_of_x < found[b];
+                                                   }) -
+                                  1);
+    return low[child] >= found[c] ? child : c;
+  };
+  std::vector<Limb> limbs;
+  for (std::uint32_t c = 0; c < k; ++c) {
+    if (parent[c] == kNone) continue;  // the start of its part
+    const std::vector<std::vector<std::uint32_t>> loops = boundary_loops(pairs, own[c]);
+    // Each loop must lead to one part, and no other loop to that part.
+    std::vector<std::uint32_t> loop_part;
+    bool separating = true;
+    for (const std::vector<std::uint32_t>& loop : loops) {
+      const std::uint32_t part = part_of(c, other(loop.front(), c));
+      for (const std::uint32_t p : loop) separating = separating && part_of(c, other(p, c)) == part;
+      separating =
+          separating && std::find(loop_part.begin(), loop_part.end(), part) == loop_part.end();
+      loop_part.push_back(part);
+    }
+    if (!separating) continue;
+    const auto attachment = static_cast<std::size_t>(
+        std::find(loop_part.begin(), loop_part.end(), c) - loop_part.begin());
+    if (attachment == loops.size()) continue;  // (c's parent is in some loop's part: not reached)
+    const double reach = protrusion(mesh, pairs, loops[attachment], cluster_vertices[c]);
+    if (reach >= min_protrusion) limbs.push_back({c, loops[attachment], reach});
+  }
+  std::stable_sort(limbs.begin(), limbs.end(),
+                   [](const Limb& a, const Limb& b) { return a.protrusion > b.protrusion; });
+  std::vector<bool> taken(pairs.size(), false);
+  std::vector<Limb> kept;
+  for (Limb& limb : limbs) {
+    if (std::any_of(limb.loop.begin(), limb.loop.end(), [&](std::uint32_t p) { return taken[p]; }))
+      continue;
+    for (const std::uint32_t p : limb.loop) taken[p] = true;
+    kept.push_back(std::move(limb));
+  }
+  return kept;
 }
 
 // The joint of the touching pair boundaries `members`: at their length-weighted midpoint, between
@@ -245,12 +410,17 @@ Joint boundary_joint(const Mesh& mesh, const std::vector<ClusterPairBoundary>& p
 std::vector<Vec3> free_ends(const Mesh& mesh, const Skeleton& skeleton, std::size_t c,
                             const std::vector<std::uint32_t>& vertices) {
   const Bone& bone = skeleton.bones[c];
+  // Up to two distinct neighbours: more change nothing, and a hub's bones can be many.
   std::vector<std::uint32_t> neighbours;
-  for (const std::uint32_t j : bone.joints)
-    for (const std::uint32_t b : skeleton.joints[j].bones)
-      if (b != c) neighbours.push_back(b);
-  std::sort(neighbours.begin(), neighbours.end());
-  neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
+  for (const std::uint32_t j : bone.joints) {
+    for (const std::uint32_t b : skeleton.joints[j].bones) {
+      if (b == c || std::find(neighbours.begin(), neighbours.end(), b) != neighbours.end())
+        continue;
+      neighbours.push_back(b);
+      if (neighbours.size() == 2) break;
+    }
+    if (neighbours.size() == 2) break;
+  }
   std::vector<Vec3> ends;
   if (neighbours.empty()) {
     ends.push_back(far_end(mesh, bone, vertices, nullptr, false));
@@ -265,8 +435,10 @@ std::vector<Vec3> free_ends(const Mesh& mesh, const Skeleton& skeleton, std::siz
 }  // namespace
 
 Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_labels,
-                          std::span<const Primitive> primitives) {
+                          std::span<const Primitive> primitives, const SkeletonOptions& options) {
   check_input(mesh, face_labels, primitives);
+  if (!(std::isfinite(options.limb_protrusion) && options.limb_protrusion >= 0))
+    throw InvalidInputError("extract_skeleton: limb_protrusion must be a finite number >= 0");
   const std::size_t k = primitives.size();
   Skeleton skeleton;
   skeleton.face_labels.assign(face_labels.begin(), face_labels.end());
@@ -281,9 +453,46 @@ Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_
   describe_bones(mesh, labels, primitives, cluster_vertices, skeleton.bones);
 
   const std::vector<ClusterPairBoundary> pairs = cluster_pair_boundaries(mesh, labels);
-  for (const std::vector<std::uint32_t>& members : touching_boundaries(mesh, pairs)) {
+  const std::vector<Limb> limbs =
+      options.joints == JointRule::Limbs
+          ? find_limbs(mesh, pairs, cluster_vertices, options.limb_protrusion)
+          : std::vector<Limb>{};
+  std::vector<bool> taken(pairs.size(), false), at_limb(mesh.vertex_count(), false);
+  for (const Limb& limb : limbs)
+    for (const std::uint32_t p : limb.loop) {
+      taken[p] = true;
+      for (const std::uint32_t v : pairs[p].vertices) at_limb[v] = true;
+    }
+  // Every joint's pairs, limbs' loops (the limb's index) and merged touching boundaries (kNone),
+  // numbered by their lowest boundary vertex.
+  std::vector<std::tuple<std::uint32_t, std::uint32_t, std::vector<std::uint32_t>>> groups;
+  const auto lowest_vertex = [&](const std::vector<std::uint32_t>& members) {
+    std::uint32_t lowest = kNone;
+    for (const std::uint32_t p : members) lowest = std::min(lowest, pairs[p].vertices.front());
+    return lowest;
+  };
+  for (std::uint32_t i = 0; i < limbs.size(); ++i)
+    groups.emplace_back(lowest_vertex(limbs[i].loop), i, limbs[i].loop);
+  for (std::vector<std::uint32_t>& members : touching_boundaries(mesh, pairs, taken))
+    groups.emplace_back(lowest_vertex(members), kNone, std::move(members));
+  std::sort(groups.begin(), groups.end());
+  for (const auto& [lowest, limb, members] : groups) {
     Joint joint =
         boundary_joint(mesh, pairs, members, static_cast<std::uint32_t>(skeleton.joints.size()));
+    if (limb != kNone) {  // between the limb and the neighbour it shares the most boundary with
+      const std::uint32_t c = limbs[limb].cluster;
+      std::uint32_t longest = members.front();
+      for (const std::uint32_t p : members)
+        if (pairs[p].length > pairs[longest].length) longest = p;
+      const std::uint32_t parent = across(pairs[longest], c);
+      joint.bones = {std::min(c, parent), std::max(c, parent)};
+      joint.kind = JointKind::Sensitive;
+    } else if (std::any_of(members.begin(), members.end(), [&](std::uint32_t p) {
+                 return std::any_of(pairs[p].vertices.begin(), pairs[p].vertices.end(),
+                                    [&](std::uint32_t v) { return at_limb[v]; });
+               })) {
+      joint.kind = JointKind::Locked;  // what a limb hangs from stays rigid
+    }
     for (const std::uint32_t b : joint.bones) skeleton.bones[b].joints.push_back(joint.id);
     skeleton.joints.push_back(std::move(joint));
   }
@@ -308,9 +517,10 @@ Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_
   return skeleton;
 }
 
-Skeleton extract_skeleton(const Hierarchy& hierarchy, const Segmentation& segmentation) {
+Skeleton extract_skeleton(const Hierarchy& hierarchy, const Segmentation& segmentation,
+                          const SkeletonOptions& options) {
   return extract_skeleton(hierarchy.mesh(), segmentation.labels,
-                          cluster_primitives(describe_clusters(hierarchy, segmentation)));
+                          cluster_primitives(describe_clusters(hierarchy, segmentation)), options);
 }
 
 }  // namespace primseg

@@ -86,9 +86,7 @@ GroundTruthShape cad_shape(const std::string& name, bool random_motion = false) 
   return make_shape(name, options);
 }
 
-double distance(const Vec3& a, const Vec3& b) {
-  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-}
+using testing::distance;
 
 TEST(ClusterBorders, ABoxHasTwelveStraightEdgesAtRightAngles) {
   for (const bool moved : {false, true}) {

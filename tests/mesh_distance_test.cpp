@@ -13,10 +13,7 @@
 namespace primseg {
 namespace {
 
-double distance(const Vec3& a, const Vec3& b) {
-  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                   (a[2] - b[2]) * (a[2] - b[2]));
-}
+using testing::distance;
 
 // A rectangle [0, width] x [0, 1] in the plane z = height, as two triangles.
 Mesh rectangle(double width, double height) {

@@ -67,6 +67,33 @@ struct Bone {
   double area = 0;
 };
 
+/// Which boundaries become movable joints.
+enum class JointRule : std::uint8_t {
+  /// The paper's: pair joints whose boundaries touch merge, so a limb meeting two or more
+  /// clusters of a bulky body (a leg on a trunk split into patches) joins a locked hub.
+  Paper = 0,
+  /// The paper's, except that a limb gets a sensitive joint where it is attached: see
+  /// SkeletonOptions::limb_protrusion.
+  Limbs = 1,
+};
+
+/// "paper" or "limbs".
+std::string_view to_string(JointRule rule);
+/// Inverse of to_string; std::nullopt for an unknown name.
+std::optional<JointRule> joint_rule_from_string(std::string_view name);
+
+struct SkeletonOptions {
+  /// Default: the paper's rule, as the format and the pictures document it.
+  JointRule joints = JointRule::Paper;
+  /// JointRule::Limbs: a cluster is a limb when its boundary has one loop on the root bone's
+  /// side (cutting it there frees the cluster and everything beyond its other loops), and its
+  /// own vertices reach farther from that loop's plane than this many times the loop's mean
+  /// radius (1: a hemisphere; a gently curved patch of a trunk stays below). Limbs are taken
+  /// by decreasing protrusion; one whose loop shares a boundary with a limb already taken is
+  /// not one. Dimensionless, >= 0.
+  double limb_protrusion = 1.0;
+};
+
 /// A skeleton and the segmentation it was made from.
 struct Skeleton {
   std::vector<Joint> joints;
@@ -96,13 +123,20 @@ struct Skeleton {
 ///   neighbour) gets two virtual joints, at both extents.
 /// - Kinds: at most two bones: sensitive; more: locked; free ends: virtual. A bone whose joints
 ///   are all locked is hidden; a joint whose bones are all hidden is hidden.
+/// - JointRule::Limbs first takes each limb's attachment loop out of that merging: one sensitive
+///   joint at the loop's length-weighted centroid, its bones the limb and the neighbour it
+///   shares the longest boundary with (the bone it turns against). A joint of the remaining
+///   boundaries that touches a limb's loop is locked: the clusters a limb hangs from stay rigid
+///   together, as the paper's hub held them.
 /// Joints are numbered by their lowest boundary vertex (virtual joints after the others, by
-/// bone), so the result is deterministic. Throws InvalidInputError when the sizes disagree or a
-/// label is out of range or unused.
+/// bone), so the result is deterministic. Throws InvalidInputError when the sizes disagree, a
+/// label is out of range or unused, or limb_protrusion is negative or not finite.
 Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_labels,
-                          std::span<const Primitive> primitives);
+                          std::span<const Primitive> primitives,
+                          const SkeletonOptions& options = {});
 
 /// The skeleton of a level of a hierarchy.
-Skeleton extract_skeleton(const Hierarchy& hierarchy, const Segmentation& segmentation);
+Skeleton extract_skeleton(const Hierarchy& hierarchy, const Segmentation& segmentation,
+                          const SkeletonOptions& options = {});
 
 }  // namespace primseg

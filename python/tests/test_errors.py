@@ -246,6 +246,8 @@ def test_skeleton_and_pose_errors(cgal_mesh):
         primseg.skeleton(mesh, k=0)
     with pytest.raises(ValueError, match="unknown primitive"):
         primseg.skeleton(mesh, primitives=("cylinder", "ellipsoid"))
+    with pytest.raises(ValueError, match=r"joints='hubs' is not 'paper' or 'limbs'"):
+        primseg.skeleton(mesh, joints="hubs")
     skeleton = primseg.skeleton(primseg.read_mesh(cgal_mesh("man.off")), k=20)
     locked = [j["id"] for j in skeleton.joints if j["kind"] != "sensitive"]
     assert locked

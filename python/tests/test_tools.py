@@ -197,7 +197,8 @@ def test_skeleton_matches_the_cli(cli, man, man_skeleton, tmp_path, cli_level, p
     expected = json.loads((tmp_path / "s.json").read_text())
     skeleton = man_skeleton if python_level == 20 else primseg.skeleton(primseg.read_mesh(man), k=python_level)
     result = skeleton.to_dict()
-    assert set(expected) - set(result) == {"mesh", "primitives", "requested_clusters", "timing"}
+    assert set(expected) - set(result) == {"mesh", "primitives", "joint_rule", "requested_clusters", "timing"}
+    assert expected["joint_rule"] == "paper"
     assert result == {key: expected[key] for key in result}  # every double bit for bit
     assert skeleton.joints == expected["joints"] and skeleton.bones == expected["bones"]
     np.testing.assert_array_equal(skeleton.face_labels, expected["face_labels"])
@@ -210,6 +211,24 @@ def test_skeleton_matches_the_cli(cli, man, man_skeleton, tmp_path, cli_level, p
     np.testing.assert_array_equal(indices, [int(b) for p in pairs for b in p[0::2]])
     np.testing.assert_array_equal(data, [float(w) for p in pairs for w in p[1::2]])
     np.testing.assert_array_equal(np.diff(indptr), [len(p) // 2 for p in pairs])
+
+
+def test_limb_joints_match_the_cli_and_free_more_joints(cli, man, man_skeleton, tmp_path):
+    run_cli(cli, "skeleton", man, "--clusters", "20", "--joints", "limbs", "-o", tmp_path / "s.json", "--quiet")
+    expected = json.loads((tmp_path / "s.json").read_text())
+    assert expected["joint_rule"] == "limbs"
+    limbs = primseg.skeleton(primseg.read_mesh(man), k=20, joints="limbs")
+    assert limbs.joints == expected["joints"] and limbs.bones == expected["bones"]
+
+    def sensitive(skeleton):
+        return sum(joint["kind"] == "sensitive" for joint in skeleton.joints)
+
+    # man.off at 20: the paper's hubs lock a leg and both shoulders; the limb rule frees them.
+    assert sensitive(limbs) > sensitive(man_skeleton)
+    for joint in limbs.joints:
+        if joint["kind"] == "sensitive":
+            assert len(joint["bones"]) == 2
+            assert 0 not in limbs.bones_beyond(joint["id"])  # the root bone never turns
 
 
 def sensitive_joint(skeleton):

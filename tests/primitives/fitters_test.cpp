@@ -54,9 +54,7 @@ double angle_between_axes(const Vec3& a, const Eigen::Vector3d& b) {
   return std::atan2(u.cross(b.normalized()).norm(), std::abs(u.dot(b.normalized())));
 }
 
-double distance(const Vec3& a, const Vec3& b) {
-  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-}
+using testing::distance;
 
 TEST(PlaneFitter, RecoversPlanesAtRandomPosesAndScales) {
   std::mt19937_64 rng(7);

@@ -70,6 +70,7 @@ TEST_F(SkeletonCli, WritesTheSkeletonAndSkinWeights) {
   const json s = skeleton("--skin-weights " + path("weights.txt"));
   EXPECT_EQ(s["cluster_count"], 8);
   EXPECT_EQ(s["primitives"], "cylinder,sphere");
+  EXPECT_EQ(s["joint_rule"], "paper");
   ASSERT_EQ(s["bones"].size(), 8u);
   EXPECT_EQ(s["face_labels"].size(), figure_.mesh.face_count());
   std::size_t sensitive = 0, virtual_joints = 0;
@@ -101,6 +102,16 @@ TEST_F(SkeletonCli, WritesTheSkeletonAndSkinWeights) {
     ++rows;
   }
   EXPECT_EQ(rows, figure_.mesh.vertex_count());
+}
+
+// --joints limbs: the figure's torso is one cluster, so every limb already turns where it is
+// attached and the skeleton is the paper rule's (limb_joints_test.cpp tests where they differ).
+TEST_F(SkeletonCli, LimbJointsAreRecordedAndAgreeWhereThePapersRuleFreesEveryLimb) {
+  const json paper = skeleton();
+  const json limbs = skeleton("--joints limbs");
+  EXPECT_EQ(limbs["joint_rule"], "limbs");
+  EXPECT_EQ(limbs["joints"], paper["joints"]);
+  EXPECT_EQ(limbs["bones"], paper["bones"]);
 }
 
 // The rigged mesh as GLB (read in depth by skeleton_gltf_test.cpp and web/test/gltf.test.mjs).
@@ -238,6 +249,11 @@ TEST_F(SkeletonCli, BadInputGivesAClearError) {
                 &output),
             1);
   EXPECT_NE(output.find("--band"), std::string::npos) << output;
+  EXPECT_EQ(
+      run("skeleton " + path("figure.off") + " --clusters 8 --joints hubs -o " + path("x.json"),
+          &output),
+      1);
+  EXPECT_NE(output.find("--joints: 'hubs' is not paper or limbs"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(path("x.json")));
 }
 

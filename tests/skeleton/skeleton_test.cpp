@@ -31,9 +31,7 @@ namespace {
 using testing::make_stick_figure;
 using testing::StickFigure;
 
-double distance(const Vec3& a, const Vec3& b) {
-  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-}
+using testing::distance;
 
 double triangle_area(const Mesh& mesh, const Triangle& t) {
   const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];

@@ -2,6 +2,7 @@
 // Shared helpers of the test suite.
 
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -13,6 +14,11 @@
 #include "primseg/primitive.hpp"
 
 namespace primseg::testing {
+
+/// Euclidean distance between two points.
+inline double distance(const Vec3& a, const Vec3& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
 
 /// Path of a mesh shipped by Debian's libcgal-demo (for example "fandisk.off"), extracted from
 /// /usr/share/doc/libcgal-dev/data.tar.gz into a cache directory at first use. Fails the

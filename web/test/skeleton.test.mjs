@@ -57,8 +57,8 @@ async function openFigure({ file: html = file('figure.html') } = {}) {
   return opened;
 }
 
-test('the page carries the skeleton primseg skeleton extracts, and draws its visible parts', async () => {
-  const { page, errors } = await openFigure();
+/** Asserts that the page's skeleton is `expected` (a skeleton file), and that it draws its visible joints. */
+async function assertPageCarries(page, expected) {
   const shown = await page.evaluate(async () => {
     const viewer = await window.primseg.ready, s = viewer.skeleton.skeleton;
     const joints = [];
@@ -69,19 +69,24 @@ test('the page carries the skeleton primseg skeleton extracts, and draws its vis
     return { joints, bones, drawnJoints: viewer.skeleton.jointMeshes.map((m) => m.userData.joint),
       faceLabels: Array.from(s.s.faceLabels), summary: document.getElementById('skeleton-summary').textContent };
   });
-  assert.equal(shown.bones.length, skeleton.cluster_count);
-  assert.deepEqual(shown.faceLabels, skeleton.face_labels);
-  assert.equal(shown.joints.length, skeleton.joints.length);
-  for (const [i, joint] of skeleton.joints.entries()) {
+  assert.equal(shown.bones.length, expected.cluster_count);
+  assert.deepEqual(shown.faceLabels, expected.face_labels);
+  assert.equal(shown.joints.length, expected.joints.length);
+  for (const [i, joint] of expected.joints.entries()) {
     assert.deepEqual(shown.joints[i].position, joint.position);
     assert.equal(KINDS[shown.joints[i].kind], joint.kind);
     assert.equal(shown.joints[i].visible, joint.visible);
     assert.deepEqual(shown.joints[i].bones, joint.bones);
   }
-  skeleton.bones.forEach((bone, b) => assert.deepEqual(shown.bones[b], { joints: bone.joints, visible: bone.visible }));
+  expected.bones.forEach((bone, b) => assert.deepEqual(shown.bones[b], { joints: bone.joints, visible: bone.visible }));
   // Hidden joints are not drawn; every visible one is.
-  assert.deepEqual(shown.drawnJoints, skeleton.joints.filter((j) => j.visible).map((j) => j.id));
-  assert.match(shown.summary, new RegExp(`^${skeleton.cluster_count} bones`));
+  assert.deepEqual(shown.drawnJoints, expected.joints.filter((j) => j.visible).map((j) => j.id));
+  assert.match(shown.summary, new RegExp(`^${expected.cluster_count} bones`));
+}
+
+test('the page carries the skeleton primseg skeleton extracts, and draws its visible parts', async () => {
+  const { page, errors } = await openFigure();
+  await assertPageCarries(page, skeleton);
   await page.screenshot({ path: join(artifacts, 'figure-skeleton.png') });
   assert.deepEqual(errors, []);
   await page.close();
@@ -222,6 +227,30 @@ test('at 9 clusters: a locked joint is drawn but cannot be dragged, hidden bones
   assert.equal(largestDifference(await page.evaluate(() => window.primseg.deformedPositions()), rest), 0);
   assert.notDeepEqual(await camera(), before, 'the drag orbits the view');
   assert.match(await page.textContent('#status'), /locked: it does not move/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('--joints limbs: the page carries the limb rule\'s skeleton, and a bone the hub hid turns', async () => {
+  // At 9 clusters the paper's rule locks a hub and hides two of its bones (the test above); the
+  // limb rule frees one of them with a sensitive joint where it is attached.
+  const extract = (rule, name) => {
+    primseg('skeleton', file('figure.off'), '--clusters', '9', '--primitives', PRIMITIVES, '--joints', rule, '-o', file(name), '--quiet');
+    return JSON.parse(readFileSync(file(name), 'utf8'));
+  };
+  const paper = extract('paper', 'paper9.json'), limbs = extract('limbs', 'limbs9.json');
+  const hidden = paper.bones.filter((b) => !b.visible).map((b) => b.id);
+  const freed = limbs.joints.find((j) => j.kind === 'sensitive' && j.bones.some((b) => hidden.includes(b)));
+  assert.ok(freed, 'a bone the paper\'s hub hid has a sensitive joint');
+  primseg('view', file('figure.off'), '--primitives', PRIMITIVES, '--clusters', K, '--skeleton-clusters', '9', '--joints', 'limbs', '-o', file('limbs9.html'), '--quiet');
+  const { page, errors } = await openFigure({ file: file('limbs9.html') });
+  await assertPageCarries(page, limbs);
+  await dragJoint(page, freed.id, 0, 80);
+  const pose = await page.evaluate(() => window.primseg.pose());
+  assert.equal(pose.rotations.length, 1);
+  assert.equal(pose.rotations[0].joint, freed.id);
+  assert.ok(largestDifference(await page.evaluate(() => window.primseg.deformedPositions()), rest) > 0.05, 'the limb moved');
+  await page.screenshot({ path: join(artifacts, 'figure-skeleton-limbs-9.png') });
   assert.deepEqual(errors, []);
   await page.close();
 });
