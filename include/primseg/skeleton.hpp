@@ -25,7 +25,8 @@ namespace primseg {
 enum class JointKind : std::uint8_t {
   /// At most two incident bones: the bones may rotate about it.
   Sensitive = 0,
-  /// Three or more incident bones (a hub where several clusters meet): not movable.
+  /// Three or more incident bones (a hub where several clusters meet), or, with
+  /// JointRule::Limbs, a joint of two that touches a limb's attachment: not movable.
   Locked = 1,
   /// The free end of a bone adjacent to only one other (a hand, a foot): a movable end.
   Virtual = 2,
