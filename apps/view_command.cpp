@@ -449,14 +449,15 @@ Hierarchy view_hierarchy(const ViewCommandOptions& o, const std::shared_ptr<cons
 }
 
 // The skeleton the page draws: of --skeleton-clusters' level, else of the level it opens at.
-PageSkeleton page_skeleton(const ViewCommandOptions& o, const Mesh& mesh,
-                           const Hierarchy& hierarchy, const Segmentation& opening_level) {
+PageSkeleton page_skeleton(const ViewCommandOptions& o, const SkeletonOptions& rule,
+                           const Mesh& mesh, const Hierarchy& hierarchy,
+                           const Segmentation& opening_level) {
   const Segmentation bones = o.skeleton_clusters
                                  ? cut(hierarchy, {o.skeleton_clusters, std::nullopt}).segmentation
                                  : opening_level;
   SkinningOptions skinning;
   skinning.band = o.band;
-  Skeleton extracted = extract_skeleton(hierarchy, bones, skeleton_options(o.joints));
+  Skeleton extracted = extract_skeleton(hierarchy, bones, rule);
   SkinWeights weights = compute_skin_weights(mesh, extracted, skinning);
   return PageSkeleton{std::move(extracted), std::move(weights), o.band};
 }
@@ -475,7 +476,7 @@ void run_view(const ViewCommandOptions& o) {
       std::make_shared<const Mesh>(read_geometry_within(o.mesh_path, o.limits, kViewerPageBytes));
   if (!(std::isfinite(o.band) && o.band >= 0))
     throw InvalidInputError("--band: must be a finite number >= 0");
-  skeleton_options(o.joints);  // before the hierarchy: a misspelt rule fails at once
+  const SkeletonOptions joint_rule = skeleton_options(o.joints);  // a misspelt rule fails at once
   if (o.clusters) validate_level({o.clusters, std::nullopt}, mesh->face_count());
   if (o.skeleton_clusters) validate_level({o.skeleton_clusters, std::nullopt}, mesh->face_count());
   const auto build_start = Clock::now();
@@ -486,7 +487,7 @@ void run_view(const ViewCommandOptions& o) {
   const AutoLevel automatic = level.automatic ? *level.automatic : choose_level(hierarchy);
   std::optional<PageSkeleton> skeleton;
   if (o.skeleton || o.skeleton_clusters)
-    skeleton = page_skeleton(o, *mesh, hierarchy, level.segmentation);
+    skeleton = page_skeleton(o, joint_rule, *mesh, hierarchy, level.segmentation);
   const std::uint32_t relation_clusters =
       o.regularize_clusters
           ? *o.regularize_clusters

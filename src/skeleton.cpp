@@ -476,6 +476,10 @@ Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_
   for (std::vector<std::uint32_t>& members : touching_boundaries(mesh, pairs, taken))
     groups.emplace_back(lowest_vertex(members), kNone, std::move(members));
   std::sort(groups.begin(), groups.end());
+  const auto touches_limb = [&](std::uint32_t p) {
+    return std::any_of(pairs[p].vertices.begin(), pairs[p].vertices.end(),
+                       [&](std::uint32_t v) { return at_limb[v]; });
+  };
   for (const auto& [lowest, limb, members] : groups) {
     Joint joint =
         boundary_joint(mesh, pairs, members, static_cast<std::uint32_t>(skeleton.joints.size()));
@@ -487,10 +491,7 @@ Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_
       const std::uint32_t parent = across(pairs[longest], c);
       joint.bones = {std::min(c, parent), std::max(c, parent)};
       joint.kind = JointKind::Sensitive;
-    } else if (std::any_of(members.begin(), members.end(), [&](std::uint32_t p) {
-                 return std::any_of(pairs[p].vertices.begin(), pairs[p].vertices.end(),
-                                    [&](std::uint32_t v) { return at_limb[v]; });
-               })) {
+    } else if (!limbs.empty() && std::any_of(members.begin(), members.end(), touches_limb)) {
       joint.kind = JointKind::Locked;  // what a limb hangs from stays rigid
     }
     for (const std::uint32_t b : joint.bones) skeleton.bones[b].joints.push_back(joint.id);
