@@ -1,0 +1,74 @@
+"""The README documents the command line as it is: every command, and every option of each, as the
+CLI's own --help lists them (an option added without its documentation fails here)."""
+
+import pathlib
+import re
+import subprocess
+
+import pytest
+
+README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
+LONG_OPTION = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
+COMMANDS = [
+    "segment", "cut", "info", "eval", "batch", "denoise", "distance", "skeleton", "deform", "view"
+]
+
+
+def command_line_part():
+    """The README from its "Command line" section up to "Library": the synopses, then each
+    command's own section (outputs, viewer, formats, batch, limits, denoising, skeletons)."""
+    text = README.read_text(encoding="utf-8")
+    start, end = text.index("\n## Command line\n"), text.index("\n## Library\n")
+    return text[start:end]
+
+
+def synopses():
+    """Each command's synopsis in the Command line block: its first line and the indented lines
+    that continue it."""
+    block = command_line_part().split("```")[1]
+    result, command = {}, None
+    for line in block.splitlines():
+        match = re.match(r"primseg (\w+)", line)
+        if match:
+            command = match.group(1)
+            result[command] = line
+        elif command and line.startswith(" "):
+            result[command] += "\n" + line
+    return result
+
+
+def run_help(cli, *args):
+    done = subprocess.run([str(cli), *args, "--help"], capture_output=True, text=True, check=True)
+    return done.stdout
+
+
+def commands(cli):
+    listing = run_help(cli).split("Subcommands:", 1)[1]
+    return re.findall(r"^  (\w+) ", listing, flags=re.MULTILINE)
+
+
+def test_every_command_has_a_synopsis(cli):
+    listed = commands(cli)
+    assert sorted(synopses()) == sorted(listed)
+    assert sorted(COMMANDS) == sorted(listed), "a new command: add it to COMMANDS below"
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_every_option_of_a_command_is_documented_and_every_documented_one_exists(cli, command):
+    help_text = run_help(cli, command)
+    options = set(LONG_OPTION.findall(help_text.split("Options:", 1)[1])) - {"--help"}
+    assert options, help_text
+    documented = set(LONG_OPTION.findall(command_line_part()))
+    # An option with a short form (-o,--output) may be documented by it alone, as the synopses do.
+    short_forms = dict(
+        (long, short) for short, long in re.findall(r"(-\w),(--[a-z][a-z0-9-]*)", help_text)
+    )
+    synopsis = synopses()[command]
+    undocumented = sorted(
+        option
+        for option in options - documented
+        if not re.search(rf"(?<![\w-]){short_forms.get(option, option)}\b", synopsis)
+    )
+    assert not undocumented, f"primseg {command}: not in the README: {undocumented}"
+    unknown = sorted(set(LONG_OPTION.findall(synopsis)) - options)
+    assert not unknown, f"primseg {command}: the README's synopsis names {unknown}"
