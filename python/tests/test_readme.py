@@ -1,10 +1,12 @@
-"""The README documents the command line as it is: every command, and every option of each, as the
-CLI's own --help lists them (an option added without its documentation fails here)."""
+"""The README documents the command line and the Python module as they are: every command, and
+every option of each, as the CLI's own --help lists them, and every public name of the module and
+of its classes (one added without its documentation fails here)."""
 
 import pathlib
 import re
 import subprocess
 
+import primseg
 import pytest
 
 README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
@@ -14,12 +16,16 @@ COMMANDS = [
 ]
 
 
-def command_line_part():
-    """The README from its "Command line" section up to "Library": the synopses, then each
-    command's own section (outputs, viewer, formats, batch, limits, denoising, skeletons)."""
+def section(first, following):
+    """The README from its section `first` up to the section `following`."""
     text = README.read_text(encoding="utf-8")
-    start, end = text.index("\n## Command line\n"), text.index("\n## Library\n")
-    return text[start:end]
+    return text[text.index(f"\n## {first}\n") : text.index(f"\n## {following}\n")]
+
+
+def command_line_part():
+    """The synopses, then each command's own section (outputs, viewer, formats, batch, limits,
+    denoising, skeletons)."""
+    return section("Command line", "Library")
 
 
 def synopses():
@@ -72,3 +78,19 @@ def test_every_option_of_a_command_is_documented_and_every_documented_one_exists
     assert not undocumented, f"primseg {command}: not in the README: {undocumented}"
     unknown = sorted(set(LONG_OPTION.findall(synopsis)) - options)
     assert not unknown, f"primseg {command}: the README's synopsis names {unknown}"
+
+
+def test_every_public_name_of_the_module_and_its_classes_is_documented():
+    python_part = section("Python", "How it works")
+    undocumented = []
+    for name in dir(primseg):
+        if name.startswith("_"):
+            continue
+        members = [name]
+        value = getattr(primseg, name)
+        if isinstance(value, type) and not issubclass(value, BaseException):  # not args, errno...
+            members += [f"{name}.{m}" for m in dir(value) if not m.startswith("_")]
+        for member in members:
+            if not re.search(rf"\b{re.escape(member.split('.')[-1])}\b", python_part):
+                undocumented.append(member)
+    assert not undocumented, f"not in the README's Python section: {undocumented}"
