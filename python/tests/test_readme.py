@@ -1,6 +1,7 @@
-"""The README documents the command line and the Python module as they are: every command, and
-every option of each, as the CLI's own --help lists them, and every public name of the module and
-of its classes (one added without its documentation fails here)."""
+"""The README documents the command line, the library and the Python module as they are: every
+command, and every option of each, as the CLI's own --help lists them, every public header, and
+every public name of the module and of its classes (one added without its documentation fails
+here)."""
 
 import pathlib
 import re
@@ -94,3 +95,14 @@ def test_every_public_name_of_the_module_and_its_classes_is_documented():
             if not re.search(rf"\b{re.escape(member.split('.')[-1])}\b", python_part):
                 undocumented.append(member)
     assert not undocumented, f"not in the README's Python section: {undocumented}"
+
+
+def test_every_public_header_is_in_the_readme():
+    include = README.parent / "include" / "primseg"
+    text = README.read_text(encoding="utf-8")
+    missing = sorted(
+        str(header.relative_to(include))
+        for header in include.rglob("*.hpp")
+        if header.name not in text and f"{header.parent.name}/*.hpp" not in text
+    )
+    assert not missing, f"public headers the README does not name: {missing}"
