@@ -3,23 +3,29 @@ command, and every option of each, as the CLI's own --help lists them, every pub
 every public name of the module and of its classes (one added without its documentation fails
 here)."""
 
+import functools
 import pathlib
 import re
-import subprocess
 
 import primseg
 import pytest
+from conftest import run_cli
 
-README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 LONG_OPTION = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
 COMMANDS = [
     "segment", "cut", "info", "eval", "batch", "denoise", "distance", "skeleton", "deform", "view"
 ]
 
 
+@functools.cache
+def readme():
+    return (ROOT / "README.md").read_text(encoding="utf-8")
+
+
 def section(first, following):
     """The README from its section `first` up to the section `following`."""
-    text = README.read_text(encoding="utf-8")
+    text = readme()
     return text[text.index(f"\n## {first}\n") : text.index(f"\n## {following}\n")]
 
 
@@ -44,13 +50,8 @@ def synopses():
     return result
 
 
-def run_help(cli, *args):
-    done = subprocess.run([str(cli), *args, "--help"], capture_output=True, text=True, check=True)
-    return done.stdout
-
-
 def commands(cli):
-    listing = run_help(cli).split("Subcommands:", 1)[1]
+    listing = run_cli(cli, "--help").split("Subcommands:", 1)[1]
     return re.findall(r"^  (\w+) ", listing, flags=re.MULTILINE)
 
 
@@ -62,14 +63,13 @@ def test_every_command_has_a_synopsis(cli):
 
 @pytest.mark.parametrize("command", COMMANDS)
 def test_every_option_of_a_command_is_documented_and_every_documented_one_exists(cli, command):
-    help_text = run_help(cli, command)
+    help_text = run_cli(cli, command, "--help")
     options = set(LONG_OPTION.findall(help_text.split("Options:", 1)[1])) - {"--help"}
     assert options, help_text
     documented = set(LONG_OPTION.findall(command_line_part()))
     # An option with a short form (-o,--output) may be documented by it alone, as the synopses do.
-    short_forms = dict(
-        (long, short) for short, long in re.findall(r"(-\w),(--[a-z][a-z0-9-]*)", help_text)
-    )
+    pairs = re.findall(r"(-\w),(--[a-z][a-z0-9-]*)", help_text)
+    short_forms = {long: short for short, long in pairs}
     synopsis = synopses()[command]
     undocumented = sorted(
         option
@@ -98,11 +98,10 @@ def test_every_public_name_of_the_module_and_its_classes_is_documented():
 
 
 def test_every_public_header_is_in_the_readme():
-    include = README.parent / "include" / "primseg"
-    text = README.read_text(encoding="utf-8")
+    include = ROOT / "include" / "primseg"
     missing = sorted(
         str(header.relative_to(include))
         for header in include.rglob("*.hpp")
-        if header.name not in text and f"{header.parent.name}/*.hpp" not in text
+        if header.name not in readme() and f"{header.parent.name}/*.hpp" not in readme()
     )
     assert not missing, f"public headers the README does not name: {missing}"
