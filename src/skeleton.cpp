@@ -194,34 +194,6 @@ std::vector<std::vector<std::uint32_t>> vertices_of_clusters(
   return cluster_vertices;
 }
 
-// The groups of pair boundaries that touch (share a vertex: union-find over pairs), leaving out
-// the pairs marked in `taken`; each group is a joint.
-std::vector<std::vector<std::uint32_t>> touching_boundaries(
-    const Mesh& mesh, const std::vector<ClusterPairBoundary>& pairs,
-    const std::vector<bool>& taken) {
-  std::vector<std::uint32_t> pair_parent(pairs.size());
-  std::iota(pair_parent.begin(), pair_parent.end(), 0u);
-  std::vector<std::uint32_t> vertex_pair(mesh.vertex_count(), kNone);  // a pair at the vertex
-  for (std::uint32_t p = 0; p < pairs.size(); ++p) {
-    if (taken[p]) continue;
-    for (const std::uint32_t v : pairs[p].vertices) {
-      if (vertex_pair[v] == kNone) {
-        vertex_pair[v] = p;
-        continue;
-      }
-      const std::uint32_t a = find_root(pair_parent, vertex_pair[v]), b = find_root(pair_parent, p);
-      if (a != b) pair_parent[std::max(a, b)] = std::min(a, b);
-    }
-  }
-  std::map<std::uint32_t, std::vector<std::uint32_t>> groups;  // root pair -> pairs
-  for (std::uint32_t p = 0; p < pairs.size(); ++p)
-    if (!taken[p]) groups[find_root(pair_parent, p)].push_back(p);
-  std::vector<std::vector<std::uint32_t>> joints;
-  joints.reserve(groups.size());
-  for (auto& [root, members] : groups) joints.push_back(std::move(members));
-  return joints;
-}
-
 // The cluster on the other side of a pair boundary from c.
 std::uint32_t across(const ClusterPairBoundary& pair, std::uint32_t c) {
   return pair.first == c ? pair.second : pair.first;
@@ -235,14 +207,17 @@ struct Limb {
   double protrusion = 0;            ///< farthest own vertex from the loop's plane / loop radius
 };
 
-// The loops of one cluster: its pair boundaries grouped by shared vertices.
-std::vector<std::vector<std::uint32_t>> boundary_loops(
-    const std::vector<ClusterPairBoundary>& pairs, const std::vector<std::uint32_t>& own) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> vertex_of;  // (vertex, index in own)
-  for (std::uint32_t i = 0; i < own.size(); ++i)
-    for (const std::uint32_t v : pairs[own[i]].vertices) vertex_of.emplace_back(v, i);
+// The pair boundaries `subset` (increasing) grouped by touch: two share a vertex, directly or
+// through others of the subset (union-find). Each group is increasing, and the groups are in the
+// order of their first pair. A joint of the paper's rule is such a group of all the pairs; a loop
+// of a cluster, one of the cluster's own pairs.
+std::vector<std::vector<std::uint32_t>> touching_groups(
+    const std::vector<ClusterPairBoundary>& pairs, const std::vector<std::uint32_t>& subset) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> vertex_of;  // (vertex, index in subset)
+  for (std::uint32_t i = 0; i < subset.size(); ++i)
+    for (const std::uint32_t v : pairs[subset[i]].vertices) vertex_of.emplace_back(v, i);
   std::sort(vertex_of.begin(), vertex_of.end());
-  std::vector<std::uint32_t> parent(own.size());
+  std::vector<std::uint32_t> parent(subset.size());
   std::iota(parent.begin(), parent.end(), 0u);
   for (std::size_t i = 1; i < vertex_of.size(); ++i)
     if (vertex_of[i].first == vertex_of[i - 1].first) {
@@ -250,11 +225,12 @@ std::vector<std::vector<std::uint32_t>> boundary_loops(
       const std::uint32_t b = find_root(parent, vertex_of[i - 1].second);
       if (a != b) parent[std::max(a, b)] = std::min(a, b);
     }
-  std::map<std::uint32_t, std::vector<std::uint32_t>> loops;
-  for (std::uint32_t i = 0; i < own.size(); ++i) loops[find_root(parent, i)].push_back(own[i]);
+  std::map<std::uint32_t, std::vector<std::uint32_t>> groups;  // root -> pairs
+  for (std::uint32_t i = 0; i < subset.size(); ++i)
+    groups[find_root(parent, i)].push_back(subset[i]);
   std::vector<std::vector<std::uint32_t>> result;
-  result.reserve(loops.size());
-  for (auto& [root, members] : loops) result.push_back(std::move(members));
+  result.reserve(groups.size());
+  for (auto& [root, members] : groups) result.push_back(std::move(members));
   return result;
 }
 
@@ -348,7 +324,7 @@ std::vector<Limb> find_limbs(const Mesh& mesh, const std::vector<ClusterPairBoun
   std::vector<Limb> limbs;
   for (std::uint32_t c = 0; c < k; ++c) {
     if (parent[c] == kNone) continue;  // the start of its part
-    const std::vector<std::vector<std::uint32_t>> loops = boundary_loops(pairs, own[c]);
+    const std::vector<std::vector<std::uint32_t>> loops = touching_groups(pairs, own[c]);
     // Each loop must lead to one part, and no other loop to that part.
     std::vector<std::uint32_t> loop_part;
     bool separating = true;
@@ -473,7 +449,10 @@ Skeleton extract_skeleton(const Mesh& mesh, std::span<const std::uint32_t> face_
   };
   for (std::uint32_t i = 0; i < limbs.size(); ++i)
     groups.emplace_back(lowest_vertex(limbs[i].loop), i, limbs[i].loop);
-  for (std::vector<std::uint32_t>& members : touching_boundaries(mesh, pairs, taken))
+  std::vector<std::uint32_t> free_pairs;  // the paper's joints: the other pairs, by touch
+  for (std::uint32_t p = 0; p < pairs.size(); ++p)
+    if (!taken[p]) free_pairs.push_back(p);
+  for (std::vector<std::uint32_t>& members : touching_groups(pairs, free_pairs))
     groups.emplace_back(lowest_vertex(members), kNone, std::move(members));
   std::sort(groups.begin(), groups.end());
   const auto touches_limb = [&](std::uint32_t p) {
