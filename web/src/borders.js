@@ -5,9 +5,12 @@
 import * as THREE from 'three';
 import { cross, dot, norm, normal, sub } from './primitives.js';
 
+/** edgeOfSide's entry for a side whose two corners are one vertex: on no edge. */
+const NO_EDGE = 0xffffffff;
+
 /**
  * Every mesh edge once: its two vertices, the triangles on it and, for drawing, the corners of
- * its first triangle in the drawn (non-indexed) geometry.
+ * its first triangle in the drawn (non-indexed) geometry; and the edge of each triangle side.
  * @param triangles vertex indices, 3 per triangle
  * @param slotOf the geometry slot of each triangle
  */
@@ -56,9 +59,12 @@ function meshEdges(triangles, slotOf, vertexCount) {
       cornerIndex.push(3 * (3 * slotOf[t] + low), 3 * (3 * slotOf[t] + high));
       i = j;
     }
+  const edgeOfSide = new Uint32Array(3 * T).fill(NO_EDGE); // side 3 t + k: its edge
+  for (let e = 0; e + 1 < sideStart.length; ++e)
+    for (let i = sideStart[e]; i < sideStart[e + 1]; ++i) edgeOfSide[side[i]] = e;
   return {
     count: ends.length / 2, ends: Uint32Array.from(ends), sideStart: Uint32Array.from(sideStart),
-    side, cornerIndex: Uint32Array.from(cornerIndex),
+    side, cornerIndex: Uint32Array.from(cornerIndex), edgeOfSide,
   };
 }
 
@@ -139,11 +145,13 @@ export class BorderLines {
    * Where cluster c of `cut` meets the others, as primseg's borders (borders.hpp) have it: one
    * entry per neighbouring cluster (-1: the mesh's open boundary) with its edge count, length and
    * mean angle in degrees between the two primitives across the border (null without both
-   * primitives or along the open boundary), longest first.
+   * primitives or along the open boundary), longest first. O(n log n) in c's n triangles: a
+   * click, or every cluster of a fine level in turn, does not scan the whole mesh.
+   * @param clusterTriangles the triangles of cluster c (any order)
    * @param primitiveOf (cluster) => primitive in the page's centred coordinates, or null
    */
-  clusterBorders(cut, c, primitiveOf) {
-    const { count, ends, sideStart, side } = this.edges;
+  clusterBorders(cut, c, clusterTriangles, primitiveOf) {
+    const { ends, sideStart, side, edgeOfSide } = this.edges;
     const labels = cut.faceCluster, faceOfTriangle = this.data.faceOfTriangle;
     const positions = this.data.positions, triangles = this.data.triangles;
     const triangleOf = (s) => Math.floor(side[s] / 3);
@@ -170,15 +178,19 @@ export class BorderLines {
       }
       neighbours.set(other, entry);
     };
-    for (let e = 0; e < count; ++e) {
+    // c's edges in increasing order, each once: the sums below add up in the order of the edge
+    // table whatever the order of c's triangles.
+    const edges = new Uint32Array(3 * clusterTriangles.length);
+    clusterTriangles.forEach((t, i) => edges.set(edgeOfSide.subarray(3 * t, 3 * t + 3), 3 * i));
+    edges.sort();
+    for (let i = 0; i < edges.length; ++i) {
+      const e = edges[i];
+      if (e === NO_EDGE || (i > 0 && e === edges[i - 1])) continue;
       const from = sideStart[e], to = sideStart[e + 1];
-      // Only edges of c on a border: one triangle, or a triangle of another cluster.
-      let mine = false, others = false;
-      for (let s = from; s < to; ++s) {
-        if (clusterOf(triangleOf(s)) === c) mine = true;
-        else others = true;
-      }
-      if (!mine || (!others && to - from > 1)) continue;
+      // Only edges on a border: one triangle, or a triangle of another cluster.
+      let others = false;
+      for (let s = from; s < to; ++s) others ||= clusterOf(triangleOf(s)) !== c;
+      if (!others && to - from > 1) continue;
       // The lowest triangle of each cluster on the edge (sides are sorted by triangle).
       const first = new Map();
       for (let s = from; s < to; ++s) if (!first.has(clusterOf(triangleOf(s)))) first.set(clusterOf(triangleOf(s)), triangleOf(s));

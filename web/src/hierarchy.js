@@ -31,6 +31,10 @@ export class Cut {
     this.nodes = nodes;
     this.tree = tree;
     this.labels = null;
+    // Made on first use too, as a cut never changes: its cluster ids (Tree.clusterIds) and the
+    // triangles of each cluster (the viewer's trianglesByCluster).
+    this.ids = null;
+    this.triangleIndex = null;
   }
   get size() {
     return this.nodes.length;
@@ -226,11 +230,13 @@ export class Tree {
 
   /** Cluster ids as primseg numbers them (by decreasing area): id of each cluster. O(K log K). */
   clusterIds(cut) {
+    if (cut.ids) return cut.ids;
     const lowest = this.lowestFaces(cut);
     const order = Array.from({ length: cut.size }, (_, c) => c);
     order.sort((a, b) => this.compareClusters(cut, lowest, a, b));
     const ids = new Uint32Array(cut.size);
     order.forEach((c, rank) => (ids[c] = rank));
+    cut.ids = ids;
     return ids;
   }
 

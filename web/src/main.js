@@ -402,6 +402,7 @@ class Viewer {
 
   // Triangles of each cluster of the current cut (counting sort): {offsets, triangles}.
   trianglesByCluster() {
+    if (this.cut.triangleIndex) return this.cut.triangleIndex;
     const faceCluster = this.cut.faceCluster, faceOfTriangle = this.data.faceOfTriangle;
     const T = this.data.triangles.length / 3, K = this.cut.size;
     const offsets = new Uint32Array(K + 1);
@@ -410,7 +411,8 @@ class Viewer {
     for (let c = 0; c < K; ++c) offsets[c + 1] += offsets[c];
     const fill = offsets.slice(0, K), triangles = new Uint32Array(T);
     for (let t = 0; t < T; ++t) triangles[fill[clusterOf(t)]++] = t;
-    return { offsets, triangles };
+    this.cut.triangleIndex = { offsets, triangles };
+    return this.cut.triangleIndex;
   }
 
   updatePrimitives() {
@@ -703,7 +705,7 @@ class Viewer {
     }
     // Its borders: the neighbouring clusters (ids as primseg numbers them, null for the open
     // boundary), with the angle between the fitted surfaces across each.
-    info.borders = this.borderLines.clusterBorders(this.cut, c, (k) => this.primitiveOf(k))
+    info.borders = this.borderLines.clusterBorders(this.cut, c, ids, (k) => this.primitiveOf(k))
       .map((b) => ({ ...b, cluster: b.cluster < 0 ? null : clusterIds[b.cluster],
         type: b.cluster < 0 ? null : TYPE_NAMES[tree.type(this.cut.nodes[b.cluster])] }));
     return info;
