@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON >/dev/null  # as test.sh
 cmake --build build --target primseg_cli
 mkdir -p out
 tar xzf /usr/share/doc/libcgal-dev/data.tar.gz -C out --strip-components=2 data/meshes/fandisk.off

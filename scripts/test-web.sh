@@ -8,7 +8,8 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 build=${PRIMSEG_BUILD_DIR:-build}
 (cd web && npm ci --no-audit --no-fund --loglevel=error)
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPRIMSEG_WERROR=ON >/dev/null
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPRIMSEG_WERROR=ON -DCMAKE_UNITY_BUILD=ON \
+  >/dev/null  # as test.sh
 cmake --build "$build" --target primseg_cli primseg_write_stick_figure
 export PRIMSEG="$PWD/$build/primseg" PRIMSEG_WEB_ARTIFACTS="$PWD/$build/web-artifacts"
 export PRIMSEG_STICK_FIGURE="$PWD/$build/tests/primseg_write_stick_figure"

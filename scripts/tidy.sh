@@ -8,7 +8,8 @@
 # includes, so one file at a time each CLI file took 44 s (Eigen, CLI11 and nlohmann-json), and the
 # library and the CLI took 9 minutes in all. The findings are the same (compared on planted ones).
 # What a unity source can hide, a .cpp missing an #include that an earlier file of its batch has,
-# the Release build catches: it compiles one file at a time.
+# a build one file at a time catches (scripts/test.sh says how); the public headers are compiled
+# on their own with the tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build-tidy}

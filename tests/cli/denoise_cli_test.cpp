@@ -264,13 +264,13 @@ TEST(CliDenoise, LevelOutputsShowTheSnapOnTheDenoisedMesh) {
   EXPECT_EQ(written_labels, level.labels);
 
   std::ifstream json_file(json_path);
-  const nlohmann::json json = nlohmann::json::parse(json_file);
-  EXPECT_EQ(json["level"]["clusters"], 6);
-  EXPECT_EQ(json["level"]["hierarchy_clusters"], 6);
-  ASSERT_EQ(json["clusters"].size(), level.clusters.size());
+  const nlohmann::json report = nlohmann::json::parse(json_file);
+  EXPECT_EQ(report["level"]["clusters"], 6);
+  EXPECT_EQ(report["level"]["hierarchy_clusters"], 6);
+  ASSERT_EQ(report["clusters"].size(), level.clusters.size());
   for (std::size_t c = 0; c < level.clusters.size(); ++c) {
     const ClusterReport& r = level.clusters[c];
-    const nlohmann::json& cluster = json["clusters"][c];
+    const nlohmann::json& cluster = report["clusters"][c];
     EXPECT_EQ(cluster["faces"], r.face_count);
     EXPECT_EQ(cluster["rms"].get<double>(), r.rms);
     EXPECT_EQ(cluster["type"], std::string(to_string(r.primitive.type)));
@@ -285,17 +285,17 @@ TEST(CliDenoise, LevelOutputsShowTheSnapOnTheDenoisedMesh) {
     }
   }
   // The relations made exact, as the library made them (the box's opposite faces).
-  ASSERT_EQ(json["relations"].size(), level.relations.size());
+  ASSERT_EQ(report["relations"].size(), level.relations.size());
   EXPECT_FALSE(level.relations.empty());
   for (std::size_t i = 0; i < level.relations.size(); ++i) {
-    EXPECT_EQ(json["relations"][i]["kind"], std::string(to_string(level.relations[i].kind)));
-    EXPECT_EQ(json["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
+    EXPECT_EQ(report["relations"][i]["kind"], std::string(to_string(level.relations[i].kind)));
+    EXPECT_EQ(report["relations"][i]["clusters"].get<std::vector<std::uint32_t>>(),
               level.relations[i].clusters);
   }
   // The box's edges (a face may be fitted by a cylinder of radius 45 times its width, whose
   // normal turns by a degree across it).
-  ASSERT_EQ(json["borders"].size(), 12u);
-  for (const nlohmann::json& border : json["borders"])
+  ASSERT_EQ(report["borders"].size(), 12u);
+  for (const nlohmann::json& border : report["borders"])
     EXPECT_NEAR(border["angle"].get<double>(), 90, 2) << border["clusters"];
 
   // The polylines run through the denoised positions.
@@ -356,10 +356,10 @@ TEST(CliDistance, PrintsATableAndIsReproducible) {
     options.samples = 20000;
     options.seed = seed;
     const MeshDistance expected = mesh_distance(noisy, clean, options);
-    const nlohmann::json json = nlohmann::json::parse(output);
-    EXPECT_EQ(json["a_to_b"]["rms"].get<double>(), expected.a_to_b.rms) << seed;
-    EXPECT_EQ(json["b_to_a"]["mean"].get<double>(), expected.b_to_a.mean) << seed;
-    rms_by_seed.push_back(json["a_to_b"]["rms"].get<double>());
+    const nlohmann::json report = nlohmann::json::parse(output);
+    EXPECT_EQ(report["a_to_b"]["rms"].get<double>(), expected.a_to_b.rms) << seed;
+    EXPECT_EQ(report["b_to_a"]["mean"].get<double>(), expected.b_to_a.mean) << seed;
+    rms_by_seed.push_back(report["a_to_b"]["rms"].get<double>());
   }
   EXPECT_NE(rms_by_seed[0], rms_by_seed[1]);
 }
