@@ -36,9 +36,8 @@ void run_skeleton(const SkeletonCommandOptions& o) {
   options.primitives = parse_primitives(o.primitives);
   options.threads = o.threads;
   validate(options);
-  if (!(std::isfinite(o.band) && o.band >= 0))
-    throw InvalidInputError("--band: must be a finite number >= 0");
   const SkeletonOptions skeleton_choice = skeleton_options(o.joints);
+  const SkinningOptions skinning = skinning_options(o.band);
   auto mesh = std::make_shared<const Mesh>(
       read_geometry_within(o.mesh_path, o.limits, o.picture.png ? kPictureBytes : 0));
   validate_level(o.level, mesh->face_count());
@@ -63,8 +62,6 @@ void run_skeleton(const SkeletonCommandOptions& o) {
   json["timing"] = {{"hierarchy_seconds", build_seconds}, {"skeleton_seconds", skeleton_seconds}};
   if (o.skin_weights || o.gltf) {
     const auto skin_start = Clock::now();
-    SkinningOptions skinning;
-    skinning.band = o.band;
     const SkinWeights weights = compute_skin_weights(*mesh, skeleton, skinning);
     json["timing"]["skin_weights_seconds"] = seconds_since(skin_start);
     if (o.skin_weights) detail::write_file_atomically(*o.skin_weights, skin_weights_text(weights));

@@ -1,5 +1,6 @@
 #include "skeleton_outputs.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 #include "primseg/error.hpp"
@@ -37,6 +38,14 @@ SkeletonOptions skeleton_options(const std::string& joints) {
   const std::optional<JointRule> rule = joint_rule_from_string(joints);
   if (!rule) throw InvalidInputError("--joints: '" + joints + "' is not paper or limbs");
   options.joints = *rule;
+  return options;
+}
+
+SkinningOptions skinning_options(double band) {
+  if (!(std::isfinite(band) && band >= 0))
+    throw InvalidInputError("--band: must be a finite number >= 0");
+  SkinningOptions options;
+  options.band = band;
   return options;
 }
 

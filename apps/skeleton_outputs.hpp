@@ -23,6 +23,8 @@ std::string skin_weights_text(const SkinWeights& weights);
 void add_joints_option(CLI::App& command, std::string& joints, const std::string& help_prefix = "");
 /// The options --joints names; throws InvalidInputError for an unknown rule.
 SkeletonOptions skeleton_options(const std::string& joints);
+/// The options --band gives; throws InvalidInputError unless it is finite and >= 0.
+SkinningOptions skinning_options(double band);
 
 /// --png FILE, --view X,Y,Z and --up X,Y,Z: a picture of the skeleton over the mesh.
 struct SkeletonPicture {

@@ -450,21 +450,18 @@ Hierarchy view_hierarchy(const ViewCommandOptions& o, const std::shared_ptr<cons
 
 // The skeleton the page draws: of --skeleton-clusters' level, else of the level it opens at.
 PageSkeleton page_skeleton(const ViewCommandOptions& o, const SkeletonOptions& rule,
-                           const Mesh& mesh, const Hierarchy& hierarchy,
-                           const Segmentation& opening_level) {
+                           const SkinningOptions& skinning, const Mesh& mesh,
+                           const Hierarchy& hierarchy, const Segmentation& opening_level) {
   const Segmentation bones = o.skeleton_clusters
                                  ? cut(hierarchy, {o.skeleton_clusters, std::nullopt}).segmentation
                                  : opening_level;
-  SkinningOptions skinning;
-  skinning.band = o.band;
   Skeleton extracted = extract_skeleton(hierarchy, bones, rule);
   SkinWeights weights = compute_skin_weights(mesh, extracted, skinning);
-  return PageSkeleton{std::move(extracted), std::move(weights), o.band};
+  return PageSkeleton{std::move(extracted), std::move(weights), skinning.band};
 }
 
 // Runs `primseg view` with its parsed options.
 void run_view(const ViewCommandOptions& o) {
-  const auto [page, marker] = viewer_page();
   HierarchyOptions options;
   options.primitives = parse_primitives(o.primitives);
   options.threads = o.threads;
@@ -472,11 +469,11 @@ void run_view(const ViewCommandOptions& o) {
   validate_relation_options(o.relations);
   if (o.tree_path == kStandardInput && o.mesh_path == kStandardInput)
     throw InvalidInputError("view: only one of MESH and --tree can be standard input ('-')");
+  const SkeletonOptions joint_rule = skeleton_options(o.joints);
+  const SkinningOptions skinning = skinning_options(o.band);
+  const auto [page, marker] = viewer_page();
   auto mesh =
       std::make_shared<const Mesh>(read_geometry_within(o.mesh_path, o.limits, kViewerPageBytes));
-  if (!(std::isfinite(o.band) && o.band >= 0))
-    throw InvalidInputError("--band: must be a finite number >= 0");
-  const SkeletonOptions joint_rule = skeleton_options(o.joints);  // a misspelt rule fails at once
   if (o.clusters) validate_level({o.clusters, std::nullopt}, mesh->face_count());
   if (o.skeleton_clusters) validate_level({o.skeleton_clusters, std::nullopt}, mesh->face_count());
   const auto build_start = Clock::now();
@@ -487,7 +484,7 @@ void run_view(const ViewCommandOptions& o) {
   const AutoLevel automatic = level.automatic ? *level.automatic : choose_level(hierarchy);
   std::optional<PageSkeleton> skeleton;
   if (o.skeleton || o.skeleton_clusters)
-    skeleton = page_skeleton(o, joint_rule, *mesh, hierarchy, level.segmentation);
+    skeleton = page_skeleton(o, joint_rule, skinning, *mesh, hierarchy, level.segmentation);
   const std::uint32_t relation_clusters =
       o.regularize_clusters
           ? *o.regularize_clusters

@@ -255,6 +255,19 @@ TEST_F(SkeletonCli, BadInputGivesAClearError) {
       1);
   EXPECT_NE(output.find("--joints: 'hubs' is not paper or limbs"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(path("x.json")));
+
+  // skeleton and view check the rule and the band before reading the mesh (a large one takes a
+  // while): a missing mesh is not what they report.
+  for (const std::string command : {"skeleton", "view"})
+    for (const std::string option : {"--joints hubs", "--band -1"}) {
+      EXPECT_EQ(run(command + " " + path("missing.off") + " --clusters 8 " + option + " -o " +
+                        path("x.out"),
+                    &output),
+                1)
+          << command << " " << option;
+      EXPECT_NE(output.find(option.substr(0, option.find(' ')) + ":"), std::string::npos)
+          << command << ": " << output;
+    }
 }
 
 }  // namespace
