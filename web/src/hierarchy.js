@@ -31,10 +31,7 @@ export class Cut {
     this.nodes = nodes;
     this.tree = tree;
     this.labels = null;
-    // Made on first use too, as a cut never changes: its cluster ids (Tree.clusterIds) and the
-    // triangles of each cluster (the viewer's trianglesByCluster).
-    this.ids = null;
-    this.triangleIndex = null;
+    this.ids = null; // Tree.clusterIds, made on first use too: a cut never changes
   }
   get size() {
     return this.nodes.length;

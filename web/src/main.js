@@ -400,9 +400,10 @@ class Viewer {
     legend.innerHTML = `<table>${rows.join('')}</table>`;
   }
 
-  // Triangles of each cluster of the current cut (counting sort): {offsets, triangles}.
+  // Triangles of each cluster of the current cut (counting sort): {offsets, triangles}, made once
+  // per cut (a click, and every cluster of a level in turn, ask again).
   trianglesByCluster() {
-    if (this.cut.triangleIndex) return this.cut.triangleIndex;
+    if (this.triangleIndex?.cut === this.cut) return this.triangleIndex;
     const faceCluster = this.cut.faceCluster, faceOfTriangle = this.data.faceOfTriangle;
     const T = this.data.triangles.length / 3, K = this.cut.size;
     const offsets = new Uint32Array(K + 1);
@@ -411,8 +412,8 @@ class Viewer {
     for (let c = 0; c < K; ++c) offsets[c + 1] += offsets[c];
     const fill = offsets.slice(0, K), triangles = new Uint32Array(T);
     for (let t = 0; t < T; ++t) triangles[fill[clusterOf(t)]++] = t;
-    this.cut.triangleIndex = { offsets, triangles };
-    return this.cut.triangleIndex;
+    this.triangleIndex = { cut: this.cut, offsets, triangles };
+    return this.triangleIndex;
   }
 
   updatePrimitives() {
@@ -506,12 +507,11 @@ class Viewer {
 
   /**
    * The current level's relations with cluster ids as primseg numbers them, as `primseg cut
-   * --regularize --json` lists them: [{kind, clusters, orthogonal_to?, deviation}], or null. `ids`: the
-   * cut's cluster ids (Tree.clusterIds), when the caller has them.
+   * --regularize --json` lists them: [{kind, clusters, orthogonal_to?, deviation}], or null.
    */
-  currentRelations(ids = null) {
+  currentRelations() {
     if (!this.levelRelations) return null;
-    ids ??= this.tree.clusterIds(this.cut);
+    const ids = this.tree.clusterIds(this.cut);
     const sorted = (list) => list.map((c) => ids[c]).sort((a, b) => a - b);
     return this.levelRelations.map(({ kind, members, others, deviation }) =>
       (kind === 'orthogonal' ? { kind, clusters: sorted(members), orthogonal_to: sorted(others), deviation }
@@ -675,10 +675,10 @@ class Viewer {
   describe(c, face) {
     const tree = this.tree, node = this.cut.nodes[c], header = this.header;
     const { offsets, triangles } = this.trianglesByCluster();
-    const ids = triangles.subarray(offsets[c], offsets[c + 1]);
+    const clusterTriangles = triangles.subarray(offsets[c], offsets[c + 1]);
     const exact = this.exactFit(c);
     const primitive = exact?.primitive ?? tree.primitive(node) ??
-      (tree.isLeaf(node) ? facePlane(this.data.positions, this.data.triangles, ids) : null);
+      (tree.isLeaf(node) ? facePlane(this.data.positions, this.data.triangles, clusterTriangles) : null);
     const clusterIds = tree.clusterIds(this.cut);
     const info = {
       id: clusterIds[c], clusters: this.cut.size, node, face,
@@ -689,7 +689,7 @@ class Viewer {
       // primseg's own figures where the page carries them; else (a single face of a fine level)
       // measured here, on the page's float32 positions.
       const { rms, max } = exact?.errors ?? tree.errors(node) ??
-        clusterErrors(primitive, this.data.positions, this.data.triangles, ids, this.cornerWeight());
+        clusterErrors(primitive, this.data.positions, this.data.triangles, clusterTriangles, this.cornerWeight());
       info.rms = rms;
       info.max = max;
       const center = header.center;
@@ -700,12 +700,12 @@ class Viewer {
       info.params = p[TYPE_NAMES[primitive.type]];
     }
     if (this.levelRelations) {
-      info.relations = this.currentRelations(clusterIds).filter((r, i) =>
+      info.relations = this.currentRelations().filter((r, i) =>
         this.levelRelations[i].members.includes(c) || this.levelRelations[i].others.includes(c));
     }
     // Its borders: the neighbouring clusters (ids as primseg numbers them, null for the open
     // boundary), with the angle between the fitted surfaces across each.
-    info.borders = this.borderLines.clusterBorders(this.cut, c, ids, (k) => this.primitiveOf(k))
+    info.borders = this.borderLines.clusterBorders(this.cut, c, clusterTriangles, (k) => this.primitiveOf(k))
       .map((b) => ({ ...b, cluster: b.cluster < 0 ? null : clusterIds[b.cluster],
         type: b.cluster < 0 ? null : TYPE_NAMES[tree.type(this.cut.nodes[b.cluster])] }));
     return info;
