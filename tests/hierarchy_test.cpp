@@ -123,6 +123,26 @@ TEST(Hierarchy, ConesAndToriAreRecoveredWhenEnabled) {
   EXPECT_EQ(tori, 2);
 }
 
+// With tori enabled, the flat faces of noisy boxes stay planes. A torus's error is estimated from a
+// sample of 32 corners, and the merge loop keeps whichever evaluation came out lowest: before the
+// sample's luck was measured on the principal plane, a face of the box (seed 2), of the slanted
+// box (seed 2) and of the box with a dome (seed 3) were typed tori, their sampled error half their
+// plane's exact one. (`primseg eval --primitives plane,cylinder,sphere,cone,torus`, noisy, 12
+// seeds: plane regions typed right 98.6% → 99.9%.)
+TEST(Hierarchy, NoisyFlatFacesAreNotToriWhenToriAreEnabled) {
+  HierarchyOptions options;
+  options.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
+                        PrimitiveType::Cone, PrimitiveType::Torus};
+  for (const char* name : {"box", "slanted_box", "box_with_dome"})
+    for (const std::uint64_t seed : {1, 2, 3}) {
+      const GroundTruthShape shape =
+          make_shape(name, variant_options({Tessellation::Uniform, seed}, 0.002));
+      const SegmentationScore score =
+          score_at_true_count(shape, build_hierarchy(shape.mesh, options));
+      EXPECT_EQ(score.type_accuracy, 1.0) << name << " seed " << seed;
+    }
+}
+
 TEST(Hierarchy, IsAFullBinaryTreeWithCostsAndTypes) {
   const GroundTruthShape shape = make_shape("box_with_boss", {});
   const Hierarchy h = build_hierarchy(shape.mesh);
