@@ -127,8 +127,8 @@ TEST(Hierarchy, ConesAndToriAreRecoveredWhenEnabled) {
 // sample of 32 corners, and the merge loop keeps whichever evaluation came out lowest: before the
 // sample's luck was measured on the principal plane, a face of the box (seed 2), of the slanted
 // box (seed 2) and of the box with a dome (seed 3) were typed tori, their sampled error half their
-// plane's exact one. (`primseg eval --primitives plane,cylinder,sphere,cone,torus`, noisy, 12
-// seeds: plane regions typed right 98.6% → 99.9%.)
+// plane's exact one. (`primseg eval --primitives plane,cylinder,sphere,cone,torus --refine 2`,
+// noisy, 12 seeds: plane regions typed right 98.6% → 99.9%.)
 TEST(Hierarchy, NoisyFlatFacesAreNotToriWhenToriAreEnabled) {
   HierarchyOptions options;
   options.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,

@@ -372,10 +372,11 @@ TEST(TorusFitter, NoisyTorusErrorEstimatesTheExactError) {
 // merge loop keeps whichever evaluation came out lowest: a noisy flat face whose torus looked
 // twice as good as its plane was typed a torus (the noisy box of `primseg eval`, with tori). The
 // sample's luck is measured on the principal plane, whose exact error is known, and taken out.
+// A torus is valid on 18 of the 300 draws (3 of them below half the plane's error before).
 TEST(TorusFitter, ANoisyFlatPatchIsNeverTwiceAsCloseToATorusAsToItsPlane) {
   std::mt19937_64 rng(2026);
   std::normal_distribution<double> noise(0.0, 0.004);
-  int lucky = 0;
+  int fitted = 0, lucky = 0;
   double smallest = 1e300;
   for (int draw = 0; draw < 300; ++draw) {
     const Pose pose = random_pose(rng);
@@ -386,12 +387,14 @@ TEST(TorusFitter, ANoisyFlatPatchIsNeverTwiceAsCloseToATorusAsToItsPlane) {
     const PrimitiveFit plane_fit = fit_whole(mesh, PlaneFitter(), &plane);
     ASSERT_TRUE(plane_fit.valid);
     if (!torus_fit.valid) continue;
+    ++fitted;
     // The torus's penalty is 2 and the plane's 1: below half, the torus would win.
     smallest = std::min(smallest, torus_fit.error / plane_fit.error);
     lucky += torus_fit.error < 0.5 * plane_fit.error;
   }
-  std::printf("torus error / plane error: smallest %.3f, below 0.5 in %d of 300 draws\n", smallest,
-              lucky);
+  std::printf(
+      "torus error / plane error: smallest %.3f, below 0.5 in %d of %d tori fitted (300 draws)\n",
+      smallest, lucky, fitted);
   EXPECT_EQ(lucky, 0);
 }
 
