@@ -198,6 +198,12 @@ double ClusterView::normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vect
   return std::abs(sum) / (radius * area_);
 }
 
+std::array<const SampleReservoir*, 2> ClusterView::sample_strata() const {
+  if (part_count_ == 2 && parts_[0].stats() && parts_[1].stats())
+    return {&parts_[0].stats()->samples, &parts_[1].stats()->samples};
+  return {&stats().samples, nullptr};
+}
+
 const ClusterStats& ClusterView::stats() const {
   if (part_count_ == 1) return *parts_[0].stats();
   if (!union_stats_) union_stats_ = stats(4);

@@ -6,6 +6,7 @@
 /// constant time, without forming the union's 35 moments (what a merge candidate costs).
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <optional>
 
@@ -108,6 +109,13 @@ class ClusterView {
   /// normals against the field ν(x) = Q (x − point) / radius.
   double normal_alignment(const Eigen::Matrix3d& q, const Eigen::Vector3d& point,
                           double radius) const;
+
+  /// The corner samples a sampled fit (the torus's) reads, one reservoir per stratum: a single
+  /// cluster's own; for a union of two clusters with statistics, each part's own, so that a fit
+  /// can sample both (a small part merged into a large one would otherwise be left out of the
+  /// union's sample by chance); else the union's (stats().samples). The second entry is null
+  /// when there is one stratum.
+  std::array<const SampleReservoir*, 2> sample_strata() const;
 
   /// The cluster's whole statistics, centred at centroid() (for a union: formed on first use,
   /// then kept; the first moments are exactly zero).
