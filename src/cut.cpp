@@ -12,6 +12,7 @@
 #include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
+#include "primseg/primitives/torus.hpp"
 #include "tree_nodes.hpp"
 #include "triangle_corners.hpp"
 #include "working_primitive.hpp"
@@ -127,8 +128,17 @@ void fit_report(const WorkingFrame& frame, const Primitive& start, std::span<con
   if (!options.geometric_fit) fit_options.max_iterations = 0;
   r.algebraic = start;
   // Fitted and measured in the working frame (no overflow for huge inputs), scaled back.
-  const GeometricFit fit =
-      fit_geometric(detail::to_working(frame, start), points, weights, fit_options);
+  GeometricFit fit = fit_geometric(detail::to_working(frame, start), points, weights, fit_options);
+  const Primitive& fitted = fit.primitive;
+  if (fit.iterations > 0 && fitted.type == PrimitiveType::Torus &&
+      !(fitted.radius >= kMinRelativeTorusMajorRadius * fitted.minor_radius)) {
+    // The fit shrank the torus's ring to (nearly) a point: the surface is the sphere of its tube.
+    Primitive sphere;
+    sphere.type = PrimitiveType::Sphere;
+    sphere.point = fitted.point;
+    sphere.radius = fitted.minor_radius;
+    fit = fit_geometric(sphere, points, weights, fit_options);
+  }
   r.primitive = fit.iterations > 0 ? frame.to_input(fit.primitive) : start;
   r.rms = std::ldexp(fit.rms, frame.exponent);
   r.max = std::ldexp(fit.max, frame.exponent);

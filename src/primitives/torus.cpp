@@ -43,9 +43,6 @@ namespace {
 constexpr int kParameters = 7;
 // The smallest eigenvalue of Σ ŵ n nᵀ over Σ ŵ below this: normals (nearly) coplanar, no torus.
 constexpr double kTorusMinNormalSpread = 1e-9;
-// A torus whose major radius is below this fraction of its minor radius is the sphere it nearly
-// is (a sphere is a torus of major radius 0 about any axis through its centre).
-constexpr double kMinRelativeMajorRadius = 0.05;
 // Largest minor radius, relative to the RMS spread of the cluster: a wider tube bends the cluster
 // by less than a fortieth of its size across, and the torus is standing in for a cone, a
 // cylinder or a plane (a cone's band is fitted by tori of growing tube as closely as wanted).
@@ -255,7 +252,8 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
       fit_geometric(start, std::span<const Vec3>(sample.points.data(), n),
                     std::span<const double>(sample.weights.data(), n), options);
   const Primitive& torus = refined.primitive;
-  if (!(torus.minor_radius > 0 && torus.radius >= kMinRelativeMajorRadius * torus.minor_radius) ||
+  if (!(torus.minor_radius > 0 &&
+        torus.radius >= kMinRelativeTorusMajorRadius * torus.minor_radius) ||
       !(torus.radius <= detail::kMaxRelativeRadius &&
         torus.minor_radius <= kMaxRelativeMinorRadius))
     return result;

@@ -493,9 +493,7 @@ TEST(TorusFitter, FacesAddedOffATorusPatchAreSeenByTheUnionsError) {
     }
     ASSERT_TRUE(large && small);
     const ClusterStats large_centred = large->centred(), small_centred = small->centred();
-    const TorusFitter torus;
-    const PrimitiveFit fit = static_cast<const PrimitiveFitter&>(torus).fit(
-        ClusterView(large_centred, small_centred, between));
+    const PrimitiveFit fit = TorusFitter().fit(ClusterView(large_centred, small_centred, between));
     ASSERT_TRUE(fit.valid) << trial;
     double exact = 0;  // Σ w d² over every corner of the union, to the fitted torus
     for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {

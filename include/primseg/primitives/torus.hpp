@@ -6,6 +6,11 @@
 
 namespace primseg {
 
+/// A torus whose major radius is below this fraction of its minor radius is the sphere it nearly
+/// is (a sphere is a torus of major radius 0 about any axis through its centre): the fitter
+/// rejects it, and a cluster report whose geometric fit ends there reports the sphere instead.
+inline constexpr double kMinRelativeTorusMajorRadius = 0.05;
+
 class TorusFitter final : public PrimitiveFitter {
  public:
   PrimitiveType type() const override { return PrimitiveType::Torus; }
