@@ -129,17 +129,18 @@ void fit_report(const WorkingFrame& frame, const Primitive& start, std::span<con
   r.algebraic = start;
   // Fitted and measured in the working frame (no overflow for huge inputs), scaled back.
   GeometricFit fit = fit_geometric(detail::to_working(frame, start), points, weights, fit_options);
+  const bool refitted = fit.iterations > 0;
   const Primitive& fitted = fit.primitive;
-  if (fit.iterations > 0 && fitted.type == PrimitiveType::Torus &&
+  if (refitted && fitted.type == PrimitiveType::Torus &&
       !(fitted.radius >= kMinRelativeTorusMajorRadius * fitted.minor_radius)) {
     // The fit shrank the torus's ring to (nearly) a point: the surface is the sphere of its tube.
     Primitive sphere;
     sphere.type = PrimitiveType::Sphere;
     sphere.point = fitted.point;
     sphere.radius = fitted.minor_radius;
-    fit = fit_geometric(sphere, points, weights, fit_options);
+    fit = fit_geometric(sphere, points, weights, fit_options);  // that sphere if nothing improves
   }
-  r.primitive = fit.iterations > 0 ? frame.to_input(fit.primitive) : start;
+  r.primitive = refitted ? frame.to_input(fit.primitive) : start;
   r.rms = std::ldexp(fit.rms, frame.exponent);
   r.max = std::ldexp(fit.max, frame.exponent);
   r.area = std::ldexp(r.area, 2 * frame.exponent);
