@@ -106,7 +106,6 @@ TEST(Cut, ScipyLinkageIsTheTreeWithStrictlyIncreasingHeights) {
   EXPECT_GT(inversions, 0u);  // fandisk has greedy costs that drop: the rule is exercised
 }
 
-// primseg view carries describe_nodes' reports for the page's clicks: they must be the cut's.
 // A torus whose ring the geometric fit shrinks below kMinRelativeTorusMajorRadius of its tube is
 // the sphere it nearly is (the tree's torus fitter rejects such tori, but a fit from a valid one
 // can end there: a noisy sphere cap of `primseg eval` with five types was reported as a torus of
@@ -138,6 +137,7 @@ TEST(Cut, ATorusShrunkToItsTubeIsReportedAsTheSphere) {
   }
 }
 
+// primseg view carries describe_nodes' reports for the page's clicks: they must be the cut's.
 TEST(Cut, NodeReportsAreTheCutsReportsBitForBit) {
   ShapeOptions options;
   options.tessellation = Tessellation::Uniform;

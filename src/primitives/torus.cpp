@@ -13,8 +13,8 @@
 // The sample of a candidate union is stratified: each of its two clusters contributes its own
 // priority sample, at least half of the 32 corners unless it has fewer (draw_sample). A union's
 // own sample is the best 32 priorities of both, which often holds none of a small part's corners:
-// four faces off the surface added to a torus of 526 faces went unseen, and the union's sampled
-// error stayed 1e-6 of what the whole cluster's torus fit has (rotor.off of libcgal-demo).
+// four faces off the surface added to a torus of 526 faces went unseen, at a sampled RMS of 1.5e-6
+// against 0.0079 for a torus fitted to all 531 (rotor.off of libcgal-demo).
 // The error is the priority-sampling estimate of Σ w d² (estimator weights max(w, τ), see
 // SampleReservoir, summed over the strata), normalised to the cluster's exact weight; when the
 // sample is not the whole cluster it is scaled by n / (n − 7), the usual correction for the 7

@@ -450,8 +450,9 @@ TEST(TorusFitter, AFlatFanOnTheTopCircleIsNotPartOfTheTorus) {
 
 // A candidate that adds a few faces to a large torus patch must pay for them when they leave the
 // torus. The union's own corner sample (the best 32 priorities of both parts) usually holds none
-// of a small part's corners, and the torus of 526 faces of rotor.off took four faces off its
-// surface at a sampled error of 1e-6 of the whole cluster's; each part is now sampled on its own.
+// of a small part's corners: a torus of 526 faces of rotor.off took four faces off its surface at
+// a sampled RMS of 1.5e-6, against 0.0079 for a torus fitted to all 531. Each part is now sampled
+// on its own.
 TEST(TorusFitter, FacesAddedOffATorusPatchAreSeenByTheUnionsError) {
   std::mt19937_64 rng(47);
   for (int trial = 0; trial < 8; ++trial) {
