@@ -377,10 +377,6 @@ void SampleReservoir::merge(const SampleReservoir& other) {
   samples = std::move(merged);
 }
 
-double SampleReservoir::threshold() const {
-  return samples.size() > kCapacity ? samples[kCapacity].priority : 0.0;
-}
-
 double SampleReservoir::estimator_weight(std::size_t i) const {
   return std::max(samples[i].weight, threshold());
 }

@@ -131,8 +131,7 @@ void fit_report(const WorkingFrame& frame, const Primitive& start, std::span<con
   GeometricFit fit = fit_geometric(detail::to_working(frame, start), points, weights, fit_options);
   const bool refitted = fit.iterations > 0;
   const Primitive& fitted = fit.primitive;
-  if (refitted && fitted.type == PrimitiveType::Torus &&
-      !(fitted.radius >= kMinRelativeTorusMajorRadius * fitted.minor_radius)) {
+  if (refitted && fitted.type == PrimitiveType::Torus && torus_ring_vanishes(fitted)) {
     // The fit shrank the torus's ring to (nearly) a point: the surface is the sphere of its tube.
     Primitive sphere;
     sphere.type = PrimitiveType::Sphere;

@@ -25,6 +25,14 @@ namespace {
 using testing::score_segmentation;
 using testing::SegmentationScore;
 
+// Plane, cylinder, sphere, cone and torus.
+HierarchyOptions every_type() {
+  HierarchyOptions options;
+  options.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
+                        PrimitiveType::Cone, PrimitiveType::Torus};
+  return options;
+}
+
 std::vector<double> face_areas(const Hierarchy& h) {
   std::vector<double> area(h.face_count(), 0.0);
   for (std::uint32_t t = 0; t < h.mesh().triangle_count(); ++t)
@@ -101,9 +109,7 @@ TEST(Hierarchy, NoisyCadShapesKeepAMeanIouAboveNinetyPercent) {
 // are segmented with every region recovered and typed right. The CAD-style fillet is left out:
 // its coarse quarter torus is still split wrongly (see README, Measured quality).
 TEST(Hierarchy, ConesAndToriAreRecoveredWhenEnabled) {
-  HierarchyOptions options;
-  options.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
-                        PrimitiveType::Cone, PrimitiveType::Torus};
+  const HierarchyOptions options = every_type();
   int cones = 0, tori = 0;
   for (const Variant& variant : kVariants)
     for (const std::string& name : shape_names()) {
@@ -132,9 +138,7 @@ TEST(Hierarchy, ConesAndToriAreRecoveredWhenEnabled) {
 // plane's exact one. (`primseg eval --primitives plane,cylinder,sphere,cone,torus --refine 2`,
 // noisy, 12 seeds: plane regions typed right 98.6% → 99.9%.)
 TEST(Hierarchy, NoisyFlatFacesAreNotToriWhenToriAreEnabled) {
-  HierarchyOptions options;
-  options.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
-                        PrimitiveType::Cone, PrimitiveType::Torus};
+  const HierarchyOptions options = every_type();
   for (const char* name : {"box", "slanted_box", "box_with_dome"})
     for (const std::uint64_t seed : {1, 2, 3}) {
       const GroundTruthShape shape =
@@ -152,9 +156,7 @@ TEST(Hierarchy, NoisyFlatFacesAreNotToriWhenToriAreEnabled) {
 // now sampled on its own (src/primitives/torus.cpp): every cluster fits within 7.2e-4.
 TEST(Hierarchy, WithToriEveryClusterOfTheRotorFitsItsPrimitive) {
   const Mesh mesh = read_mesh(testing::cgal_mesh("rotor.off"));
-  HierarchyOptions options;
-  options.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
-                        PrimitiveType::Cone, PrimitiveType::Torus};
+  const HierarchyOptions options = every_type();
   const Hierarchy h = build_hierarchy(mesh, options);
   Eigen::AlignedBox3d box;
   for (const Vec3& p : mesh.positions) box.extend(Eigen::Vector3d(p[0], p[1], p[2]));
@@ -266,9 +268,7 @@ TEST(Hierarchy, RenumberedVerticesAndRotatedCornersGiveTheSameTree) {
   };
   HierarchyOptions uniform;
   uniform.weights = VertexWeights::Uniform;
-  HierarchyOptions five_types;  // the torus's fit reads a sample of the corners
-  five_types.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
-                           PrimitiveType::Cone, PrimitiveType::Torus};
+  const HierarchyOptions five_types = every_type();  // the torus's fit reads a sample of corners
   ShapeOptions noisy;
   noisy.tessellation = Tessellation::Uniform;
   noisy.noise = 0.002;

@@ -134,7 +134,12 @@ struct SampleReservoir {
   /// Adds the samples of a disjoint cluster.
   void merge(const SampleReservoir& other);
   /// τ: the priority of the (kCapacity + 1)-th sample, 0 when the cluster is kept whole.
-  double threshold() const;
+  double threshold() const { return threshold(kCapacity); }
+  /// τ of the smaller sample made of the best `size` samples (the best k of a priority sample are
+  /// a priority sample of size k): the priority of the (size + 1)-th, 0 when there is none.
+  double threshold(std::size_t size) const {
+    return size < samples.size() ? samples[size].priority : 0.0;
+  }
   /// Number of samples of the estimate (at most kCapacity).
   std::size_t estimate_size() const { return std::min(samples.size(), kCapacity); }
   /// Estimator weight max(w, τ) of sample i < estimate_size().

@@ -65,8 +65,8 @@ struct TorusSample {
 
 // Draws the sample of a cluster whose corner samples come in `strata` (ClusterView::
 // sample_strata), about `origin` in units of 1 / scale. One stratum: its estimate as it is. Two:
-// each stratum's highest priorities, k of them, with estimator weights max(w, τ_k), τ_k the
-// (k + 1)-th priority (the best k of a priority sample are a priority sample of size k); the
+// each stratum's highest priorities, k of them, with estimator weights max(w, τ_k)
+// (SampleReservoir::threshold(k)); the
 // first stratum gets at least half of the capacity, or all of its corners when it has fewer, and
 // the second the rest, so that neither part of a union goes unseen.
 void draw_sample(const std::array<const SampleReservoir*, 2>& strata, const Eigen::Vector3d& origin,
@@ -83,10 +83,9 @@ void draw_sample(const std::array<const SampleReservoir*, 2>& strata, const Eige
   sample.whole = true;
   for (int s = 0; s < 2 && strata[s]; ++s) {
     const std::vector<SurfaceSample>& corners = strata[s]->samples;
-    const std::size_t k = taken[s];
-    const double threshold = k < corners.size() ? corners[k].priority : 0.0;
+    const double threshold = strata[s]->threshold(taken[s]);
     if (threshold > 0) sample.whole = false;
-    for (std::size_t i = 0; i < k; ++i, ++sample.n) {
+    for (std::size_t i = 0; i < taken[s]; ++i, ++sample.n) {
       const SurfaceSample& corner = corners[i];
       const std::size_t j = sample.n;
       sample.positions[j] = (corner.position - origin) * scale;
@@ -252,8 +251,7 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
       fit_geometric(start, std::span<const Vec3>(sample.points.data(), n),
                     std::span<const double>(sample.weights.data(), n), options);
   const Primitive& torus = refined.primitive;
-  if (!(torus.minor_radius > 0 &&
-        torus.radius >= kMinRelativeTorusMajorRadius * torus.minor_radius) ||
+  if (!(torus.minor_radius > 0) || torus_ring_vanishes(torus) ||
       !(torus.radius <= detail::kMaxRelativeRadius &&
         torus.minor_radius <= kMaxRelativeMinorRadius))
     return result;

@@ -4,7 +4,6 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
-#include <optional>
 #include <random>
 
 #include "primseg/cluster_view.hpp"
@@ -20,6 +19,7 @@ namespace primseg {
 namespace {
 
 using testing::grid_mesh;
+using testing::part_stats;
 using testing::whole_mesh_stats;
 
 struct Pose {
@@ -475,26 +475,13 @@ TEST(TorusFitter, FacesAddedOffATorusPatchAreSeenByTheUnionsError) {
       in_small[f] = corners[0] == 0 || corners[1] == 0 || corners[2] == 0;
     }
     // The two parts' statistics, accumulated as the engine does, and the edges between them.
-    std::optional<ClusterStats> large, small;
+    std::vector<bool> in_large(in_small.size());
+    for (std::size_t f = 0; f < in_small.size(); ++f) in_large[f] = !in_small[f];
+    const ClusterStats large = part_stats(graph, in_large), small = part_stats(graph, in_small);
     EdgeStats between;
-    for (std::uint32_t f = 0; f < mesh.face_count(); ++f) {
-      std::optional<ClusterStats>& part = in_small[f] ? small : large;
-      if (part) {
-        part->merge(graph.face_stats(f, true), {});
-      } else {
-        part = graph.face_stats(f, true);
-      }
-    }
-    for (const DualEdge& e : graph.edges()) {
-      if (in_small[e.first] != in_small[e.second]) {
-        between += e.shared;
-      } else {
-        (in_small[e.first] ? small : large)->edges += e.shared;
-      }
-    }
-    ASSERT_TRUE(large && small);
-    const ClusterStats large_centred = large->centred(), small_centred = small->centred();
-    const PrimitiveFit fit = TorusFitter().fit(ClusterView(large_centred, small_centred, between));
+    for (const DualEdge& e : graph.edges())
+      if (in_small[e.first] != in_small[e.second]) between += e.shared;
+    const PrimitiveFit fit = TorusFitter().fit(ClusterView(large, small, between));
     ASSERT_TRUE(fit.valid) << trial;
     double exact = 0;  // Σ w d² over every corner of the union, to the fitted torus
     for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {

@@ -13,7 +13,10 @@
 #include <fstream>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <vector>
 
 #include "primseg/shape_generator.hpp"
 
@@ -135,10 +138,23 @@ Mesh noisy_uniform_shape(const std::string& name) {
 }
 
 ClusterStats whole_mesh_stats(const DualGraph& graph) {
-  ClusterStats stats = graph.face_stats(0, true);
-  for (std::uint32_t f = 1; f < graph.face_count(); ++f) stats.merge(graph.face_stats(f, true), {});
-  for (const DualEdge& e : graph.edges()) stats.edges += e.shared;
-  return stats.centred();
+  return part_stats(graph, std::vector<bool>(graph.face_count(), true));
+}
+
+ClusterStats part_stats(const DualGraph& graph, const std::vector<bool>& in_part) {
+  std::optional<ClusterStats> stats;
+  for (std::uint32_t f = 0; f < graph.face_count(); ++f) {
+    if (!in_part[f]) continue;
+    if (stats) {
+      stats->merge(graph.face_stats(f, true), {});
+    } else {
+      stats = graph.face_stats(f, true);
+    }
+  }
+  if (!stats) throw std::invalid_argument("part_stats: the part has no face");
+  for (const DualEdge& e : graph.edges())
+    if (in_part[e.first] && in_part[e.second]) stats->edges += e.shared;
+  return stats->centred();
 }
 
 }  // namespace primseg::testing

@@ -110,6 +110,8 @@ struct TetrahedronWithInwardFaces {
 /// Statistics of the whole mesh as one cluster, accumulated face by face and edge by edge the way
 /// the engine does (corner samples included), with moments centred at the centroid.
 ClusterStats whole_mesh_stats(const DualGraph& graph);
+/// The same for the faces f with in_part[f] (at least one), with the edges between two of them.
+ClusterStats part_stats(const DualGraph& graph, const std::vector<bool>& in_part);
 
 }  // namespace primseg::testing
 

@@ -11,6 +11,11 @@ namespace primseg {
 /// rejects it, and a cluster report whose geometric fit ends there reports the sphere instead.
 inline constexpr double kMinRelativeTorusMajorRadius = 0.05;
 
+/// Whether a torus's ring is below kMinRelativeTorusMajorRadius of its tube (or not a number).
+inline bool torus_ring_vanishes(const Primitive& torus) {
+  return !(torus.radius >= kMinRelativeTorusMajorRadius * torus.minor_radius);
+}
+
 class TorusFitter final : public PrimitiveFitter {
  public:
   PrimitiveType type() const override { return PrimitiveType::Torus; }
