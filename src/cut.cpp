@@ -12,7 +12,6 @@
 #include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
-#include "primseg/primitives/torus.hpp"
 #include "tree_nodes.hpp"
 #include "triangle_corners.hpp"
 #include "working_primitive.hpp"
@@ -128,17 +127,9 @@ void fit_report(const WorkingFrame& frame, const Primitive& start, std::span<con
   if (!options.geometric_fit) fit_options.max_iterations = 0;
   r.algebraic = start;
   // Fitted and measured in the working frame (no overflow for huge inputs), scaled back.
-  GeometricFit fit = fit_geometric(detail::to_working(frame, start), points, weights, fit_options);
+  const GeometricFit fit =
+      fit_geometric_or_sphere(detail::to_working(frame, start), points, weights, fit_options);
   const bool refitted = fit.iterations > 0;
-  const Primitive& fitted = fit.primitive;
-  if (refitted && fitted.type == PrimitiveType::Torus && torus_ring_vanishes(fitted)) {
-    // The fit shrank the torus's ring to (nearly) a point: the surface is the sphere of its tube.
-    Primitive sphere;
-    sphere.type = PrimitiveType::Sphere;
-    sphere.point = fitted.point;
-    sphere.radius = fitted.minor_radius;
-    fit = fit_geometric(sphere, points, weights, fit_options);  // that sphere if nothing improves
-  }
   r.primitive = refitted ? frame.to_input(fit.primitive) : start;
   r.rms = std::ldexp(fit.rms, frame.exponent);
   r.max = std::ldexp(fit.max, frame.exponent);

@@ -174,14 +174,15 @@ std::size_t parameter_count(PrimitiveType type) {
   return 8;
 }
 
-// Geometric least-squares refinement of a curved primitive (fit_geometric); nullopt when it does
-// not lower the error, or for fewer than two points per stored parameter, where a curved fit
-// follows the noise.
+// Geometric least-squares refinement of a curved primitive (fit_geometric_or_sphere: a torus
+// whose ring vanishes comes back as the sphere of its tube, which is what the snap moves vertices
+// onto and what snapped_level() reports); nullopt when it does not lower the error, or for fewer
+// than two points per stored parameter, where a curved fit follows the noise.
 std::optional<Primitive> fit_curved(const Primitive& start, std::span<const Vec3> points,
                                     std::span<const double> weights) {
   if (points.size() < 2 * parameter_count(start.type) || !has_valid_size(start))
     return std::nullopt;
-  const GeometricFit fit = fit_geometric(start, points, weights);
+  const GeometricFit fit = fit_geometric_or_sphere(start, points, weights);
   if (fit.iterations == 0 || !has_valid_size(fit.primitive)) return std::nullopt;
   return fit.primitive;
 }

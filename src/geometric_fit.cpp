@@ -11,6 +11,7 @@
 #include "orthonormal_pair.hpp"
 #include "primseg/error.hpp"
 #include "primseg/primitives/primitive_fitter.hpp"
+#include "primseg/primitives/torus.hpp"
 #include "small_cholesky.hpp"
 
 namespace primseg {
@@ -498,6 +499,22 @@ GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> point
   GeometricFit closer = fit_in_one_frame(fit.primitive, points, weights, rest, widened);
   closer.iterations += fit.iterations;
   return closer.rms <= fit.rms ? closer : fit;
+}
+
+GeometricFit fit_geometric_or_sphere(const Primitive& initial, std::span<const Vec3> points,
+                                     std::span<const double> weights,
+                                     const GeometricFitOptions& options) {
+  const GeometricFit fit = fit_geometric(initial, points, weights, options);
+  if (fit.iterations == 0 || fit.primitive.type != PrimitiveType::Torus ||
+      !torus_ring_vanishes(fit.primitive))
+    return fit;
+  Primitive sphere;
+  sphere.type = PrimitiveType::Sphere;
+  sphere.point = fit.primitive.point;
+  sphere.radius = fit.primitive.minor_radius;
+  GeometricFit refitted = fit_geometric(sphere, points, weights, options);  // that sphere at worst
+  refitted.iterations += fit.iterations;
+  return refitted;
 }
 
 }  // namespace primseg

@@ -12,6 +12,7 @@
 
 #include "primseg/cut.hpp"
 #include "primseg/error.hpp"
+#include "primseg/primitives/torus.hpp"
 #include "support/test_support.hpp"
 
 namespace primseg {
@@ -178,6 +179,53 @@ TEST(GeometricFit, RecoversConesAndToriFromPerturbedStarts) {
   }
   for (int t = 0; t < kPrimitiveTypeCount; ++t)
     EXPECT_TRUE(has_geometric_model(static_cast<PrimitiveType>(t)));
+}
+
+// A torus whose fit shrinks its ring to a point is the sphere of its tube: fit_geometric_or_sphere
+// returns that sphere (what reports and the denoiser show), and a true torus as fit_geometric does.
+TEST(GeometricFit, ATorusWhoseRingVanishesIsFittedAsTheSphereOfItsTube) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal;
+  const Eigen::Vector3d centre(2, -1, 0.5);
+  const double radius = 0.4;
+  std::vector<Vec3> sphere_points;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d x =
+        centre + radius * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    sphere_points.push_back({x.x(), x.y(), x.z()});
+  }
+  const std::vector<double> weights(sphere_points.size(), 1.0);
+  Primitive torus;
+  torus.type = PrimitiveType::Torus;
+  torus.point = {centre.x() + 0.01, centre.y(), centre.z() - 0.01};
+  torus.axis = {0, 0, 1};
+  torus.radius = 0.06 * radius;
+  torus.minor_radius = 0.95 * radius;
+  ASSERT_TRUE(torus_ring_vanishes(fit_geometric(torus, sphere_points, weights).primitive))
+      << "the torus's own fit must shrink its ring for this test to mean anything";
+  const GeometricFit fit = fit_geometric_or_sphere(torus, sphere_points, weights);
+  EXPECT_EQ(fit.primitive.type, PrimitiveType::Sphere);
+  EXPECT_NEAR(fit.primitive.radius, radius, 1e-9 * radius);
+  EXPECT_LE((eigen(fit.primitive.point) - centre).norm(), 1e-9 * radius);
+  EXPECT_LE(fit.max, 1e-9 * radius);
+
+  // A torus whose ring stays is fit_geometric's torus, bit for bit.
+  std::vector<Vec3> torus_points;
+  for (int i = 0; i < 300; ++i) {
+    const double phi = 0.02 * i, psi = 0.05 * i;
+    torus_points.push_back({(1 + 0.3 * std::cos(psi)) * std::cos(phi),
+                            (1 + 0.3 * std::cos(psi)) * std::sin(phi), 0.3 * std::sin(psi)});
+  }
+  torus.point = {0.01, -0.02, 0};
+  torus.radius = 1.05;
+  torus.minor_radius = 0.28;
+  const GeometricFit kept = fit_geometric_or_sphere(torus, torus_points, weights);
+  const GeometricFit plain = fit_geometric(torus, torus_points, weights);
+  EXPECT_EQ(kept.primitive.type, PrimitiveType::Torus);
+  EXPECT_EQ(kept.primitive.point, plain.primitive.point);
+  EXPECT_EQ(kept.primitive.radius, plain.primitive.radius);
+  EXPECT_EQ(kept.rms, plain.rms);
+  EXPECT_NEAR(kept.primitive.radius, 1, 1e-9);
 }
 
 // Noisy points have no exact fit: the refinement must still reach the least-squares minimum,

@@ -28,8 +28,7 @@ using testing::SegmentationScore;
 // Plane, cylinder, sphere, cone and torus.
 HierarchyOptions every_type() {
   HierarchyOptions options;
-  options.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
-                        PrimitiveType::Cone, PrimitiveType::Torus};
+  options.primitives = testing::every_primitive_type();
   return options;
 }
 

@@ -248,8 +248,7 @@ TEST(TreeIo, TreesHaveTheSameChecksumOnEveryBuild) {
     std::uint64_t expected;
   };
   HierarchyOptions every_type;
-  every_type.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
-                           PrimitiveType::Cone, PrimitiveType::Torus};
+  every_type.primitives = testing::every_primitive_type();
   every_type.weights = VertexWeights::Uniform;
   ShapeOptions noisy;
   noisy.noise = 0.002;

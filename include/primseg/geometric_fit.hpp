@@ -40,6 +40,15 @@ GeometricFit fit_geometric(const Primitive& initial, std::span<const Vec3> point
                            std::span<const double> weights,
                            const GeometricFitOptions& options = {});
 
+/// fit_geometric(), except for a torus whose ring the fit shrinks to (nearly) a point
+/// (torus_ring_vanishes: major radius below kMinRelativeTorusMajorRadius × the minor one): its
+/// surface is then the sphere of its tube, so that sphere is refitted and returned instead, with
+/// four parameters for seven. `iterations` counts both fits' steps. What reports and the denoiser
+/// use, so that neither lists a torus that is a sphere.
+GeometricFit fit_geometric_or_sphere(const Primitive& initial, std::span<const Vec3> points,
+                                     std::span<const double> weights,
+                                     const GeometricFitOptions& options = {});
+
 /// Whether a type has a geometric model (otherwise fit_geometric returns it unchanged).
 bool has_geometric_model(PrimitiveType type);
 

@@ -137,6 +137,12 @@ Mesh noisy_uniform_shape(const std::string& name) {
   return make_shape(name, options).mesh;
 }
 
+std::vector<PrimitiveType> every_primitive_type() {
+  std::vector<PrimitiveType> types;
+  for (int t = 0; t < kPrimitiveTypeCount; ++t) types.push_back(static_cast<PrimitiveType>(t));
+  return types;
+}
+
 ClusterStats whole_mesh_stats(const DualGraph& graph) {
   return part_stats(graph, std::vector<bool>(graph.face_count(), true));
 }

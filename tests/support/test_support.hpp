@@ -95,6 +95,10 @@ Mesh grid_mesh(int rows, int cols, Surface&& p, bool alternate = false) {
   return Mesh::from_triangles(std::move(positions), std::move(triangles));
 }
 
+/// Every primitive type, in tie order (plane, cylinder, sphere, cone, torus): the
+/// `--primitives` list that enables cones and tori.
+std::vector<PrimitiveType> every_primitive_type();
+
 /// A generated shape (shape_generator.hpp) in its Uniform tessellation with random vertex motion
 /// and Gaussian noise of 0.3% of its size along the normals: a small scan-like input.
 Mesh noisy_uniform_shape(const std::string& name);
