@@ -4,10 +4,12 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <string>
 
 #include "face_adjacency.hpp"
+#include "geometric_models.hpp"
 #include "no_index.hpp"
 #include "primseg/error.hpp"
 #include "working_primitive.hpp"
@@ -122,6 +124,83 @@ double face_error(const Hierarchy& hierarchy, std::uint32_t f, const Primitive& 
   return sum;
 }
 
+// Area of face f's triangles (working frame).
+double face_area(const Hierarchy& hierarchy, std::uint32_t f,
+                 const std::vector<std::uint32_t>& first_triangle) {
+  double area = 0;
+  for (std::uint32_t t = first_triangle[f]; t < first_triangle[f + 1]; ++t)
+    area += hierarchy.graph().triangle_area(t);
+  return area;
+}
+
+// Each cluster's noise (working frame): the standard deviation of its vertices' signed
+// distances s to its primitive that varies from vertex to vertex. For two triangles of the
+// cluster sharing an edge ab, with c and d their other corners, s_c + s_d - s_a - s_b cancels any
+// misfit linear across them (exactly on a parallelogram), so a misfit shows only by its
+// curvature over one edge, while independent noise gives it a standard deviation of 2σ; the
+// median over the cluster's edges (/ 0.6745) ignores the few edges along a crease the cluster
+// straddles. 0 for a cluster without such a pair (polygon faces are left out).
+std::vector<double> cluster_noise(const Hierarchy& hierarchy,
+                                  const std::vector<std::uint32_t>& labels,
+                                  const std::vector<Primitive>& working,
+                                  const std::vector<std::uint32_t>& first_triangle) {
+  const DualGraph& graph = hierarchy.graph();
+  const auto single_triangle = [&](std::uint32_t f) {
+    return first_triangle[f + 1] == first_triangle[f] + 1;
+  };
+  // The signed distance of every corner of a single-triangle face to its cluster's primitive.
+  std::vector<std::unique_ptr<detail::GeometricModel>> models(working.size());
+  for (std::size_t c = 0; c < working.size(); ++c)
+    models[c] = detail::geometric_model_for(working[c]);
+  std::vector<std::array<double, 3>> corner_distance(labels.size());
+  for (std::uint32_t f = 0; f < labels.size(); ++f) {
+    const detail::GeometricModel* model = models[labels[f]].get();
+    if (!model || !single_triangle(f)) continue;
+    const Triangle corners = graph.corners(first_triangle[f]);
+    double gradient[detail::kMaxParameters];
+    for (int k = 0; k < 3; ++k)
+      corner_distance[f][k] = model->residual(graph.position(corners[k]), gradient);
+  }
+  std::vector<std::vector<double>> second_differences(working.size());
+  for (const DualEdge& edge : graph.edges()) {
+    const std::uint32_t c = labels[edge.first];
+    if (labels[edge.second] != c || !models[c] || !single_triangle(edge.first) ||
+        !single_triangle(edge.second))
+      continue;
+    const Triangle one = graph.corners(first_triangle[edge.first]);
+    const Triangle two = graph.corners(first_triangle[edge.second]);
+    // s_c + s_d - s_a - s_b, c and d the corners of each triangle that the other lacks.
+    double sum = 0;
+    int apart = 0;
+    for (int k = 0; k < 3; ++k) {
+      const bool one_apart = std::find(two.begin(), two.end(), one[k]) == two.end();
+      const bool two_apart = std::find(one.begin(), one.end(), two[k]) == one.end();
+      sum += one_apart ? corner_distance[edge.first][k] : -corner_distance[edge.first][k];
+      if (two_apart) sum += corner_distance[edge.second][k];
+      apart += one_apart + two_apart;
+    }
+    if (apart == 2) second_differences[c].push_back(std::abs(sum));
+  }
+  std::vector<double> noise(working.size(), 0);
+  for (std::size_t c = 0; c < noise.size(); ++c) {
+    std::vector<double>& d = second_differences[c];
+    if (d.empty()) continue;
+    const auto middle = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
+    std::nth_element(d.begin(), middle, d.end());
+    noise[c] = *middle / (0.6745 * 2);
+  }
+  return noise;
+}
+
+// face_error of f (given: `error`) and of the faces sharing an edge with it, summed.
+double pooled_error(const Hierarchy& hierarchy, std::uint32_t f, double error,
+                    const Primitive& working, const Adjacency& adjacency,
+                    const std::vector<std::uint32_t>& first_triangle) {
+  for (std::uint32_t i = adjacency.offset[f]; i < adjacency.offset[f + 1]; ++i)
+    error += face_error(hierarchy, adjacency.neighbour[i], working, first_triangle);
+  return error;
+}
+
 // Σ w d² of every cluster to its reported primitive, over the triangle corners weighted as in
 // the hierarchy: the error the reports' RMS values measure.
 double total_squared_error(const Hierarchy& hierarchy, const std::vector<std::uint32_t>& labels,
@@ -150,6 +229,8 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
                             std::to_string(f_count) + " faces");
   if (!(options.improvement > 0) || !std::isfinite(options.improvement))
     throw InvalidInputError("refine_boundaries: the improvement factor must be positive");
+  if (!(options.pooling_gap >= 0) || !std::isfinite(options.pooling_gap))
+    throw InvalidInputError("refine_boundaries: the pooling gap must be a non-negative number");
   const Adjacency adjacency(hierarchy.graph());
   std::vector<std::uint32_t> first_triangle(f_count + 1, 0);
   for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
@@ -165,26 +246,44 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
   for (std::uint32_t label : labels) ++sizes[label];
   const double cut_error = total_squared_error(hierarchy, labels, result.reports);
 
-  for (std::uint32_t pass = 0; pass < options.max_passes; ++pass) {
-    std::vector<Primitive> working(k);
+  std::vector<Primitive> working(k);
+  const auto update_working = [&] {
     for (std::uint32_t c = 0; c < k; ++c)
       working[c] = detail::to_working(hierarchy.graph().frame(), result.reports[c].primitive);
+  };
+  update_working();
+  // The noise is the data's: estimated once, on the cut (a fifth of the passes' time otherwise).
+  const std::vector<double> noise = options.pooling_gap > 0
+                                        ? cluster_noise(hierarchy, labels, working, first_triangle)
+                                        : std::vector<double>(k, 0.0);
+  for (std::uint32_t pass = 0; pass < options.max_passes; ++pass) {
+    if (pass > 0) update_working();
     // Decide every move against the labels at the start of the pass.
     std::vector<std::uint32_t> target(f_count, kNone);
     std::vector<std::uint32_t> leaving(k, 0);
     for (std::uint32_t f = 0; f < f_count; ++f) {
       const std::uint32_t own = labels[f];
-      double own_error = -1, best_error = std::numeric_limits<double>::infinity();
+      double own_error = -1, area = 0, best_ratio = std::numeric_limits<double>::infinity();
       std::uint32_t best = kNone;
       for (std::uint32_t i = adjacency.offset[f]; i < adjacency.offset[f + 1]; ++i) {
         const std::uint32_t other = labels[adjacency.neighbour[i]];
         if (other == own || other == best) continue;
-        if (own_error < 0) own_error = face_error(hierarchy, f, working[own], first_triangle);
+        if (own_error < 0) {
+          own_error = face_error(hierarchy, f, working[own], first_triangle);
+          area = face_area(hierarchy, f, first_triangle);
+        }
         const double error = face_error(hierarchy, f, working[other], first_triangle);
-        if (error < best_error || (error == best_error && other < best))
-          best_error = error, best = other;
+        double ratio = error / own_error;
+        // Nearer the other primitive by less than the clusters' noise, the face alone cannot
+        // tell: its neighbours' errors join the decision (only ever towards a nearer primitive).
+        if (error < own_error && std::sqrt(own_error / area) - std::sqrt(error / area) <
+                                     options.pooling_gap * std::max(noise[own], noise[other]))
+          ratio = pooled_error(hierarchy, f, error, working[other], adjacency, first_triangle) /
+                  pooled_error(hierarchy, f, own_error, working[own], adjacency, first_triangle);
+        if (ratio < best_ratio || (ratio == best_ratio && other < best))
+          best_ratio = ratio, best = other;
       }
-      if (best != kNone && best_error < options.improvement * own_error) target[f] = best;
+      if (best != kNone && best_ratio < options.improvement) target[f] = best;
     }
     // No cluster may lose all its faces: the last faces of a cluster stay.
     std::vector<std::uint32_t> moves;

@@ -21,6 +21,19 @@ struct BoundaryRefinementOptions {
   /// A face moves only if its error to the other primitive is below this fraction of its error
   /// to its own (no churn between primitives that fit it equally well).
   double improvement = 0.5;
+  /// A face is judged together with the faces sharing an edge with it (the sums of their errors
+  /// to the two primitives, against `improvement`) when its RMS distance to the other primitive
+  /// is below its RMS distance to its own by less than this many times the larger of the two
+  /// clusters' noise: a gap a single noisy face cannot measure. A cluster's noise is the
+  /// standard deviation of its vertices' distances to its primitive from vertex to vertex
+  /// (second differences across its edges, median; estimated once, on the cut), near 0 on
+  /// noise-free parts, where faces are still judged alone. A pooled face moves only to a
+  /// primitive nearer to it than its own. On the generated noisy shapes (`primseg eval --variants
+  /// noisy --seeds 6 --refine 2`) mean IoU 0.9813 → 0.9828 with the default types and 0.9880 →
+  /// 0.9919 with cones and tori, where a fillet's torus no longer keeps a strip of its tangent
+  /// neighbours. 0: every face alone (the refinement before this option, bit for bit). Must be
+  /// >= 0.
+  double pooling_gap = 1.0;
   /// How the primitives are refitted and reported.
   DescribeOptions describe;
 };
