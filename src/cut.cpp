@@ -129,8 +129,7 @@ void fit_report(const WorkingFrame& frame, const Primitive& start, std::span<con
   // Fitted and measured in the working frame (no overflow for huge inputs), scaled back.
   const GeometricFit fit =
       fit_geometric_or_sphere(detail::to_working(frame, start), points, weights, fit_options);
-  const bool refitted = fit.iterations > 0;
-  r.primitive = refitted ? frame.to_input(fit.primitive) : start;
+  r.primitive = fit.iterations > 0 ? frame.to_input(fit.primitive) : start;
   r.rms = std::ldexp(fit.rms, frame.exponent);
   r.max = std::ldexp(fit.max, frame.exponent);
   r.area = std::ldexp(r.area, 2 * frame.exponent);

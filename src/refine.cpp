@@ -124,6 +124,16 @@ double face_error(const Hierarchy& hierarchy, std::uint32_t f, const Primitive& 
   return sum;
 }
 
+// The reports' primitives in the working frame, where faces are measured.
+std::vector<Primitive> working_primitives(const Hierarchy& hierarchy,
+                                          const std::vector<ClusterReport>& reports) {
+  std::vector<Primitive> working;
+  working.reserve(reports.size());
+  for (const ClusterReport& r : reports)
+    working.push_back(detail::to_working(hierarchy.graph().frame(), r.primitive));
+  return working;
+}
+
 // Area of face f's triangles (working frame).
 double face_area(const Hierarchy& hierarchy, std::uint32_t f,
                  const std::vector<std::uint32_t>& first_triangle) {
@@ -246,24 +256,21 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
   for (std::uint32_t label : labels) ++sizes[label];
   const double cut_error = total_squared_error(hierarchy, labels, result.reports);
 
-  std::vector<Primitive> working(k);
-  const auto update_working = [&] {
-    for (std::uint32_t c = 0; c < k; ++c)
-      working[c] = detail::to_working(hierarchy.graph().frame(), result.reports[c].primitive);
-  };
-  update_working();
   // The noise is the data's: estimated once, on the cut (a fifth of the passes' time otherwise).
-  const std::vector<double> noise = options.pooling_gap > 0
-                                        ? cluster_noise(hierarchy, labels, working, first_triangle)
-                                        : std::vector<double>(k, 0.0);
+  const std::vector<double> noise =
+      options.pooling_gap > 0
+          ? cluster_noise(hierarchy, labels, working_primitives(hierarchy, result.reports),
+                          first_triangle)
+          : std::vector<double>(k, 0.0);
   for (std::uint32_t pass = 0; pass < options.max_passes; ++pass) {
-    if (pass > 0) update_working();
+    const std::vector<Primitive> working = working_primitives(hierarchy, result.reports);
     // Decide every move against the labels at the start of the pass.
     std::vector<std::uint32_t> target(f_count, kNone);
     std::vector<std::uint32_t> leaving(k, 0);
     for (std::uint32_t f = 0; f < f_count; ++f) {
       const std::uint32_t own = labels[f];
-      double own_error = -1, area = 0, best_ratio = std::numeric_limits<double>::infinity();
+      double own_error = -1, own_pooled = -1, area = 0;
+      double best_ratio = std::numeric_limits<double>::infinity();
       std::uint32_t best = kNone;
       for (std::uint32_t i = adjacency.offset[f]; i < adjacency.offset[f + 1]; ++i) {
         const std::uint32_t other = labels[adjacency.neighbour[i]];
@@ -277,9 +284,13 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
         // Nearer the other primitive by less than the clusters' noise, the face alone cannot
         // tell: its neighbours' errors join the decision (only ever towards a nearer primitive).
         if (error < own_error && std::sqrt(own_error / area) - std::sqrt(error / area) <
-                                     options.pooling_gap * std::max(noise[own], noise[other]))
+                                     options.pooling_gap * std::max(noise[own], noise[other])) {
+          if (own_pooled < 0)
+            own_pooled =
+                pooled_error(hierarchy, f, own_error, working[own], adjacency, first_triangle);
           ratio = pooled_error(hierarchy, f, error, working[other], adjacency, first_triangle) /
-                  pooled_error(hierarchy, f, own_error, working[own], adjacency, first_triangle);
+                  own_pooled;
+        }
         if (ratio < best_ratio || (ratio == best_ratio && other < best))
           best_ratio = ratio, best = other;
       }
