@@ -317,11 +317,17 @@ namespace {
 void print_automatic_level(const AutoLevel& level) {
   switch (level.rule) {
     case AutoLevelRule::Jump: {
-      double score = 0;
+      LevelCandidate chosen;
       for (const LevelCandidate& c : level.candidates)
-        if (c.clusters == level.clusters) score = c.score;
-      std::printf("automatic level: %u clusters, where the error curve jumps (score %.3g)\n",
-                  level.clusters, score);
+        if (c.clusters == level.clusters) chosen = c;
+      if (chosen.score >= AutoLevelOptions{}.min_score)
+        std::printf("automatic level: %u clusters, where the error curve jumps (score %.3g)\n",
+                    level.clusters, chosen.score);
+      else
+        std::printf(
+            "automatic level: %u clusters, where the next merge makes a cluster %.3g times the "
+            "level's RMS (score %.3g)\n",
+            level.clusters, chosen.merge_score, chosen.score);
       break;
     }
     case AutoLevelRule::Knee:
@@ -387,7 +393,10 @@ nlohmann::json level_summary(const LevelOptions& options, const ChosenLevel& lev
     summary["rule"] = by_noise ? "noise" : to_string(level.automatic->rule);
     nlohmann::json candidates = nlohmann::json::array();
     for (const LevelCandidate& c : level.automatic->candidates)
-      candidates.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
+      candidates.push_back({{"clusters", c.clusters},
+                            {"rms", c.rms},
+                            {"score", c.score},
+                            {"merge_score", c.merge_score}});
     summary["candidates"] = std::move(candidates);
     if (level.noise) {
       summary["noise_estimate"] = level.noise->estimate;

@@ -382,7 +382,10 @@ std::string page_data(const Hierarchy& hierarchy, const std::string& mesh_name,
   // Automatic levels, best score first (as segment --clusters auto lists its candidates).
   nlohmann::json levels = nlohmann::json::array();
   for (const LevelCandidate& c : automatic.candidates)
-    levels.push_back({{"clusters", c.clusters}, {"rms", c.rms}, {"score", c.score}});
+    levels.push_back({{"clusters", c.clusters},
+                      {"rms", c.rms},
+                      {"score", c.score},
+                      {"mergeScore", c.merge_score}});
   header["levels"] = std::move(levels);
   std::string skeleton_arrays;
   if (skeleton) header["skeleton"] = append_skeleton(skeleton_arrays, mesh, *skeleton);

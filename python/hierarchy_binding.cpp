@@ -491,6 +491,7 @@ of faces (F), not ...", and TypeError for an entry that is not an integer.)",
               candidate["clusters"] = c.clusters;
               candidate["rms"] = c.rms;
               candidate["score"] = c.score;
+              candidate["merge_score"] = c.merge_score;
               candidates.append(candidate);
             }
             py::dict d;
@@ -503,10 +504,12 @@ of faces (F), not ...", and TypeError for an entry that is not an integer.)",
 
 The level cut("auto") takes and why, as the CLI's --json "level" reports it: clusters (K), rule
 ("jump", "knee" or "components") and candidates (best score first: dicts of clusters, rms in
-input units, and score).)",
+input units, score and merge_score).)",
                      cpp_doc("choose_level", doc::auto_level__choose_level),
                      cpp_doc("AutoLevel::clusters", doc::auto_level__AutoLevel__clusters),
-                     cpp_doc("LevelCandidate::score", doc::auto_level__LevelCandidate__score)})
+                     cpp_doc("LevelCandidate::score", doc::auto_level__LevelCandidate__score),
+                     cpp_doc("LevelCandidate::merge_score",
+                             doc::auto_level__LevelCandidate__merge_score)})
               .c_str())
       .def(
           "error_curve",

@@ -3,11 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "primseg/cut.hpp"
 #include "primseg/dual_graph.hpp"
 #include "primseg/error.hpp"
+#include "primseg/mesh.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/shape_generator.hpp"
 #include "support/test_support.hpp"
@@ -87,6 +89,87 @@ TEST(AutoLevel, ExactPlaneCylinderSphereShapesGetTheirTrueCount) {
     ASSERT_GT(exactly.min_score, 2.0) << name;
     EXPECT_EQ(choose_level(h, exactly).clusters, level.clusters) << name;
   }
+}
+
+// A small region joining its neighbour raises the RMS of a noisy level by far less than twice
+// (1.3 to 1.9 here), while the cluster it makes fits two to four times worse than the level: a
+// chamfer, a fillet, a countersink, the dome's sphere and the slanted face, with cones and tori
+// enabled (tori can bend over two of these surfaces at once). Without cluster jumps the level
+// before the region joins was found in 1 of these 10 cases.
+TEST(AutoLevel, ASmallRegionJoiningItsNeighbourIsAJumpOfTheMergedCluster) {
+  int found = 0, found_by_level_alone = 0, by_merge_score = 0, cases = 0;
+  for (const char* name : {"slanted_box", "box_with_dome", "chamfered_cylinder",
+                           "filleted_cylinder", "box_with_countersink"})
+    for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+      const GroundTruthShape shape = testing::noisy_uniform_truth(name, seed, 0.002);
+      HierarchyOptions hierarchy_options;
+      hierarchy_options.primitives = testing::every_primitive_type();
+      const Hierarchy h = build_hierarchy(shape.mesh, hierarchy_options);
+      const AutoLevel level = choose_level(h);
+      AutoLevelOptions level_alone;
+      level_alone.cluster_jumps = false;
+      const auto truth = static_cast<std::uint32_t>(shape.regions.size());
+      ++cases;
+      found += level.clusters == truth;
+      found_by_level_alone += choose_level(h, level_alone).clusters == truth;
+      for (const LevelCandidate& c : level.candidates) {
+        if (c.clusters != level.clusters || c.score >= AutoLevelOptions{}.min_score) continue;
+        ++by_merge_score;
+        EXPECT_GE(c.merge_score, AutoLevelOptions{}.min_score) << name << " seed " << seed;
+      }
+    }
+  EXPECT_GE(found, cases - 1) << found << " of " << cases;
+  EXPECT_LE(found_by_level_alone, cases / 2) << "the cases must need the rule";
+  EXPECT_GE(by_merge_score, cases / 2) << "chosen by the merged cluster's jump";
+}
+
+// oblong.off of libcgal-demo, a CAD part: the level's score alone chose 30 clusters, three of
+// which straddle two surfaces; the next merge after 40 clusters, every one of them fitting,
+// makes a cluster 5.7 times the level's RMS (though the level's RMS rises by 1.7 only).
+TEST(AutoLevel, ACadPartIsCutWhereEveryClusterFits) {
+  const Hierarchy oblong = build_hierarchy(read_mesh(testing::cgal_mesh("oblong.off")));
+  const AutoLevel level = choose_level(oblong);
+  AutoLevelOptions level_alone;
+  level_alone.cluster_jumps = false;
+  const AutoLevel before = choose_level(oblong, level_alone);
+  EXPECT_EQ(level.rule, AutoLevelRule::Jump);
+  EXPECT_EQ(level.clusters, 40u);
+  EXPECT_EQ(before.clusters, 30u);
+  auto worst_rms = [&](std::uint32_t k) {
+    double worst = 0;
+    for (const ClusterReport& c : describe_clusters(oblong, cut_by_count(oblong, k)))
+      worst = std::max(worst, c.rms);
+    return worst;
+  };
+  const double diagonal = bounding_box_diagonal(oblong.mesh());
+  EXPECT_LT(worst_rms(level.clusters), 0.001 * diagonal);   // 0.036%
+  EXPECT_GT(worst_rms(before.clusters), 0.003 * diagonal);  // 0.45%
+}
+
+// merge_score is the RMS of the cluster the level's next merge makes over the level's RMS, the
+// latter at least 0.1% of the bounding-box diagonal.
+TEST(AutoLevel, TheMergeScoreIsTheMergedClustersRmsOverTheLevels) {
+  const GroundTruthShape shape = testing::noisy_uniform_truth("box_with_boss", 1, 0.002);
+  const Hierarchy h = build_hierarchy(shape.mesh);
+  AutoLevelOptions all;
+  all.max_candidates = h.face_count();
+  const AutoLevel level = choose_level(h, all);
+  const std::vector<ErrorCurvePoint> curve = error_curve(h);
+  const double floor = 1e-3 * bounding_box_diagonal(shape.mesh);
+  const std::uint32_t f = h.face_count();
+  int checked = 0;
+  for (const LevelCandidate& c : level.candidates) {
+    if (c.clusters == 1) {
+      EXPECT_EQ(c.merge_score, 0.0);
+      continue;
+    }
+    // The merge that takes level K to K - 1 is the (F - K + 1)-th; its node is F + F - K.
+    const double expected =
+        h.rms_estimate(f + (f - c.clusters)) / std::max(curve[c.clusters - 1].rms, floor);
+    EXPECT_NEAR(c.merge_score, expected, 1e-12 * expected) << "K = " << c.clusters;
+    ++checked;
+  }
+  EXPECT_GE(checked, 100);
 }
 
 // Real CAD parts with blends have no jump of 2 (fandisk's best score is 1.56): the curve falls

@@ -58,12 +58,7 @@ TEST(RefineBoundaries, ImprovesNoisyBordersAndKeepsClustersConnected) {
   for (const std::string name : {"box", "slanted_box", "box_with_hole", "cylinder_with_sphere_cap"})
     for (std::uint64_t seed : {1, 2}) {
       ++cases;
-      ShapeOptions options;
-      options.tessellation = Tessellation::Uniform;
-      options.noise = 0.002;
-      options.random_motion = true;
-      options.seed = seed;
-      const GroundTruthShape shape = make_shape(name, options);
+      const GroundTruthShape shape = testing::noisy_uniform_truth(name, seed, 0.002);
       const Hierarchy h = build_hierarchy(shape.mesh);
       const auto k = static_cast<std::uint32_t>(shape.regions.size());
       const Segmentation cut = cut_by_count(h, k);

@@ -41,11 +41,24 @@ struct AutoLevelOptions {
   /// When no jump is significant, choose the knee of the curve (AutoLevelRule::Knee) rather
   /// than one cluster per component.
   bool knee_fallback = true;
+  /// Also count a jump of the cluster the next merge makes (LevelCandidate::merge_score), on a
+  /// level at the noise plateau: where a small region (a chamfer, a fillet, a dome) joins its
+  /// neighbour, the RMS of the whole level rises by far less than min_score even when the merged
+  /// cluster fits several times worse than the level. On the generated shapes (9 seeds, three
+  /// tessellations) the chosen K is the true count in 98% of cases with cones and tori enabled,
+  /// 88% without this rule; 95% and 92% with the default types. false: the level's score alone.
+  bool cluster_jumps = true;
 };
 
 /// Which rule chose the level.
 enum class AutoLevelRule {
-  /// The finest K whose score reaches min_score: a jump of the curve.
+  /// The finest K whose score reaches min_score: a jump of the curve. With
+  /// AutoLevelOptions::cluster_jumps, also a K whose next merge makes a cluster at least
+  /// min_score times the level's RMS (merge_score), while the level's RMS rises by at least 25%
+  /// and K lies on the curve's noise plateau: rms(K) at most 1.15 times rms(min(2K, F)), so that
+  /// twice the clusters would fit hardly better (noise, not detail, is what is left). A merged
+  /// cluster within 0.2% of the bounding-box diagonal (twice 0.1%) is never such a jump: that
+  /// small a misfit of an exact surface is tessellation, not a second surface.
   Jump,
   /// No significant jump: the knee of log rms against K, by the L-method (Salvador and Chan
   /// 2004): two least-squares lines, one through the coarse levels and one through the fine
@@ -67,6 +80,10 @@ struct LevelCandidate {
   /// the curve when the next merge is applied (a smooth curve scores about 1). One cluster per
   /// component scores min_score.
   double score = 0;
+  /// The jump of the cluster the next merge makes: its RMS over the level's (the larger of rms
+  /// and 0.1% of the bounding-box diagonal); 0 for one cluster per component. See
+  /// AutoLevelOptions::cluster_jumps.
+  double merge_score = 0;
 };
 
 /// "jump", "knee" or "components".
@@ -74,10 +91,11 @@ std::string_view to_string(AutoLevelRule rule);
 
 /// The chosen level and the candidates.
 struct AutoLevel {
-  /// The chosen K: the finest level with a significant score (a coarser jump, however large,
-  /// only says that the regions of the finer level are themselves grouped: a small chamfer
-  /// joining a face is a smaller jump than two large faces joining, and just as real); when no
-  /// jump is significant, the knee of the curve; else one cluster per component (see `rule`).
+  /// The chosen K: the finest level with a significant jump (AutoLevelRule::Jump: of the curve
+  /// or of the merged cluster; a coarser jump, however large, only says that the regions of the
+  /// finer level are themselves grouped: a small chamfer joining a face is a smaller jump than
+  /// two large faces joining, and just as real); when no jump is significant, the knee of the
+  /// curve; else one cluster per component (see `rule`).
   std::uint32_t clusters = 0;
   AutoLevelRule rule = AutoLevelRule::Components;  ///< how `clusters` was chosen
   /// Best score first: the best-scored levels, and the chosen one wherever it ranks.

@@ -924,6 +924,7 @@ TEST(Cli, ClustersAutoFindsTheRegionsAndReportsCandidatesAndTheCurve) {
   bool listed = false;
   for (const json& c : j["level"]["candidates"]) {
     EXPECT_GE(c.at("score").get<double>(), 0.0);
+    EXPECT_GE(c.at("merge_score").get<double>(), 0.0);
     EXPECT_GE(c.at("rms").get<double>(), 0.0);
     listed |= c.at("clusters") == 7;
   }

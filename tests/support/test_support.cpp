@@ -130,11 +130,16 @@ void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation,
 namespace primseg::testing {
 
 Mesh noisy_uniform_shape(const std::string& name) {
+  return noisy_uniform_truth(name, 1, 0.003).mesh;
+}
+
+GroundTruthShape noisy_uniform_truth(const std::string& name, std::uint64_t seed, double noise) {
   ShapeOptions options;
   options.tessellation = Tessellation::Uniform;
-  options.noise = 0.003;
+  options.noise = noise;
   options.random_motion = true;
-  return make_shape(name, options).mesh;
+  options.seed = seed;
+  return make_shape(name, options);
 }
 
 std::vector<PrimitiveType> every_primitive_type() {

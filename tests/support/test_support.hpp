@@ -12,6 +12,7 @@
 
 #include "primseg/mesh.hpp"
 #include "primseg/primitive.hpp"
+#include "primseg/shape_generator.hpp"
 
 namespace primseg::testing {
 
@@ -102,6 +103,10 @@ std::vector<PrimitiveType> every_primitive_type();
 /// A generated shape (shape_generator.hpp) in its Uniform tessellation with random vertex motion
 /// and Gaussian noise of 0.3% of its size along the normals: a small scan-like input.
 Mesh noisy_uniform_shape(const std::string& name);
+/// A generated shape and its ground truth, Uniform tessellation, moved by the random rigid motion
+/// of `seed`, with Gaussian noise of `noise` times its size along the normals (`primseg eval`'s
+/// noisy variant is noise 0.002).
+GroundTruthShape noisy_uniform_truth(const std::string& name, std::uint64_t seed, double noise);
 
 /// The tetrahedron with corners (0, 0, 0), (0, 1, 0), (1, 1, 0) and (0, 0, 1) (its `corners`),
 /// its four faces listed in that order of corners, two of them facing inwards: files often mix

@@ -36,7 +36,7 @@ async function readArray(document, name, ArrayType, required = true) {
  * of the node's vertices to it, input units); leafRms or null.
  *
  * header.autoLevel: the automatic level's K (auto_level.hpp choose_level); header.levels: its
- * candidates [{clusters, rms, score}], best score first.
+ * candidates [{clusters, rms, score, mergeScore}], best score first.
  *
  * header.skeleton (primseg view --skeleton): {clusters K, joints J, rootBone, band}, and then
  * `skeleton` holds (input units, absolute, not relative to center): rest Float64Array (V*3, the

@@ -1,6 +1,6 @@
 // Extension points for what other issues add to the page.
 //
-// - Automatic levels: `primseg view` writes `"levels": [{clusters, rms, score}, ...]` and
+// - Automatic levels: `primseg view` writes `"levels": [{clusters, rms, score, mergeScore}, ...]` and
 //   `"autoLevel": K` in the page header; they are marked on the error plot and offered as buttons
 //   (main.js: showLevels).
 // - Overlays: an overlay is an object {name, update(cut), dispose()} made by a factory registered

@@ -231,7 +231,8 @@ class Viewer {
 
   /**
    * Ticks the automatic levels on the plot and offers them as buttons, by increasing K.
-   * @param levels [{clusters, score, rms}] (or plain K); chosen: the automatic level's K
+   * @param levels [{clusters, score, mergeScore, rms}] (or plain K); chosen: the automatic
+   *     level's K
    */
   showLevels(levels, chosen) {
     const marks = levels.map((level) => (typeof level === 'number' ? { clusters: level } : level))
@@ -239,12 +240,13 @@ class Viewer {
     this.plot.setLevels(marks, chosen);
     const box = $('levels');
     box.textContent = '';
-    for (const { clusters, score } of marks) {
+    for (const { clusters, score, mergeScore } of marks) {
       const button = document.createElement('button');
       button.textContent = String(clusters);
       button.dataset.clusters = String(clusters);
       button.title = (clusters === chosen ? 'the automatic level (--clusters auto)' : 'a candidate level') +
-        (score !== undefined ? `: the error curve jumps ${format(score)}x at the next merge` : '');
+        (score !== undefined ? `: the error curve jumps ${format(score)}x at the next merge` : '') +
+        (mergeScore !== undefined ? `, which makes a cluster ${format(mergeScore)}x the level's RMS` : '');
       if (clusters === chosen) button.classList.add('chosen');
       button.addEventListener('click', () => this.setClusters(clusters));
       box.appendChild(button);

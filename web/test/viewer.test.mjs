@@ -166,7 +166,8 @@ test('fandisk: the automatic levels are marked on the plot and offered as button
       buttons: Array.from(document.querySelectorAll('#levels button'), (b) => Number(b.dataset.clusters)) };
   });
   // The page's levels are primseg's: same K and scores, the same chosen level.
-  assert.deepEqual(shown.levels.map((l) => [l.clusters, l.score]), level.candidates.map((c) => [c.clusters, c.score]));
+  assert.deepEqual(shown.levels.map((l) => [l.clusters, l.score, l.mergeScore]),
+    level.candidates.map((c) => [c.clusters, c.score, c.merge_score]));
   assert.equal(shown.autoLevel, level.clusters);
   const Ks = level.candidates.map((c) => c.clusters).sort((a, b) => a - b);
   assert.deepEqual(shown.buttons, Ks);
