@@ -186,7 +186,7 @@ AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& optio
   auto level_at = [&](std::uint32_t k, double score) {
     const double rms = curve[k - c].rms;
     const double merged = hierarchy.rms_estimate(f + (f - k));
-    return LevelCandidate{k, rms, score, merged / std::max({rms, merge_floor, floored(0.0)})};
+    return LevelCandidate{k, rms, score, merged / std::max(merge_floor, floored(rms))};
   };
   std::vector<LevelCandidate> candidates{{c, curve[0].rms, options.min_score}};
   // Levels finer than F / 2 are left out: there the curve rises from zero (single triangles fit
@@ -195,8 +195,8 @@ AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& optio
   for (std::uint32_t k = c + 1; k <= finest && k - c < curve.size(); ++k)
     candidates.push_back(level_at(k, floored(curve[k - 1 - c].rms) / floored(curve[k - c].rms)));
   auto significant = [&](const LevelCandidate& level) {
-    if (level.score >= options.min_score) return true;
-    if (!options.cluster_jumps || level.clusters == c) return false;
+    if (level.score >= options.min_score) return true;  // one cluster per component, too
+    if (!options.cluster_jumps) return false;
     const auto twice =
         static_cast<std::uint32_t>(std::min<std::uint64_t>(2ull * level.clusters, f));
     return level.score >= kClusterJumpMinScore && level.merge_score >= options.min_score &&
