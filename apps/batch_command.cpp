@@ -35,6 +35,7 @@ struct BatchOptions {
   std::string input, out, shard, primitives = "plane,cylinder,sphere", weights = "area";
   unsigned jobs = 0;
   bool resume = false, exact_costs = false, quiet = false;
+  double merge_batch_tolerance = 0;
   LevelChoice level;
   LevelOptions fit;  // --refine, --regularize and its options only
   ResourceLimits limits;
@@ -138,6 +139,9 @@ std::string options_signature(const BatchOptions& o) {
          " clusters=" + o.level.clusters.value_or("-") +
          " tolerance=" + o.level.tolerance.value_or(kDefaultTolerance) +
          // Only when set, so that outputs made before these options existed still resume.
+         (o.merge_batch_tolerance > 0
+              ? " merge_batch_tolerance=" + nlohmann::json(o.merge_batch_tolerance).dump()
+              : "") +
          (o.fit.refine > 0 ? " refine=" + std::to_string(o.fit.refine) : "") +
          (o.fit.regularize ? " regularize=1" + relation_options_signature(o.fit.relations) : "");
 }
@@ -250,6 +254,7 @@ void run_batch(const BatchOptions& o) {
   options.primitives = parse_primitives(o.primitives);
   options.weights = o.weights == "uniform" ? VertexWeights::Uniform : VertexWeights::Area;
   options.exact_costs = o.exact_costs;
+  options.merge_batch_tolerance = o.merge_batch_tolerance;
   options.threads = 1;  // The workers are the parallelism: one file each.
   validate(options);
   validate_relation_options(o.fit.relations);
@@ -336,6 +341,7 @@ Command add_batch_command(CLI::App& app) {
       ->check(CLI::IsMember({"area", "uniform"}))
       ->capture_default_str();
   batch->add_flag("--exact-costs", o->exact_costs, "Reference mode: exact Euclidean errors");
+  add_merge_batch_option(*batch, o->merge_batch_tolerance);
   add_fit_options(*batch, o->fit);
   add_limit_options(*batch, o->limits, kHierarchyBytesPerFace);
   batch->add_flag("--quiet,-q", o->quiet, "No progress or summary output");

@@ -175,6 +175,16 @@ void add_level_options(CLI::App& command, LevelOptions& options, std::string_vie
   command.add_flag("--quiet,-q", options.quiet, "No summary or progress output");
 }
 
+void add_merge_batch_option(CLI::App& command, double& tolerance) {
+  command
+      .add_option("--merge-batch-tolerance", tolerance,
+                  "Approximate, faster merge order (0: the exact greedy order): merges within "
+                  "(1 + T) times the cheapest are applied in a batch, their clusters' candidates "
+                  "evaluated once at its end; 0.1 is a good start")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+}
+
 void add_fit_options(CLI::App& command, LevelOptions& options) {
   command
       .add_option("--refine", options.refine,

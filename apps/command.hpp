@@ -124,6 +124,9 @@ void add_level_options(CLI::App& command, LevelOptions& options,
 /// Adds --refine and --regularize (LevelOptions::refine and ::regularize) to a command that
 /// reports a hierarchy's level, and the options of --regularize (add_relation_options).
 void add_fit_options(CLI::App& command, LevelOptions& options);
+/// Adds --merge-batch-tolerance (HierarchyOptions::merge_batch_tolerance) to a command that builds
+/// a hierarchy.
+void add_merge_batch_option(CLI::App& command, double& tolerance);
 /// Adds --relation-significance, --max-relation-angle, --relation-angle-tolerance,
 /// --relation-length-tolerance and --max-radius-difference (the RelationOptions of --regularize),
 /// checked by validate_relation_options() when the command runs.

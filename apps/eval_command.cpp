@@ -70,6 +70,7 @@ struct EvalCommandOptions {
   std::string variants = "cad,uniform,noisy", shapes, primitives = "plane,cylinder,sphere";
   std::uint32_t seeds = 3, refine = 0;
   unsigned threads = 0;
+  double merge_batch_tolerance = 0;
   std::optional<std::string> json;
   bool quiet = false;
 };
@@ -134,6 +135,7 @@ void run_eval(const EvalCommandOptions& o) {
   HierarchyOptions options;
   options.primitives = parse_primitives(o.primitives);
   options.threads = o.threads;
+  options.merge_batch_tolerance = o.merge_batch_tolerance;
   validate(options);
   const std::vector<const Variant*> variants = chosen_variants(o.variants);
   const std::vector<std::string> shapes =
@@ -206,6 +208,7 @@ Command add_eval_command(CLI::App& app) {
       ->capture_default_str();
   eval->add_option("--threads", o->threads, "Threads of the hierarchy (0: all cores)")
       ->capture_default_str();
+  add_merge_batch_option(*eval, o->merge_batch_tolerance);
   eval->add_option("--refine", o->refine, "Boundary refinement passes after the cut (0: none)")
       ->check(CLI::Range(0u, 1000u))
       ->capture_default_str();

@@ -13,6 +13,7 @@ Command add_segment_command(CLI::App& app) {
     std::string mesh_path, primitives = "plane,cylinder,sphere", weights = "area";
     bool exact_costs = false, eager = false;
     unsigned threads = 0;
+    double merge_batch_tolerance = 0;
     LevelOptions level;
     ResourceLimits limits;
   };
@@ -38,6 +39,7 @@ Command add_segment_command(CLI::App& app) {
   segment->add_flag(
       "--eager", o->eager,
       "Reference mode: evaluate every candidate at once (same tree as the default lazy mode)");
+  add_merge_batch_option(*segment, o->merge_batch_tolerance);
   segment->add_flag("--exact-costs", o->exact_costs,
                     "Reference mode: exact Euclidean errors, O(cluster size) per candidate");
 
@@ -49,6 +51,7 @@ Command add_segment_command(CLI::App& app) {
         options.exact_costs = o->exact_costs;
         options.threads = o->threads;
         options.evaluation = o->eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
+        options.merge_batch_tolerance = o->merge_batch_tolerance;
         validate(options);
         validate_level_outputs(o->level);
         const auto read_start = Clock::now();

@@ -232,6 +232,18 @@ void register_benchmarks() {
   configure(benchmark::RegisterBenchmark("hierarchy_all_types/fandisk", hierarchy, "fandisk.off",
                                          all_types))
       ->Iterations(1);
+  // The approximate merge order at the tolerance the CLI's help suggests.
+  HierarchyOptions batched;
+  batched.merge_batch_tolerance = 0.1;
+  configure(
+      benchmark::RegisterBenchmark("hierarchy_batched/fandisk", hierarchy, "fandisk.off", batched))
+      ->Iterations(1);
+  configure(
+      benchmark::RegisterBenchmark("hierarchy_batched/bunny00", hierarchy, "bunny00.off", batched))
+      ->Iterations(1);
+  configure(benchmark::RegisterBenchmark("hierarchy_batched/box_with_hole_uniform_0.01", hierarchy,
+                                         shape, batched))
+      ->Iterations(1);
   configure(benchmark::RegisterBenchmark("read_mesh/fandisk", read, "fandisk.off"));
   configure(benchmark::RegisterBenchmark("read_mesh/bunny00", read, "bunny00.off"));
   configure(benchmark::RegisterBenchmark("cut_describe_k30/fandisk", cut_and_describe,

@@ -100,6 +100,11 @@ rows = [
      "--cgal fandisk.off --exact-costs"),
     ("fandisk.off, all five types (plane, cylinder, sphere, cone, torus)",
      "hierarchy_all_types/fandisk/", None, None),
+    ("fandisk.off, `--merge-batch-tolerance 0.1` (approximate order)",
+     "hierarchy_batched/fandisk/", None, None),
+    ("bunny00.off, `--merge-batch-tolerance 0.1`", "hierarchy_batched/bunny00/", None, None),
+    ("box_with_hole, `--merge-batch-tolerance 0.1`",
+     "hierarchy_batched/box_with_hole_uniform_0.01/", None, None),
 ]
 
 print("| input | faces | full hierarchy, median of 5 (ms) | faces/s | peak RSS (MB) "
@@ -122,7 +127,8 @@ for label, hierarchy, read, mem in rows:
           f"| {read_cell} |")
     notes.append(f"{label.split(',')[0].split(' (')[0]}"
                  f"{' exact' if 'exact' in hierarchy else ''}"
-                 f"{' all types' if 'all_types' in hierarchy else ''}: CPU {ms(median, 'cpu_time'):,.0f} ms,"
+                 f"{' all types' if 'all_types' in hierarchy else ''}"
+                 f"{' batched' if 'batched' in hierarchy else ''}: CPU {ms(median, 'cpu_time'):,.0f} ms,"
                  f" CV {100 * cv['real_time']:.0f}%")
 
 cut = aggregate("cut_describe_k30/fandisk/", "median")

@@ -5,6 +5,9 @@
 # second, and time / (n log2 n) relative to the smallest input (flat if the growth is n log n).
 #
 #   bench/scaling.sh [--large] [BUILD_DIR]     (default BUILD_DIR: <repo>/build-bench)
+#
+# SEGMENT_ARGS adds options to every `primseg segment` run, for example
+# SEGMENT_ARGS="--merge-batch-tolerance 0.1" for the approximate merge order.
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 large=0
@@ -34,10 +37,11 @@ if ((large)); then
   runs_large=${RUNS_LARGE:-1}
 fi
 
-python3 - "$build/primseg" "$runs" "${runs_large:-1}" "${inputs[@]}" <<'PY'
-import json, math, os, resource, statistics, subprocess, sys, tempfile
+python3 - "$build/primseg" "$runs" "${runs_large:-1}" "${SEGMENT_ARGS:-}" "${inputs[@]}" <<'PY'
+import json, math, os, resource, shlex, statistics, subprocess, sys, tempfile
 
-cli, runs, runs_large, inputs = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4:]
+cli, runs, runs_large = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+extra, inputs = shlex.split(sys.argv[4]), sys.argv[5:]
 rows = []
 for path in inputs:
     times, peaks = [], []
@@ -46,7 +50,8 @@ for path in inputs:
             # Each run in its own child, so the peak RSS is that run's alone.
             pid = os.fork()
             if pid == 0:
-                os.execv(cli, [cli, "segment", path, "--clusters", "1", "-q", "--json", out.name])
+                os.execv(cli, [cli, "segment", path, "--clusters", "1", "-q", "--json", out.name]
+                         + extra)
             _, status, usage = os.wait4(pid, 0)
             if status != 0:
                 sys.exit(f"{path}: primseg failed with status {status}")

@@ -5,7 +5,8 @@
 //   parent, every node but the root has exactly one parent), and Hierarchy's constructor from
 //   parts, which checks tree files, accepts it (tree_invariants.hpp);
 // - every cut, by count for every K in 1..F and by tolerance at a few levels, labels each face
-//   with a cluster in 0..K'-1, every cluster is non-empty and edge-connected in the dual graph.
+//   with a cluster in 0..K'-1, every cluster is non-empty and edge-connected in the dual graph;
+// - the approximate merge order (merge_batch_tolerance) builds such a tree too.
 //
 // Input layout: grid_mesh.hpp.
 
@@ -38,5 +39,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   for (const double tolerance : {0.0, 1e-9, 0.01, 0.3, 1.0, 100.0})
     primseg::fuzz::check_cut(hierarchy, primseg::cut_by_tolerance(hierarchy, tolerance));
+  // The approximate merge order (large batches) builds a full tree over the same faces too.
+  options.merge_batch_tolerance = 0.5;
+  const primseg::Hierarchy batched = primseg::build_hierarchy(mesh, options);
+  primseg::fuzz::check_tree(batched);
+  if (batched.merges().size() != hierarchy.merges().size())
+    primseg::fuzz::fail("merges of the batched order", double(hierarchy.merges().size()),
+                        double(batched.merges().size()));
   return 0;
 }

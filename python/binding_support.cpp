@@ -204,7 +204,8 @@ PyMesh mesh_from_state(const py::tuple& state) {
 }
 
 HierarchyOptions hierarchy_options(const py::object& primitives, const std::string& weights,
-                                   unsigned threads, bool exact_costs, bool eager) {
+                                   unsigned threads, bool exact_costs, bool eager,
+                                   double merge_batch_tolerance) {
   HierarchyOptions options;
   options.primitives = parse_primitives(primitives);
   if (weights != "area" && weights != "uniform")
@@ -213,6 +214,7 @@ HierarchyOptions hierarchy_options(const py::object& primitives, const std::stri
   options.threads = threads;
   options.exact_costs = exact_costs;
   options.evaluation = eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
+  options.merge_batch_tolerance = merge_batch_tolerance;
   validate(options);
   return options;
 }

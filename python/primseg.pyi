@@ -188,6 +188,7 @@ def segment(
     threads: int = 0,
     exact_costs: bool = False,
     eager: bool = False,
+    merge_batch_tolerance: float = 0.0,
     progress: _Progress = None,
 ) -> Hierarchy: ...
 def render(

@@ -273,6 +273,11 @@ class HierarchyBuilder::Impl {
         slots_[face].first_link = link;
       }
     lazy_ = options_.evaluation != CandidateEvaluation::Eager && !options_.exact_costs;
+    batched_ = options_.merge_batch_tolerance > 0;
+    if (batched_) {
+      formed_at_.assign(f, 0);
+      evaluated_at_.assign(dual_edges.size(), 0);
+    }
     by_corners_ = !selector_.needs_samples();
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
     // Every candidate's cost and first degree is independent of the others: all in parallel.
@@ -299,6 +304,7 @@ class HierarchyBuilder::Impl {
   }
 
   bool step() {
+    if (batched_) return batched_step();
     while (!queue_.empty()) {
       const QueuedCandidate top = queue_.top();
       if (!top.exact()) {
@@ -735,7 +741,99 @@ class HierarchyBuilder::Impl {
     max_cost_ = std::max(max_cost_, model.cost);
 
     keep_merged(slot_a, slot_b, edge_id, faces, triangles, node);
-    queue_candidates_of(slot_a, head);
+    if (batched_) {
+      formed_at_[slot_a] = static_cast<std::uint32_t>(merges_.size());
+      dirty_slots_.push_back(slot_a);
+    } else {
+      queue_candidates_of(slot_a, head);
+    }
+  }
+
+  // merge_batch_tolerance > 0: one merge of the open batch (see HierarchyOptions), closing and
+  // opening batches on the way.
+  bool batched_step() {
+    for (;;) {
+      if (queue_.empty()) {
+        if (dirty_slots_.empty()) return false;
+        close_batch();
+        continue;
+      }
+      const QueuedCandidate top = queue_.top();
+      if (batch_limit_ >= 0 && top.cost > batch_limit_) {
+        close_batch();
+        continue;
+      }
+      if (!top.exact() || stale(top.id)) {
+        reevaluate(top.id);
+        continue;
+      }
+      // A batch opens at the cheapest candidate's true cost.
+      if (batch_limit_ < 0) batch_limit_ = top.cost * (1 + options_.merge_batch_tolerance);
+      const QueuedCandidate chosen = top.cost > 0 ? settle_tie(top) : top;
+      if (stale(chosen.id)) {
+        reevaluate(chosen.id);
+        continue;
+      }
+      merge(chosen);
+      return true;
+    }
+  }
+
+  // Whether a cluster of the edge formed after the edge's cost was taken (batched merging).
+  bool stale(std::uint32_t id) const {
+    const LiveEdge& e = edges_[id];
+    return evaluated_at_[id] < std::max(formed_at_[e.a], formed_at_[e.b]);
+  }
+
+  // A candidate evaluated alone, with its degree.
+  void reevaluate(std::uint32_t id) {
+    QueuedCandidate c = evaluate(id, scratch_[0]);
+    if (c.cost == 0) c.set_degree(merged_degree(edges_[id].a, edges_[id].b));
+    evaluated_at_[id] = static_cast<std::uint32_t>(merges_.size());
+    requeue(c);
+    ++evaluations_;
+  }
+
+  // Evaluates every candidate the batch's merges left stale, on all threads, and opens the next.
+  void close_batch() {
+    const auto now = static_cast<std::uint32_t>(merges_.size());
+    batch_.clear();
+    batch_slots_.clear();
+    for (std::uint32_t slot : dirty_slots_) {
+      if (slots_[slot].node == kNone) continue;  // merged into another slot since
+      // Unlinks the edges later merges of its neighbours killed (mark_neighbours() needs live
+      // lists).
+      for (std::uint32_t* link = &slots_[slot].first_link; *link != kNone;) {
+        const std::uint32_t id = *link / 2;
+        if (!edges_[id].alive()) {
+          *link = next_link_[*link];
+          continue;
+        }
+        link = &next_link_[*link];
+        if (!stale(id)) continue;
+        evaluated_at_[id] = now;
+        batch_.emplace_back(0.0, false, PrimitiveType::Plane, id);
+        batch_slots_.push_back(slot);
+      }
+    }
+    dirty_slots_.clear();
+    batch_limit_ = -1;
+    auto evaluate_batch = [&](std::size_t i, unsigned thread) {
+      batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
+    };
+    pool_.run(batch_.size(), evaluate_batch);
+    evaluations_ += batch_.size();
+    // Degrees of zero-cost candidates, by the slot that collected them (in runs).
+    std::uint32_t marked = kNone;
+    for (std::size_t i = 0; i < batch_.size(); ++i) {
+      QueuedCandidate& evaluated = batch_[i];
+      if (evaluated.cost == 0) {
+        const std::uint32_t slot = batch_slots_[i];
+        if (slot != marked) mark_neighbours(marked = slot);
+        evaluated.set_degree(degree_with_marked(slot, other_end(edges_[evaluated.id], slot)));
+      }
+      requeue(evaluated);
+    }
   }
 
   // The merged cluster (node `node`, of `faces` faces and `triangles` triangles, its statistics in
@@ -844,6 +942,10 @@ class HierarchyBuilder::Impl {
     release(next_face_);
     release(face_list_head_);
     release(face_list_tail_);
+    release(formed_at_);
+    release(evaluated_at_);
+    release(dirty_slots_);
+    release(batch_slots_);
   }
 
   // Components are joined in the order of their lowest face, each trailing merge costed above
@@ -907,7 +1009,14 @@ class HierarchyBuilder::Impl {
   double max_cost_ = 0;
   std::uint64_t evaluations_ = 0;
   bool lazy_ = false;
-  bool by_corners_ = false;  // faces are read by their corners (see face_part())
+  // Batched merging only (see HierarchyOptions::merge_batch_tolerance): per slot, the merge
+  // count just after its cluster formed; per edge, the merge count when its cost was taken.
+  bool batched_ = false;
+  std::vector<std::uint32_t> formed_at_, evaluated_at_;
+  std::vector<std::uint32_t> dirty_slots_;  // slots whose cluster formed in the open batch
+  std::vector<std::uint32_t> batch_slots_;  // close_batch(): the slot that collected batch_[i]
+  double batch_limit_ = -1;                 // the open batch's largest cost; < 0: none open
+  bool by_corners_ = false;                 // faces are read by their corners (see face_part())
   double max_penalty_ = 0;
 };
 

@@ -25,6 +25,8 @@ void validate(const HierarchyOptions& options) {
       throw InvalidInputError("type penalties must be positive and finite");
   if (!(options.zero_cost_tolerance >= 0) || !std::isfinite(options.zero_cost_tolerance))
     throw InvalidInputError("zero_cost_tolerance must be non-negative and finite");
+  if (!(options.merge_batch_tolerance >= 0) || !std::isfinite(options.merge_batch_tolerance))
+    throw InvalidInputError("merge_batch_tolerance must be non-negative and finite");
 }
 
 namespace detail {

@@ -490,6 +490,19 @@ def test_deterministic_for_any_thread_count(fandisk_tree):
     np.testing.assert_array_equal(primseg.segment(mesh, eager=True).linkage(), fandisk_tree.linkage())
 
 
+def test_merge_batch_tolerance_gives_the_approximate_order(fandisk_tree):
+    mesh = fandisk_tree.mesh
+    batched = primseg.segment(mesh, merge_batch_tolerance=0.1, threads=1)
+    np.testing.assert_array_equal(
+        primseg.segment(mesh, merge_batch_tolerance=0.1, threads=2).linkage(), batched.linkage())
+    assert not np.array_equal(batched.linkage(), fandisk_tree.linkage())
+    # The coarse levels are the exact order's.
+    np.testing.assert_array_equal(batched.cut(10), fandisk_tree.cut(10))
+    for bad in (-0.1, float("nan")):
+        with pytest.raises(primseg.InvalidInputError, match="merge_batch_tolerance"):
+            primseg.segment(mesh, merge_batch_tolerance=bad)
+
+
 def test_segment_releases_the_gil(fandisk_tree):
     mesh = fandisk_tree.mesh
     assert_releases_the_gil(lambda: primseg.segment(mesh, threads=1))

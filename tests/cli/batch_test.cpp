@@ -209,6 +209,13 @@ TEST(Batch, ResumeSkipsCompletedOutputsAndRedoesTheRest) {
   ASSERT_EQ(primseg(base + " --clusters 4 --resume"), 0);
   for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
     EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  // So does another merge order (it makes another tree); resumed with it, they are kept.
+  ASSERT_EQ(primseg(base + " --clusters 4 --merge-batch-tolerance 0.1 --resume"), 0);
+  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
+    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  ASSERT_EQ(primseg(base + " --clusters 4 --merge-batch-tolerance 0.1 --resume"), 0);
+  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
+    EXPECT_EQ(row.substr(row.find(',')), ",skipped") << file;
   fs::remove_all(dir);
 }
 

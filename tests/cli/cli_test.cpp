@@ -18,11 +18,13 @@
 #include <string>
 #include <vector>
 
+#include "primseg/hierarchy.hpp"
 #include "primseg/mesh.hpp"
 #include "primseg/mesh_io.hpp"
 #include "primseg/primitive.hpp"
 #include "primseg/relations.hpp"
 #include "primseg/shape_generator.hpp"
+#include "primseg/tree_io.hpp"
 #include "support/regularity_shapes.hpp"
 #include "support/test_support.hpp"
 
@@ -1844,6 +1846,27 @@ TEST(Cli, ThreadCountDoesNotChangeTheTree) {
                        dir.q(std::string("t") + threads + ".tree")));
   EXPECT_EQ(testing::file_contents(dir / "t1.tree"), testing::file_contents(dir / "t2.tree"));
   EXPECT_EQ(testing::file_contents(dir / "t1.tree"), testing::file_contents(dir / "t3.tree"));
+}
+
+// --merge-batch-tolerance builds the library's batched tree (another tree than the exact order's,
+// the same for any thread count), and a bad value is refused before the mesh is read.
+TEST(Cli, MergeBatchToleranceBuildsTheBatchedTree) {
+  TempDir dir("batched");
+  const Mesh mesh = read_mesh(testing::cgal_mesh("fandisk.off"));
+  write_mesh(dir / "in.off", mesh);
+  for (const char* threads : {"1", "2"})
+    ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --merge-batch-tolerance 0.1" +
+                       " --threads " + threads + " --tree " + dir.q(std::string("b") + threads)));
+  ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --tree " + dir.q("exact")));
+  const std::string batched = testing::file_contents(dir / "b1");
+  EXPECT_EQ(testing::file_contents(dir / "b2"), batched);
+  EXPECT_NE(testing::file_contents(dir / "exact"), batched);
+  HierarchyOptions options;
+  options.merge_batch_tolerance = 0.1;
+  EXPECT_EQ(serialize_tree(build_hierarchy(read_mesh(dir / "in.off"), options)), batched);
+  const CliRun refused = run("segment missing.off --merge-batch-tolerance -1");
+  EXPECT_NE(refused.status, 0);
+  EXPECT_NE(refused.output.find("--merge-batch-tolerance"), std::string::npos) << refused.output;
 }
 
 TEST(Cli, LinkageIsAValidScipyLinkageMatrixOfTheWholeTree) {
