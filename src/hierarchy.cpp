@@ -272,8 +272,9 @@ class HierarchyBuilder::Impl {
         next_link_[link] = slots_[face].first_link;
         slots_[face].first_link = link;
       }
-    lazy_ = options_.evaluation != CandidateEvaluation::Eager && !options_.exact_costs;
     batched_ = options_.merge_batch_tolerance > 0;
+    // Batches keep stale costs instead of bounds: no bound is ever queued there.
+    lazy_ = options_.evaluation != CandidateEvaluation::Eager && !options_.exact_costs && !batched_;
     if (batched_) {
       formed_at_.assign(f, 0);
       evaluated_at_.assign(dual_edges.size(), 0);
@@ -763,7 +764,7 @@ class HierarchyBuilder::Impl {
         close_batch();
         continue;
       }
-      if (!top.exact() || stale(top.id)) {
+      if (stale(top.id)) {  // (every entry is exact: no bounds in batches)
         reevaluate(top.id);
         continue;
       }
@@ -818,22 +819,7 @@ class HierarchyBuilder::Impl {
     }
     dirty_slots_.clear();
     batch_limit_ = -1;
-    auto evaluate_batch = [&](std::size_t i, unsigned thread) {
-      batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
-    };
-    pool_.run(batch_.size(), evaluate_batch);
-    evaluations_ += batch_.size();
-    // Degrees of zero-cost candidates, by the slot that collected them (in runs).
-    std::uint32_t marked = kNone;
-    for (std::size_t i = 0; i < batch_.size(); ++i) {
-      QueuedCandidate& evaluated = batch_[i];
-      if (evaluated.cost == 0) {
-        const std::uint32_t slot = batch_slots_[i];
-        if (slot != marked) mark_neighbours(marked = slot);
-        evaluated.set_degree(degree_with_marked(slot, other_end(edges_[evaluated.id], slot)));
-      }
-      requeue(evaluated);
-    }
+    evaluate_and_queue_batch([this](std::size_t i) { return batch_slots_[i]; });
   }
 
   // The merged cluster (node `node`, of `faces` faces and `triangles` triangles, its statistics in
@@ -877,17 +863,27 @@ class HierarchyBuilder::Impl {
       const std::uint32_t other = e.a == slot ? e.b : e.a;
       if (slots_[other].stats == kNone) graph_->prefetch_face_corners(other);
     }
+    evaluate_and_queue_batch([slot](std::size_t) { return slot; });
+  }
+
+  // Evaluates the candidates in batch_ on all threads and queues them in order. A zero-cost
+  // candidate's merged degree is counted from the cluster in slot_of(i), the end that collected
+  // it (batch_ holds each slot's candidates in one run).
+  template <class SlotOf>
+  void evaluate_and_queue_batch(SlotOf slot_of) {
     auto evaluate_batch = [&](std::size_t i, unsigned thread) {
       batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
     };
     pool_.run(batch_.size(), evaluate_batch);
     for (const QueuedCandidate& evaluated : batch_) queue_.prefetch_node(evaluated.id);
-    bool zero_cost = false;
-    for (const QueuedCandidate& evaluated : batch_) zero_cost = zero_cost || evaluated.cost == 0;
-    if (zero_cost) mark_neighbours(slot);
-    for (QueuedCandidate& evaluated : batch_) {
-      if (evaluated.cost == 0)
+    std::uint32_t marked = kNone;
+    for (std::size_t i = 0; i < batch_.size(); ++i) {
+      QueuedCandidate& evaluated = batch_[i];
+      if (evaluated.cost == 0) {
+        const std::uint32_t slot = slot_of(i);
+        if (slot != marked) mark_neighbours(marked = slot);
         evaluated.set_degree(degree_with_marked(slot, other_end(edges_[evaluated.id], slot)));
+      }
       requeue(evaluated);
     }
     evaluations_ += batch_.size();

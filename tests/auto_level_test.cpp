@@ -54,12 +54,8 @@ TEST(AutoLevel, FindsTheTrueNumberOfRegionsOfGeneratedShapes) {
        {Variant{Tessellation::Cad, 0.0}, Variant{Tessellation::Uniform, 0.0},
         Variant{Tessellation::Uniform, 0.002}})
     for (const std::string& name : shape_names()) {
-      ShapeOptions options;
-      options.tessellation = variant.tessellation;
-      options.noise = variant.noise;
-      options.random_motion = true;
-      options.seed = 7;
-      const GroundTruthShape shape = make_shape(name, options);
+      const GroundTruthShape shape =
+          testing::moved_shape_truth(name, variant.tessellation, 7, variant.noise);
       const AutoLevel level = choose_level(build_hierarchy(shape.mesh));
       const auto truth = static_cast<std::uint32_t>(shape.regions.size());
       ++cases;

@@ -18,6 +18,8 @@
 namespace primseg {
 namespace {
 
+using testing::score_at_true_count;
+
 constexpr double kTolerance = 0.1;  // the value the CLI's help suggests
 
 struct Build {
@@ -47,15 +49,6 @@ double level_rms(const Hierarchy& h, std::uint32_t k) {
     weight += h.weight(node);
   }
   return std::sqrt(error / weight);
-}
-
-SegmentationScore score_at_true_count(const GroundTruthShape& shape, const Hierarchy& h) {
-  const Segmentation seg = cut_by_count(h, static_cast<std::uint32_t>(shape.regions.size()));
-  std::vector<PrimitiveType> types, truth_types;
-  for (const ClusterReport& r : describe_clusters(h, seg)) types.push_back(r.primitive.type);
-  for (const Primitive& p : shape.regions) truth_types.push_back(p.type);
-  return score_segmentation(seg.labels, shape.region_of_face, face_areas(shape.mesh), types,
-                            truth_types);
 }
 
 // With planes only, a union's cost is at least its parts' (the smallest eigenvalue of a sum of
@@ -93,12 +86,7 @@ TEST(BatchedMerging, RecoversTheTrueRegionsAsWellAsTheExactOrder) {
   int count = 0;
   for (const Case& c : cases)
     for (const std::string& name : shape_names()) {
-      ShapeOptions shape_options;
-      shape_options.tessellation = c.tessellation;
-      shape_options.noise = c.noise;
-      shape_options.random_motion = true;
-      shape_options.seed = 3;
-      const GroundTruthShape shape = make_shape(name, shape_options);
+      const GroundTruthShape shape = testing::moved_shape_truth(name, c.tessellation, 3, c.noise);
       const bool default_types =
           std::all_of(shape.regions.begin(), shape.regions.end(), [](const Primitive& p) {
             return p.type != PrimitiveType::Cone && p.type != PrimitiveType::Torus;

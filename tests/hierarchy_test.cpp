@@ -22,6 +22,7 @@
 namespace primseg {
 namespace {
 
+using testing::score_at_true_count;
 using testing::score_segmentation;
 using testing::SegmentationScore;
 
@@ -30,21 +31,6 @@ HierarchyOptions every_type() {
   HierarchyOptions options;
   options.primitives = testing::every_primitive_type();
   return options;
-}
-
-std::vector<double> face_areas(const Hierarchy& h) {
-  std::vector<double> area(h.face_count(), 0.0);
-  for (std::uint32_t t = 0; t < h.mesh().triangle_count(); ++t)
-    area[h.mesh().face_of_triangle[t]] += h.graph().triangle_area(t);
-  return area;
-}
-
-SegmentationScore score_at_true_count(const GroundTruthShape& shape, const Hierarchy& h) {
-  const Segmentation seg = cut_by_count(h, static_cast<std::uint32_t>(shape.regions.size()));
-  std::vector<PrimitiveType> types, truth_types;
-  for (const ClusterReport& r : describe_clusters(h, seg)) types.push_back(r.primitive.type);
-  for (const Primitive& p : shape.regions) truth_types.push_back(p.type);
-  return score_segmentation(seg.labels, shape.region_of_face, face_areas(h), types, truth_types);
 }
 
 // Whether every region of the shape has a type of the default primitive set (cones and tori,

@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "primseg/cut.hpp"
 #include "primseg/shape_generator.hpp"
 
 namespace primseg::testing {
@@ -133,13 +134,18 @@ Mesh noisy_uniform_shape(const std::string& name) {
   return noisy_uniform_truth(name, 1, 0.003).mesh;
 }
 
-GroundTruthShape noisy_uniform_truth(const std::string& name, std::uint64_t seed, double noise) {
+GroundTruthShape moved_shape_truth(const std::string& name, Tessellation tessellation,
+                                   std::uint64_t seed, double noise) {
   ShapeOptions options;
-  options.tessellation = Tessellation::Uniform;
+  options.tessellation = tessellation;
   options.noise = noise;
   options.random_motion = true;
   options.seed = seed;
   return make_shape(name, options);
+}
+
+GroundTruthShape noisy_uniform_truth(const std::string& name, std::uint64_t seed, double noise) {
+  return moved_shape_truth(name, Tessellation::Uniform, seed, noise);
 }
 
 std::vector<PrimitiveType> every_primitive_type() {
@@ -166,6 +172,19 @@ ClusterStats part_stats(const DualGraph& graph, const std::vector<bool>& in_part
   for (const DualEdge& e : graph.edges())
     if (in_part[e.first] && in_part[e.second]) stats->edges += e.shared;
   return stats->centred();
+}
+
+SegmentationScore score_at_true_count(const GroundTruthShape& shape, const Hierarchy& hierarchy) {
+  const Segmentation segmentation =
+      cut_by_count(hierarchy, static_cast<std::uint32_t>(shape.regions.size()));
+  std::vector<PrimitiveType> types, truth_types;
+  for (const ClusterReport& r : describe_clusters(hierarchy, segmentation))
+    types.push_back(r.primitive.type);
+  for (const Primitive& p : shape.regions) truth_types.push_back(p.type);
+  std::vector<double> area(hierarchy.face_count(), 0.0);
+  for (std::uint32_t t = 0; t < hierarchy.mesh().triangle_count(); ++t)
+    area[hierarchy.mesh().face_of_triangle[t]] += hierarchy.graph().triangle_area(t);
+  return score_segmentation(segmentation.labels, shape.region_of_face, area, types, truth_types);
 }
 
 }  // namespace primseg::testing

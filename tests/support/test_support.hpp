@@ -70,6 +70,7 @@ void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation,
 #include "primseg/cluster_stats.hpp"
 #include "primseg/dual_graph.hpp"
 #include "primseg/evaluation.hpp"
+#include "primseg/hierarchy.hpp"
 
 namespace primseg::testing {
 
@@ -103,9 +104,12 @@ std::vector<PrimitiveType> every_primitive_type();
 /// A generated shape (shape_generator.hpp) in its Uniform tessellation with random vertex motion
 /// and Gaussian noise of 0.3% of its size along the normals: a small scan-like input.
 Mesh noisy_uniform_shape(const std::string& name);
-/// A generated shape and its ground truth, Uniform tessellation, moved by the random rigid motion
-/// of `seed`, with Gaussian noise of `noise` times its size along the normals (`primseg eval`'s
-/// noisy variant is noise 0.002).
+/// A generated shape and its ground truth in `tessellation`, moved by the random rigid motion of
+/// `seed`, with Gaussian noise of `noise` times its size along the normals (`primseg eval`'s
+/// variants: Cad and Uniform without noise, Uniform with noise 0.002).
+GroundTruthShape moved_shape_truth(const std::string& name, Tessellation tessellation,
+                                   std::uint64_t seed, double noise);
+/// moved_shape_truth() in the Uniform tessellation.
 GroundTruthShape noisy_uniform_truth(const std::string& name, std::uint64_t seed, double noise);
 
 /// The tetrahedron with corners (0, 0, 0), (0, 1, 0), (1, 1, 0) and (0, 0, 1) (its `corners`),
@@ -129,5 +133,9 @@ namespace primseg::testing {
 // The scores moved into the library (evaluation.hpp); tests keep their short names.
 using primseg::score_segmentation;
 using primseg::SegmentationScore;
+
+/// The score of the hierarchy's level with as many clusters as the shape has regions, each
+/// cluster typed by its reported (geometric) fit, faces weighted by their area.
+SegmentationScore score_at_true_count(const GroundTruthShape& shape, const Hierarchy& hierarchy);
 
 }  // namespace primseg::testing
