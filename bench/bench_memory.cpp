@@ -1,8 +1,11 @@
 // primseg_bench_memory: peak resident memory of one full hierarchy build (see bench/README.md).
 //
-//   primseg_bench_memory MESH_FILE [--exact-costs]
-//   primseg_bench_memory --cgal NAME [--exact-costs]     (a libcgal-demo mesh, e.g. fandisk.off)
-//   primseg_bench_memory --shape NAME [EDGE_LENGTH]      (generated, Uniform tessellation)
+//   primseg_bench_memory MESH_FILE [OPTIONS]
+//   primseg_bench_memory --cgal NAME [OPTIONS]            (a libcgal-demo mesh, e.g. fandisk.off)
+//   primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]  (generated, Uniform tessellation)
+//
+// OPTIONS: --exact-costs, --threads N (HierarchyOptions::threads, default 0: all), and
+// --merge-batch-tolerance T (default 0: the exact order).
 //
 // Prints one line of key=value pairs:
 //   faces             input faces F
@@ -11,14 +14,21 @@
 //   peak_rss          getrusage ru_maxrss at the end, after the hierarchy is built (bytes)
 //   bytes_per_face    peak_rss / F (the whole process)
 //   hierarchy_bytes_per_face  (peak_rss - input_rss) / F: what the build adds to the mesh
-//   build_seconds     wall-clock time of build_hierarchy
-// One build per process, so that ru_maxrss is this build's peak and nothing else's.
+//   build_seconds     wall-clock time of the build (HierarchyBuilder and finish(), as
+//                     build_hierarchy does), destroying the tree included
+//   evaluations       candidate evaluations of the build (HierarchyBuilder::evaluation_count())
+//   evaluations_per_face  evaluations / F
+// One build per process, so that ru_maxrss is this build's peak and nothing else's. The build is
+// the function build_and_destroy_tree alone, so that bench/instructions.sh can count its
+// instructions (valgrind --toggle-collect) without reading or generating the input.
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "bench_support.hpp"
@@ -30,26 +40,55 @@ namespace {
 
 int usage() {
   std::fprintf(stderr,
-               "usage: primseg_bench_memory MESH_FILE [--exact-costs]\n"
-               "       primseg_bench_memory --cgal NAME [--exact-costs]\n"
-               "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [--exact-costs]\n");
+               "usage: primseg_bench_memory MESH_FILE [OPTIONS]\n"
+               "       primseg_bench_memory --cgal NAME [OPTIONS]\n"
+               "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
+               "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T\n");
   return 2;
+}
+
+// The whole of `text` as a number, or an error naming the option.
+double number(const std::string& option, const char* text) {
+  char* end = nullptr;
+  const double value = std::strtod(text, &end);
+  if (end == text || *end != '\0') throw std::invalid_argument(option + ": not a number: " + text);
+  return value;
+}
+
+struct BuildFigures {
+  std::size_t merges = 0;
+  std::uint64_t evaluations = 0;
+};
+
+// Not inlined: bench/instructions.sh counts the instructions of this function alone.
+[[gnu::noinline]] BuildFigures build_and_destroy_tree(std::shared_ptr<const primseg::Mesh> mesh,
+                                                      const primseg::HierarchyOptions& options) {
+  primseg::HierarchyBuilder builder(std::move(mesh), options);
+  const primseg::Hierarchy tree = builder.finish();
+  return {tree.merges().size(), builder.evaluation_count()};
 }
 
 int run(int argc, char** argv) {
   using namespace primseg;
   std::string source, name;
   double edge_length = 0.01;
-  bool exact_costs = false;
+  HierarchyOptions options;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--exact-costs") {
-      exact_costs = true;
+      options.exact_costs = true;
+    } else if (arg == "--threads" && i + 1 < argc) {
+      const double threads = number(arg, argv[++i]);
+      if (!(threads >= 0 && threads <= 1024 && threads == static_cast<unsigned>(threads)))
+        throw std::invalid_argument("--threads: not a thread count from 0 to 1024");
+      options.threads = static_cast<unsigned>(threads);
+    } else if (arg == "--merge-batch-tolerance" && i + 1 < argc) {
+      options.merge_batch_tolerance = number(arg, argv[++i]);
     } else if ((arg == "--cgal" || arg == "--shape") && i + 1 < argc && source.empty()) {
       source = arg;
       name = argv[++i];
       if (arg == "--shape" && i + 1 < argc && argv[i + 1][0] != '-')
-        edge_length = std::stod(argv[++i]);
+        edge_length = number("EDGE_LENGTH", argv[++i]);
     } else if (!arg.starts_with("-") && source.empty()) {
       source = "file";
       name = arg;
@@ -62,24 +101,18 @@ int run(int argc, char** argv) {
   const std::size_t baseline = bench::current_rss_bytes();
   std::shared_ptr<const Mesh> mesh;
   if (source == "--shape") {
-    ShapeOptions options;
-    options.tessellation = Tessellation::Uniform;
-    options.edge_length = edge_length;
-    mesh = std::make_shared<const Mesh>(make_shape(name, options).mesh);
+    ShapeOptions shape_options;
+    shape_options.tessellation = Tessellation::Uniform;
+    shape_options.edge_length = edge_length;
+    mesh = std::make_shared<const Mesh>(make_shape(name, shape_options).mesh);
   } else {
     mesh = std::make_shared<const Mesh>(
         read_mesh(source == "--cgal" ? bench::cgal_mesh(name) : std::filesystem::path(name)));
   }
   const std::size_t input = bench::current_rss_bytes();
 
-  HierarchyOptions options;
-  options.exact_costs = exact_costs;
   const auto start = std::chrono::steady_clock::now();
-  std::size_t merges = 0;
-  {
-    const Hierarchy tree = build_hierarchy(mesh, options);
-    merges = tree.merges().size();
-  }
+  const BuildFigures build = build_and_destroy_tree(mesh, options);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::size_t peak = bench::peak_rss_bytes();
@@ -87,10 +120,13 @@ int run(int argc, char** argv) {
   const double faces = mesh->face_count();
   std::printf(
       "input=%s faces=%u merges=%zu baseline_rss=%zu input_rss=%zu peak_rss=%zu "
-      "bytes_per_face=%.0f hierarchy_bytes_per_face=%.0f build_seconds=%.3f\n",
-      name.c_str(), mesh->face_count(), merges, baseline, input, peak,
+      "bytes_per_face=%.0f hierarchy_bytes_per_face=%.0f build_seconds=%.3f evaluations=%llu "
+      "evaluations_per_face=%.3f\n",
+      name.c_str(), mesh->face_count(), build.merges, baseline, input, peak,
       static_cast<double>(peak) / faces,
-      static_cast<double>(peak > input ? peak - input : 0) / faces, seconds);
+      static_cast<double>(peak > input ? peak - input : 0) / faces, seconds,
+      static_cast<unsigned long long>(build.evaluations),
+      static_cast<double>(build.evaluations) / faces);
   return 0;
 }
 
