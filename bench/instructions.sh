@@ -62,12 +62,14 @@ if compgen -G "$out/*.failed" >/dev/null; then
   exit 1
 fi
 
-python3 - "$out" "$commit" "${BENCH_ARGS:-}" "${#runs[@]}" "${runs[@]}" "${labels[@]}" <<'PY'
+# Runs, input labels and merge orders go to Python one list per line.
+lines() { printf '%s\n' "$@"; }
+python3 - "$out" "$commit" "${BENCH_ARGS:-}" "$(lines "${runs[@]}")" "$(lines "${labels[@]}")" \
+  "$(lines "${orders[@]}")" <<'PY'
 import re, sys
 
-out, commit, extra, count = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
-runs, labels = sys.argv[5:5 + count], sys.argv[5 + count:]
-orders = {"0": "exact", "1": "`--merge-batch-tolerance 0.1`"}
+out, commit, extra = sys.argv[1:4]
+runs, labels, orders = (arg.split("\n") for arg in sys.argv[4:7])
 print("| input | faces | merge order | evaluations / face | instructions (M) | instructions / face "
       "| instructions / evaluation |")
 print("|---|---:|---|---:|---:|---:|---:|")
@@ -80,7 +82,9 @@ for run in runs:
         sys.exit(f"{run}: no instruction total in the callgrind output")
     instructions, faces = int(totals.group(1)), int(fields["faces"])
     evaluations = int(fields["evaluations"])
-    print(f"| {labels[int(run.split('-')[0])]} | {faces:,} | {orders[run.split('-')[1]]} "
+    input_index, order_index = map(int, run.split("-"))
+    order = f"`{orders[order_index]}`" if orders[order_index] else "exact"
+    print(f"| {labels[input_index]} | {faces:,} | {order} "
           f"| {evaluations / faces:.2f} | {instructions / 1e6:,.0f} | {instructions / faces:,.0f} "
           f"| {instructions / evaluations:,.0f} |")
 print()

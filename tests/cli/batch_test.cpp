@@ -55,6 +55,16 @@ std::map<std::string, std::string> summary_rows(const fs::path& csv) {
   return rows;
 }
 
+/// The status of a summary row ("faces,status").
+std::string status_of(const std::string& row) {
+  return row.substr(row.find(',') + 1);
+}
+
+/// Expects every file of a summary CSV to have `status` ("ok", "skipped").
+void expect_every_status(const fs::path& csv, const std::string& status) {
+  for (const auto& [file, row] : summary_rows(csv)) EXPECT_EQ(status_of(row), status) << file;
+}
+
 /// Every file under `dir` but the summaries, relative, with its content (JSON without timings).
 std::map<std::string, std::string> outputs(const fs::path& dir) {
   std::map<std::string, std::string> files;
@@ -102,8 +112,7 @@ TEST(Batch, OneBadFileIsReportedAndDoesNotStopTheOthers) {
   EXPECT_EQ(rows.at((in / "box.off").string()),
             std::to_string(make_shape("box").mesh.face_count()) + ",ok");
   for (const char* name : {"box.off", "parts/hole.ply", "dome.obj", "boss.stl"})
-    EXPECT_EQ(rows.at((in / name).string()).substr(rows.at((in / name).string()).find(',')), ",ok")
-        << name;
+    EXPECT_EQ(status_of(rows.at((in / name).string())), "ok") << name;
   // The failure's message names the file and the problem.
   const json report = json::parse(testing::file_contents(dir / "out" / "summary.json"));
   ASSERT_EQ(report.size(), 5u);
@@ -143,15 +152,13 @@ TEST(Batch, RefinedAndRegularizedOutputsAreSegments) {
   EXPECT_EQ(batch["level"]["refinement"], segment["level"]["refinement"]);
   // Without --regularize the outputs differ, and --resume does not take the old ones for them.
   ASSERT_EQ(primseg(base + " --resume"), 0);
-  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
-    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  expect_every_status(dir / "out" / "summary.csv", "ok");
   batch = json::parse(testing::file_contents(dir / "out" / "parts" / "hole.ply.json"));
   EXPECT_FALSE(batch.contains("relations"));
   // The options of --regularize are the outputs' too: a resumed run with others redoes them.
   ASSERT_EQ(primseg(base + " --regularize"), 0);
   ASSERT_EQ(primseg(base + " --regularize --max-relation-angle 5 --resume"), 0);
-  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
-    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  expect_every_status(dir / "out" / "summary.csv", "ok");
   batch = json::parse(testing::file_contents(dir / "out" / "parts" / "hole.ply.json"));
   EXPECT_NE(batch["batch_options"].get<std::string>().find("max_relation_angle=5"),
             std::string::npos);
@@ -170,11 +177,9 @@ TEST(Batch, RefinedAndRegularizedOutputsAreSegments) {
   EXPECT_NE(batch["batch_options"].get<std::string>().find("relation_length_tolerance=\"0.5%\""),
             std::string::npos);
   ASSERT_EQ(primseg(base + " --regularize --relation-length-tolerance 0.5% --resume"), 0);
-  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
-    EXPECT_EQ(row.substr(row.find(',')), ",skipped") << file;
+  expect_every_status(dir / "out" / "summary.csv", "skipped");
   ASSERT_EQ(primseg(base + " --regularize --relation-length-tolerance 0.25% --resume"), 0);
-  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
-    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  expect_every_status(dir / "out" / "summary.csv", "ok");
   fs::remove_all(dir);
 }
 
@@ -192,30 +197,20 @@ TEST(Batch, ResumeSkipsCompletedOutputsAndRedoesTheRest) {
   const auto box_time = fs::last_write_time(dir / "out" / "box.off.labels");
   ASSERT_EQ(primseg(base + " --clusters 6 --resume"), 0);
   const auto rows = summary_rows(dir / "out" / "summary.csv");
-  EXPECT_EQ(rows.at((in / "box.off").string()).substr(rows.at((in / "box.off").string()).find(',')),
-            ",skipped");
-  EXPECT_EQ(
-      rows.at((in / "boss.stl").string()).substr(rows.at((in / "boss.stl").string()).find(',')),
-      ",skipped");
-  EXPECT_EQ(
-      rows.at((in / "dome.obj").string()).substr(rows.at((in / "dome.obj").string()).find(',')),
-      ",ok");
-  EXPECT_EQ(rows.at((in / "parts/hole.ply").string())
-                .substr(rows.at((in / "parts/hole.ply").string()).find(',')),
-            ",ok");
+  EXPECT_EQ(status_of(rows.at((in / "box.off").string())), "skipped");
+  EXPECT_EQ(status_of(rows.at((in / "boss.stl").string())), "skipped");
+  EXPECT_EQ(status_of(rows.at((in / "dome.obj").string())), "ok");
+  EXPECT_EQ(status_of(rows.at((in / "parts/hole.ply").string())), "ok");
   EXPECT_EQ(fs::last_write_time(dir / "out" / "box.off.labels"), box_time);
   EXPECT_EQ(outputs(dir / "out"), first);
   // Other options make other outputs: nothing is skipped.
   ASSERT_EQ(primseg(base + " --clusters 4 --resume"), 0);
-  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
-    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  expect_every_status(dir / "out" / "summary.csv", "ok");
   // So does another merge order (it makes another tree); resumed with it, they are kept.
   ASSERT_EQ(primseg(base + " --clusters 4 --merge-batch-tolerance 0.1 --resume"), 0);
-  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
-    EXPECT_EQ(row.substr(row.find(',')), ",ok") << file;
+  expect_every_status(dir / "out" / "summary.csv", "ok");
   ASSERT_EQ(primseg(base + " --clusters 4 --merge-batch-tolerance 0.1 --resume"), 0);
-  for (const auto& [file, row] : summary_rows(dir / "out" / "summary.csv"))
-    EXPECT_EQ(row.substr(row.find(',')), ",skipped") << file;
+  expect_every_status(dir / "out" / "summary.csv", "skipped");
   fs::remove_all(dir);
 }
 
