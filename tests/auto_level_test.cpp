@@ -87,6 +87,20 @@ TEST(AutoLevel, ExactPlaneCylinderSphereShapesGetTheirTrueCount) {
   }
 }
 
+// The clean CAD chamfered cylinder with every primitive type: its top's fan and the chamfer, all
+// of whose vertices lie on two circles, once merged into a torus of RMS 1e-16 on seeds 2 and 4,
+// and the automatic level chose 3 regions.
+TEST(AutoLevel, ACadChamferAndTheTopItBevelsStayTwoRegionsWithEveryType) {
+  HierarchyOptions options;
+  options.primitives = testing::every_primitive_type();
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const GroundTruthShape shape =
+        testing::moved_shape_truth("chamfered_cylinder", Tessellation::Cad, seed, 0.0);
+    const Hierarchy h = build_hierarchy(shape.mesh, options);
+    EXPECT_EQ(choose_level(h).clusters, shape.regions.size()) << "seed " << seed;
+  }
+}
+
 // A small region joining its neighbour raises the RMS of a noisy level by far less than twice
 // (1.3 to 1.9 here), while the cluster it makes fits two to four times worse than the level: a
 // chamfer, a fillet, a countersink, the dome's sphere and the slanted face, with cones and tori

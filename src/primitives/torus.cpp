@@ -47,6 +47,10 @@ constexpr double kTorusMinNormalSpread = 1e-9;
 // by less than a fortieth of its size across, and the torus is standing in for a cone, a
 // cylinder or a plane (a cone's band is fitted by tori of growing tube as closely as wanted).
 constexpr double kMaxRelativeMinorRadius = 20;
+// Smallest determinant of the profile's weighted second moment over its squared trace (about the
+// ratio of its two principal spreads, squared lengths): below it the profile points lie on a line
+// to within 1e-6 of their extent.
+constexpr double kMinProfileDeterminant = 1e-12;
 // Levenberg–Marquardt steps on the sample (each O(32)).
 constexpr int kTorusRefinementSteps = 8;
 
@@ -126,35 +130,62 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> revolution_axis(
   return std::pair{axis, axis.cross(moment)};
 }
 
+// The samples in the half-plane through the axis (`axis` through `on_axis`): (ρ, h) = (distance
+// to the axis, height along it), their weighted mean and their weighted second moment about it.
+struct SampleProfile {
+  std::array<Eigen::Vector2d, TorusSample::kCapacity> rho_h;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
+};
+
+SampleProfile profile_of(const TorusSample& sample, const Eigen::Vector3d& axis,
+                         const Eigen::Vector3d& on_axis) {
+  SampleProfile profile;
+  for (std::size_t i = 0; i < sample.n; ++i) {
+    const Eigen::Vector3d y = sample.positions[i] - on_axis;
+    const double h = axis.dot(y);
+    profile.rho_h[i] = {(y - h * axis).norm(), h};
+    profile.mean += sample.weights[i] * profile.rho_h[i];
+  }
+  profile.mean /= sample.weight;
+  for (std::size_t i = 0; i < sample.n; ++i) {
+    const Eigen::Vector2d p = profile.rho_h[i] - profile.mean;
+    profile.second.noalias() += sample.weights[i] * p * p.transpose();
+  }
+  return profile;
+}
+
 // The tube's circle in the (ρ, h) half-plane of the axis through `on_axis`: its centre (ρ, h)
 // and radius. Nothing when Pratt's fit fails or the centre is not off the axis.
 std::optional<std::pair<Eigen::Vector2d, double>> tube_circle(const TorusSample& sample,
                                                               const Eigen::Vector3d& axis,
                                                               const Eigen::Vector3d& on_axis) {
-  detail::CentredMomentsND<2> profile;
-  std::array<Eigen::Vector2d, TorusSample::kCapacity> rho_h;
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  const SampleProfile profile = profile_of(sample, axis, on_axis);
+  detail::CentredMomentsND<2> moments;
+  moments.weight = sample.weight;
+  moments.second = profile.second;
+  moments.third.setZero();
   for (std::size_t i = 0; i < sample.n; ++i) {
-    const Eigen::Vector3d y = sample.positions[i] - on_axis;
-    const double h = axis.dot(y);
-    rho_h[i] = {(y - h * axis).norm(), h};
-    mean += sample.weights[i] * rho_h[i];
+    const Eigen::Vector2d p = profile.rho_h[i] - profile.mean;
+    moments.third += sample.weights[i] * p * p.squaredNorm();
+    moments.fourth += sample.weights[i] * p.squaredNorm() * p.squaredNorm();
   }
-  mean /= sample.weight;
-  profile.weight = sample.weight;
-  profile.second.setZero();
-  profile.third.setZero();
-  for (std::size_t i = 0; i < sample.n; ++i) {
-    const Eigen::Vector2d p = rho_h[i] - mean;
-    profile.second.noalias() += sample.weights[i] * p * p.transpose();
-    profile.third += sample.weights[i] * p * p.squaredNorm();
-    profile.fourth += sample.weights[i] * p.squaredNorm() * p.squaredNorm();
-  }
-  const detail::PrattResult<2> circle = detail::pratt_fit(profile);
+  const detail::PrattResult<2> circle = detail::pratt_fit(moments);
   if (!circle.valid) return std::nullopt;
-  const Eigen::Vector2d tube_centre = mean + circle.centre;
+  const Eigen::Vector2d tube_centre = profile.mean + circle.centre;
   if (!(tube_centre.x() > 0)) return std::nullopt;  // the centre circle must have a radius
   return std::pair{tube_centre, circle.radius};
+}
+
+// Whether the samples' profile about the torus's axis determines the tube's circle. Corners on
+// at most two rings (a CAD cone, or a fan and a cone between two circles) put it on a line or on
+// two points, through which a whole family of circles passes: any of them fits exactly, and the
+// one a fit lands on is arbitrary. A cone or a plane fits such a band.
+bool profile_determines_tube(const Primitive& torus, const TorusSample& sample) {
+  const Eigen::Matrix2d second =
+      profile_of(sample, detail::to_eigen(torus.axis), detail::to_eigen(torus.point)).second;
+  const double trace = second.trace();
+  return second.determinant() > kMinProfileDeterminant * trace * trace;
 }
 
 // Face normals must follow the torus's across each face: mean |n · ν| over the sample, ν the
@@ -255,6 +286,7 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
       !(torus.radius <= detail::kMaxRelativeRadius &&
         torus.minor_radius <= kMaxRelativeMinorRadius))
     return result;
+  if (!profile_determines_tube(torus, sample)) return result;
   result.normal_alignment = torus_normal_alignment(torus, sample);
   if (!(result.normal_alignment >= kMinNormalAlignment)) return result;
 

@@ -448,6 +448,48 @@ TEST(TorusFitter, AFlatFanOnTheTopCircleIsNotPartOfTheTorus) {
                            << " r " << p.minor_radius;
 }
 
+// A CAD chamfer, one row of triangles between two circles, and the flat fan of the top it bevels,
+// whose vertices all lie on the chamfer's top circle: every vertex is on two coaxial circles, and
+// a one-parameter family of tori passes through both exactly. The chamfered cylinder of `primseg
+// eval` (clean CAD, seeds 2 and 4, five types) merged its top and chamfer into such a torus of
+// RMS 1e-16, and the automatic level took that for a true surface. The torus is not determined by
+// them; with a second row of triangles (three circles) it is.
+TEST(TorusFitter, CornersOnTwoCirclesDoNotDetermineATorus) {
+  std::mt19937_64 rng(53);
+  for (int trial = 0; trial < 8; ++trial) {
+    const Pose pose = random_pose(rng);
+    const double span = 1.5 * M_PI, top = 0.4, base = 0.5, height = 0.1;
+    const auto ring_point = [&](double radius, double z, double around) {
+      return pose.apply(Eigen::Vector3d(radius * std::cos(around), radius * std::sin(around), z));
+    };
+    const Mesh chamfer = grid_mesh(1, 24, [&](double u, double v) {
+      return ring_point(base + (top - base) * u, height * u, span * v);
+    });
+    std::vector<Vec3> positions = chamfer.positions;
+    std::vector<Triangle> triangles = chamfer.triangles;
+    const auto first = static_cast<std::uint32_t>(positions.size());
+    const int arc = 24;
+    for (int j = 0; j <= arc; ++j) positions.push_back(ring_point(top, height, span * j / arc));
+    for (std::uint32_t j = 1; j < arc; ++j) triangles.push_back({first, first + j, first + j + 1});
+    const Mesh with_top = Mesh::from_triangles(std::move(positions), std::move(triangles));
+    Primitive p;
+    const PrimitiveFit two_circles = fit_whole(with_top, TorusFitter(), &p);
+    EXPECT_FALSE(two_circles.valid) << trial << ": R " << p.radius << " r " << p.minor_radius
+                                    << ", normal agreement " << two_circles.normal_alignment;
+
+    // Three circles of a quarter torus, two rows of the same CAD tessellation: determined.
+    const double major = 2, minor = 0.5;
+    const Mesh fillet = grid_mesh(2, 24, [&](double u, double v) {
+      const double tube = M_PI / 2 * u, ring = major + minor * std::cos(tube);
+      return ring_point(ring, minor * std::sin(tube), span * v);
+    });
+    const PrimitiveFit three_circles = fit_whole(fillet, TorusFitter(), &p);
+    ASSERT_TRUE(three_circles.valid) << trial;
+    EXPECT_NEAR(p.radius, major * pose.scale, 1e-6 * pose.scale) << trial;
+    EXPECT_NEAR(p.minor_radius, minor * pose.scale, 1e-6 * pose.scale) << trial;
+  }
+}
+
 // A candidate that adds a few faces to a large torus patch must pay for them when they leave the
 // torus. The union's own corner sample (the best 32 priorities of both parts) usually holds none
 // of a small part's corners: a torus of 526 faces of rotor.off took four faces off its surface at
