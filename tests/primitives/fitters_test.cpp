@@ -57,6 +57,19 @@ double angle_between_axes(const Vec3& a, const Eigen::Vector3d& b) {
   return std::atan2(u.cross(b.normalized()).norm(), std::abs(u.dot(b.normalized())));
 }
 
+// `mesh` and a flat cap over an arc: a fan of triangles from the first of the arc's points
+// arc_point(j / 24), j = 0..24, with no vertex inside (a CAD-style flat face).
+template <typename ArcPoint>
+Mesh with_fan_cap(const Mesh& mesh, ArcPoint&& arc_point) {
+  std::vector<Vec3> positions = mesh.positions;
+  std::vector<Triangle> triangles = mesh.triangles;
+  const auto first = static_cast<std::uint32_t>(positions.size());
+  const int arc = 24;
+  for (int j = 0; j <= arc; ++j) positions.push_back(arc_point(double(j) / arc));
+  for (std::uint32_t j = 1; j < arc; ++j) triangles.push_back({first, first + j, first + j + 1});
+  return Mesh::from_triangles(std::move(positions), std::move(triangles));
+}
+
 using testing::distance;
 
 TEST(PlaneFitter, RecoversPlanesAtRandomPosesAndScales) {
@@ -430,13 +443,8 @@ TEST(TorusFitter, AFlatFanOnTheTopCircleIsNotPartOfTheTorus) {
   };
   const Mesh fillet =
       grid_mesh(4, 24, [&](double u, double v) { return torus_point(M_PI / 2 * u, span * v); });
-  std::vector<Vec3> positions = fillet.positions;
-  std::vector<Triangle> triangles = fillet.triangles;
-  const auto first = static_cast<std::uint32_t>(positions.size());
-  const int arc = 24;
-  for (int j = 0; j <= arc; ++j) positions.push_back(torus_point(M_PI / 2, span * j / arc));
-  for (std::uint32_t j = 1; j < arc; ++j) triangles.push_back({first, first + j, first + j + 1});
-  const Mesh with_top = Mesh::from_triangles(std::move(positions), std::move(triangles));
+  const Mesh with_top =
+      with_fan_cap(fillet, [&](double t) { return torus_point(M_PI / 2, span * t); });
 
   Primitive p;
   const PrimitiveFit alone = fit_whole(fillet, TorusFitter(), &p);
@@ -465,13 +473,8 @@ TEST(TorusFitter, CornersOnTwoCirclesDoNotDetermineATorus) {
     const Mesh chamfer = grid_mesh(1, 24, [&](double u, double v) {
       return ring_point(base + (top - base) * u, height * u, span * v);
     });
-    std::vector<Vec3> positions = chamfer.positions;
-    std::vector<Triangle> triangles = chamfer.triangles;
-    const auto first = static_cast<std::uint32_t>(positions.size());
-    const int arc = 24;
-    for (int j = 0; j <= arc; ++j) positions.push_back(ring_point(top, height, span * j / arc));
-    for (std::uint32_t j = 1; j < arc; ++j) triangles.push_back({first, first + j, first + j + 1});
-    const Mesh with_top = Mesh::from_triangles(std::move(positions), std::move(triangles));
+    const Mesh with_top =
+        with_fan_cap(chamfer, [&](double t) { return ring_point(top, height, span * t); });
     Primitive p;
     const PrimitiveFit two_circles = fit_whole(with_top, TorusFitter(), &p);
     EXPECT_FALSE(two_circles.valid) << trial << ": R " << p.radius << " r " << p.minor_radius
