@@ -5,16 +5,20 @@
 # tests/mesh_io/).
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 45: 9 targets, about 4 minutes on 2 cores)
-#   PRIMSEG_FUZZ_BUILD_DIR=build-fuzz        build directory
+#   PRIMSEG_FUZZ_BUILD_DIR=build-fuzz        build directory; one already configured with
+#                                            PRIMSEG_FUZZ=ON is built as it is (CI fuzzes in its
+#                                            sanitizer pass's build, PRIMSEG_FUZZ_COVERAGE=edges)
 #   PRIMSEG_FUZZ_JOBS=$(nproc)               targets run at once
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-45}
 build=${PRIMSEG_FUZZ_BUILD_DIR:-build-fuzz}
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
-  -DPRIMSEG_FUZZ=ON -DPRIMSEG_WERROR=ON -DPRIMSEG_BUILD_TESTS=OFF -DPRIMSEG_BUILD_CLI=OFF \
-  -DPRIMSEG_BUILD_BENCH=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
+if ! grep -qx 'PRIMSEG_FUZZ:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
+  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
+    -DPRIMSEG_FUZZ=ON -DPRIMSEG_WERROR=ON -DPRIMSEG_BUILD_TESTS=OFF -DPRIMSEG_BUILD_CLI=OFF \
+    -DPRIMSEG_BUILD_BENCH=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
+fi
 cmake --build "$build" --target fuzz_read_off fuzz_read_obj fuzz_read_ply fuzz_read_stl \
   fuzz_read_detect fuzz_read_tree fuzz_read_skeleton fuzz_segment fuzz_tools
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
