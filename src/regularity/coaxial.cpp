@@ -4,7 +4,6 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -19,6 +18,7 @@
 
 #include "eigen_conversions.hpp"
 #include "orthonormal_pair.hpp"
+#include "symmetric_eigen2.hpp"
 
 namespace primseg::detail {
 
@@ -290,7 +290,7 @@ std::optional<FreeLineFit> fit_free_line(const Eigen::Vector3d& direction, const
   item.frame.col(0) = line.u();
   item.frame.col(1) = line.v();
   item.covariance = covariance.topLeftCorner<2, 2>() / (scale * scale);
-  item.variance = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(item.covariance).eigenvalues()(1);
+  item.variance = larger_eigenvalue(item.covariance);
   if (!std::isfinite(item.variance) || !(item.variance > 0)) return std::nullopt;
   for (std::size_t k = 0; k < clusters.size(); ++k)
     fit.rms.push_back(std::max(std::sqrt(member_squares[k] / double(points[clusters[k]].size())),

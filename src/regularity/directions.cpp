@@ -22,6 +22,8 @@
 
 #include "eigen_conversions.hpp"
 #include "orthonormal_pair.hpp"
+#include "rotation_between.hpp"
+#include "symmetric_eigen2.hpp"
 
 namespace primseg::detail {
 
@@ -125,7 +127,7 @@ std::optional<Oriented> oriented_cylinder(std::size_t cluster, const Primitive& 
       std::max(residuals / double(n - 5), kResolution * kResolution * radius * radius);
   if (!covariance.allFinite()) return std::nullopt;
   item.covariance = covariance.topLeftCorner<2, 2>() / (radius * radius);
-  item.variance = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(item.covariance).eigenvalues()(1);
+  item.variance = larger_eigenvalue(item.covariance);
   return item;
 }
 
@@ -240,8 +242,8 @@ std::optional<std::vector<Eigen::Vector3d>> turn_trees(std::size_t i, std::size_
                                                        const std::vector<DirectionGroup>& groups) {
   Eigen::Vector3d a = solved[i], b = solved[j];
   if (!make_orthogonal(a, groups[i].covariance, b, groups[j].covariance)) return std::nullopt;
-  const Eigen::Quaterniond turn_i = Eigen::Quaterniond::FromTwoVectors(solved[i], a);
-  const Eigen::Quaterniond turn_j = Eigen::Quaterniond::FromTwoVectors(solved[j], b);
+  const Eigen::Quaterniond turn_i = rotation_between(solved[i], a);
+  const Eigen::Quaterniond turn_j = rotation_between(solved[j], b);
   std::vector<Eigen::Vector3d> moved;
   moved.reserve(component.size());
   for (const std::size_t g : component)

@@ -17,6 +17,7 @@
 
 #include "eigen_conversions.hpp"
 #include "orthonormal_pair.hpp"
+#include "symmetric_eigen2.hpp"
 
 namespace primseg::detail {
 
@@ -28,9 +29,7 @@ double largest_variance(const Eigen::Matrix<double, D, D>& covariance) {
   if constexpr (D == 1) {
     return covariance(0, 0);
   } else if constexpr (D == 2) {
-    const double half_difference = (covariance(0, 0) - covariance(1, 1)) / 2;
-    return (covariance(0, 0) + covariance(1, 1)) / 2 +
-           std::hypot(half_difference, covariance(0, 1));
+    return larger_eigenvalue(covariance);
   } else {
     return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>>(covariance,
                                                                       Eigen::EigenvaluesOnly)
