@@ -3,7 +3,8 @@
 //
 // Eigen's Quaternion::FromTwoVectors computes the same (this is its formula where the directions
 // are not opposite), but for opposite ones it finds the axis with a JacobiSVD, whose instantiation
-// took 15 s of g++ time in the file that used it (session 58). Here opposite directions turn about
+// took a quarter of the compile time of the file that used it (regularity/directions.cpp, g++ -O3:
+// 59 s with it, 44 s without; session 58). Here opposite directions turn about
 // a fixed axis orthogonal to the first, which is as good: every such axis gives a half turn.
 
 #include <Eigen/Core>
