@@ -26,6 +26,7 @@
 #include <cstdint>
 
 #include "small_cholesky.hpp"
+#include "symmetric_eigen2.hpp"
 
 namespace primseg {
 namespace {
@@ -160,11 +161,17 @@ ConeAtApex cone_at_apex(const Moments& moments, const Eigen::Vector3d& apex, dou
   span.col(1) = -coefficients_of(Eigen::Matrix3d::Identity());
   const Eigen::Matrix2d a2 = span.transpose().lazyProduct(system.a.lazyProduct(span));
   const Eigen::Matrix2d b2 = span.transpose().lazyProduct(system.b.lazyProduct(span));
-  const GeneralizedEigen<2> circular = generalized_eigen(a2, b2);
+  // In closed form: the ratio is the smaller eigenvalue, a few thousandths of the larger in a
+  // typical fit and far less in a close one, which an iterative solver gets only to round-off of
+  // the larger. Against a 60-digit reference on 100,924 matrices of the generated shapes' fits,
+  // Eigen's solver erred by more than 3e-8 relatively on 1% of them, the closed form by 1.5e-15
+  // at worst (session 59).
+  const detail::SmallerGeneralizedEigenpair circular =
+      detail::smaller_generalized_eigenpair(a2, b2);
   if (!circular.valid) return cone;
-  const Eigen::Vector2d x = circular.vectors.col(0);
+  const Eigen::Vector2d& x = circular.vector;
   cone.cos2 = x(1) / x(0);
-  cone.ratio = std::max(0.0, circular.values(0));
+  cone.ratio = std::max(0.0, circular.value);
   cone.valid = cone.cos2 > 0 && cone.cos2 < 1 && std::isfinite(cone.ratio);
   return cone;
 }
