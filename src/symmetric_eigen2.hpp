@@ -5,7 +5,8 @@
 // Eigen's SelfAdjointEigenSolver gives eigenvalues to round-off of the norm, but instantiating it
 // for a 2x2 matrix (tridiagonalisation, implicit QR and the dynamic-size code they reach) took a
 // third of regularity/directions.cpp's compile time (g++ -O3: 44 s with it, 26 s without; session
-// 58) and 15 s of primitives/cone.cpp's (51 s with it, 36 s without).
+// 58) and a quarter of primitives/cone.cpp's (medians of 5 runs: 47 s with it, 36 s without;
+// session 59).
 
 #include <Eigen/Core>
 #include <cmath>

@@ -54,24 +54,23 @@ constexpr std::array<double, 6> kMultiplicity = {1, 1, 1, 2, 2, 2};
 constexpr std::array<std::array<int, 2>, 6> kEntries = {
     {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
 
-// The eigenpairs of A x = λ B x, A symmetric and B symmetric positive definite: eigenvalues
+// The eigenpairs of the quadric's 6×6 problem A x = λ B x (step 2; step 3's 2×2 one has a closed
+// form in symmetric_eigen2.hpp), A symmetric and B symmetric positive definite: eigenvalues
 // ascending, eigenvectors with xᵀBx = 1. The steps of Eigen's GeneralizedSelfAdjointEigenSolver
 // (B = L Lᵀ, the ordinary problem of C = L⁻¹ A L⁻ᵀ, x = L⁻ᵀ y), with the written-out factor
 // and substitutions of small_cholesky.hpp: Eigen's solver also compiles its two other problem types
 // and its blocked matrix kernels, the slowest part of the slowest file to compile (g++ -O3: 65 s
 // with it, 49 s without).
-template <int N>
 struct GeneralizedEigen {
   bool valid = false;
-  Eigen::Matrix<double, N, 1> values;
-  Eigen::Matrix<double, N, N> vectors;  // one per column
+  Eigen::Matrix<double, 6, 1> values;
+  Eigen::Matrix<double, 6, 6> vectors;  // one per column
 };
 
-template <int N>
-GeneralizedEigen<N> generalized_eigen(const Eigen::Matrix<double, N, N>& a,
-                                      const Eigen::Matrix<double, N, N>& b) {
-  using Matrix = Eigen::Matrix<double, N, N>;
-  GeneralizedEigen<N> result;
+GeneralizedEigen generalized_eigen(const Eigen::Matrix<double, 6, 6>& a,
+                                   const Eigen::Matrix<double, 6, 6>& b) {
+  using Matrix = Eigen::Matrix<double, 6, 6>;
+  GeneralizedEigen result;
   Matrix l;
   if (!detail::cholesky_factor(b, l)) return result;
   // C = L⁻¹ (L⁻¹ A)ᵀ, A being symmetric.
@@ -147,7 +146,7 @@ ConeAtApex cone_at_apex(const Moments& moments, const Eigen::Vector3d& apex, dou
   ConeAtApex cone;
   cone.about_apex = moments.translated(apex);
   const TaubinSystem system = taubin_system(cone.about_apex, scale);
-  const GeneralizedEigen<6> quadric = generalized_eigen(system.a, system.b);
+  const GeneralizedEigen quadric = generalized_eigen(system.a, system.b);
   if (!quadric.valid) return cone;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(matrix_of(quadric.vectors.col(0)));
   const Eigen::Vector3d& mu = shape.eigenvalues();  // ascending
