@@ -19,27 +19,18 @@ if ! grep -qx 'PRIMSEG_FUZZ:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
     -DPRIMSEG_FUZZ=ON -DPRIMSEG_WERROR=ON -DPRIMSEG_BUILD_TESTS=OFF -DPRIMSEG_BUILD_CLI=OFF \
     -DPRIMSEG_BUILD_BENCH=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
 fi
-# A target's name is fuzz_read_<target> for the readers, fuzz_<target> for the others.
-targets=(off obj ply stl detect tree skeleton segment tools)
-binary_name() {
-  case $1 in
-    segment | tools) echo "fuzz_$1" ;;
-    *) echo "fuzz_read_$1" ;;
-  esac
-}
-binaries=()
-for target in "${targets[@]}"; do binaries+=("$(binary_name "$target")"); done
-cmake --build "$build" --target "${binaries[@]}"
+cmake --build "$build" --target fuzz_targets
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 mkdir -p "$build/artifacts"
 # Runs one target into $build/logs/$target.log; libFuzzer is single-threaded, so the targets run
 # $jobs at a time (both cores in CI: 9 x 20 s takes 100 s instead of 180 s).
 fuzz_one() {
-  local target=$1 dict=fuzz/dict/$1.dict binary=$build/fuzz/$(binary_name "$1")
+  local target=$1 dict=fuzz/dict/$1.dict binary=$build/fuzz/fuzz_read_$1
   case $target in
     detect) dict=$build/detect.dict ;;
-    tree | segment | tools) dict= ;;
+    tree) dict= ;;
+    segment | tools) dict= binary=$build/fuzz/fuzz_$1 ;;
   esac
   # New inputs go to a scratch corpus in the build directory, never into the committed seeds.
   local work=$build/corpus/$target
@@ -49,6 +40,7 @@ fuzz_one() {
     -artifact_prefix="$build/artifacts/$target-" >"$build/logs/$target.log" 2>&1 || true
 }
 jobs=${PRIMSEG_FUZZ_JOBS:-$(nproc)}
+targets=(off obj ply stl detect tree skeleton segment tools)
 cat fuzz/dict/{off,obj,ply,stl}.dict >"$build/detect.dict"
 rm -rf "$build/logs" && mkdir -p "$build/logs"
 running=0
