@@ -91,8 +91,9 @@ TEST(Hierarchy, NoisyCadShapesKeepAMeanIouAboveNinetyPercent) {
 }
 
 // With cones and tori enabled, the shapes that contain them (a chamfer, a countersink, a fillet)
-// are segmented with every region recovered and typed right. The CAD-style fillet is left out:
-// its coarse quarter torus is still split wrongly (see README, Measured quality).
+// are segmented with every region recovered and typed right. The CAD-style fillet of seed 1 had
+// its flat top join a fragment of the fillet (min IoU 0.875) until its first wedges were fitted
+// as tori (TorusFitter.WedgesOfACadFilletAreTori).
 TEST(Hierarchy, ConesAndToriAreRecoveredWhenEnabled) {
   const HierarchyOptions options = every_type();
   int cones = 0, tori = 0;
@@ -104,7 +105,6 @@ TEST(Hierarchy, ConesAndToriAreRecoveredWhenEnabled) {
                            [&](const Primitive& p) { return p.type == type; });
       };
       if (!has(PrimitiveType::Cone) && !has(PrimitiveType::Torus)) continue;
-      if (has(PrimitiveType::Torus) && variant.tessellation == Tessellation::Cad) continue;
       cones += has(PrimitiveType::Cone);
       tori += has(PrimitiveType::Torus);
       const SegmentationScore score =
@@ -113,7 +113,7 @@ TEST(Hierarchy, ConesAndToriAreRecoveredWhenEnabled) {
       EXPECT_EQ(score.type_accuracy, 1.0) << name << " seed " << variant.seed;
     }
   EXPECT_EQ(cones, 8);
-  EXPECT_EQ(tori, 2);
+  EXPECT_EQ(tori, 4);
 }
 
 // With tori enabled, the flat faces of noisy boxes stay planes. A torus's error is estimated from a
