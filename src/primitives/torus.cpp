@@ -281,22 +281,17 @@ double lucky_sample_factor(const Moments& centred, const TorusSample& sample) {
   return exact > sampled && sampled > 0 && std::isfinite(exact) ? exact / sampled : 1;
 }
 
-// How a torus about a given axis line is refined and accepted.
-struct Refinement {
-  int steps = kTorusRefinementSteps;  // Levenberg–Marquardt steps at most
-  // Exact tori only: after `probe_steps` steps the RMS distance to the sample must be below
-  // `probe_rms` to go on (LM's progress on points off every torus stalls far above it), and at
-  // the end below kExactRms. 0 probe steps: any torus, as fitted.
-  int probe_steps = 0;
-  double probe_rms = 0;
-};
-
-// The second try, across the normals' least direction: exact tori only. Its start is rougher
-// than the first try's (the face normals' lines meet the axis less well on a narrow wedge), so
-// it may take more steps, and the probe keeps their cost off clusters on no torus (most second
-// tries are unions of two surfaces): over `primseg eval --seeds 3` with five types, 3% of the
-// uniform shapes' 160,288 second tries and none of the noisy ones' pass it (docs/method.md).
-constexpr Refinement kExactRefinement{.steps = 16, .probe_steps = 2, .probe_rms = 1e-2};
+// The second try, across the normals' least direction, takes exact tori only. Its start is
+// rougher than the first try's (the face normals' lines meet the axis less well on a narrow
+// wedge), so it may take up to kExactTorusSteps Levenberg–Marquardt steps; after the first
+// kExactProbeSteps the RMS distance to the sample must be within kExactProbeRms (spread units),
+// where LM's progress on points off every torus stalls. The probe keeps the cost of those steps
+// off clusters on no torus (most second tries are unions of two surfaces): over `primseg eval
+// --seeds 3` with five types, 3% of the uniform shapes' 160,288 second tries and none of the noisy
+// ones' pass it (docs/method.md).
+constexpr int kExactTorusSteps = 16;
+constexpr int kExactProbeSteps = 2;
+constexpr double kExactProbeRms = 1e-2;
 
 // A fit about one axis line, and whether the samples' profile about it gave a tube's circle.
 struct AxisFit {
@@ -305,10 +300,10 @@ struct AxisFit {
 };
 
 // Steps 2 and 3 and the validity rules, about the axis line (`axis`, through `on_axis`, sample
-// units).
+// units); with `exact_only`, a torus farther than kExactRms from the sample is not valid.
 AxisFit fit_about_axis(const TorusSample& sample, const Moments& m, double scale,
                        const Eigen::Vector3d& axis, const Eigen::Vector3d& on_axis,
-                       const Refinement& refinement) {
+                       bool exact_only) {
   AxisFit about;
   PrimitiveFit& result = about.fit;
   result.primitive.type = PrimitiveType::Torus;
@@ -329,15 +324,15 @@ AxisFit fit_about_axis(const TorusSample& sample, const Moments& m, double scale
   const std::span<const double> weights(sample.weights.data(), n);
   GeometricFitOptions options;
   GeometricFit refined;
-  if (refinement.probe_steps > 0) {
-    options.max_iterations = refinement.probe_steps;
+  if (exact_only) {
+    options.max_iterations = kExactProbeSteps;
     refined = fit_geometric(start, points, weights, options);
-    if (!(refined.rms <= refinement.probe_rms)) return about;
-    options.max_iterations = refinement.steps - refinement.probe_steps;
+    if (!(refined.rms <= kExactProbeRms)) return about;
+    options.max_iterations = kExactTorusSteps - kExactProbeSteps;
     refined = fit_geometric(refined.primitive, points, weights, options);
     if (!(refined.rms <= kExactRms)) return about;
   } else {
-    options.max_iterations = refinement.steps;
+    options.max_iterations = kTorusRefinementSteps;
     refined = fit_geometric(start, points, weights, options);
   }
   const Primitive& torus = refined.primitive;
@@ -390,19 +385,18 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   if (!problem) return result;
   const Eigen::Vector3d first = best_axis(*problem);
   const auto [axis, on_axis] = axis_line(*problem, first);
-  const AxisFit about_first = fit_about_axis(sample, m, scale, axis, on_axis, Refinement{});
+  const AxisFit about_first = fit_about_axis(sample, m, scale, axis, on_axis, false);
   // No tube's circle about a best direction along the normals' least one: on a narrow wedge of
   // an exact torus (the first faces of a CAD fillet, up to about 70 degrees round with 48
   // segments) that is the wedge's own cylinder axis, about which its profile is a short line, and
   // the torus's axis is the best direction across it. Only an exact torus counts there: about a
   // direction across a noisy cylinder's axis, a torus of wide ring fits the cylinder, and its
   // sampled error would win by chance.
-  if (about_first.fit.valid || about_first.tube ||
-      !(std::abs(first.dot(problem->least_normal)) >= kAlongLeastNormal))
+  if (about_first.tube || !(std::abs(first.dot(problem->least_normal)) >= kAlongLeastNormal))
     return about_first.fit;
   const Eigen::Vector3d second = best_axis_across_least_normal(*problem);
   const auto [second_axis, second_on_axis] = axis_line(*problem, second);
-  return fit_about_axis(sample, m, scale, second_axis, second_on_axis, kExactRefinement).fit;
+  return fit_about_axis(sample, m, scale, second_axis, second_on_axis, true).fit;
 }
 
 }  // namespace primseg
