@@ -6,12 +6,17 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <span>
 #include <string>
 
 #include "face_adjacency.hpp"
 #include "geometric_models.hpp"
+#include "model_selection.hpp"
 #include "no_index.hpp"
+#include "parallel.hpp"
+#include "primseg/cluster_view.hpp"
 #include "primseg/error.hpp"
+#include "primseg/primitives/primitive_fitter.hpp"
 #include "working_primitive.hpp"
 
 namespace primseg {
@@ -227,6 +232,111 @@ double total_squared_error(const Hierarchy& hierarchy, const std::vector<std::ui
   return sum;
 }
 
+// Compressed rows of items by cluster, for the clusters flagged in `changed`: cluster c's items
+// are item[offset[c]] .. item[offset[c + 1] - 1], in the order given.
+struct ClusterRows {
+  std::vector<std::uint32_t> offset, item;
+
+  template <typename ClusterOf>
+  ClusterRows(std::size_t clusters, std::size_t items, ClusterOf cluster_of)
+      : offset(clusters + 1, 0) {
+    for (std::uint32_t i = 0; i < items; ++i)
+      if (const std::uint32_t c = cluster_of(i); c != kNone) ++offset[c + 1];
+    std::partial_sum(offset.begin(), offset.end(), offset.begin());
+    item.resize(offset.back());
+    std::vector<std::uint32_t> next(offset.begin(), offset.end() - 1);
+    for (std::uint32_t i = 0; i < items; ++i)
+      if (const std::uint32_t c = cluster_of(i); c != kNone) item[next[c]++] = i;
+  }
+  std::span<const std::uint32_t> of(std::size_t c) const {
+    return {item.data() + offset[c], item.data() + offset[c + 1]};
+  }
+};
+
+// Chooses again the type of each cluster flagged in `changed`, on the faces it has now: the tree
+// chose it on the faces of the cluster's node, and a cluster that gained or lost faces may fit
+// another type better (a noisy chamfer merged with a few faces of the corner it bevels is typed a
+// sphere, whose arc bends towards the corner; given back its true faces, it fits its cone
+// better). The hierarchy's rule (ModelSelector, over the corners, with the type penalties)
+// proposes a type; it replaces the cluster's own only if it also fits the faces better, by the
+// same integral as the moves and with the same penalties, than the cluster's own type fitted to
+// the same faces: the corners of a CAD fan and of one ring of the fillet beyond it lie exactly on
+// a sphere, which misses the flat fan's triangles by far. Where the type changes, `start` (input
+// units) becomes the proposed fit. Each cluster on its own: the same result for any thread count.
+void choose_types_again(const Hierarchy& hierarchy, const std::vector<std::uint32_t>& labels,
+                        const std::vector<char>& changed,
+                        const std::vector<std::uint32_t>& first_triangle, unsigned threads,
+                        std::vector<Primitive>& start) {
+  const DualGraph& graph = hierarchy.graph();
+  const HierarchyOptions& options = hierarchy.options();
+  const detail::ModelSelector selector(options);
+  const std::vector<DualEdge>& edges = graph.edges();
+  const auto changed_cluster = [&](std::uint32_t c) { return changed[c] ? c : kNone; };
+  const ClusterRows faces(changed.size(), labels.size(),
+                          [&](std::uint32_t f) { return changed_cluster(labels[f]); });
+  const ClusterRows inner_edges(changed.size(), edges.size(), [&](std::uint32_t e) {
+    const std::uint32_t c = labels[edges[e].first];
+    return c == labels[edges[e].second] ? changed_cluster(c) : kNone;
+  });
+  std::vector<std::uint32_t> clusters;
+  for (std::uint32_t c = 0; c < changed.size(); ++c)
+    if (changed[c]) clusters.push_back(c);
+  const auto penalty = [&](PrimitiveType t) { return options.type_penalty[static_cast<int>(t)]; };
+  threads = detail::thread_count(threads);
+  std::vector<ClusterStats> face(threads);
+  std::vector<FaceCorners> face_corners(threads);
+  detail::parallel_for_threads(clusters.size(), threads, [&](std::size_t i, unsigned thread) {
+    const std::uint32_t c = clusters[i];
+    const std::span<const std::uint32_t> members = faces.of(c);
+    // The moments are summed about the area-weighted mean of the triangles' centroids, near the
+    // cluster's centroid, corner by corner: translating every face's moments instead took twice
+    // the whole refinement's instructions.
+    Eigen::Vector3d weighted_centroids = Eigen::Vector3d::Zero();
+    double area = 0;
+    for (const std::uint32_t f : members)
+      for (std::uint32_t t = first_triangle[f]; t < first_triangle[f + 1]; ++t) {
+        const Triangle tri = graph.corners(t);
+        const double a = graph.triangle_area(t);
+        weighted_centroids +=
+            a * (graph.position(tri[0]) + graph.position(tri[1]) + graph.position(tri[2]));
+        area += 3 * a;
+      }
+    ClusterStats stats;
+    stats.moments =
+        Moments(area > 0 ? Eigen::Vector3d(weighted_centroids / area)
+                         : graph.position(graph.corners(first_triangle[members[0]])[0]));
+    for (const std::uint32_t f : members) {
+      // A face of more than FaceCorners::kMaxTriangles triangles by its moments.
+      if (graph.face_corners(f, face_corners[thread])) {
+        stats.add(face_corners[thread]);
+        if (!selector.needs_samples()) continue;
+        graph.face_stats(f, face[thread], true, 2);
+        stats.samples.merge(face[thread].samples);
+      } else {
+        graph.face_stats(f, face[thread], selector.needs_samples(), 4);
+        stats.merge(face[thread], EdgeStats{});
+      }
+    }
+    for (const std::uint32_t e : inner_edges.of(c)) stats.edges += edges[e].shared;
+    const ClusterStats centred = stats.centred();
+    const ClusterView cluster(centred);
+    // Working frame: the proposed fit and the cluster's own type fitted to the same faces.
+    const Primitive chosen = selector.select(cluster).fit.primitive;
+    if (chosen.type == start[c].type) return;
+    const PrimitiveFit own_fit = fitter_for(start[c].type).fit(cluster);
+    const Primitive last = detail::to_working(graph.frame(), start[c]);
+    double chosen_error = 0, own_error = 0, last_error = 0;
+    for (const std::uint32_t f : members) {
+      chosen_error += face_error(hierarchy, f, chosen, first_triangle);
+      if (own_fit.valid) own_error += face_error(hierarchy, f, own_fit.primitive, first_triangle);
+      last_error += face_error(hierarchy, f, last, first_triangle);
+    }
+    if (!own_fit.valid || last_error < own_error) own_error = last_error;
+    if (chosen_error * penalty(chosen.type) < own_error * penalty(start[c].type))
+      start[c] = graph.frame().to_input(chosen);
+  });
+}
+
 }  // namespace
 
 RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& segmentation,
@@ -307,8 +417,13 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
     for (std::uint32_t f : moves) origin[f] = labels[f], labels[f] = target[f];
     undo_splitting_moves(adjacency, initial_components, moves, origin, labels);
     if (moves.empty()) break;
+    // Each cluster's fit starts from its last one, or from another type that fits its faces
+    // better now.
     std::vector<Primitive> start(k);
     for (std::uint32_t c = 0; c < k; ++c) start[c] = result.reports[c].primitive;
+    std::vector<char> changed(k, 0);
+    for (std::uint32_t f : moves) changed[origin[f]] = changed[labels[f]] = 1;
+    choose_types_again(hierarchy, labels, changed, first_triangle, options.describe.threads, start);
     std::vector<ClusterReport> refitted =
         describe_clusters(hierarchy, result.segmentation, start, options.describe);
     // A face is judged over its flat triangles, which see what its corners cannot (the faces of

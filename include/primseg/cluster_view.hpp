@@ -62,6 +62,8 @@ class ClusterView {
  public:
   /// One cluster, with statistics centred at its centroid.
   explicit ClusterView(const ClusterStats& centred);
+  /// Not from a temporary, which would die before the view (`ClusterView v(s.centred());`).
+  explicit ClusterView(const ClusterStats&& centred) = delete;
   /// The union of two disjoint clusters (centred statistics or single faces' corners); `shared`
   /// holds the mesh edges between them.
   ClusterView(ClusterPart a, ClusterPart b, const EdgeStats& shared);

@@ -59,6 +59,9 @@ struct RefinedLevel {
 /// total error over their corners (Σ w d², what ClusterReport::rms measures) more than 5% above
 /// the cut's is undone and ends the refinement: over its flat triangles, a face of an exact but
 /// coarsely tessellated cylinder can look closer to a plane it meets at a shallow crease.
+/// After each pass, a cluster that gained or lost faces may change type: the type the tree's rule
+/// (every enabled type, the type penalties) chooses on its faces now, if that type also fits
+/// them better than its own by the face integral above, with the same penalties.
 /// Deterministic. Throws InvalidInputError for a segmentation of another mesh or a non-positive
 /// improvement factor.
 RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& segmentation,
