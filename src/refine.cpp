@@ -9,6 +9,7 @@
 #include <span>
 #include <string>
 
+#include "cluster_triangles.hpp"
 #include "face_adjacency.hpp"
 #include "geometric_models.hpp"
 #include "model_selection.hpp"
@@ -232,27 +233,6 @@ double total_squared_error(const Hierarchy& hierarchy, const std::vector<std::ui
   return sum;
 }
 
-// Compressed rows of items by cluster, for the clusters flagged in `changed`: cluster c's items
-// are item[offset[c]] .. item[offset[c + 1] - 1], in the order given.
-struct ClusterRows {
-  std::vector<std::uint32_t> offset, item;
-
-  template <typename ClusterOf>
-  ClusterRows(std::size_t clusters, std::size_t items, ClusterOf cluster_of)
-      : offset(clusters + 1, 0) {
-    for (std::uint32_t i = 0; i < items; ++i)
-      if (const std::uint32_t c = cluster_of(i); c != kNone) ++offset[c + 1];
-    std::partial_sum(offset.begin(), offset.end(), offset.begin());
-    item.resize(offset.back());
-    std::vector<std::uint32_t> next(offset.begin(), offset.end() - 1);
-    for (std::uint32_t i = 0; i < items; ++i)
-      if (const std::uint32_t c = cluster_of(i); c != kNone) item[next[c]++] = i;
-  }
-  std::span<const std::uint32_t> of(std::size_t c) const {
-    return {item.data() + offset[c], item.data() + offset[c + 1]};
-  }
-};
-
 // Chooses again the type of each cluster flagged in `changed`, on the faces it has now: the tree
 // chose it on the faces of the cluster's node, and a cluster that gained or lost faces may fit
 // another type better (a noisy chamfer merged with a few faces of the corner it bevels is typed a
@@ -275,53 +255,45 @@ void choose_types_again(const Hierarchy& hierarchy, const std::vector<std::uint3
   const HierarchyOptions& options = hierarchy.options();
   if (options.primitives.size() < 2) return;  // nothing to choose from
   const detail::ModelSelector selector(options);
-  const std::vector<DualEdge>& edges = graph.edges();
-  const auto changed_cluster = [&](std::uint32_t c) { return changed[c] ? c : kNone; };
-  const ClusterRows faces(changed.size(), labels.size(),
-                          [&](std::uint32_t f) { return changed_cluster(labels[f]); });
-  const ClusterRows inner_edges(changed.size(), edges.size(), [&](std::uint32_t e) {
-    const std::uint32_t c = labels[edges[e].first];
-    return c == labels[edges[e].second] ? changed_cluster(c) : kNone;
-  });
+  const auto k = static_cast<std::uint32_t>(changed.size());
+  const detail::ClusterTriangles triangles(hierarchy.mesh(), labels, k);
+  // The mesh edges inside each changed cluster, summed in the dual graph's order.
+  std::vector<EdgeStats> inner_edges(k);
+  for (const DualEdge& e : graph.edges())
+    if (labels[e.first] == labels[e.second] && changed[labels[e.first]])
+      inner_edges[labels[e.first]] += e.shared;
   std::vector<std::uint32_t> clusters;
-  for (std::uint32_t c = 0; c < changed.size(); ++c)
+  for (std::uint32_t c = 0; c < k; ++c)
     if (changed[c]) clusters.push_back(c);
   const auto penalty = [&](PrimitiveType t) { return options.type_penalty[static_cast<int>(t)]; };
   threads = detail::thread_count(threads);
   std::vector<ClusterStats> face(threads);
-  std::vector<FaceCorners> face_corners(threads);
+  std::vector<FaceCorners> corners(threads);
   detail::parallel_for_threads(clusters.size(), threads, [&](std::size_t i, unsigned thread) {
     const std::uint32_t c = clusters[i];
-    const std::span<const std::uint32_t> members = faces.of(c);
-    // The moments are summed corner by corner about the area-weighted mean of the triangles'
-    // centroids, near the cluster's centroid, rather than translating every face's own moments.
-    Eigen::Vector3d weighted_centroids = Eigen::Vector3d::Zero();
-    double area = 0;
-    for (const std::uint32_t f : members)
-      for (std::uint32_t t = first_triangle[f]; t < first_triangle[f + 1]; ++t) {
-        const Triangle tri = graph.corners(t);
-        const double a = graph.triangle_area(t);
-        weighted_centroids +=
-            a * (graph.position(tri[0]) + graph.position(tri[1]) + graph.position(tri[2]));
-        area += 3 * a;
-      }
+    // Its faces, ascending: a face's triangles are consecutive.
+    std::vector<std::uint32_t> members;
+    for (const std::uint32_t t : triangles.of(c))
+      if (const std::uint32_t f = hierarchy.mesh().face_of_triangle[t]; first_triangle[f] == t)
+        members.push_back(f);
+    // The moments are summed corner by corner about the first face's centroid, inside the
+    // cluster, rather than translating every face's own moments.
     ClusterStats stats;
-    stats.moments =
-        Moments(area > 0 ? Eigen::Vector3d(weighted_centroids / area)
-                         : graph.position(graph.corners(first_triangle[members[0]])[0]));
     for (const std::uint32_t f : members) {
       // A face of more than FaceCorners::kMaxTriangles triangles by its moments.
-      if (graph.face_corners(f, face_corners[thread])) {
-        stats.add(face_corners[thread]);
+      if (graph.face_corners(f, corners[thread])) {
+        if (f == members.front()) stats.moments = Moments(corners[thread].centroid);
+        stats.add(corners[thread]);
         if (!selector.needs_samples()) continue;
         graph.face_stats(f, face[thread], true, 2);
         stats.samples.merge(face[thread].samples);
       } else {
         graph.face_stats(f, face[thread], selector.needs_samples(), 4);
+        if (f == members.front()) stats.moments = Moments(face[thread].moments.origin());
         stats.merge(face[thread], EdgeStats{});
       }
     }
-    for (const std::uint32_t e : inner_edges.of(c)) stats.edges += edges[e].shared;
+    stats.edges += inner_edges[c];
     const ClusterStats centred = stats.centred();
     const ClusterView cluster(centred);
     // Working frame: the proposed fit and the cluster's own type fitted to the same faces.
