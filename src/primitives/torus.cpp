@@ -115,8 +115,8 @@ void draw_sample(const std::array<const SampleReservoir*, 2>& strata, const Eige
 
 // The normal lines' least squares over the axis (a, p × a), p × a eliminated: a's quadratic form
 // `reduced`, and how the moment follows from a. Nothing when the normals are (nearly) coplanar.
-// Each face's normal line is drawn through the sampled corner or, `through_centroids`, through
-// its face's centroid.
+// Each face's normal line is drawn through the sampled corner (axis_problem) or through its
+// face's centroid (through_centroids).
 struct AxisProblem {
   Eigen::Matrix3d reduced;
   Eigen::Matrix3d nn_inverse, cross_block;
@@ -125,27 +125,45 @@ struct AxisProblem {
   Eigen::Vector3d least_normal;
 };
 
-std::optional<AxisProblem> axis_problem(const TorusSample& sample, bool through_centroids) {
-  Eigen::Matrix<double, 6, 6> lines = Eigen::Matrix<double, 6, 6>::Zero();
+// The lines' part of `problem`, for normal lines through point(i); the normals' part (nn_inverse,
+// least_normal) is the same wherever the lines are drawn through.
+template <typename Point>
+void set_lines(const TorusSample& sample, const Point& point, AxisProblem& problem) {
+  Eigen::Matrix3d moments = Eigen::Matrix3d::Zero(), cross = Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < sample.n; ++i) {
-    Eigen::Matrix<double, 6, 1> l;
-    const Eigen::Vector3d through =
-        through_centroids ? Eigen::Vector3d(sample.positions[i] + sample.to_centroids[i])
-                          : sample.positions[i];
-    l << through.cross(sample.normals[i]), sample.normals[i];
-    lines.noalias() += sample.weights[i] * l * l.transpose();
+    const Eigen::Vector3d moment = point(i).cross(sample.normals[i]);
+    const Eigen::Vector3d weighted = sample.weights[i] * moment;
+    moments.noalias() += weighted * moment.transpose();
+    cross.noalias() += weighted * sample.normals[i].transpose();
   }
-  const Eigen::Matrix3d nn = lines.bottomRightCorner<3, 3>();
+  problem.cross_block = cross;
+  problem.reduced = moments - cross * problem.nn_inverse * cross.transpose();
+}
+
+std::optional<AxisProblem> axis_problem(const TorusSample& sample) {
+  Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < sample.n; ++i)
+    nn.noalias() += (sample.weights[i] * sample.normals[i]) * sample.normals[i].transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> normal_eigen(nn);
   if (!(normal_eigen.eigenvalues()(0) > kTorusMinNormalSpread * sample.weight)) return std::nullopt;
   AxisProblem problem;
   problem.nn_inverse = normal_eigen.eigenvectors() *
                        normal_eigen.eigenvalues().cwiseInverse().asDiagonal() *
                        normal_eigen.eigenvectors().transpose();
-  problem.cross_block = lines.topRightCorner<3, 3>();
-  problem.reduced = lines.topLeftCorner<3, 3>() -
-                    problem.cross_block * problem.nn_inverse * problem.cross_block.transpose();
   problem.least_normal = normal_eigen.eigenvectors().col(0);
+  set_lines(
+      sample, [&](std::size_t i) { return sample.positions[i]; }, problem);
+  return problem;
+}
+
+// `problem` with the normal lines through the faces' centroids instead of the corners.
+AxisProblem through_centroids(const TorusSample& sample, AxisProblem problem) {
+  set_lines(
+      sample,
+      [&](std::size_t i) -> Eigen::Vector3d {
+        return sample.positions[i] + sample.to_centroids[i];
+      },
+      problem);
   return problem;
 }
 
@@ -386,7 +404,7 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   if (sample.n <= kParameters + 1 || !(sample.weight > 0)) return result;
 
   // 1. The axis; 2. the tube's circle; 3. geometric refinement on the sample.
-  const std::optional<AxisProblem> problem = axis_problem(sample, false);
+  const std::optional<AxisProblem> problem = axis_problem(sample);
   if (!problem) return result;
   const Eigen::Vector3d first = best_axis(*problem);
   const auto [axis, on_axis] = axis_line(*problem, first);
@@ -402,10 +420,9 @@ PrimitiveFit TorusFitter::fit(const ClusterView& cluster, double /*error_to_beat
   // through the corners give the sampled fits the balance with the other types they were set on.
   if (about_first.tube || !(std::abs(first.dot(problem->least_normal)) >= kAlongLeastNormal))
     return about_first.fit;
-  const std::optional<AxisProblem> through_centroids = axis_problem(sample, true);
-  if (!through_centroids) return about_first.fit;
-  const Eigen::Vector3d second = best_axis_across_least_normal(*through_centroids);
-  const auto [second_axis, second_on_axis] = axis_line(*through_centroids, second);
+  const AxisProblem across = through_centroids(sample, *problem);
+  const Eigen::Vector3d second = best_axis_across_least_normal(across);
+  const auto [second_axis, second_on_axis] = axis_line(across, second);
   return fit_about_axis(sample, m, scale, second_axis, second_on_axis, true).fit;
 }
 
