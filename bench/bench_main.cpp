@@ -232,6 +232,16 @@ void register_benchmarks() {
   configure(benchmark::RegisterBenchmark("hierarchy_all_types/fandisk", hierarchy, "fandisk.off",
                                          all_types))
       ->Iterations(1);
+  // One thread against the default (all cores): whether the second core pays (it did not when a
+  // merge's few cheap candidates were shared between cores that share no cache).
+  HierarchyOptions one_thread;
+  one_thread.threads = 1;
+  configure(benchmark::RegisterBenchmark("hierarchy_one_thread/fandisk", hierarchy, "fandisk.off",
+                                         one_thread))
+      ->Iterations(1);
+  configure(benchmark::RegisterBenchmark("hierarchy_one_thread/bunny00", hierarchy, "bunny00.off",
+                                         one_thread))
+      ->Iterations(1);
   // The approximate merge order at the tolerance the CLI's help suggests.
   HierarchyOptions batched;
   batched.merge_batch_tolerance = 0.1;

@@ -98,6 +98,8 @@ rows = [
      "--shape box_with_hole 0.01"),
     ("fandisk.off, `exact_costs` (reference mode)", "hierarchy_exact_costs/fandisk/", None,
      "--cgal fandisk.off --exact-costs"),
+    ("fandisk.off, one thread (`--threads 1`)", "hierarchy_one_thread/fandisk/", None, None),
+    ("bunny00.off, one thread", "hierarchy_one_thread/bunny00/", None, None),
     ("fandisk.off, all five types (plane, cylinder, sphere, cone, torus)",
      "hierarchy_all_types/fandisk/", None, None),
     ("fandisk.off, `--merge-batch-tolerance 0.1` (approximate order)",
@@ -128,6 +130,7 @@ for label, hierarchy, read, mem in rows:
     notes.append(f"{label.split(',')[0].split(' (')[0]}"
                  f"{' exact' if 'exact' in hierarchy else ''}"
                  f"{' all types' if 'all_types' in hierarchy else ''}"
+                 f"{' one thread' if 'one_thread' in hierarchy else ''}"
                  f"{' batched' if 'batched' in hierarchy else ''}: CPU {ms(median, 'cpu_time'):,.0f} ms,"
                  f" CV {100 * cv['real_time']:.0f}%")
 

@@ -21,6 +21,9 @@ namespace {
 
 using detail::kNone;
 constexpr std::uint32_t kPairTag = 1u << 31;
+// Candidates evaluated at once from which they are shared among the threads even when each is
+// cheap (see evaluate_and_queue_batch()).
+constexpr std::size_t kParallelBatch = 32;
 
 // A candidate merge in the queue: the dual edge's id and its key. Candidates are ordered by
 // (cost, exactness, primitive type, merged degree, smaller node id, larger node id). On equal cost
@@ -280,6 +283,7 @@ class HierarchyBuilder::Impl {
       evaluated_at_.assign(dual_edges.size(), 0);
     }
     by_corners_ = !selector_.needs_samples();
+    share_merges_ = options_.exact_costs || !selector_.closed_form();
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
     // Every candidate's cost and first degree is independent of the others: all in parallel.
     // In chunks of consecutive edges: those of a face to its higher neighbours follow each other,
@@ -709,9 +713,10 @@ class HierarchyBuilder::Impl {
     const ClusterPart part_a = part_of(slot_a, scratch_[0], 0, 4);  // (part 0 first)
     const ClusterPart part_b = part_of(slot_b, scratch_[0], 1, 4);
     const ClusterView cluster(part_a, part_b, shared);
-    // Two independent jobs, on two threads when there are: the new cluster's edges, and its fit
-    // and statistics. (The type is known: only its fit is needed, and it has the candidate's cost
-    // exactly.)
+    // Two independent jobs: the new cluster's edges, and its fit and statistics (the type is
+    // known: only its fit is needed, and it has the candidate's cost exactly). On two threads
+    // only when a fit is costly; else in this order, so that what the new cluster's candidates
+    // will read arrives while its fit is computed.
     std::uint32_t head = kNone;
     detail::SelectedModel model;
     auto jobs = [&](std::size_t job, unsigned) {
@@ -727,7 +732,12 @@ class HierarchyBuilder::Impl {
         if (!(faces == 2 && pair_by_corners(triangles))) merged_ = cluster.stats(4);
       }
     };
-    pool_.run(2, jobs);
+    if (share_merges_) {
+      pool_.run(2, jobs);
+    } else {
+      jobs(0, 0u);
+      jobs(1, 0u);
+    }
     const std::uint32_t node = next_node();
 
     Merge record;
@@ -866,15 +876,21 @@ class HierarchyBuilder::Impl {
     evaluate_and_queue_batch([slot](std::size_t) { return slot; });
   }
 
-  // Evaluates the candidates in batch_ on all threads and queues them in order. A zero-cost
-  // candidate's merged degree is counted from the cluster in slot_of(i), the end that collected
-  // it (batch_ holds each slot's candidates in one run).
+  // Evaluates the candidates in batch_ (on all threads if they are many or costly) and queues
+  // them in order. A zero-cost candidate's merged degree is counted from the cluster in
+  // slot_of(i), the end that collected it (batch_ holds each slot's candidates in one run).
   template <class SlotOf>
   void evaluate_and_queue_batch(SlotOf slot_of) {
     auto evaluate_batch = [&](std::size_t i, unsigned thread) {
       batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
     };
-    pool_.run(batch_.size(), evaluate_batch);
+    // Cheap candidates go to other threads only in numbers (a batch of merge_batch_tolerance):
+    // on two cores that share no cache, sharing a merge's five or so made the build 30% slower
+    // than one thread (docs/method.md, "Threads in the merge loop").
+    if (share_merges_ || batch_.size() >= kParallelBatch)
+      pool_.run(batch_.size(), evaluate_batch);
+    else
+      for (std::size_t i = 0; i < batch_.size(); ++i) evaluate_batch(i, 0u);
     for (const QueuedCandidate& evaluated : batch_) queue_.prefetch_node(evaluated.id);
     std::uint32_t marked = kNone;
     for (std::size_t i = 0; i < batch_.size(); ++i) {
@@ -1013,6 +1029,7 @@ class HierarchyBuilder::Impl {
   std::vector<std::uint32_t> batch_slots_;  // close_batch(): the slot that collected batch_[i]
   double batch_limit_ = -1;                 // the open batch's largest cost; < 0: none open
   bool by_corners_ = false;                 // faces are read by their corners (see face_part())
+  bool share_merges_ = false;               // a merge's jobs on all threads: its fits are costly
   double max_penalty_ = 0;
 };
 

@@ -42,6 +42,7 @@ ModelSelector::ModelSelector(const HierarchyOptions& options) : options_(options
   for (PrimitiveType t : types) {
     fitters_.push_back(&fitter_for(t));
     needs_samples_ = needs_samples_ || fitters_.back()->needs_samples();
+    closed_form_ = closed_form_ && fitters_.back()->closed_form();
     if (t != PrimitiveType::Plane)
       min_curved_triangles_ = std::min(min_curved_triangles_, fitters_.back()->min_triangles());
   }

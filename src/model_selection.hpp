@@ -35,6 +35,8 @@ class ModelSelector {
   }
   /// Whether some enabled type reads ClusterStats::samples (DualGraph::face_stats must fill them).
   bool needs_samples() const { return needs_samples_; }
+  /// Whether every enabled type's fit is a closed form (PrimitiveFitter::closed_form).
+  bool closed_form() const { return closed_form_; }
   /// The model of a cluster or of the union of two (a merge candidate). `exact`: if given,
   /// replaces each fit's error by the exact one.
   SelectedModel select(const ClusterView& cluster, const ExactError* exact = nullptr) const;
@@ -53,6 +55,7 @@ class ModelSelector {
   std::vector<const PrimitiveFitter*> fitters_;  // ascending type
   std::uint32_t min_curved_triangles_ = UINT32_MAX;
   bool needs_samples_ = false;
+  bool closed_form_ = true;
   HierarchyOptions options_;
 };
 

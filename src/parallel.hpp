@@ -13,7 +13,7 @@
 namespace primseg::detail {
 
 /// Most threads one parallel loop uses. Results are the same for any count, and beyond this many
-/// threads only contend (a merge's batch holds about five jobs).
+/// threads only contend.
 inline constexpr unsigned kMaxThreads = 256;
 
 /// Threads to use for `requested` (0: all hardware threads), from 1 to kMaxThreads.

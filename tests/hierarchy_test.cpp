@@ -212,27 +212,34 @@ TEST(Hierarchy, SameInputGivesTheSameTreeBitForBit) {
   EXPECT_EQ(first, second);
 }
 
+// Both ways the merge loop uses threads: with closed-form types a merge's few jobs stay on the
+// calling thread (only the first evaluation and large sets are shared); with cones and tori every
+// merge's jobs are shared.
 TEST(Hierarchy, AnyThreadCountGivesTheSameTreeBitForBit) {
-  ShapeOptions options;
-  options.tessellation = Tessellation::Uniform;
-  options.edge_length = 0.02;  // about 10k faces: enough work for every thread
-  options.noise = 0.002;
-  options.random_motion = true;
-  const GroundTruthShape shape = make_shape("box_with_boss", options);
-  HierarchyOptions one_thread;
-  one_thread.threads = 1;
-  const std::string reference = serialize_tree(build_hierarchy(shape.mesh, one_thread));
-  for (unsigned threads : {2u, 3u, 0u}) {
-    HierarchyOptions parallel = one_thread;
-    parallel.threads = threads;
-    EXPECT_EQ(serialize_tree(build_hierarchy(shape.mesh, parallel)), reference) << threads;
-  }
-  // Threads the system refuses to start (a process limit): the work runs on the others.
-  const testing::RefuseNewThreads refused;
-  for (unsigned threads : {2u, 100000u}) {
-    HierarchyOptions parallel = one_thread;
-    parallel.threads = threads;
-    EXPECT_EQ(serialize_tree(build_hierarchy(shape.mesh, parallel)), reference) << threads;
+  for (const bool costly_fits : {false, true}) {
+    SCOPED_TRACE(costly_fits ? "every type" : "default types");
+    ShapeOptions options;
+    options.tessellation = Tessellation::Uniform;
+    // About 10k faces, enough work for every thread; 2.5k with the costly fits.
+    options.edge_length = costly_fits ? 0.04 : 0.02;
+    options.noise = 0.002;
+    options.random_motion = true;
+    const GroundTruthShape shape = make_shape("box_with_boss", options);
+    HierarchyOptions one_thread = costly_fits ? every_type() : HierarchyOptions{};
+    one_thread.threads = 1;
+    const std::string reference = serialize_tree(build_hierarchy(shape.mesh, one_thread));
+    for (unsigned threads : {2u, 3u, 0u}) {
+      HierarchyOptions parallel = one_thread;
+      parallel.threads = threads;
+      EXPECT_EQ(serialize_tree(build_hierarchy(shape.mesh, parallel)), reference) << threads;
+    }
+    // Threads the system refuses to start (a process limit): the work runs on the others.
+    const testing::RefuseNewThreads refused;
+    for (unsigned threads : {2u, 100000u}) {
+      HierarchyOptions parallel = one_thread;
+      parallel.threads = threads;
+      EXPECT_EQ(serialize_tree(build_hierarchy(shape.mesh, parallel)), reference) << threads;
+    }
   }
 }
 

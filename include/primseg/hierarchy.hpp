@@ -56,11 +56,14 @@ struct HierarchyOptions {
   /// (Euclidean distance to the same fitted primitive), as the paper's prototype computed it.
   /// Cost O(|A| + |B|) per candidate instead of O(1): for comparison only.
   bool exact_costs = false;
-  /// Threads for the parallel parts: the first evaluation of every candidate, and at each merge
-  /// the new cluster's candidates and its own fit (helper threads spin between merges, then
-  /// sleep once the loop ends); 0 uses all hardware threads. The tree is the same, bit for bit,
-  /// for any number of threads. On a machine already loaded by other processes one thread can
-  /// be the fastest. At most 256 threads are used, and fewer if the system refuses to start more
+  /// Threads for the parallel parts: the dual graph, the first evaluation of every candidate,
+  /// and in the merge loop each merge's candidates and own fit where fits are costly (cones,
+  /// tori, exact_costs), else only sets of 32 candidates or more (a batch of
+  /// merge_batch_tolerance, a merge that leaves a cluster with that many neighbours): a merge's
+  /// five or so cheap candidates are faster on the calling thread than handed to another core.
+  /// 0 uses all hardware threads. The tree is the same, bit for bit, for any
+  /// number of threads. On a machine already loaded by other processes one thread can be the
+  /// fastest. At most 256 threads are used, and fewer if the system refuses to start more
   /// (a process or memory limit): the work then runs on those that started. The same holds for
   /// the `threads` of every other options struct.
   unsigned threads = 0;

@@ -16,6 +16,7 @@ class ConeFitter final : public PrimitiveFitter {
   std::uint32_t min_triangles() const override;
   using PrimitiveFitter::fit;
   PrimitiveFit fit(const ClusterView& cluster, double error_to_beat) const override;
+  bool closed_form() const override { return false; }
 };
 
 }  // namespace primseg

@@ -59,6 +59,12 @@ class PrimitiveFitter {
   PrimitiveFit fit(const ClusterStats& centred) const { return fit(ClusterView(centred)); }
   /// Whether the fit reads ClusterStats::samples (then the engine keeps them, at a memory cost).
   virtual bool needs_samples() const { return false; }
+  /// Whether a fit is (nearly) a closed form of the statistics: a few small eigen-problems and
+  /// solves, about a microsecond (plane, sphere, cylinder), rather than an iterative solve of
+  /// tens of microseconds (cone, torus: Levenberg–Marquardt). Only where some enabled type is
+  /// iterative does the hierarchy share a merge's few candidates among threads: cheap ones cost
+  /// less on the calling thread than handed to another core.
+  virtual bool closed_form() const { return true; }
 };
 
 /// Curved fits must agree with the face normals (ClusterStats::normal_alignment at least this):
