@@ -9,6 +9,7 @@
 #include <tuple>
 #include <utility>
 
+#include "huge_pages.hpp"
 #include "no_index.hpp"
 #include "parallel.hpp"
 
@@ -97,7 +98,9 @@ SideBuckets bucket_sides(const Mesh& mesh) {
   const std::vector<std::size_t> high_offsets = high_cursor;
 
   // `high` of these holds the lower vertex.
-  std::vector<Side> by_high(high_offsets.back());
+  std::vector<Side> by_high;
+  detail::reserve_huge(by_high, high_offsets.back());
+  by_high.resize(high_offsets.back());
   const std::uint32_t triangle_count = mesh.triangle_count();
   for (std::uint32_t t = 0; t < triangle_count; ++t) {
     if (t + 2 * kAhead < triangle_count)
@@ -115,6 +118,7 @@ SideBuckets bucket_sides(const Mesh& mesh) {
   }
   std::vector<std::size_t>().swap(high_cursor);
 
+  detail::reserve_huge(buckets.sides, by_high.size());
   buckets.sides.resize(by_high.size());
   for (std::uint32_t high = 0; high < vertex_count; ++high)
     for (std::size_t s = high_offsets[high]; s < high_offsets[high + 1]; ++s) {
@@ -169,6 +173,7 @@ Links link_triangles(const Mesh& mesh, const SideBuckets& buckets,
                      const std::vector<std::uint32_t>& chunk_begin) {
   Links links;
   std::vector<TriangleSlots>& slots = links.slots;
+  detail::reserve_huge(slots, mesh.triangle_count());
   slots.resize(mesh.triangle_count());
   links.count.assign(chunk_begin.size() - 1, 0);
   links.internal.assign(chunk_begin.size() - 1, 0);
@@ -602,9 +607,9 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
   const std::size_t external =
       std::accumulate(links.count.begin(), links.count.end(), std::size_t{0}) -
       std::accumulate(links.internal.begin(), links.internal.end(), std::size_t{0});
-  edges_.reserve(external);
-  internal_edges_.reserve(
-      std::accumulate(links.internal.begin(), links.internal.end(), std::size_t{0}));
+  detail::reserve_huge(edges_, external);
+  detail::reserve_huge(internal_edges_, std::accumulate(links.internal.begin(),
+                                                        links.internal.end(), std::size_t{0}));
   const FaceLinks face_links(mesh, positions_, flipped_, first_triangle_, neighbours);
   std::vector<std::vector<DualEdge>> later_edges(chunk_count - 1);
   std::vector<std::vector<std::pair<std::uint32_t, EdgeStats>>> later_internal(chunk_count - 1);
@@ -614,8 +619,8 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
         std::vector<std::pair<std::uint32_t, EdgeStats>>& internal =
             chunk == 0 ? internal_edges_ : later_internal[chunk - 1];
         if (chunk > 0) {
-          edges.reserve(links.count[chunk] - links.internal[chunk]);
-          internal.reserve(links.internal[chunk]);
+          detail::reserve_huge(edges, links.count[chunk] - links.internal[chunk]);
+          detail::reserve_huge(internal, links.internal[chunk]);
         }
         face_links.add(chunk_face(chunk), chunk_face(chunk + 1), edges, internal);
       });

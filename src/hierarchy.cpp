@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "batch_pool.hpp"
+#include "huge_pages.hpp"
 #include "indexed_heap.hpp"
 #include "model_selection.hpp"
 #include "no_index.hpp"
@@ -246,8 +247,9 @@ class HierarchyBuilder::Impl {
     const std::uint32_t f = mesh_->face_count();
     // Statistics are stored for clusters of three faces or more only (at most F / 3 live at
     // once); a single face's or a pair's are recomputed when needed (see store_pair()).
-    stats_.reserve(f / 3 + 1);  // address space only: pages are touched as clusters form
-    merges_.reserve(f - 1);
+    detail::reserve_huge(stats_, f / 3 + 1);  // address space: touched as clusters form
+    detail::reserve_huge(merges_, f - 1);
+    detail::reserve_huge(slots_, f);
     slots_.resize(f);
     for (std::uint32_t face = 0; face < f; ++face)
       slots_[face] = {
@@ -264,9 +266,10 @@ class HierarchyBuilder::Impl {
     const std::vector<DualEdge>& dual_edges = graph_->edges();
     if (dual_edges.size() >= kPairTag)
       throw InvalidInputError("mesh too large: more than 2^31 pairs of adjacent faces");
-    edges_.reserve(dual_edges.size());
+    detail::reserve_huge(edges_, dual_edges.size());
     for (const DualEdge& e : dual_edges) edges_.push_back({e.first, e.second});
     // Each face's list in increasing edge id: prepend in decreasing order.
+    detail::reserve_huge(next_link_, 2 * dual_edges.size());
     next_link_.resize(2 * dual_edges.size());
     for (std::size_t id = dual_edges.size(); id-- > 0;)
       for (std::uint32_t side = 0; side < 2; ++side) {
@@ -288,7 +291,9 @@ class HierarchyBuilder::Impl {
     // Every candidate's cost and first degree is independent of the others: all in parallel.
     // In chunks of consecutive edges: those of a face to its higher neighbours follow each other,
     // and the face's statistics stay in the thread's cache.
-    std::vector<QueuedCandidate> candidates(edges_.size());
+    std::vector<QueuedCandidate> candidates;
+    detail::reserve_huge(candidates, edges_.size());
+    candidates.resize(edges_.size());
     constexpr std::size_t kChunk = 256;
     auto first_evaluation = [&](std::size_t chunk, unsigned thread) {
       const std::size_t end = std::min(edges_.size(), (chunk + 1) * kChunk);
@@ -300,6 +305,7 @@ class HierarchyBuilder::Impl {
     };
     pool_.run((edges_.size() + kChunk - 1) / kChunk, first_evaluation);
     evaluations_ = candidates.size();
+    detail::reserve_huge(queued_pairs_, edges_.size());
     queued_pairs_.resize(edges_.size());
     for (std::size_t id = 0; id < edges_.size(); ++id)
       queued_pairs_[id] = {dual_edges[id].first, dual_edges[id].second};  // faces: first < second

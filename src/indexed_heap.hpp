@@ -16,6 +16,8 @@
 #include <utility>
 #include <vector>
 
+#include "huge_pages.hpp"
+
 namespace primseg::detail {
 
 /// Node: a trivially copyable 16-byte type with a std::uint32_t member `id` below the id count.
@@ -33,8 +35,11 @@ class IndexedHeap {
       : storage_(static_cast<Node*>(::operator new(
             (std::size_t{id_count} + kArity - 1) * sizeof(Node), std::align_val_t(64)))),
         nodes_(storage_.get() + kArity - 1),
-        position_(id_count, kAbsent),
-        before_(std::move(before)) {}
+        before_(std::move(before)) {
+    advise_huge_pages(storage_.get(), (std::size_t{id_count} + kArity - 1) * sizeof(Node));
+    reserve_huge(position_, id_count);
+    position_.assign(id_count, kAbsent);
+  }
 
   /// Replaces the contents by `nodes` (distinct ids) in O(n).
   void assign(const std::vector<Node>& nodes) {

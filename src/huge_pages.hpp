@@ -1,0 +1,48 @@
+#pragma once
+// Transparent huge pages for the large arrays of a build.
+//
+// A mesh of a million faces touches about 200,000 pages of 4 KB, and each first touch is a page
+// fault: on a virtual machine about 7 µs each, 13% of bunny00's build. Where the kernel leaves
+// transparent huge pages to the program (/sys/kernel/mm/transparent_hugepage/enabled =
+// madvise, the usual default), an array asked for with madvise(MADV_HUGEPAGE) before its first
+// touch takes one fault per 2 MB instead of 512, and fewer TLB misses when read at random. The
+// advice changes no value: only where the memory comes from.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+namespace primseg::detail {
+
+/// Advises the kernel to back the 2 MB-aligned part of [data, data + bytes) with huge pages
+/// (Linux; elsewhere nothing). Only pages not yet touched are affected. Errors are ignored: the
+/// advice is an optimisation (kernels without THP refuse it).
+inline void advise_huge_pages(const void* data, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+  const auto begin = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t last = (begin + bytes) & ~(kHugePage - 1);
+  if (last <= first) return;
+  void* start = reinterpret_cast<void*>(first);  // NOLINT(performance-no-int-to-ptr)
+  madvise(start, last - first, MADV_HUGEPAGE);
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
+
+/// v.reserve(n), the storage past v's elements advised for huge pages (all of it for an empty
+/// vector, before anything is written to it).
+template <typename T>
+void reserve_huge(std::vector<T>& v, std::size_t n) {
+  if (n <= v.capacity()) return;
+  v.reserve(n);
+  advise_huge_pages(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
+}
+
+}  // namespace primseg::detail

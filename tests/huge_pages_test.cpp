@@ -1,0 +1,75 @@
+#include "huge_pages.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+namespace primseg::detail {
+namespace {
+
+TEST(HugePages, ReserveKeepsTheElementsAndMakesRoom) {
+  std::vector<std::uint64_t> empty;
+  reserve_huge(empty, 1u << 20);
+  EXPECT_GE(empty.capacity(), 1u << 20);
+  EXPECT_TRUE(empty.empty());
+
+  std::vector<std::uint64_t> values = {3, 1, 4, 1, 5};
+  reserve_huge(values, 1u << 20);
+  EXPECT_GE(values.capacity(), 1u << 20);
+  EXPECT_EQ(values, (std::vector<std::uint64_t>{3, 1, 4, 1, 5}));
+  const std::uint64_t* data = values.data();
+  reserve_huge(values, 10);  // already has room: the storage stays
+  EXPECT_EQ(values.data(), data);
+}
+
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+// The VmFlags of the mapping that holds `address`, from /proc/self/smaps.
+std::string vm_flags_at(const void* address) {
+  const auto a = reinterpret_cast<std::uintptr_t>(address);
+  std::ifstream smaps("/proc/self/smaps");
+  bool inside = false;
+  for (std::string line; std::getline(smaps, line);) {
+    std::uintptr_t begin = 0, end = 0;
+    char dash = 0;
+    std::istringstream range(line);
+    if (range >> std::hex >> begin >> dash >> end && dash == '-' &&
+        line.find(':') > line.find(' ')) {
+      inside = begin <= a && a < end;
+    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
+      return line;
+    }
+  }
+  return "";
+}
+
+// The advice reaches the 2 MB-aligned inside of a range and nothing outside it.
+TEST(HugePages, TheAlignedInsideOfARangeIsAdvised) {
+  if (!std::ifstream("/sys/kernel/mm/transparent_hugepage/enabled"))
+    GTEST_SKIP() << "no transparent huge pages in this kernel";
+  constexpr std::size_t kHuge = std::size_t{2} << 20;
+  void* block =
+      mmap(nullptr, 4 * kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(block, MAP_FAILED);
+  const auto base = reinterpret_cast<std::uintptr_t>(block);
+  const std::uintptr_t aligned = (base + kHuge - 1) & ~(kHuge - 1);
+  // A range that starts 100 bytes before an aligned address and ends 100 bytes after the next.
+  auto* begin = reinterpret_cast<char*>(aligned - 100);  // NOLINT(performance-no-int-to-ptr)
+  advise_huge_pages(begin, kHuge + 200);
+  EXPECT_NE(vm_flags_at(begin + 100).find(" hg"), std::string::npos) << vm_flags_at(begin + 100);
+  EXPECT_NE(vm_flags_at(begin + 100 + kHuge - 1).find(" hg"), std::string::npos);
+  EXPECT_EQ(vm_flags_at(begin + 99).find(" hg"), std::string::npos) << vm_flags_at(begin + 99);
+  EXPECT_EQ(vm_flags_at(begin + 100 + kHuge).find(" hg"), std::string::npos);
+  munmap(block, 4 * kHuge);
+}
+#endif
+
+}  // namespace
+}  // namespace primseg::detail
