@@ -99,8 +99,7 @@ SideBuckets bucket_sides(const Mesh& mesh) {
 
   // `high` of these holds the lower vertex.
   std::vector<Side> by_high;
-  detail::reserve_huge(by_high, high_offsets.back());
-  by_high.resize(high_offsets.back());
+  detail::resize_huge(by_high, high_offsets.back());
   const std::uint32_t triangle_count = mesh.triangle_count();
   for (std::uint32_t t = 0; t < triangle_count; ++t) {
     if (t + 2 * kAhead < triangle_count)
@@ -118,8 +117,7 @@ SideBuckets bucket_sides(const Mesh& mesh) {
   }
   std::vector<std::size_t>().swap(high_cursor);
 
-  detail::reserve_huge(buckets.sides, by_high.size());
-  buckets.sides.resize(by_high.size());
+  detail::resize_huge(buckets.sides, by_high.size());
   for (std::uint32_t high = 0; high < vertex_count; ++high)
     for (std::size_t s = high_offsets[high]; s < high_offsets[high + 1]; ++s) {
       if (s + 2 * kAhead < by_high.size())
@@ -173,8 +171,7 @@ Links link_triangles(const Mesh& mesh, const SideBuckets& buckets,
                      const std::vector<std::uint32_t>& chunk_begin) {
   Links links;
   std::vector<TriangleSlots>& slots = links.slots;
-  detail::reserve_huge(slots, mesh.triangle_count());
-  slots.resize(mesh.triangle_count());
+  detail::resize_huge(slots, mesh.triangle_count());
   links.count.assign(chunk_begin.size() - 1, 0);
   links.internal.assign(chunk_begin.size() - 1, 0);
   const bool polygons = mesh.face_count() != mesh.triangle_count();

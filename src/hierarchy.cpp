@@ -249,8 +249,7 @@ class HierarchyBuilder::Impl {
     // once); a single face's or a pair's are recomputed when needed (see store_pair()).
     detail::reserve_huge(stats_, f / 3 + 1);  // address space: touched as clusters form
     detail::reserve_huge(merges_, f - 1);
-    detail::reserve_huge(slots_, f);
-    slots_.resize(f);
+    detail::resize_huge(slots_, f);
     for (std::uint32_t face = 0; face < f; ++face)
       slots_[face] = {
           face, kNone, 1,     graph_->first_triangle(face + 1) - graph_->first_triangle(face),
@@ -269,8 +268,7 @@ class HierarchyBuilder::Impl {
     detail::reserve_huge(edges_, dual_edges.size());
     for (const DualEdge& e : dual_edges) edges_.push_back({e.first, e.second});
     // Each face's list in increasing edge id: prepend in decreasing order.
-    detail::reserve_huge(next_link_, 2 * dual_edges.size());
-    next_link_.resize(2 * dual_edges.size());
+    detail::resize_huge(next_link_, 2 * dual_edges.size());
     for (std::size_t id = dual_edges.size(); id-- > 0;)
       for (std::uint32_t side = 0; side < 2; ++side) {
         const std::uint32_t face = side == 0 ? dual_edges[id].first : dual_edges[id].second;
@@ -292,8 +290,7 @@ class HierarchyBuilder::Impl {
     // In chunks of consecutive edges: those of a face to its higher neighbours follow each other,
     // and the face's statistics stay in the thread's cache.
     std::vector<QueuedCandidate> candidates;
-    detail::reserve_huge(candidates, edges_.size());
-    candidates.resize(edges_.size());
+    detail::resize_huge(candidates, edges_.size());
     constexpr std::size_t kChunk = 256;
     auto first_evaluation = [&](std::size_t chunk, unsigned thread) {
       const std::size_t end = std::min(edges_.size(), (chunk + 1) * kChunk);
@@ -305,8 +302,7 @@ class HierarchyBuilder::Impl {
     };
     pool_.run((edges_.size() + kChunk - 1) / kChunk, first_evaluation);
     evaluations_ = candidates.size();
-    detail::reserve_huge(queued_pairs_, edges_.size());
-    queued_pairs_.resize(edges_.size());
+    detail::resize_huge(queued_pairs_, edges_.size());
     for (std::size_t id = 0; id < edges_.size(); ++id)
       queued_pairs_[id] = {dual_edges[id].first, dual_edges[id].second};  // faces: first < second
     queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{&queued_pairs_});

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <fstream>
 #include <sstream>
@@ -15,7 +16,7 @@
 namespace primseg::detail {
 namespace {
 
-TEST(HugePages, ReserveKeepsTheElementsAndMakesRoom) {
+TEST(HugePages, ReserveAndResizeKeepTheElementsAndMakeRoom) {
   std::vector<std::uint64_t> empty;
   reserve_huge(empty, 1u << 20);
   EXPECT_GE(empty.capacity(), 1u << 20);
@@ -28,6 +29,11 @@ TEST(HugePages, ReserveKeepsTheElementsAndMakesRoom) {
   const std::uint64_t* data = values.data();
   reserve_huge(values, 10);  // already has room: the storage stays
   EXPECT_EQ(values.data(), data);
+
+  std::vector<std::uint32_t> zeros;
+  resize_huge(zeros, 3u << 20);
+  ASSERT_EQ(zeros.size(), 3u << 20);
+  EXPECT_TRUE(std::all_of(zeros.begin(), zeros.end(), [](std::uint32_t z) { return z == 0; }));
 }
 
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
