@@ -7,8 +7,8 @@
 // stay awake while batches follow each other and release their core once the loop ends. Each
 // job is claimed with an atomic operation on a line the caller also writes, about 130 ns when the
 // threads run on cores that share no cache: batches of a few short jobs are faster on the
-// caller alone (HierarchyBuilder shares a merge's five or so candidates only when their fits
-// are costly).
+// caller alone (run()'s parallel_from; HierarchyBuilder shares a merge's five or so candidates
+// only when their fits are costly).
 //
 // The caller never waits for a helper to show up: jobs are claimed one at a time from a cursor
 // tagged with the batch's number, the caller claims them too, and it waits only for jobs a helper
@@ -19,6 +19,7 @@
 // Each job's result must not depend on which thread runs it; callers write results to distinct
 // slots and apply them in order afterwards, so the outcome is the same for any thread count.
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstddef>
@@ -59,10 +60,12 @@ class BatchPool {
   /// Calls job(i, thread) for every i in [0, count) (count < 2^32) and returns when all calls
   /// have returned; `thread` in [0, thread_count()) names the calling thread (0: the caller), for
   /// per-thread scratch space. The first exception a job throws is rethrown here once all are
-  /// done. Not reentrant: one caller at a time.
+  /// done. Batches of fewer than `parallel_from` jobs (at least 2) run on the caller alone, in
+  /// order: for short jobs the hand-off costs more than it saves. Not reentrant: one caller at a
+  /// time.
   template <typename Job>
-  void run(std::size_t count, Job& job) {
-    if (helpers_.empty() || count < 2) {
+  void run(std::size_t count, Job& job, std::size_t parallel_from = 2) {
+    if (helpers_.empty() || count < std::max<std::size_t>(parallel_from, 2)) {
       for (std::size_t i = 0; i < count; ++i) job(i, 0u);
       return;
     }

@@ -23,7 +23,7 @@ namespace {
 using detail::kNone;
 constexpr std::uint32_t kPairTag = 1u << 31;
 // Candidates evaluated at once from which they are shared among the threads even when each is
-// cheap (see evaluate_and_queue_batch()).
+// cheap (see parallel_from_).
 constexpr std::size_t kParallelBatch = 32;
 
 // A candidate merge in the queue: the dual edge's id and its key. Candidates are ordered by
@@ -284,7 +284,10 @@ class HierarchyBuilder::Impl {
       evaluated_at_.assign(dual_edges.size(), 0);
     }
     by_corners_ = !selector_.needs_samples();
-    share_merges_ = options_.exact_costs || !selector_.closed_form();
+    // A merge's own jobs are shared only when its fits are costly; cheap ones only in numbers (a
+    // batch of merge_batch_tolerance): on two cores that share no cache, sharing a merge's five or
+    // so made the build 30% slower than one thread (docs/method.md, "Threads in the merge loop").
+    parallel_from_ = options_.exact_costs || !selector_.closed_form() ? 2 : kParallelBatch;
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
     // Every candidate's cost and first degree is independent of the others: all in parallel.
     // In chunks of consecutive edges: those of a face to its higher neighbours follow each other,
@@ -734,12 +737,7 @@ class HierarchyBuilder::Impl {
         if (!(faces == 2 && pair_by_corners(triangles))) merged_ = cluster.stats(4);
       }
     };
-    if (share_merges_) {
-      pool_.run(2, jobs);
-    } else {
-      jobs(0, 0u);
-      jobs(1, 0u);
-    }
+    pool_.run(2, jobs, parallel_from_);
     const std::uint32_t node = next_node();
 
     Merge record;
@@ -886,13 +884,7 @@ class HierarchyBuilder::Impl {
     auto evaluate_batch = [&](std::size_t i, unsigned thread) {
       batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
     };
-    // Cheap candidates go to other threads only in numbers (a batch of merge_batch_tolerance):
-    // on two cores that share no cache, sharing a merge's five or so made the build 30% slower
-    // than one thread (docs/method.md, "Threads in the merge loop").
-    if (share_merges_ || batch_.size() >= kParallelBatch)
-      pool_.run(batch_.size(), evaluate_batch);
-    else
-      for (std::size_t i = 0; i < batch_.size(); ++i) evaluate_batch(i, 0u);
+    pool_.run(batch_.size(), evaluate_batch, parallel_from_);
     for (const QueuedCandidate& evaluated : batch_) queue_.prefetch_node(evaluated.id);
     std::uint32_t marked = kNone;
     for (std::size_t i = 0; i < batch_.size(); ++i) {
@@ -1031,7 +1023,7 @@ class HierarchyBuilder::Impl {
   std::vector<std::uint32_t> batch_slots_;  // close_batch(): the slot that collected batch_[i]
   double batch_limit_ = -1;                 // the open batch's largest cost; < 0: none open
   bool by_corners_ = false;                 // faces are read by their corners (see face_part())
-  bool share_merges_ = false;               // a merge's jobs on all threads: its fits are costly
+  std::size_t parallel_from_ = 2;           // merge loop: jobs from which a batch is shared
   double max_penalty_ = 0;
 };
 

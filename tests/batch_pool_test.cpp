@@ -34,6 +34,25 @@ TEST(BatchPool, RunsEveryJobOnceForAnyBatchSizeAndThreadCount) {
   }
 }
 
+// Below parallel_from a batch runs on the caller alone, in order; from it, on any thread.
+TEST(BatchPool, ABatchSmallerThanParallelFromRunsOnTheCallerInOrder) {
+  BatchPool pool(2);
+  std::vector<std::size_t> order;
+  bool only_caller = true;
+  auto job = [&](std::size_t i, unsigned thread) {
+    order.push_back(i);
+    only_caller = only_caller && thread == 0;
+  };
+  pool.run(31, job, 32);
+  EXPECT_TRUE(only_caller);
+  ASSERT_EQ(order.size(), 31u);
+  for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], i);
+  std::vector<std::atomic<int>> runs(32);
+  auto counted = [&](std::size_t i, unsigned) { runs[i].fetch_add(1); };
+  pool.run(32, counted, 32);
+  for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].load(), 1) << i;
+}
+
 TEST(BatchPool, ManySmallBatchesInARow) {
   BatchPool pool(2);
   std::vector<double> results(6);
