@@ -4,8 +4,9 @@
 //   primseg_bench_memory --cgal NAME [OPTIONS]            (a libcgal-demo mesh, e.g. fandisk.off)
 //   primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]  (generated, Uniform tessellation)
 //
-// OPTIONS: --exact-costs, --threads N (HierarchyOptions::threads, default 0: all), and
-// --merge-batch-tolerance T (default 0: the exact order).
+// OPTIONS: --exact-costs, --threads N (HierarchyOptions::threads, default 0: all),
+// --merge-batch-tolerance T (default 0: the exact order), and --read-only (read the input, print
+// read_seconds, build nothing; bench/read_speed.sh).
 //
 // Prints one line of key=value pairs:
 //   faces             input faces F
@@ -18,6 +19,9 @@
 //                     build_hierarchy does), destroying the tree included
 //   evaluations       candidate evaluations of the build (HierarchyBuilder::evaluation_count())
 //   evaluations_per_face  evaluations / F
+//   read_seconds      wall-clock time of read_mesh, in this fresh process (a mesh file only; 0
+//                     for a generated shape), page faults of its arrays included as a user meets
+//                     them
 // One build per process, so that ru_maxrss is this build's peak and nothing else's. The build is
 // the function build_and_destroy_tree alone, so that bench/instructions.sh can count its
 // instructions (valgrind --toggle-collect) without reading or generating the input.
@@ -43,7 +47,7 @@ int usage() {
                "usage: primseg_bench_memory MESH_FILE [OPTIONS]\n"
                "       primseg_bench_memory --cgal NAME [OPTIONS]\n"
                "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
-               "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T\n");
+               "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T --read-only\n");
   return 2;
 }
 
@@ -73,9 +77,12 @@ int run(int argc, char** argv) {
   std::string source, name;
   double edge_length = 0.01;
   HierarchyOptions options;
+  bool read_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--exact-costs") {
+    if (arg == "--read-only") {
+      read_only = true;
+    } else if (arg == "--exact-costs") {
       options.exact_costs = true;
     } else if (arg == "--threads" && i + 1 < argc) {
       const double threads = number(arg, argv[++i]);
@@ -100,16 +107,26 @@ int run(int argc, char** argv) {
 
   const std::size_t baseline = bench::current_rss_bytes();
   std::shared_ptr<const Mesh> mesh;
+  double read_seconds = 0;
   if (source == "--shape") {
     ShapeOptions shape_options;
     shape_options.tessellation = Tessellation::Uniform;
     shape_options.edge_length = edge_length;
     mesh = std::make_shared<const Mesh>(make_shape(name, shape_options).mesh);
   } else {
-    mesh = std::make_shared<const Mesh>(
-        read_mesh(source == "--cgal" ? bench::cgal_mesh(name) : std::filesystem::path(name)));
+    const std::filesystem::path path =
+        source == "--cgal" ? bench::cgal_mesh(name) : std::filesystem::path(name);
+    const auto read_start = std::chrono::steady_clock::now();
+    mesh = std::make_shared<const Mesh>(read_mesh(path));
+    read_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
   }
   const std::size_t input = bench::current_rss_bytes();
+  if (read_only) {
+    std::printf("input=%s faces=%u read_seconds=%.4f\n", name.c_str(), mesh->face_count(),
+                read_seconds);
+    return 0;
+  }
 
   const auto start = std::chrono::steady_clock::now();
   const BuildFigures build = build_and_destroy_tree(mesh, options);
@@ -121,12 +138,12 @@ int run(int argc, char** argv) {
   std::printf(
       "input=%s faces=%u merges=%zu baseline_rss=%zu input_rss=%zu peak_rss=%zu "
       "bytes_per_face=%.0f hierarchy_bytes_per_face=%.0f build_seconds=%.3f evaluations=%llu "
-      "evaluations_per_face=%.3f\n",
+      "evaluations_per_face=%.3f read_seconds=%.4f\n",
       name.c_str(), mesh->face_count(), build.merges, baseline, input, peak,
       static_cast<double>(peak) / faces,
       static_cast<double>(peak > input ? peak - input : 0) / faces, seconds,
       static_cast<unsigned long long>(build.evaluations),
-      static_cast<double>(build.evaluations) / faces);
+      static_cast<double>(build.evaluations) / faces, read_seconds);
   return 0;
 }
 

@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 
+#include "huge_pages.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg::detail {
@@ -68,6 +69,7 @@ FileImage read_to_end(int fd, const std::filesystem::path& name, bool sized, std
   const std::uint64_t largest_buffer = most == UINT64_MAX ? most : most + 1;
   std::size_t capacity = static_cast<std::size_t>(std::min(expected + 1, largest_buffer));
   FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
+  advise_huge_pages(image.bytes.get(), capacity);
   while (true) {
     if (image.size > limits.max_bytes)
       throw InvalidInputError(name.string() + ": more than " + limit_phrase(limits));
@@ -85,6 +87,7 @@ FileImage read_to_end(int fd, const std::filesystem::path& name, bool sized, std
       const std::size_t grown = static_cast<std::size_t>(
           std::min<std::uint64_t>(capacity + capacity / 2 + 4096, largest_buffer));
       auto larger = std::make_unique_for_overwrite<char[]>(grown);
+      advise_huge_pages(larger.get(), grown);
       std::memcpy(larger.get(), image.bytes.get(), image.size);
       image.bytes = std::move(larger);
       capacity = grown;

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -13,6 +14,7 @@
 #include "indexed_heap.hpp"
 #include "model_selection.hpp"
 #include "no_index.hpp"
+#include "page_warmer.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "tree_check.hpp"
@@ -311,6 +313,12 @@ class HierarchyBuilder::Impl {
     queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{&queued_pairs_});
     queue_.assign(candidates);
     total_merges_ = f - graph_->component_count();
+    // The loop is the first to write the merge records and the statistics pool; with a second
+    // thread allowed, their pages are faulted in ahead of it (see page_warmer.hpp).
+    if (pool_.thread_count() >= 2 && merges_.capacity() * sizeof(Merge) >= kWarmFrom)
+      warmer_.start({{merges_.data(), merges_.capacity() * sizeof(Merge), &merges_used_},
+                     {stats_.data(), stats_.capacity() * sizeof(ClusterStats), &stats_used_}},
+                    kWarmLead);
   }
 
   bool step() {
@@ -583,6 +591,7 @@ class HierarchyBuilder::Impl {
       if (free_stats_.empty()) {
         index = static_cast<std::uint32_t>(stats_.size());
         stats_.push_back(std::move(stats));
+        stats_used_.store(stats_.size() * sizeof(ClusterStats), std::memory_order_relaxed);
         return;
       }
       index = free_stats_.back();
@@ -749,6 +758,7 @@ class HierarchyBuilder::Impl {
     record.face_count = faces;
     record.primitive = graph_->frame().to_input(model.fit.primitive);
     merges_.push_back(record);
+    merges_used_.store(merges_.size() * sizeof(Merge), std::memory_order_relaxed);
     max_cost_ = std::max(max_cost_, model.cost);
 
     keep_merged(slot_a, slot_b, edge_id, faces, triangles, node);
@@ -933,6 +943,7 @@ class HierarchyBuilder::Impl {
   // What only the merge loop needs (about two thirds of the peak memory) is freed before the
   // caller goes on with the tree.
   void release_working_memory() {
+    warmer_.stop();  // before the storage it warms goes
     auto release = [](auto& vector) { std::decay_t<decltype(vector)>().swap(vector); };
     release(stats_);
     release(free_stats_);
@@ -1025,6 +1036,12 @@ class HierarchyBuilder::Impl {
   bool by_corners_ = false;                 // faces are read by their corners (see face_part())
   std::size_t parallel_from_ = 2;           // merge loop: jobs from which a batch is shared
   double max_penalty_ = 0;
+  // Bytes of merges_ and stats_ in use, for warmer_, which faults their next pages in ahead of
+  // the loop when merges_ takes kWarmFrom bytes or more (about 65,000 faces), kWarmLead ahead.
+  static constexpr std::size_t kWarmFrom = std::size_t{8} << 20;
+  static constexpr std::size_t kWarmLead = std::size_t{4} << 20;
+  std::atomic<std::size_t> merges_used_{0}, stats_used_{0};
+  detail::PageWarmer warmer_;  // last: stopped before the arrays it warms are destroyed
 };
 
 HierarchyBuilder::HierarchyBuilder(std::shared_ptr<const Mesh> mesh, HierarchyOptions options)

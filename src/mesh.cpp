@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "huge_pages.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg {
@@ -407,8 +408,8 @@ Mesh Mesh::from_polygons(std::vector<Vec3> positions, std::vector<std::uint32_t>
   mesh.polygon_vertices = std::move(vertices);
   const std::uint32_t faces = mesh.face_count();
   const std::size_t triangle_estimate = mesh.polygon_vertices.size() - 2 * std::size_t{faces};
-  mesh.triangles.reserve(triangle_estimate);
-  mesh.face_of_triangle.reserve(triangle_estimate);
+  detail::reserve_huge(mesh.triangles, triangle_estimate);
+  detail::reserve_huge(mesh.face_of_triangle, triangle_estimate);
 
   EarClipper clipper;
   const std::uint32_t* corners = mesh.polygon_vertices.data();
@@ -435,9 +436,11 @@ Mesh Mesh::from_triangles(std::vector<Vec3> positions, std::vector<Triangle> tri
   }
   Mesh mesh;
   // A fresh vector, not a resize of the default {0}: g++ 12 warns falsely about the latter.
-  mesh.polygon_offsets = std::vector<std::uint32_t>(triangles.size() + 1, 0);
-  mesh.polygon_vertices.reserve(3 * triangles.size());
-  mesh.face_of_triangle.resize(triangles.size());
+  std::vector<std::uint32_t> offsets;
+  detail::resize_huge(offsets, triangles.size() + 1);
+  mesh.polygon_offsets = std::move(offsets);
+  detail::reserve_huge(mesh.polygon_vertices, 3 * triangles.size());
+  detail::resize_huge(mesh.face_of_triangle, triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
     for (std::uint32_t corner : triangles[t]) {
       if (corner >= positions.size()) {

@@ -61,7 +61,9 @@ struct HierarchyOptions {
   /// tori, exact_costs), else only sets of 32 candidates or more (a batch of
   /// merge_batch_tolerance, a merge that leaves a cluster with that many neighbours): a merge's
   /// five or so cheap candidates are faster on the calling thread than handed to another core.
-  /// 0 uses all hardware threads. The tree is the same, bit for bit, for any number of threads.
+  /// With two or more, and from about 65,000 faces, one more thread faults in the pages the merge
+  /// loop is about to write for the first time (Linux; mostly asleep). 0 uses all hardware
+  /// threads. The tree is the same, bit for bit, for any number of threads.
   /// On a machine already loaded by other processes one thread can be the fastest. At most 256
   /// threads are used, and fewer if the system refuses to start more (a process or memory limit):
   /// the work then runs on those that started. The same holds for the `threads` of every other

@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "huge_pages.hpp"
 #include "readers.hpp"
 #include "text_scanner.hpp"
 
@@ -59,9 +60,9 @@ class ObjReader {
       const void* newline = std::memchr(line, '\n', static_cast<std::size_t>(end - line));
       line = newline == nullptr ? end : static_cast<const char*>(newline) + 1;
     }
-    soup_.positions.reserve(vertices);
-    soup_.offsets.reserve(faces + 1);
-    soup_.vertices.reserve(3 * faces);
+    detail::reserve_huge(soup_.positions, vertices);
+    detail::reserve_huge(soup_.offsets, faces + 1);
+    detail::reserve_huge(soup_.vertices, 3 * faces);
   }
 
   void read_vertex() {

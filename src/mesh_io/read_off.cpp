@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "huge_pages.hpp"
 #include "readers.hpp"
 #include "text_scanner.hpp"
 
@@ -84,7 +85,7 @@ OffCounts read_off_header(TextScanner& in) {
 }
 
 void read_off_vertices(TextScanner& in, std::int64_t vertex_count, std::vector<Vec3>& positions) {
-  positions.resize(static_cast<std::size_t>(vertex_count));
+  detail::resize_huge(positions, static_cast<std::size_t>(vertex_count));
   for (std::int64_t v = 0; v < vertex_count; ++v) {
     Vec3& position = positions[static_cast<std::size_t>(v)];
     for (double& coordinate : position) {
@@ -104,8 +105,8 @@ void read_off_vertices(TextScanner& in, std::int64_t vertex_count, std::vector<V
 }
 
 void read_off_faces(TextScanner& in, const OffCounts& counts, PolygonSoup& soup) {
-  soup.offsets.reserve(static_cast<std::size_t>(counts.faces) + 1);
-  soup.vertices.reserve(3 * static_cast<std::size_t>(counts.faces));
+  detail::reserve_huge(soup.offsets, static_cast<std::size_t>(counts.faces) + 1);
+  detail::reserve_huge(soup.vertices, 3 * static_cast<std::size_t>(counts.faces));
   const auto vertex_limit = static_cast<std::uint64_t>(counts.vertices);
   for (std::int64_t f = 0; f < counts.faces; ++f) {
     std::int64_t size = 0;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "binary_reader.hpp"
+#include "huge_pages.hpp"
 #include "readers.hpp"
 #include "text_scanner.hpp"
 
@@ -255,10 +256,10 @@ class PlyReader {
       }
       needed += element.count * min_record;
     }
-    soup_.positions.resize(static_cast<std::size_t>(vertex_count_));
+    detail::resize_huge(soup_.positions, static_cast<std::size_t>(vertex_count_));
     const auto faces = static_cast<std::size_t>(elements_[*face_element_].count);
-    soup_.offsets.reserve(faces + 1);
-    soup_.vertices.reserve(3 * faces);
+    detail::reserve_huge(soup_.offsets, faces + 1);
+    detail::reserve_huge(soup_.vertices, 3 * faces);
   }
 
   // ---- Ascii body ------------------------------------------------------------------------

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "binary_reader.hpp"
+#include "huge_pages.hpp"
 #include "readers.hpp"
 #include "text_scanner.hpp"
 
@@ -23,10 +24,15 @@ constexpr std::size_t kTriangleBytes = 50;  // Normal, 3 corners (12 floats) and
 class VertexWelder {
  public:
   explicit VertexWelder(std::size_t expected_corners) {
+    // A closed mesh has about one vertex per 6 corners; a soup of separate triangles (one per
+    // corner) grows the table as it fills. A table sized for the corners would be 12 times
+    // larger than needed, and its random probes would miss the caches far more often.
+    const std::size_t expected_vertices = expected_corners / 6 + 4;
     std::size_t capacity = 16;
-    while (capacity < 2 * expected_corners) capacity *= 2;
-    slots_.assign(capacity, kEmpty);
-    positions_.reserve(expected_corners / 2 + 4);
+    while (capacity < 2 * expected_vertices) capacity *= 2;
+    detail::resize_huge(slots_, capacity);
+    std::fill(slots_.begin(), slots_.end(), kEmpty);
+    detail::reserve_huge(positions_, expected_vertices);
   }
 
   std::uint32_t add(const Vec3& position) {
@@ -115,7 +121,8 @@ Mesh read_binary_stl(std::span<const char> bytes, std::string_view file_name) {
                ErrorKind::InvalidInput);
   }
   VertexWelder welder(3 * std::size_t{count});
-  std::vector<Triangle> triangles(count);
+  std::vector<Triangle> triangles;
+  detail::resize_huge(triangles, count);
   const char* data = bytes.data();
   for (std::uint32_t t = 0; t < count; ++t) {
     const std::size_t corners = kPreambleBytes + std::size_t{t} * kTriangleBytes + 12;

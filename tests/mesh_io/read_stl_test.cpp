@@ -97,6 +97,19 @@ TEST(ReadStl, WeldingUsesExactCoordinates) {
   EXPECT_EQ(mesh.triangles[1], (Triangle{3, 4, 2}));
 }
 
+/// A soup of `triangles` triangles whose corners t, k are at (t, k, 0) and then the first again:
+/// a vertex per corner, in order, and the last triangle welded onto the first.
+void expect_separate_triangles_then_the_first(const Mesh& mesh, std::uint32_t triangles) {
+  ASSERT_EQ(mesh.vertex_count(), 3 * triangles);
+  ASSERT_EQ(mesh.face_count(), triangles + 1);
+  for (std::uint32_t t = 0; t < triangles; ++t) {
+    EXPECT_EQ(mesh.triangles[t], (Triangle{3 * t, 3 * t + 1, 3 * t + 2}));
+    for (std::uint32_t k = 0; k < 3; ++k)
+      EXPECT_EQ(mesh.positions[3 * t + k], (Vec3{double(t), double(k), 0}));
+  }
+  EXPECT_EQ(mesh.triangles[triangles], (Triangle{0, 1, 2}));
+}
+
 TEST(ReadStl, TightAsciiOutgrowsTheWeldersFirstGuess) {
   // The welder's table is sized from the file's bytes (a corner per 64); a tightly written soup
   // of separate triangles has three new vertices in about 85 bytes, so the table must grow and
@@ -114,14 +127,27 @@ TEST(ReadStl, TightAsciiOutgrowsTheWeldersFirstGuess) {
   text += "endsolid s\n";
   ASSERT_GT(3 * kTriangles, 2 * (text.size() / 64));
 
-  const Mesh mesh = parse_stl(text);
-  ASSERT_EQ(mesh.vertex_count(), 3 * kTriangles);
-  ASSERT_EQ(mesh.face_count(), kTriangles + 1);
-  for (std::uint32_t t = 0; t < kTriangles; ++t) {
-    EXPECT_EQ(mesh.triangles[t], (Triangle{3 * t, 3 * t + 1, 3 * t + 2}));
-    EXPECT_EQ(mesh.positions[3 * t + 2], (Vec3{double(t), 2, 0}));
-  }
-  EXPECT_EQ(mesh.triangles[kTriangles], (Triangle{0, 1, 2}));
+  expect_separate_triangles_then_the_first(parse_stl(text), kTriangles);
+}
+
+TEST(ReadStl, BinarySoupOutgrowsTheWeldersFirstGuess) {
+  // The binary welder's table starts at twice the vertices of a closed mesh (a corner in six); a
+  // soup of separate triangles has a vertex per corner, six times more, so the table grows
+  // several times and must still find every vertex: the last triangle repeats the first one's.
+  constexpr std::uint32_t kTriangles = 5000;
+  Bytes bytes;
+  bytes.text(std::string(80, ' ')).put(std::uint32_t{kTriangles + 1});
+  auto triangle = [&](std::uint32_t t) {
+    for (int i = 0; i < 3; ++i) bytes.put(0.0f);
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      bytes.put(static_cast<float>(t)).put(static_cast<float>(k)).put(0.0f);
+    }
+    bytes.put(std::uint16_t{0});
+  };
+  for (std::uint32_t t = 0; t < kTriangles; ++t) triangle(t);
+  triangle(0);
+
+  expect_separate_triangles_then_the_first(parse_stl(bytes.str()), kTriangles);
 }
 
 TEST(ReadStl, TruncatedBinary) {
