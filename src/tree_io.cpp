@@ -5,8 +5,11 @@
 #include <cstring>
 #include <iterator>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "file_io.hpp"
+#include "huge_pages.hpp"
 #include "primseg/error.hpp"
 
 namespace primseg {
@@ -38,6 +41,11 @@ class Writer {
   }
   void put_raw(const char* data, std::size_t n) { bytes_.append(data, n); }
   std::string& bytes() { return bytes_; }
+  /// Room for `total` bytes in all, in huge pages (a million-face tree takes about 200 MB).
+  void reserve(std::size_t total) {
+    bytes_.reserve(total);
+    detail::advise_huge_pages(bytes_.data() + bytes_.size(), bytes_.capacity() - bytes_.size());
+  }
 
  private:
   std::string bytes_;
@@ -108,6 +116,11 @@ void read_magic_and_version(Reader& r) {
 
 std::string serialize_tree(const Hierarchy& hierarchy) {
   Writer w;
+  const Mesh& mesh = hierarchy.mesh();
+  // The header and counts take a few hundred bytes; the arrays their items' sizes.
+  w.reserve(1024 + 24 * mesh.positions.size() + 4 * mesh.polygon_offsets.size() +
+            4 * mesh.polygon_vertices.size() + 16 * mesh.triangles.size() +
+            kMergeBytes * hierarchy.merges().size());
   w.put_raw(kMagic, sizeof kMagic);
   w.put(kVersion);
   const HierarchyOptions& options = hierarchy.options();
@@ -118,7 +131,6 @@ std::string serialize_tree(const Hierarchy& hierarchy) {
   for (double p : options.type_penalty) w.put(p);
   w.put(options.zero_cost_tolerance);
 
-  const Mesh& mesh = hierarchy.mesh();
   w.put(static_cast<std::uint64_t>(mesh.positions.size()));
   for (const Vec3& p : mesh.positions) w.put_vec3(p);
   w.put(static_cast<std::uint64_t>(mesh.polygon_offsets.size()));
@@ -183,15 +195,18 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
   options.zero_cost_tolerance = r.get<double>("the options");
 
   auto mesh = std::make_shared<Mesh>();
-  mesh->positions.resize(r.get_count(24, "vertex"));
+  // The arrays in huge pages, as read_mesh's (a million faces fill about 200 MB here).
+  detail::resize_huge(mesh->positions, r.get_count(24, "vertex"));
   for (Vec3& p : mesh->positions) p = r.get_vec3("the vertices");
-  mesh->polygon_offsets.resize(r.get_count(4, "polygon offset"));
-  for (std::uint32_t& o : mesh->polygon_offsets) o = r.get<std::uint32_t>("the polygons");
-  mesh->polygon_vertices.resize(r.get_count(4, "polygon vertex"));
+  std::vector<std::uint32_t> offsets;  // fresh, not the default {0} resized (see from_triangles)
+  detail::resize_huge(offsets, r.get_count(4, "polygon offset"));
+  for (std::uint32_t& o : offsets) o = r.get<std::uint32_t>("the polygons");
+  mesh->polygon_offsets = std::move(offsets);
+  detail::resize_huge(mesh->polygon_vertices, r.get_count(4, "polygon vertex"));
   for (std::uint32_t& v : mesh->polygon_vertices) v = r.get<std::uint32_t>("the polygons");
   const std::size_t triangle_count = r.get_count(16, "triangle");
-  mesh->triangles.resize(triangle_count);
-  mesh->face_of_triangle.resize(triangle_count);
+  detail::resize_huge(mesh->triangles, triangle_count);
+  detail::resize_huge(mesh->face_of_triangle, triangle_count);
   for (std::size_t t = 0; t < triangle_count; ++t) {
     for (std::uint32_t& v : mesh->triangles[t]) v = r.get<std::uint32_t>("the triangles");
     mesh->face_of_triangle[t] = r.get<std::uint32_t>("the triangles");
@@ -203,7 +218,8 @@ Hierarchy deserialize_tree(std::span<const char> bytes, const std::string& name)
     r.fail(std::string("invalid mesh: ") + e.what());
   }
 
-  std::vector<Merge> merges(r.get_count(kMergeBytes, "merge"));
+  std::vector<Merge> merges;
+  detail::resize_huge(merges, r.get_count(kMergeBytes, "merge"));
   for (Merge& m : merges) {
     m.first = r.get<std::uint32_t>("the merges");
     m.second = r.get<std::uint32_t>("the merges");
