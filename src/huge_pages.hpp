@@ -38,12 +38,13 @@ inline void advise_huge_pages(const void* data, std::size_t bytes) {
 }
 
 /// v.reserve(n), the storage past v's elements advised for huge pages (all of it for an empty
-/// vector, before anything is written to it).
-template <typename T>
-void reserve_huge(std::vector<T>& v, std::size_t n) {
+/// container, before anything is written to it). `v`: a std::vector, or a std::string that a file
+/// is assembled in.
+template <typename Contiguous>
+void reserve_huge(Contiguous& v, std::size_t n) {
   if (n <= v.capacity()) return;
   v.reserve(n);
-  advise_huge_pages(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
+  advise_huge_pages(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(*v.data()));
 }
 
 /// v.resize(n) for an empty v, its storage advised for huge pages before it is filled.

@@ -41,11 +41,6 @@ class Writer {
   }
   void put_raw(const char* data, std::size_t n) { bytes_.append(data, n); }
   std::string& bytes() { return bytes_; }
-  /// Room for `total` bytes in all, in huge pages (a million-face tree takes about 200 MB).
-  void reserve(std::size_t total) {
-    bytes_.reserve(total);
-    detail::advise_huge_pages(bytes_.data() + bytes_.size(), bytes_.capacity() - bytes_.size());
-  }
 
  private:
   std::string bytes_;
@@ -117,10 +112,12 @@ void read_magic_and_version(Reader& r) {
 std::string serialize_tree(const Hierarchy& hierarchy) {
   Writer w;
   const Mesh& mesh = hierarchy.mesh();
-  // The header and counts take a few hundred bytes; the arrays their items' sizes.
-  w.reserve(1024 + 24 * mesh.positions.size() + 4 * mesh.polygon_offsets.size() +
-            4 * mesh.polygon_vertices.size() + 16 * mesh.triangles.size() +
-            kMergeBytes * hierarchy.merges().size());
+  // The header and counts take a few hundred bytes, the arrays their items' sizes; in huge pages
+  // (a million-face tree takes about 200 MB).
+  detail::reserve_huge(w.bytes(),
+                       1024 + 24 * mesh.positions.size() + 4 * mesh.polygon_offsets.size() +
+                           4 * mesh.polygon_vertices.size() + 16 * mesh.triangles.size() +
+                           kMergeBytes * hierarchy.merges().size());
   w.put_raw(kMagic, sizeof kMagic);
   w.put(kVersion);
   const HierarchyOptions& options = hierarchy.options();

@@ -30,8 +30,8 @@ class VertexWelder {
     const std::size_t expected_vertices = expected_corners / 6 + 4;
     std::size_t capacity = 16;
     while (capacity < 2 * expected_vertices) capacity *= 2;
-    detail::resize_huge(slots_, capacity);
-    std::fill(slots_.begin(), slots_.end(), kEmpty);
+    detail::reserve_huge(slots_, capacity);
+    slots_.assign(capacity, kEmpty);
     detail::reserve_huge(positions_, expected_vertices);
   }
 

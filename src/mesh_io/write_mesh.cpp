@@ -28,14 +28,6 @@ class OutputBuffer {
  public:
   std::string& text() { return text_; }
 
-  /// Room for `bytes` in all, asked for in huge pages before anything is written to it: a
-  /// million faces take tens of MB, whose first touch in 4 KB pages is costly (see
-  /// huge_pages.hpp). Pages past what is written are never touched.
-  void reserve(std::size_t bytes) {
-    text_.reserve(bytes);
-    detail::advise_huge_pages(text_.data() + text_.size(), text_.capacity() - text_.size());
-  }
-
   OutputBuffer& operator<<(std::string_view s) {
     text_.append(s);
     return *this;
@@ -257,11 +249,14 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
   OutputBuffer out;
   // At most what any format takes (text: a shortest round-trip double has at most 24
   // characters, an index 10, a colour channel 3; binary: 24 bytes a vertex, a 4-byte index, a
-  // length and a colour; STL 50 bytes a triangle), and the headers.
+  // length and a colour; STL 50 bytes a triangle), and the headers, in huge pages: a million
+  // faces take tens of MB, whose first touch in 4 KB pages is costly. Pages past what is written
+  // are never touched.
   const std::size_t corners = mesh.polygon_vertices.size();
   const std::size_t faces = mesh.face_count();
-  out.reserve(std::max(4096 + 80 * mesh.positions.size() + 12 * corners + 32 * faces,
-                       84 + 50 * mesh.triangles.size()));
+  detail::reserve_huge(out.text(),
+                       std::max(4096 + 80 * mesh.positions.size() + 12 * corners + 32 * faces,
+                                84 + 50 * mesh.triangles.size()));
   switch (format) {
     case MeshFormat::Off:
       write_off(out, mesh, face_colors(options));
