@@ -5,8 +5,9 @@
 //   primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]  (generated, Uniform tessellation)
 //
 // OPTIONS: --exact-costs, --threads N (HierarchyOptions::threads, default 0: all),
-// --merge-batch-tolerance T (default 0: the exact order), and --read-only (read the input, print
-// read_seconds, build nothing; bench/read_speed.sh).
+// --merge-batch-tolerance T (default 0: the exact order), --read-only (read the input, print
+// read_seconds, build nothing; bench/read_speed.sh) and --face-order auto|spatial|as-listed
+// (HierarchyOptions::face_order, default auto).
 //
 // Prints one line of key=value pairs:
 //   faces             input faces F
@@ -47,7 +48,8 @@ int usage() {
                "usage: primseg_bench_memory MESH_FILE [OPTIONS]\n"
                "       primseg_bench_memory --cgal NAME [OPTIONS]\n"
                "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
-               "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T --read-only\n");
+               "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T --read-only\n"
+               "         --face-order auto|spatial|as-listed\n");
   return 2;
 }
 
@@ -91,6 +93,16 @@ int run(int argc, char** argv) {
       options.threads = static_cast<unsigned>(threads);
     } else if (arg == "--merge-batch-tolerance" && i + 1 < argc) {
       options.merge_batch_tolerance = number(arg, argv[++i]);
+    } else if (arg == "--face-order" && i + 1 < argc) {
+      const std::string order = argv[++i];
+      if (order == "auto")
+        options.face_order = FaceOrder::Automatic;
+      else if (order == "spatial")
+        options.face_order = FaceOrder::Spatial;
+      else if (order == "as-listed")
+        options.face_order = FaceOrder::AsListed;
+      else
+        throw std::invalid_argument("--face-order: auto, spatial or as-listed");
     } else if ((arg == "--cgal" || arg == "--shape") && i + 1 < argc && source.empty()) {
       source = arg;
       name = argv[++i];

@@ -9,10 +9,19 @@
 #                                            PRIMSEG_FUZZ=ON is built as it is (CI fuzzes in its
 #                                            sanitizer pass's build, PRIMSEG_FUZZ_COVERAGE=edges)
 #   PRIMSEG_FUZZ_JOBS=$(nproc)               targets run at once
+#   PRIMSEG_FUZZ_TARGETS="stl tree"          a subset of the targets (default: all nine)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-45}
 build=${PRIMSEG_FUZZ_BUILD_DIR:-build-fuzz}
+all_targets=" off obj ply stl detect tree skeleton segment tools "
+read -ra targets <<<"${PRIMSEG_FUZZ_TARGETS:-$all_targets}"
+for target in "${targets[@]}"; do
+  if [[ $all_targets != *" $target "* ]]; then
+    echo "fuzz.sh: unknown target '$target' (targets:${all_targets% })" >&2
+    exit 2
+  fi
+done
 if ! grep -qx 'PRIMSEG_FUZZ:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
@@ -40,7 +49,6 @@ fuzz_one() {
     -artifact_prefix="$build/artifacts/$target-" >"$build/logs/$target.log" 2>&1 || true
 }
 jobs=${PRIMSEG_FUZZ_JOBS:-$(nproc)}
-targets=(off obj ply stl detect tree skeleton segment tools)
 cat fuzz/dict/{off,obj,ply,stl}.dict >"$build/detect.dict"
 rm -rf "$build/logs" && mkdir -p "$build/logs"
 running=0

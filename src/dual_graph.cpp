@@ -632,6 +632,7 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
 }
 
 Triangle DualGraph::corners(std::uint32_t t) const {
+  if (!renumbered_triangles_.empty()) return renumbered_triangles_[t];
   return canonical_corners(mesh_->triangles[t], positions_);
 }
 
@@ -646,13 +647,13 @@ inline double DualGraph::area_of(const Triangle& corners) const {
 void DualGraph::prefetch_face(std::uint32_t f) const {
   __builtin_prefetch(&first_triangle_[f]);
   // Most faces are one triangle, and face f's is then triangle f when all are.
-  if (first_triangle_.size() == mesh_->triangles.size() + 1)
-    __builtin_prefetch(&mesh_->triangles[f]);
+  const std::span<const Triangle> all = triangles();
+  if (first_triangle_.size() == all.size() + 1) __builtin_prefetch(&all[f]);
 }
 
 void DualGraph::prefetch_face_corners(std::uint32_t f) const {
   for (std::uint32_t t = first_triangle_[f]; t < first_triangle_[f + 1]; ++t)
-    for (std::uint32_t v : mesh_->triangles[t]) __builtin_prefetch(&positions_[v]);
+    for (std::uint32_t v : triangles()[t]) __builtin_prefetch(&positions_[v]);
 }
 
 std::array<double, 3> DualGraph::corner_weights(std::uint32_t t) const {
@@ -799,6 +800,140 @@ void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_sampl
     ++stats.triangle_count;
   }
   stats.moments.discard_first_moments();
+}
+
+namespace {
+
+// The Morton code of a working-frame point (coordinates within [-1, 1]): 10 bits per axis,
+// interleaved from x's lowest, 30 bits in all: a surface crosses millions of the billion cells,
+// about one face each at 10M faces.
+std::uint32_t morton_code(const Eigen::Vector3d& p) {
+  auto spread = [](std::uint32_t v) {  // bit k of v to bit 3k
+    v = (v | v << 16) & 0x030000ffu;
+    v = (v | v << 8) & 0x0300f00fu;
+    v = (v | v << 4) & 0x030c30c3u;
+    v = (v | v << 2) & 0x09249249u;
+    return v;
+  };
+  constexpr double kCells = 1023;
+  std::uint32_t code = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double unit = (p[axis] + 1) * 0.5;
+    const double cell = unit > 0 ? std::min(unit, 1.0) * kCells : 0.0;
+    code |= spread(static_cast<std::uint32_t>(cell)) << axis;
+  }
+  return code;
+}
+
+// Sorts keys (a 30-bit code above a 32-bit payload) by their code, stably: a least-significant-
+// digit radix sort, three passes of 10 bits.
+void sort_by_code(std::vector<std::uint64_t>& keys) {
+  std::vector<std::uint64_t> buffer;
+  detail::resize_huge(buffer, keys.size());
+  for (int shift = 32; shift < 62; shift += 10) {
+    std::array<std::size_t, 1025> start{};
+    for (std::uint64_t key : keys) ++start[((key >> shift) & 1023) + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    for (std::uint64_t key : keys) buffer[start[(key >> shift) & 1023]++] = key;
+    keys.swap(buffer);
+  }
+}
+
+}  // namespace
+
+SpatialOrder DualGraph::in_spatial_order() const {
+  const std::uint32_t face_count = this->face_count();
+  SpatialOrder order;
+  {
+    std::vector<std::uint64_t> keys;  // code above face: equal codes keep the faces' order
+    detail::resize_huge(keys, face_count);
+    for (std::uint32_t f = 0; f < face_count; ++f)
+      keys[f] = std::uint64_t{morton_code(centroid_of(corners(first_triangle_[f])))} << 32 | f;
+    sort_by_code(keys);
+    detail::resize_huge(order.original_face, face_count);
+    for (std::uint32_t i = 0; i < face_count; ++i)
+      order.original_face[i] = static_cast<std::uint32_t>(keys[i]);
+  }
+  std::vector<std::uint32_t> new_face;
+  detail::resize_huge(new_face, face_count);
+  for (std::uint32_t i = 0; i < face_count; ++i) new_face[order.original_face[i]] = i;
+
+  order.graph.reset(new DualGraph());
+  DualGraph& graph = *order.graph;
+  graph.mesh_ = mesh_;
+  graph.weights_ = weights_;
+  graph.frame_ = frame_;
+  graph.component_count_ = component_count_;
+  // Triangles face by face in the new order, each face's in its own order; vertices numbered as
+  // they are first met (vertices of no triangle are dropped: nothing reads them).
+  const std::size_t triangle_count = first_triangle_.back();
+  detail::resize_huge(graph.first_triangle_, std::size_t{face_count} + 1);
+  detail::resize_huge(graph.renumbered_triangles_, triangle_count);
+  detail::resize_huge(graph.flipped_, triangle_count);
+  detail::resize_huge(graph.component_of_face_, face_count);
+  std::vector<std::uint32_t> new_vertex;
+  detail::resize_huge(new_vertex, positions_.size());
+  std::fill(new_vertex.begin(), new_vertex.end(), kNone);
+  detail::reserve_huge(graph.positions_, positions_.size());
+  detail::reserve_huge(graph.valence_, valence_.size());
+  std::uint32_t u = 0;
+  graph.first_triangle_[0] = 0;
+  for (std::uint32_t i = 0; i < face_count; ++i) {
+    const std::uint32_t f = order.original_face[i];
+    for (std::uint32_t t = first_triangle_[f]; t < first_triangle_[f + 1]; ++t, ++u) {
+      Triangle tri = corners(t);  // in the original ids' order, which renumbering would not keep
+      for (std::uint32_t& v : tri) {
+        std::uint32_t& renumbered = new_vertex[v];
+        if (renumbered == kNone) {
+          renumbered = static_cast<std::uint32_t>(graph.positions_.size());
+          graph.positions_.push_back(positions_[v]);
+          graph.valence_.push_back(valence_[v]);
+        }
+        v = renumbered;
+      }
+      graph.renumbered_triangles_[u] = tri;
+      graph.flipped_[u] = flipped_[t];
+    }
+    graph.first_triangle_[i + 1] = u;
+    graph.component_of_face_[i] = component_of_face_[f];
+  }
+
+  // Dual edges by their (lower, higher) new faces: bucketed by the lower, each bucket (a face's
+  // few edges to higher faces) sorted by the higher.
+  const std::size_t edge_count = edges_.size();
+  std::vector<std::uint64_t> edge_keys;  // lower above higher
+  detail::resize_huge(edge_keys, edge_count);
+  std::vector<std::uint32_t> bucket_start(std::size_t{face_count} + 1, 0);
+  for (std::size_t j = 0; j < edge_count; ++j) {
+    const std::uint32_t a = new_face[edges_[j].first], b = new_face[edges_[j].second];
+    const std::uint32_t lower = std::min(a, b);
+    edge_keys[j] = std::uint64_t{lower} << 32 | std::max(a, b);
+    ++bucket_start[lower + 1];
+  }
+  std::partial_sum(bucket_start.begin(), bucket_start.end(), bucket_start.begin());
+  detail::resize_huge(order.original_edge, edge_count);
+  {
+    std::vector<std::uint32_t> next(bucket_start.begin(), bucket_start.end() - 1);
+    for (std::size_t j = 0; j < edge_count; ++j)
+      order.original_edge[next[edge_keys[j] >> 32]++] = static_cast<std::uint32_t>(j);
+  }
+  for (std::uint32_t i = 0; i < face_count; ++i)
+    stable_sort_small(
+        order.original_edge.begin() + bucket_start[i],
+        order.original_edge.begin() + bucket_start[i + 1],
+        [&](std::uint32_t x, std::uint32_t y) { return edge_keys[x] < edge_keys[y]; });
+  detail::resize_huge(graph.edges_, edge_count);
+  for (std::size_t k = 0; k < edge_count; ++k) {
+    const DualEdge& e = edges_[order.original_edge[k]];
+    graph.edges_[k] = {new_face[e.first], new_face[e.second], e.shared};
+  }
+
+  // Edges inside polygon faces: by new face, each face's in their order.
+  graph.internal_edges_ = internal_edges_;
+  for (auto& entry : graph.internal_edges_) entry.first = new_face[entry.first];
+  std::stable_sort(graph.internal_edges_.begin(), graph.internal_edges_.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
+  return order;
 }
 
 }  // namespace primseg

@@ -233,6 +233,21 @@ std::vector<std::array<double, 4>> Hierarchy::linkage() const {
 // ---------------------------------------------------------------------------------------------
 // HierarchyBuilder
 
+namespace {
+
+// Whether the merge loop runs on the graph in spatial order (see FaceOrder::Automatic).
+bool in_spatial_order(FaceOrder order, const DualGraph& graph) {
+  if (order != FaceOrder::Automatic) return order == FaceOrder::Spatial;
+  constexpr std::uint32_t kFrom = std::uint32_t{1} << 17, kWindow = 1024;
+  if (graph.face_count() < kFrom) return false;
+  const std::size_t near = static_cast<std::size_t>(
+      std::count_if(graph.edges().begin(), graph.edges().end(),
+                    [](const DualEdge& e) { return e.second - e.first < kWindow; }));
+  return 2 * near < graph.edges().size();
+}
+
+}  // namespace
+
 class HierarchyBuilder::Impl {
  public:
   Impl(std::shared_ptr<const Mesh> mesh, HierarchyOptions options)
@@ -247,15 +262,29 @@ class HierarchyBuilder::Impl {
     check_geometric_range(*mesh_);
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, options_.threads);
     const std::uint32_t f = mesh_->face_count();
+    // The loop may run on the graph in a spatial order (not with the torus: faces' samples would
+    // take other priorities). Node ids stay the input's faces, so the queue's ties are the
+    // input's, and so are each dual edge's sides, so every union is summed in the input's order:
+    // the tree is the same, bit for bit.
+    if (in_spatial_order(options_.face_order, *graph_) && !selector_.needs_samples()) {
+      SpatialOrder order = graph_->in_spatial_order();
+      graph_ = std::move(order.graph);
+      original_face_ = std::move(order.original_face);
+    }
     // Statistics are stored for clusters of three faces or more only (at most F / 3 live at
     // once); a single face's or a pair's are recomputed when needed (see store_pair()).
     detail::reserve_huge(stats_, f / 3 + 1);  // address space: touched as clusters form
     detail::reserve_huge(merges_, f - 1);
     detail::resize_huge(slots_, f);
     for (std::uint32_t face = 0; face < f; ++face)
-      slots_[face] = {
-          face, kNone, 1,     graph_->first_triangle(face + 1) - graph_->first_triangle(face),
-          face, kNone, kNone, 0};
+      slots_[face] = {input_face(face),
+                      kNone,
+                      1,
+                      graph_->first_triangle(face + 1) - graph_->first_triangle(face),
+                      input_face(face),
+                      kNone,
+                      kNone,
+                      0};
     if (options_.exact_costs) {
       next_face_.assign(f, kNone);
       face_list_head_.resize(f);
@@ -269,7 +298,8 @@ class HierarchyBuilder::Impl {
       throw InvalidInputError("mesh too large: more than 2^31 pairs of adjacent faces");
     detail::reserve_huge(edges_, dual_edges.size());
     for (const DualEdge& e : dual_edges) edges_.push_back({e.first, e.second});
-    // Each face's list in increasing edge id: prepend in decreasing order.
+    // Each face's list in increasing edge id: prepend in decreasing order. (The lists' order
+    // changes no sum and no tie: a graph in spatial order gives the same tree.)
     detail::resize_huge(next_link_, 2 * dual_edges.size());
     for (std::size_t id = dual_edges.size(); id-- > 0;)
       for (std::uint32_t side = 0; side < 2; ++side) {
@@ -309,7 +339,8 @@ class HierarchyBuilder::Impl {
     evaluations_ = candidates.size();
     detail::resize_huge(queued_pairs_, edges_.size());
     for (std::size_t id = 0; id < edges_.size(); ++id)
-      queued_pairs_[id] = {dual_edges[id].first, dual_edges[id].second};  // faces: first < second
+      queued_pairs_[id] = {input_face(dual_edges[id].first),
+                           input_face(dual_edges[id].second)};  // first < second in the input
     queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{&queued_pairs_});
     queue_.assign(candidates);
     total_merges_ = f - graph_->component_count();
@@ -359,10 +390,20 @@ class HierarchyBuilder::Impl {
     add_trailing_merges();
     if (progress) progress(1);
     release_working_memory();
+    // A graph in spatial order is not the tree's: Hierarchy builds the input's.
+    if (!original_face_.empty()) {
+      graph_.reset();
+      std::vector<std::uint32_t>().swap(original_face_);
+    }
     return {std::move(mesh_), std::move(options_), std::move(merges_), std::move(graph_)};
   }
 
  private:
+  // The input face (and leaf node) that face `face` of graph_ is.
+  std::uint32_t input_face(std::uint32_t face) const {
+    return original_face_.empty() ? face : original_face_[face];
+  }
+
   std::uint32_t next_node() const {
     return mesh_->face_count() + static_cast<std::uint32_t>(merges_.size());
   }
@@ -996,6 +1037,8 @@ class HierarchyBuilder::Impl {
   detail::BatchPool pool_;
   std::vector<Scratch> scratch_;  // per thread of pool_
   std::unique_ptr<DualGraph> graph_;
+  // Per face of graph_, its input face, when graph_ is in spatial order (else empty).
+  std::vector<std::uint32_t> original_face_;
   std::vector<ClusterStats> stats_;  // merged clusters' statistics, pooled
   // Statistics of recent pairs by key (kPairTag | dual edge), direct-mapped: see store_pair().
   // Written between batches only.

@@ -235,8 +235,103 @@ bool same_bits(const EdgeStats& a, const EdgeStats& b) {
   return true;
 }
 
+template <int Rows, int Cols>
+bool same_bits(const Eigen::Matrix<double, Rows, Cols>& a,
+               const Eigen::Matrix<double, Rows, Cols>& b) {
+  for (Eigen::Index i = 0; i < a.size(); ++i)
+    if (!same_bits(a.data()[i], b.data()[i])) return false;
+  return true;
+}
+
+// What the merge loop reads of a face, bit for bit: its statistics (moments about its origin,
+// internal edges, normal sums, face planes, area) and its corners.
+void expect_same_face(const DualGraph& got, std::uint32_t got_face, const DualGraph& want,
+                      std::uint32_t want_face) {
+  const ClusterStats a = got.face_stats(got_face), b = want.face_stats(want_face);
+  ASSERT_TRUE(same_bits(a.moments.origin(), b.moments.origin()));
+  for (std::size_t i = 0; i < a.moments.values().size(); ++i)
+    ASSERT_TRUE(same_bits(a.moments.values()[i], b.moments.values()[i])) << "moment " << i;
+  ASSERT_TRUE(same_bits(a.edges, b.edges));
+  ASSERT_TRUE(same_bits(a.normal_sum, b.normal_sum));
+  ASSERT_TRUE(same_bits(a.normal_position, b.normal_position));
+  for (int i = 0; i < 6; ++i)
+    ASSERT_TRUE(same_bits(a.face_planes.normal_normal[i], b.face_planes.normal_normal[i]));
+  ASSERT_TRUE(same_bits(a.face_planes.normal_offset, b.face_planes.normal_offset));
+  ASSERT_TRUE(same_bits(a.face_planes.offset_square, b.face_planes.offset_square));
+  ASSERT_TRUE(same_bits(a.area, b.area));
+  FaceCorners x, y;
+  const bool by_corners = got.face_corners(got_face, x);
+  ASSERT_EQ(by_corners, want.face_corners(want_face, y));
+  if (!by_corners) return;
+  ASSERT_EQ(x.triangle_count, y.triangle_count);
+  ASSERT_TRUE(same_bits(x.centroid, y.centroid));
+  for (std::uint32_t c = 0; c < x.corner_count(); ++c) {
+    ASSERT_TRUE(same_bits(x.offsets[c], y.offsets[c])) << "corner " << c;
+    ASSERT_TRUE(same_bits(x.weights[c], y.weights[c])) << "corner " << c;
+  }
+  ASSERT_TRUE(same_bits(x.second_moment, y.second_moment));
+  ASSERT_TRUE(same_bits(x.normal_position, y.normal_position));
+  ASSERT_TRUE(same_bits(x.edges, y.edges));
+}
+
+// DualGraph::in_spatial_order(): the same faces (statistics and corners bit for bit, the same
+// orientation and components) and the same dual edges (each one's faces in their order, its
+// mesh edges bit for bit), renumbered, with the edges sorted by their new faces.
+void expect_same_graph_in_spatial_order(const DualGraph& graph) {
+  const SpatialOrder order = graph.in_spatial_order();
+  const DualGraph& renumbered = *order.graph;
+  const std::uint32_t faces = graph.face_count();
+  ASSERT_EQ(renumbered.face_count(), faces);
+  ASSERT_EQ(renumbered.component_count(), graph.component_count());
+  ASSERT_EQ(order.original_face.size(), faces);
+  std::vector<std::uint32_t> new_face(faces, faces);
+  for (std::uint32_t i = 0; i < faces; ++i) {
+    const std::uint32_t f = order.original_face[i];
+    ASSERT_LT(f, faces);
+    ASSERT_EQ(new_face[f], faces) << "face " << f << " twice";
+    new_face[f] = i;
+    SCOPED_TRACE("new face " + std::to_string(i) + ", face " + std::to_string(f));
+    ASSERT_EQ(renumbered.component_of_face()[i], graph.component_of_face()[f]);
+    const std::uint32_t begin = graph.first_triangle(f),
+                        count = graph.first_triangle(f + 1) - begin;
+    ASSERT_EQ(renumbered.first_triangle(i + 1) - renumbered.first_triangle(i), count);
+    for (std::uint32_t k = 0; k < count; ++k) {
+      const std::uint32_t t = begin + k, u = renumbered.first_triangle(i) + k;
+      ASSERT_EQ(renumbered.flipped(u), graph.flipped(t));
+      const Triangle want = graph.corners(t), got = renumbered.corners(u);
+      const std::array<double, 3> want_weights = graph.corner_weights(t),
+                                  got_weights = renumbered.corner_weights(u);
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_TRUE(same_bits(renumbered.position(got[c]), graph.position(want[c])));
+        ASSERT_TRUE(same_bits(got_weights[c], want_weights[c]));
+      }
+    }
+    expect_same_face(renumbered, i, graph, f);
+  }
+  const std::vector<DualEdge>& edges = renumbered.edges();
+  ASSERT_EQ(edges.size(), graph.edges().size());
+  ASSERT_EQ(order.original_edge.size(), edges.size());
+  std::vector<bool> seen(edges.size());
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const std::uint32_t j = order.original_edge[k];
+    ASSERT_LT(j, edges.size());
+    ASSERT_FALSE(seen[j]) << "edge " << j << " twice";
+    seen[j] = true;
+    const DualEdge& want = graph.edges()[j];
+    ASSERT_EQ(edges[k].first, new_face[want.first]) << "edge " << k;
+    ASSERT_EQ(edges[k].second, new_face[want.second]) << "edge " << k;
+    ASSERT_TRUE(same_bits(edges[k].shared, want.shared)) << "edge " << k;
+    auto key = [](const DualEdge& e) {
+      return std::make_pair(std::min(e.first, e.second), std::max(e.first, e.second));
+    };
+    if (k > 0) {
+      ASSERT_LT(key(edges[k - 1]), key(edges[k])) << "edge " << k;
+    }
+  }
+}
+
 // Every output of DualGraph's constructor, built with `threads` threads, equals the reference's,
-// bit for bit.
+// bit for bit; and so does the graph in spatial order, renumbered.
 void expect_reference_graph(const Mesh& mesh, const std::string& what, unsigned threads = 1) {
   SCOPED_TRACE(what + ", " + std::to_string(threads) + " threads");
   mesh.validate();
@@ -283,6 +378,7 @@ void expect_reference_graph(const Mesh& mesh, const std::string& what, unsigned 
     graph.face_stats(f, stats, false, 2);
     ASSERT_TRUE(same_bits(stats.edges, internal[f])) << "face " << f;
   }
+  expect_same_graph_in_spatial_order(graph);
 }
 
 // The same surface with its vertices, faces and each face's first corner in random order.

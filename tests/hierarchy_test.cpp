@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 
@@ -302,6 +303,91 @@ TEST(Hierarchy, RenumberedVerticesAndRotatedCornersGiveTheSameTree) {
         ASSERT_TRUE(same_bits(got.primitive.radius, want.primitive.radius)) << "merge " << i;
       }
     }
+  }
+}
+
+// HierarchyOptions::face_order: the merge loop on the graph in spatial order makes the
+// same tree, bit for bit (serialize_tree writes every merge's ids, costs, errors, weights and
+// primitive), in each mode of the loop and on input with polygons, non-manifold edges, degenerate
+// and duplicate faces and several components; faces listed in random order included.
+TEST(Hierarchy, TheGraphInSpatialOrderGivesTheSameTreeBitForBit) {
+  struct Case {
+    std::string what;
+    Mesh mesh;
+    HierarchyOptions options;
+  };
+  ShapeOptions noisy;
+  noisy.tessellation = Tessellation::Uniform;
+  noisy.noise = 0.002;
+  noisy.random_motion = true;
+  const Mesh fandisk = read_mesh(testing::cgal_mesh("fandisk.off"));
+  const Mesh shaft = make_shape("chamfered_cylinder", noisy).mesh;
+  HierarchyOptions uniform, eager, exact, batched, one_thread, cones;
+  uniform.weights = VertexWeights::Uniform;
+  eager.evaluation = CandidateEvaluation::Eager;
+  exact.exact_costs = true;
+  batched.merge_batch_tolerance = 0.1;
+  one_thread.threads = 1;
+  cones.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
+                      PrimitiveType::Cone};
+
+  // The faces in random order, and a polygon mesh: a grid of quads on a cylinder, closed by two
+  // polygons of 40 corners (more triangles than a face's corners are read for).
+  std::vector<std::uint32_t> order(fandisk.face_count());
+  std::iota(order.begin(), order.end(), 0u);
+  std::shuffle(order.begin(), order.end(), std::mt19937_64(67));
+  std::vector<Triangle> shuffled(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) shuffled[i] = fandisk.triangles[order[i]];
+  std::vector<Vec3> ring;
+  const int around = 40, rows = 12;
+  for (int i = 0; i <= rows; ++i)
+    for (int j = 0; j < around; ++j) {
+      const double angle = 2 * M_PI * j / around;
+      ring.push_back({std::cos(angle), std::sin(angle), 0.1 * i + 0.01 * std::sin(3.0 * j + i)});
+    }
+  std::vector<std::uint32_t> offsets{0}, corners;
+  auto id = [&](int i, int j) { return static_cast<std::uint32_t>(i * around + j % around); };
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < around; ++j) {
+      corners.insert(corners.end(), {id(i, j), id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)});
+      offsets.push_back(static_cast<std::uint32_t>(corners.size()));
+    }
+  for (int j = around; j-- > 0;) corners.push_back(id(0, j));
+  offsets.push_back(static_cast<std::uint32_t>(corners.size()));
+  for (int j = 0; j < around; ++j) corners.push_back(id(rows, j));
+  offsets.push_back(static_cast<std::uint32_t>(corners.size()));
+
+  // A box with a duplicate face, a zero-area face, a non-manifold fin, and a second component.
+  const Mesh box = make_shape("box", {}).mesh;
+  std::vector<Vec3> positions = box.positions;
+  std::vector<Triangle> triangles = box.triangles;
+  const Triangle first = triangles[0];
+  triangles.insert(triangles.end(), {first, {first[0], first[1], first[0]}});
+  positions.push_back({0.123, 5, 0.321});
+  triangles.push_back({first[0], first[1], static_cast<std::uint32_t>(positions.size() - 1)});
+  const auto offset = static_cast<std::uint32_t>(positions.size());
+  positions.insert(positions.end(), shaft.positions.begin(), shaft.positions.end());
+  for (Triangle t : shaft.triangles)
+    triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+
+  const std::vector<Case> cases = {
+      {"fandisk", fandisk, {}},
+      {"fandisk, faces shuffled", Mesh::from_triangles(fandisk.positions, shuffled), {}},
+      {"fandisk, uniform weights", fandisk, uniform},
+      {"fandisk, eager", fandisk, eager},
+      {"fandisk, batched", fandisk, batched},
+      {"fandisk, one thread", fandisk, one_thread},
+      {"noisy chamfered cylinder, cones", shaft, cones},
+      {"noisy chamfered cylinder, exact costs", shaft, exact},
+      {"polygons", Mesh::from_polygons(ring, offsets, corners), {}},
+      {"odd faces, two components", Mesh::from_triangles(positions, triangles), {}}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    HierarchyOptions as_listed = c.options, in_spatial_order = c.options;
+    as_listed.face_order = FaceOrder::AsListed;
+    in_spatial_order.face_order = FaceOrder::Spatial;
+    EXPECT_EQ(serialize_tree(build_hierarchy(c.mesh, in_spatial_order)),
+              serialize_tree(build_hierarchy(c.mesh, as_listed)));
   }
 }
 

@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "primseg/cluster_stats.hpp"
@@ -50,6 +52,18 @@ struct DualEdge {
   EdgeStats shared;
 };
 
+class DualGraph;
+
+/// A dual graph renumbered for memory locality by DualGraph::in_spatial_order(), and the way back
+/// to the graph it came from.
+struct SpatialOrder {
+  std::unique_ptr<DualGraph> graph;
+  /// The face of the original graph that each face of `graph` is, shape (F).
+  std::vector<std::uint32_t> original_face;
+  /// The index in the original graph's edges() of each of `graph`'s dual edges, shape (E).
+  std::vector<std::uint32_t> original_edge;
+};
+
 /// Dual graph and working geometry of a mesh.
 ///
 /// Non-manifold edges: the k >= 3 triangles on one mesh edge are sorted by index and joined in a
@@ -66,15 +80,20 @@ class DualGraph {
   /// for any number.
   DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads = 0);
 
+  /// The mesh the graph was built on (for a graph from in_spatial_order(), the original graph's
+  /// mesh, whose face, triangle and vertex ids are not this graph's).
   const Mesh& mesh() const { return *mesh_; }
   const WorkingFrame& frame() const { return frame_; }
   VertexWeights weights() const { return weights_; }
-  std::uint32_t face_count() const { return mesh_->face_count(); }
+  std::uint32_t face_count() const {
+    return static_cast<std::uint32_t>(first_triangle_.size() - 1);
+  }
   /// Edge-connected components of the dual graph.
   std::uint32_t component_count() const { return component_count_; }
   /// Component of each input face, numbered by their lowest face, shape (F).
   const std::vector<std::uint32_t>& component_of_face() const { return component_of_face_; }
-  /// Dual edges sorted by (first, second), each face pair once.
+  /// Dual edges sorted by (first, second), each face pair once (from in_spatial_order(): sorted
+  /// by their lower and higher face, first and second as they were in the original graph).
   const std::vector<DualEdge>& edges() const { return edges_; }
 
   /// Triangles of input face f: [first_triangle(f), first_triangle(f + 1)).
@@ -107,7 +126,21 @@ class DualGraph {
   /// unspecified, when f has more than FaceCorners::kMaxTriangles triangles.
   bool face_corners(std::uint32_t f, FaceCorners& corners) const;
 
+  /// The same graph with its faces in a spatial order (the Morton order of their first
+  /// triangle's centroid), its triangles in that order, its vertices in order of first use and
+  /// its dual edges sorted again, so that faces near each other on the surface are near each
+  /// other in memory: the merge loop's reads of faces, corners and edges then hit the caches far
+  /// more often on meshes whose file lists faces in no spatial order (a scan's bunny00 does).
+  /// Everything that does not name an id is the same, bit for bit: a face's statistics and
+  /// corners, in the same order, the orientation, the components (numbered as before) and
+  /// each dual edge's first and second face; corners() is the original graph's, renumbered
+  /// (the lowest index among equal positions is the original vertex's). face_stats()'s samples
+  /// take their priorities from triangle ids, which differ. Linear in F and E (but for sorting
+  /// the edges inside polygon faces).
+  SpatialOrder in_spatial_order() const;
+
  private:
+  DualGraph() = default;
   // A triangle's area, centroid and corner weights from its corners(), for the accessors above
   // and for face_stats() and face_corners(); what the last two also share: the origin of face f's
   // statistics (its corners' weighted centroid from their weighted sum, or its first triangle's
@@ -119,8 +152,14 @@ class DualGraph {
                               double weight) const;
   EdgeStats internal_edges_of(std::uint32_t f) const;
 
-  const Mesh* mesh_;
-  VertexWeights weights_;
+  // The triangles corners() reads: the mesh's, or in_spatial_order()'s renumbered own.
+  std::span<const Triangle> triangles() const {
+    return renumbered_triangles_.empty() ? std::span<const Triangle>(mesh_->triangles)
+                                         : std::span<const Triangle>(renumbered_triangles_);
+  }
+
+  const Mesh* mesh_ = nullptr;
+  VertexWeights weights_ = VertexWeights::Area;
   WorkingFrame frame_;
   std::vector<Eigen::Vector3d> positions_;
   std::vector<std::uint32_t> first_triangle_;
@@ -131,6 +170,8 @@ class DualGraph {
   std::vector<DualEdge> edges_;
   /// Edges inside polygon faces, sorted by face (only faces that have some).
   std::vector<std::pair<std::uint32_t, EdgeStats>> internal_edges_;
+  /// From in_spatial_order(): the triangles, renumbered and already in corners() order.
+  std::vector<Triangle> renumbered_triangles_;
 };
 
 }  // namespace primseg
