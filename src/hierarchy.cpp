@@ -235,8 +235,11 @@ std::vector<std::array<double, 4>> Hierarchy::linkage() const {
 
 namespace {
 
-// Whether the merge loop runs on the graph in spatial order (see FaceOrder::Automatic).
-bool in_spatial_order(FaceOrder order, const DualGraph& graph) {
+// Whether the merge loop runs on the graph in spatial order (see FaceOrder). Not with the torus:
+// faces' samples would take other priorities.
+bool merges_in_spatial_order(FaceOrder order, const detail::ModelSelector& selector,
+                             const DualGraph& graph) {
+  if (selector.needs_samples()) return false;
   if (order != FaceOrder::Automatic) return order == FaceOrder::Spatial;
   constexpr std::uint32_t kFrom = std::uint32_t{1} << 17, kWindow = 1024;
   if (graph.face_count() < kFrom) return false;
@@ -262,11 +265,10 @@ class HierarchyBuilder::Impl {
     check_geometric_range(*mesh_);
     graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, options_.threads);
     const std::uint32_t f = mesh_->face_count();
-    // The loop may run on the graph in a spatial order (not with the torus: faces' samples would
-    // take other priorities). Node ids stay the input's faces, so the queue's ties are the
-    // input's, and so are each dual edge's sides, so every union is summed in the input's order:
-    // the tree is the same, bit for bit.
-    if (in_spatial_order(options_.face_order, *graph_) && !selector_.needs_samples()) {
+    // The loop may run on the graph in a spatial order. Node ids stay the input's faces, so the
+    // queue's ties are the input's, and so are each dual edge's sides, so every union is summed
+    // in the input's order: the tree is the same, bit for bit.
+    if (merges_in_spatial_order(options_.face_order, selector_, *graph_)) {
       SpatialOrder order = graph_->in_spatial_order();
       graph_ = std::move(order.graph);
       original_face_ = std::move(order.original_face);

@@ -227,6 +227,7 @@ ReferenceGraph reference_graph(const Mesh& mesh) {
   return g;
 }
 
+using testing::concatenated;
 using testing::same_bits;
 
 bool same_bits(const EdgeStats& a, const EdgeStats& b) {
@@ -402,21 +403,6 @@ Mesh shuffled(const Mesh& mesh, std::uint64_t seed) {
     for (std::size_t i = 0; i < polygon.size(); ++i)
       vertices.push_back(new_index[polygon[(start + i) % polygon.size()]]);
     offsets.push_back(static_cast<std::uint32_t>(vertices.size()));
-  }
-  return Mesh::from_polygons(std::move(positions), std::move(offsets), std::move(vertices));
-}
-
-// Several meshes as the components of one (the second's vertices after the first's).
-Mesh concatenated(const std::vector<Mesh>& parts) {
-  std::vector<Vec3> positions;
-  std::vector<std::uint32_t> offsets{0}, vertices;
-  for (const Mesh& part : parts) {
-    const auto base = static_cast<std::uint32_t>(positions.size());
-    positions.insert(positions.end(), part.positions.begin(), part.positions.end());
-    for (std::uint32_t f = 0; f < part.face_count(); ++f) {
-      for (std::uint32_t v : part.polygon(f)) vertices.push_back(base + v);
-      offsets.push_back(static_cast<std::uint32_t>(vertices.size()));
-    }
   }
   return Mesh::from_polygons(std::move(positions), std::move(offsets), std::move(vertices));
 }

@@ -43,6 +43,22 @@ bool fittable(const GroundTruthShape& shape) {
   });
 }
 
+// A box with a duplicate face, a zero-area face (a repeated vertex), a non-manifold fin and an
+// isolated vertex.
+Mesh box_with_odd_faces() {
+  const Mesh box = make_shape("box", {}).mesh;
+  std::vector<Vec3> positions = box.positions;
+  std::vector<Triangle> triangles = box.triangles;
+  const Triangle first = triangles[0];
+  triangles.push_back(first);                           // duplicate
+  triangles.push_back({first[0], first[1], first[0]});  // zero area, repeated vertex
+  positions.push_back({9, 9, 9});                       // isolated
+  positions.push_back({0.123, 5, 0.321});
+  triangles.push_back(
+      {first[0], first[1], static_cast<std::uint32_t>(positions.size() - 1)});  // fin
+  return Mesh::from_triangles(std::move(positions), std::move(triangles));
+}
+
 struct Variant {
   Tessellation tessellation;
   std::uint64_t seed;
@@ -357,19 +373,6 @@ TEST(Hierarchy, TheGraphInSpatialOrderGivesTheSameTreeBitForBit) {
   for (int j = 0; j < around; ++j) corners.push_back(id(rows, j));
   offsets.push_back(static_cast<std::uint32_t>(corners.size()));
 
-  // A box with a duplicate face, a zero-area face, a non-manifold fin, and a second component.
-  const Mesh box = make_shape("box", {}).mesh;
-  std::vector<Vec3> positions = box.positions;
-  std::vector<Triangle> triangles = box.triangles;
-  const Triangle first = triangles[0];
-  triangles.insert(triangles.end(), {first, {first[0], first[1], first[0]}});
-  positions.push_back({0.123, 5, 0.321});
-  triangles.push_back({first[0], first[1], static_cast<std::uint32_t>(positions.size() - 1)});
-  const auto offset = static_cast<std::uint32_t>(positions.size());
-  positions.insert(positions.end(), shaft.positions.begin(), shaft.positions.end());
-  for (Triangle t : shaft.triangles)
-    triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-
   const std::vector<Case> cases = {
       {"fandisk", fandisk, {}},
       {"fandisk, faces shuffled", Mesh::from_triangles(fandisk.positions, shuffled), {}},
@@ -380,7 +383,7 @@ TEST(Hierarchy, TheGraphInSpatialOrderGivesTheSameTreeBitForBit) {
       {"noisy chamfered cylinder, cones", shaft, cones},
       {"noisy chamfered cylinder, exact costs", shaft, exact},
       {"polygons", Mesh::from_polygons(ring, offsets, corners), {}},
-      {"odd faces, two components", Mesh::from_triangles(positions, triangles), {}}};
+      {"odd faces, two components", testing::concatenated({box_with_odd_faces(), shaft}), {}}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.what);
     HierarchyOptions as_listed = c.options, in_spatial_order = c.options;
@@ -434,18 +437,7 @@ TEST(Hierarchy, ExactCostModeAgreesWithTheConstantTimeCostsOnCleanShapes) {
 }
 
 TEST(Hierarchy, DegenerateAndNonManifoldInputIsHandled) {
-  // A zero-area face, a duplicate face, a non-manifold fin and an isolated vertex on a box.
-  const GroundTruthShape box = make_shape("box", {});
-  std::vector<Vec3> positions = box.mesh.positions;
-  std::vector<Triangle> triangles = box.mesh.triangles;
-  const Triangle first = triangles[0];
-  triangles.push_back(first);                           // duplicate
-  triangles.push_back({first[0], first[1], first[0]});  // zero area, repeated vertex
-  positions.push_back({9, 9, 9});                       // isolated
-  positions.push_back({0.123, 5, 0.321});
-  triangles.push_back(
-      {first[0], first[1], static_cast<std::uint32_t>(positions.size() - 1)});  // fin
-  const Mesh mesh = Mesh::from_triangles(std::move(positions), std::move(triangles));
+  const Mesh mesh = box_with_odd_faces();
   const Hierarchy h = build_hierarchy(mesh);
   EXPECT_EQ(h.merges().size(), h.face_count() - 1);
   EXPECT_EQ(h.component_count(), 1u);

@@ -130,6 +130,20 @@ void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation,
 
 namespace primseg::testing {
 
+Mesh concatenated(const std::vector<Mesh>& parts) {
+  std::vector<Vec3> positions;
+  std::vector<std::uint32_t> offsets{0}, vertices;
+  for (const Mesh& part : parts) {
+    const auto base = static_cast<std::uint32_t>(positions.size());
+    positions.insert(positions.end(), part.positions.begin(), part.positions.end());
+    for (std::uint32_t f = 0; f < part.face_count(); ++f) {
+      for (std::uint32_t v : part.polygon(f)) vertices.push_back(base + v);
+      offsets.push_back(static_cast<std::uint32_t>(vertices.size()));
+    }
+  }
+  return Mesh::from_polygons(std::move(positions), std::move(offsets), std::move(vertices));
+}
+
 Mesh noisy_uniform_shape(const std::string& name) {
   return noisy_uniform_truth(name, 1, 0.003).mesh;
 }

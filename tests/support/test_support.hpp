@@ -101,6 +101,9 @@ Mesh grid_mesh(int rows, int cols, Surface&& p, bool alternate = false) {
 /// `--primitives` list that enables cones and tori.
 std::vector<PrimitiveType> every_primitive_type();
 
+/// Several meshes as the components of one (each part's vertices after the previous parts').
+Mesh concatenated(const std::vector<Mesh>& parts);
+
 /// A generated shape (shape_generator.hpp) in its Uniform tessellation with random vertex motion
 /// and Gaussian noise of 0.3% of its size along the normals: a small scan-like input.
 Mesh noisy_uniform_shape(const std::string& name);
