@@ -23,12 +23,12 @@ std::uint32_t side_end(const Triangle& tri, unsigned c) {
   return tri[c == 2 ? 0 : c + 1];
 }
 
-// The triangle's corners from the one whose position is lexicographically smallest (the lowest
-// index among equal positions) on, in their cyclic order, so the orientation is kept. Every sum
-// over a triangle's corners runs in this order: a file that lists a triangle from another corner
-// gives the same statistics, costs and tree, bit for bit (round-off would otherwise settle the
-// ties of symmetric parts differently).
-Triangle canonical_corners(const Triangle& tri, std::span<const Eigen::Vector3d> positions) {
+// Which corner of a triangle comes first in every sum over its corners: the one whose position
+// is lexicographically smallest (the lowest index among equal positions). The others follow in
+// their cyclic order, so the orientation is kept. A file that lists a triangle from another
+// corner thus gives the same statistics, costs and tree, bit for bit (round-off would otherwise
+// settle the ties of symmetric parts differently).
+unsigned canonical_first_corner(const Triangle& tri, std::span<const Eigen::Vector3d> positions) {
   auto before = [&](std::uint32_t a, std::uint32_t b) {
     const Eigen::Vector3d& p = positions[a];
     const Eigen::Vector3d& q = positions[b];
@@ -36,7 +36,24 @@ Triangle canonical_corners(const Triangle& tri, std::span<const Eigen::Vector3d>
   };
   unsigned first = before(tri[1], tri[0]) ? 1 : 0;
   if (before(tri[2], tri[first])) first = 2;
-  return {tri[first], tri[(first + 1) % 3], tri[(first + 2) % 3]};
+  return first;
+}
+
+// A triangle's code in DualGraph (bit 0: flipped; bits 1 and 2: its first corner) and what it
+// says.
+constexpr std::uint8_t kFlippedBit = 1;
+std::uint8_t with_first_corner(std::uint8_t code, unsigned first) {
+  return static_cast<std::uint8_t>(code | first << 1);
+}
+bool is_flipped(std::uint8_t code) {
+  return (code & kFlippedBit) != 0;
+}
+Triangle coded_corners(const Triangle& tri, std::uint8_t code) {
+  // By table rather than by tests on the first corner, which branch at random.
+  static constexpr std::array<std::array<std::uint8_t, 3>, 4> kFrom = {
+      {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 1, 2}}};
+  const std::array<std::uint8_t, 3>& from = kFrom[code >> 1 & 3];
+  return {tri[from[0]], tri[from[1]], tri[from[2]]};
 }
 
 // Sorts [begin, end) stably: by insertion when tiny (as nearly all ranges are here).
@@ -226,8 +243,8 @@ inline Eigen::Vector3d oriented_normal(const Triangle& corners,
 // area.
 inline Eigen::Vector3d oriented_normal(std::span<const Triangle> triangles,
                                        std::span<const Eigen::Vector3d> positions,
-                                       std::span<const std::uint8_t> flipped, std::uint32_t t) {
-  return oriented_normal(canonical_corners(triangles[t], positions), positions, flipped[t] != 0);
+                                       std::span<const std::uint8_t> codes, std::uint32_t t) {
+  return oriented_normal(coded_corners(triangles[t], codes[t]), positions, is_flipped(codes[t]));
 }
 
 // The dual edges of ranges of faces, each face's links in the order (other face, edge, lower
@@ -236,12 +253,12 @@ inline Eigen::Vector3d oriented_normal(std::span<const Triangle> triangles,
 class FaceLinks {
  public:
   FaceLinks(const Mesh& mesh, std::span<const Eigen::Vector3d> positions,
-            std::span<const std::uint8_t> flipped, std::span<const std::uint32_t> first_triangle,
+            std::span<const std::uint8_t> codes, std::span<const std::uint32_t> first_triangle,
             std::span<const TriangleSlots> neighbours)
       : triangles_(mesh.triangles),
         face_of_triangle_(mesh.face_of_triangle),
         positions_(positions),
-        flipped_(flipped),
+        codes_(codes),
         first_triangle_(first_triangle),
         neighbours_(neighbours),
         polygons_(mesh.face_count() != mesh.triangle_count()) {}
@@ -264,7 +281,7 @@ class FaceLinks {
           const std::uint32_t other = slots.other[k];
           if (other < t) continue;  // a manifold edge seen from above
           __builtin_prefetch(&triangles_[other]);
-          __builtin_prefetch(&flipped_[other]);
+          __builtin_prefetch(&codes_[other]);
           const std::uint32_t from = tri[slots.side(k)], to = side_end(tri, slots.side(k));
           block.push_back({f, polygons_ ? face_of_triangle_[other] : other, std::min(from, to),
                            std::max(from, to), t, other});
@@ -293,7 +310,7 @@ class FaceLinks {
   };
 
   Eigen::Vector3d oriented_normal(std::uint32_t t) const {
-    return primseg::oriented_normal(triangles_, positions_, flipped_, t);
+    return primseg::oriented_normal(triangles_, positions_, codes_, t);
   }
 
   void add_block(std::vector<Link>& block, std::vector<DualEdge>& edges,
@@ -350,7 +367,7 @@ class FaceLinks {
   std::span<const Triangle> triangles_;
   std::span<const std::uint32_t> face_of_triangle_;
   std::span<const Eigen::Vector3d> positions_;
-  std::span<const std::uint8_t> flipped_;
+  std::span<const std::uint8_t> codes_;
   std::span<const std::uint32_t> first_triangle_;
   std::span<const TriangleSlots> neighbours_;
   bool polygons_;
@@ -473,11 +490,12 @@ std::vector<Eigen::Vector3d> working_positions(const Mesh& mesh, const WorkingFr
   return positions;
 }
 
-// The triangles' orientation, before closed components are turned outward: `flipped` per
-// triangle, each triangle's orientation component (numbered by its lowest triangle) and whether
-// each component is open (a boundary, or not orientable: no inside).
+// The triangles' orientation, before closed components are turned outward: each triangle's code
+// (bit 0 only, flipped, until turn_outward() adds the first corner), each triangle's orientation
+// component (numbered by its lowest triangle) and whether each component is open (a boundary, or
+// not orientable: no inside).
 struct Orientation {
-  std::vector<std::uint8_t> flipped;
+  std::vector<std::uint8_t> codes;
   std::vector<std::uint32_t> component;
   std::vector<std::uint8_t> open;
 };
@@ -502,7 +520,7 @@ Orientation orient(const std::vector<TriangleSlots>& neighbours) {
         const TriangleSlots& ahead = neighbours[queue[head + 4]];
         for (unsigned k = 0; k < ahead.count(); ++k) {
           __builtin_prefetch(&o.component[ahead.other[k]]);
-          __builtin_prefetch(&o.flipped[ahead.other[k]]);
+          __builtin_prefetch(&o.codes[ahead.other[k]]);
         }
       }
       if (head + 8 < queued) __builtin_prefetch(&neighbours[queue[head + 8]]);
@@ -512,12 +530,12 @@ Orientation orient(const std::vector<TriangleSlots>& neighbours) {
       for (unsigned k = 0; k < slots.count(); ++k) {
         if (!slots.manifold(k)) continue;
         const std::uint32_t other = slots.other[k];
-        const std::uint8_t wanted = o.flipped[t] ^ std::uint8_t{slots.same_direction(k)};
+        const std::uint8_t wanted = o.codes[t] ^ std::uint8_t{slots.same_direction(k)};
         if (o.component[other] == kNone) {
           o.component[other] = component;
-          o.flipped[other] = wanted;
+          o.codes[other] = wanted;
           queue[queued++] = other;
-        } else if (o.flipped[other] != wanted) {
+        } else if (o.codes[other] != wanted) {
           o.open[component] = 1;  // not orientable (a Möbius band): no inside
         }
       }
@@ -526,7 +544,8 @@ Orientation orient(const std::vector<TriangleSlots>& neighbours) {
   return o;
 }
 
-// Closed components face outward: flips those of negative signed volume in `orientation`.
+// Closed components face outward: flips those of negative signed volume in `orientation`, whose
+// codes also get each triangle's first corner.
 // Returns each face's connected component of the dual graph and sets `count`: the components of
 // the orientation joined across the other links and within polygon faces; numbered by their
 // lowest member, as the orientation components are by their lowest triangle, they are numbered
@@ -544,9 +563,11 @@ std::vector<std::uint32_t> turn_outward(const Mesh& mesh,
   for (std::uint32_t t = 0; t < triangle_count; ++t) {
     if (t + 16 < triangle_count)
       for (std::uint32_t u : mesh.triangles[t + 16]) __builtin_prefetch(&positions[u]);
-    const Triangle tri = canonical_corners(mesh.triangles[t], positions);
+    std::uint8_t& code = orientation.codes[t];
+    code = with_first_corner(code, canonical_first_corner(mesh.triangles[t], positions));
+    const Triangle tri = coded_corners(mesh.triangles[t], code);
     const double v = positions[tri[0]].dot(positions[tri[1]].cross(positions[tri[2]]));
-    volume[orientation.component[t]] += orientation.flipped[t] ? -v : v;
+    volume[orientation.component[t]] += is_flipped(code) ? -v : v;
     const TriangleSlots& slots = neighbours[t];
     for (unsigned k = 0; k < slots.count(); ++k)
       if (!slots.manifold(k))
@@ -556,7 +577,7 @@ std::vector<std::uint32_t> turn_outward(const Mesh& mesh,
   }
   for (std::uint32_t t = 0; t < triangle_count; ++t) {
     const std::uint32_t c = orientation.component[t];
-    if (!orientation.open[c] && volume[c] < 0) orientation.flipped[t] ^= 1;
+    if (!orientation.open[c] && volume[c] < 0) orientation.codes[t] ^= kFlippedBit;
   }
   const std::vector<std::uint32_t> label = std::move(joined).labels(count);
   std::vector<std::uint32_t> component_of_face(face_count);
@@ -596,7 +617,7 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
     Orientation orientation = orient(neighbours);
     component_of_face_ =
         turn_outward(mesh, positions_, neighbours, first_triangle_, orientation, component_count_);
-    flipped_ = std::move(orientation.flipped);
+    triangle_codes_ = std::move(orientation.codes);
   }
 
   // The dual edges: faces are independent, so ranges of them go to threads, their results
@@ -607,7 +628,7 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
   detail::reserve_huge(edges_, external);
   detail::reserve_huge(internal_edges_, std::accumulate(links.internal.begin(),
                                                         links.internal.end(), std::size_t{0}));
-  const FaceLinks face_links(mesh, positions_, flipped_, first_triangle_, neighbours);
+  const FaceLinks face_links(mesh, positions_, triangle_codes_, first_triangle_, neighbours);
   std::vector<std::vector<DualEdge>> later_edges(chunk_count - 1);
   std::vector<std::vector<std::pair<std::uint32_t, EdgeStats>>> later_internal(chunk_count - 1);
   detail::parallel_for_threads(
@@ -632,8 +653,7 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
 }
 
 Triangle DualGraph::corners(std::uint32_t t) const {
-  if (!renumbered_triangles_.empty()) return renumbered_triangles_[t];
-  return canonical_corners(mesh_->triangles[t], positions_);
+  return coded_corners(triangles()[t], triangle_codes_[t]);
 }
 
 double DualGraph::triangle_area(std::uint32_t t) const {
@@ -699,7 +719,7 @@ bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
   for (std::uint32_t t = begin; t < end; ++t) {
     const std::uint32_t i = t - begin;
     const Triangle& tri = triangles[i] = this->corners(t);
-    const Eigen::Vector3d normal = oriented_normal(tri, positions_, flipped_[t] != 0);
+    const Eigen::Vector3d normal = oriented_normal(tri, positions_, is_flipped(triangle_codes_[t]));
     corners.areas[i] = 0.5 * normal.norm();
     corners.area_normals[i] = 0.5 * normal;
     const std::array<double, 3> w = corner_weights_of(tri, corners.areas[i]);
@@ -761,7 +781,7 @@ void DualGraph::face_stats(std::uint32_t f, ClusterStats& stats, bool with_sampl
   for (std::uint32_t t = begin; t < end; ++t) {
     Corners& c = corners[t - begin];
     const Triangle& tri = c.corners = this->corners(t);
-    c.normal = oriented_normal(tri, positions_, flipped_[t] != 0);
+    c.normal = oriented_normal(tri, positions_, is_flipped(triangle_codes_[t]));
     c.weights = corner_weights_of(tri, 0.5 * c.normal.norm());
     for (int k = 0; k < 3; ++k) {
       weighted_sum += c.weights[k] * positions_[tri[k]];
@@ -869,7 +889,7 @@ SpatialOrder DualGraph::in_spatial_order() const {
   const std::size_t triangle_count = first_triangle_.back();
   detail::resize_huge(graph.first_triangle_, std::size_t{face_count} + 1);
   detail::resize_huge(graph.renumbered_triangles_, triangle_count);
-  detail::resize_huge(graph.flipped_, triangle_count);
+  detail::resize_huge(graph.triangle_codes_, triangle_count);
   detail::resize_huge(graph.component_of_face_, face_count);
   std::vector<std::uint32_t> new_vertex;
   detail::resize_huge(new_vertex, positions_.size());
@@ -892,7 +912,7 @@ SpatialOrder DualGraph::in_spatial_order() const {
         v = renumbered;
       }
       graph.renumbered_triangles_[u] = tri;
-      graph.flipped_[u] = flipped_[t];
+      graph.triangle_codes_[u] = triangle_codes_[t] & kFlippedBit;  // stored from its first corner
     }
     graph.first_triangle_[i + 1] = u;
     graph.component_of_face_[i] = component_of_face_[f];
