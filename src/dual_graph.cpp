@@ -95,7 +95,9 @@ SideBuckets bucket_sides(const Mesh& mesh) {
   // addresses before that (those of every vertex of the triangle: the cheapest superset).
   constexpr std::size_t kAhead = 8;
   const std::size_t vertex_count = mesh.vertex_count();
-  std::vector<std::size_t> high_cursor(vertex_count + 1, 0), low_cursor(vertex_count + 1, 0);
+  std::vector<std::size_t> high_cursor, low_cursor;
+  detail::resize_huge(high_cursor, vertex_count + 1);
+  detail::resize_huge(low_cursor, vertex_count + 1);
   for (const Triangle& tri : mesh.triangles)
     for (unsigned c = 0; c < 3; ++c) {
       const std::uint32_t from = tri[c], to = side_end(tri, c);
@@ -476,7 +478,8 @@ namespace {
 
 // The mesh's positions in the working frame.
 std::vector<Eigen::Vector3d> working_positions(const Mesh& mesh, const WorkingFrame& frame) {
-  std::vector<Eigen::Vector3d> positions(mesh.positions.size());
+  std::vector<Eigen::Vector3d> positions;
+  detail::resize_huge(positions, mesh.positions.size());
   // A product by a power of two rounds once, as ldexp does, when the power is a double.
   const double scale = std::ldexp(1.0, -frame.exponent);
   if (scale > 0 && std::isfinite(scale)) {
@@ -504,10 +507,12 @@ struct Orientation {
 // in increasing order (on a non-orientable component the order decides the flips).
 Orientation orient(const std::vector<TriangleSlots>& neighbours) {
   const auto triangle_count = static_cast<std::uint32_t>(neighbours.size());
-  Orientation o{std::vector<std::uint8_t>(triangle_count, 0),
-                std::vector<std::uint32_t>(triangle_count, kNone),
-                {}};
-  std::vector<std::uint32_t> queue(triangle_count);  // every triangle enters it once
+  Orientation o;
+  detail::resize_huge(o.codes, triangle_count);
+  detail::resize_huge(o.component, triangle_count);
+  std::fill(o.component.begin(), o.component.end(), kNone);
+  std::vector<std::uint32_t> queue;  // every triangle enters it once
+  detail::resize_huge(queue, triangle_count);
   std::size_t queued = 0;
   for (std::uint32_t seed = 0; seed < triangle_count; ++seed) {
     if (o.component[seed] != kNone) continue;
@@ -593,13 +598,13 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
   threads = detail::thread_count(threads);
   const std::uint32_t face_count = mesh.face_count();
 
-  valence_.assign(mesh.positions.size(), 0);
+  detail::resize_huge(valence_, mesh.positions.size());
   for (const Triangle& t : mesh.triangles)
     for (std::uint32_t v : t) ++valence_[v];
   frame_ = working_frame_of_used(mesh, valence_);
   positions_ = working_positions(mesh, frame_);
 
-  first_triangle_.assign(face_count + 1, 0);
+  detail::resize_huge(first_triangle_, std::size_t{face_count} + 1);
   for (std::uint32_t f : mesh.face_of_triangle) ++first_triangle_[f + 1];
   std::partial_sum(first_triangle_.begin(), first_triangle_.end(), first_triangle_.begin());
 
@@ -625,9 +630,10 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
   const std::size_t external =
       std::accumulate(links.count.begin(), links.count.end(), std::size_t{0}) -
       std::accumulate(links.internal.begin(), links.internal.end(), std::size_t{0});
-  detail::reserve_huge(edges_, external);
-  detail::reserve_huge(internal_edges_, std::accumulate(links.internal.begin(),
-                                                        links.internal.end(), std::size_t{0}));
+  detail::reserve_huge_to_fill(edges_, external);
+  detail::reserve_huge_to_fill(
+      internal_edges_,
+      std::accumulate(links.internal.begin(), links.internal.end(), std::size_t{0}));
   const FaceLinks face_links(mesh, positions_, triangle_codes_, first_triangle_, neighbours);
   std::vector<std::vector<DualEdge>> later_edges(chunk_count - 1);
   std::vector<std::vector<std::pair<std::uint32_t, EdgeStats>>> later_internal(chunk_count - 1);
@@ -637,8 +643,8 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
         std::vector<std::pair<std::uint32_t, EdgeStats>>& internal =
             chunk == 0 ? internal_edges_ : later_internal[chunk - 1];
         if (chunk > 0) {
-          detail::reserve_huge(edges, links.count[chunk] - links.internal[chunk]);
-          detail::reserve_huge(internal, links.internal[chunk]);
+          detail::reserve_huge_to_fill(edges, links.count[chunk] - links.internal[chunk]);
+          detail::reserve_huge_to_fill(internal, links.internal[chunk]);
         }
         face_links.add(chunk_face(chunk), chunk_face(chunk + 1), edges, internal);
       });
@@ -894,8 +900,8 @@ SpatialOrder DualGraph::in_spatial_order() const {
   std::vector<std::uint32_t> new_vertex;
   detail::resize_huge(new_vertex, positions_.size());
   std::fill(new_vertex.begin(), new_vertex.end(), kNone);
-  detail::reserve_huge(graph.positions_, positions_.size());
-  detail::reserve_huge(graph.valence_, valence_.size());
+  detail::reserve_huge_to_fill(graph.positions_, positions_.size());
+  detail::reserve_huge_to_fill(graph.valence_, valence_.size());
   std::uint32_t u = 0;
   graph.first_triangle_[0] = 0;
   for (std::uint32_t i = 0; i < face_count; ++i) {

@@ -70,6 +70,9 @@ FileImage read_to_end(int fd, const std::filesystem::path& name, bool sized, std
   std::size_t capacity = static_cast<std::size_t>(std::min(expected + 1, largest_buffer));
   FileImage image{std::make_unique_for_overwrite<char[]>(capacity), 0};
   advise_huge_pages(image.bytes.get(), capacity);
+  // A file's size is known to be there: its pages at once rather than one fault at a time as
+  // read() copies into them.
+  if (sized) populate_pages(image.bytes.get(), capacity);
   while (true) {
     if (image.size > limits.max_bytes)
       throw InvalidInputError(name.string() + ": more than " + limit_phrase(limits));

@@ -278,6 +278,7 @@ class HierarchyBuilder::Impl {
     detail::reserve_huge(stats_, f / 3 + 1);  // address space: touched as clusters form
     detail::reserve_huge(merges_, f - 1);
     detail::resize_huge(slots_, f);
+    detail::resize_huge(pair_cache_, kCachedPairs);  // (half a megabyte: its pages at once)
     for (std::uint32_t face = 0; face < f; ++face)
       slots_[face] = {input_face(face),
                       kNone,
@@ -298,7 +299,7 @@ class HierarchyBuilder::Impl {
     const std::vector<DualEdge>& dual_edges = graph_->edges();
     if (dual_edges.size() >= kPairTag)
       throw InvalidInputError("mesh too large: more than 2^31 pairs of adjacent faces");
-    detail::reserve_huge(edges_, dual_edges.size());
+    detail::reserve_huge_to_fill(edges_, dual_edges.size());
     for (const DualEdge& e : dual_edges) edges_.push_back({e.first, e.second});
     // Each face's list in increasing edge id: prepend in decreasing order. (The lists' order
     // changes no sum and no tie: a graph in spatial order gives the same tree.)
@@ -347,11 +348,14 @@ class HierarchyBuilder::Impl {
     queue_.assign(candidates);
     total_merges_ = f - graph_->component_count();
     // The loop is the first to write the merge records and the statistics pool; with a second
-    // thread allowed, their pages are faulted in ahead of it (see page_warmer.hpp).
+    // thread allowed, their pages are faulted in ahead of it (see page_warmer.hpp). Else the
+    // records, which will all be written, are faulted in now, at half the cost of a fault each.
     if (pool_.thread_count() >= 2 && merges_.capacity() * sizeof(Merge) >= kWarmFrom)
       warmer_.start({{merges_.data(), merges_.capacity() * sizeof(Merge), &merges_used_},
                      {stats_.data(), stats_.capacity() * sizeof(ClusterStats), &stats_used_}},
                     kWarmLead);
+    else
+      detail::populate_pages(merges_.data(), merges_.capacity() * sizeof(Merge));
   }
 
   bool step() {
@@ -1049,7 +1053,7 @@ class HierarchyBuilder::Impl {
     std::uint32_t key = kNone;
     ClusterStats stats;
   };
-  std::vector<CachedPair> pair_cache_ = std::vector<CachedPair>(kCachedPairs);
+  std::vector<CachedPair> pair_cache_;     // kCachedPairs entries
   std::vector<std::uint32_t> free_stats_;  // unused entries of stats_
   std::vector<Slot> slots_;                // per input face
   // Adjacency as intrusive lists: link 2 id + side is edge id on the list of the slot of its

@@ -37,7 +37,9 @@ class IndexedHeap {
         nodes_(storage_.get() + kArity - 1),
         before_(std::move(before)) {
     advise_huge_pages(storage_.get(), (std::size_t{id_count} + kArity - 1) * sizeof(Node));
-    reserve_huge(position_, id_count);
+    // The merge loop's first assign() fills every node.
+    populate_pages(storage_.get(), (std::size_t{id_count} + kArity - 1) * sizeof(Node));
+    reserve_huge_to_fill(position_, id_count);
     position_.assign(id_count, kAbsent);
   }
 

@@ -408,8 +408,8 @@ Mesh Mesh::from_polygons(std::vector<Vec3> positions, std::vector<std::uint32_t>
   mesh.polygon_vertices = std::move(vertices);
   const std::uint32_t faces = mesh.face_count();
   const std::size_t triangle_estimate = mesh.polygon_vertices.size() - 2 * std::size_t{faces};
-  detail::reserve_huge(mesh.triangles, triangle_estimate);
-  detail::reserve_huge(mesh.face_of_triangle, triangle_estimate);
+  detail::reserve_huge_to_fill(mesh.triangles, triangle_estimate);
+  detail::reserve_huge_to_fill(mesh.face_of_triangle, triangle_estimate);
 
   EarClipper clipper;
   const std::uint32_t* corners = mesh.polygon_vertices.data();
@@ -439,7 +439,7 @@ Mesh Mesh::from_triangles(std::vector<Vec3> positions, std::vector<Triangle> tri
   std::vector<std::uint32_t> offsets;
   detail::resize_huge(offsets, triangles.size() + 1);
   mesh.polygon_offsets = std::move(offsets);
-  detail::reserve_huge(mesh.polygon_vertices, 3 * triangles.size());
+  detail::reserve_huge_to_fill(mesh.polygon_vertices, 3 * triangles.size());
   detail::resize_huge(mesh.face_of_triangle, triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
     for (std::uint32_t corner : triangles[t]) {

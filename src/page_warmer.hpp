@@ -24,6 +24,8 @@
 #include <thread>
 #include <vector>
 
+#include "huge_pages.hpp"
+
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -127,14 +129,9 @@ class PageWarmer {
   }
 
   static bool populate(std::uintptr_t start, std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
-    void* address = reinterpret_cast<void*>(start);  // NOLINT(performance-no-int-to-ptr)
-    return madvise(address, bytes, MADV_POPULATE_WRITE) == 0;
-#else
-    (void)start;
-    (void)bytes;
-    return false;
-#endif
+    return populate_pages(
+        reinterpret_cast<const void*>(start),  // NOLINT(performance-no-int-to-ptr)
+        bytes);
   }
 
   std::vector<Region> regions_;

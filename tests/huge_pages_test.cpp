@@ -11,6 +11,7 @@
 
 #if defined(__linux__)
 #include <sys/mman.h>
+#include <unistd.h>
 #endif
 
 namespace primseg::detail {
@@ -34,7 +35,37 @@ TEST(HugePages, ReserveAndResizeKeepTheElementsAndMakeRoom) {
   resize_huge(zeros, 3u << 20);
   ASSERT_EQ(zeros.size(), 3u << 20);
   EXPECT_TRUE(std::all_of(zeros.begin(), zeros.end(), [](std::uint32_t z) { return z == 0; }));
+
+  std::vector<std::uint64_t> filled = {2, 7};
+  reserve_huge_to_fill(filled, 1u << 20);
+  EXPECT_GE(filled.capacity(), 1u << 20);
+  EXPECT_EQ(filled, (std::vector<std::uint64_t>{2, 7}));
 }
+
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+// Faulting in makes every page of the range resident, from the page that holds its first byte to
+// the one that holds its last, and nothing past them; what the pages held is kept.
+TEST(HugePages, PopulatingMakesExactlyTheRangesPagesResidentAndKeepsTheirContents) {
+  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  constexpr std::size_t kPages = 16;
+  void* block =
+      mmap(nullptr, kPages * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(block, MAP_FAILED);
+  auto* bytes = static_cast<char*>(block);
+  bytes[page + 5] = 42;  // page 1 already resident, with a value
+  auto resident = [&](std::size_t index) {
+    unsigned char flag = 0;
+    return mincore(bytes + index * page, page, &flag) == 0 && (flag & 1) != 0;
+  };
+  // From the middle of page 1 to the middle of page 9.
+  ASSERT_TRUE(populate_pages(bytes + page + 100, 8 * page));
+  for (std::size_t i = 0; i < kPages; ++i) EXPECT_EQ(resident(i), i >= 1 && i <= 9) << "page " << i;
+  EXPECT_EQ(bytes[page + 5], 42);
+  EXPECT_TRUE(std::all_of(bytes + 2 * page, bytes + 10 * page, [](char c) { return c == 0; }));
+  EXPECT_TRUE(populate_pages(bytes, 0));  // nothing to do
+  munmap(block, kPages * page);
+}
+#endif
 
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
 // The VmFlags of the mapping that holds `address`, from /proc/self/smaps.
