@@ -146,11 +146,16 @@ std::vector<ErrorCurvePoint> error_curve(const Hierarchy& hierarchy) {
   const auto merges = hierarchy.merges();
   // Working-frame sums, as the tree stores them; each merge replaces its children's errors by
   // its own. Weights do not change with K: every level covers every face.
+  // A leaf's error is a fit (leaves are not stored): each is computed once.
+  std::vector<double> leaf_error(f);
   double error = 0, weight = 0;
   for (std::uint32_t leaf = 0; leaf < f; ++leaf) {
-    error += hierarchy.error(leaf);
+    error += leaf_error[leaf] = hierarchy.error(leaf);
     weight += hierarchy.weight(leaf);
   }
+  auto error_of = [&](std::uint32_t node) {
+    return node < f ? leaf_error[node] : hierarchy.error(node);
+  };
   const int exponent = hierarchy.graph().frame().exponent;
   auto rms = [&](double e) {
     return weight > 0 ? std::ldexp(std::sqrt(std::max(e, 0.0) / weight), exponent) : 0.0;
@@ -159,7 +164,7 @@ std::vector<ErrorCurvePoint> error_curve(const Hierarchy& hierarchy) {
   curve[real] = {f, rms(error)};
   for (std::uint32_t i = 0; i < real; ++i) {
     const Merge& m = merges[i];
-    error += m.error - hierarchy.error(m.first) - hierarchy.error(m.second);
+    error += m.error - error_of(m.first) - error_of(m.second);
     curve[real - 1 - i] = {f - 1 - i, rms(error)};
   }
   return curve;

@@ -158,6 +158,7 @@ Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
       graph_(std::move(graph)),
       merges_(std::move(merges)) {
   validate(options_);
+  leaf_selector_ = std::make_shared<const detail::ModelSelector>(options_);
   if (!mesh_ || mesh_->face_count() == 0) throw InvalidInputError("mesh has no faces");
   const std::uint32_t f = mesh_->face_count();
   if (merges_.size() != f - 1)
@@ -179,9 +180,8 @@ Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
 namespace {
 
 // Leaves are not stored: their fit is recomputed from the face, by the same rule as merges.
-detail::SelectedModel select_leaf(const HierarchyOptions& options, const DualGraph& graph,
+detail::SelectedModel select_leaf(const detail::ModelSelector& selector, const DualGraph& graph,
                                   std::uint32_t face) {
-  const detail::ModelSelector selector(options);
   return selector.select(graph.face_stats(face, selector.needs_samples()).centred());
 }
 
@@ -196,19 +196,19 @@ void Hierarchy::check_node(std::uint32_t node) const {
 Primitive Hierarchy::primitive(std::uint32_t node) const {
   check_node(node);
   if (!is_leaf(node)) return merges_[node - face_count()].primitive;
-  return graph_->frame().to_input(select_leaf(options_, *graph_, node).fit.primitive);
+  return graph_->frame().to_input(select_leaf(*leaf_selector_, *graph_, node).fit.primitive);
 }
 
 double Hierarchy::error(std::uint32_t node) const {
   check_node(node);
   if (!is_leaf(node)) return merges_[node - face_count()].error;
-  return select_leaf(options_, *graph_, node).fit.error;
+  return select_leaf(*leaf_selector_, *graph_, node).fit.error;
 }
 
 double Hierarchy::weight(std::uint32_t node) const {
   check_node(node);
   if (!is_leaf(node)) return merges_[node - face_count()].weight;
-  return graph_->face_stats(node).moments.weight();
+  return graph_->face_stats(node, false, 2).moments.weight();  // (the weight is of degree 0)
 }
 
 std::uint32_t Hierarchy::face_count(std::uint32_t node) const {

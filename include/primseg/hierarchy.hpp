@@ -22,6 +22,10 @@
 
 namespace primseg {
 
+namespace detail {
+class ModelSelector;
+}  // namespace detail
+
 /// How candidate merges are (re)evaluated after each merge.
 enum class CandidateEvaluation {
   /// Every candidate of a new cluster is evaluated at once: the reference.
@@ -183,6 +187,9 @@ class Hierarchy {
   std::unique_ptr<DualGraph> graph_;
   std::vector<Merge> merges_;
   std::vector<std::uint32_t> parents_;
+  // Leaves are not stored: their fits are recomputed by the merges' rule, made once here (making
+  // it for each leaf cost a third of choose_level()).
+  std::shared_ptr<const detail::ModelSelector> leaf_selector_;
 };
 
 /// Step-by-step construction of a Hierarchy.
