@@ -157,7 +157,7 @@ Hierarchy::Hierarchy(std::shared_ptr<const Mesh> mesh, HierarchyOptions options,
       options_(std::move(options)),
       graph_(std::move(graph)),
       merges_(std::move(merges)) {
-  validate(options_);
+  // The leaves' rule, which also validates the options.
   leaf_selector_ = std::make_shared<const detail::ModelSelector>(options_);
   if (!mesh_ || mesh_->face_count() == 0) throw InvalidInputError("mesh has no faces");
   const std::uint32_t f = mesh_->face_count();
