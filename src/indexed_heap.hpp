@@ -61,6 +61,16 @@ class IndexedHeap {
   const Node& top() const { return nodes_[0]; }
   /// The node at a position (0 is the top; the children of p are kArity p + 1 ...).
   const Node& at(std::size_t position) const { return nodes_[position]; }
+  /// The position of the node that comes out second if no key changes (the first of the top's
+  /// children), or kAbsent below two nodes. O(kArity).
+  std::uint32_t runner_up() const {
+    if (size_ < 2) return kAbsent;
+    const std::size_t end = size_ < kArity + 1 ? size_ : kArity + 1;
+    std::size_t best = 1;
+    for (std::size_t c = 2; c < end; ++c)
+      if (before_(nodes_[c], nodes_[best])) best = c;
+    return to_u32(best);
+  }
 
   /// Inserts a node whose id is absent.
   void push(const Node& node) {

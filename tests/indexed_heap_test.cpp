@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <iterator>
 #include <random>
 #include <set>
 
@@ -20,7 +21,7 @@ struct Before {
   }
 };
 
-TEST(IndexedHeap, PopsInOrderThroughRandomPushesUpdatesAndErasures) {
+TEST(IndexedHeap, PopsInOrderAndNamesTheRunnerUpThroughRandomPushesUpdatesAndErasures) {
   constexpr std::uint32_t kIds = 2000;
   std::mt19937_64 rng(11);
   std::uniform_int_distribution<std::uint32_t> any_id(0, kIds - 1);
@@ -60,6 +61,11 @@ TEST(IndexedHeap, PopsInOrderThroughRandomPushesUpdatesAndErasures) {
           const auto [key, top] = *reference.begin();
           ASSERT_EQ(heap.top().id, top);
           ASSERT_EQ(heap.top().key, key);
+          // What comes out next, unless keys change.
+          if (reference.size() < 2)
+            ASSERT_EQ(heap.runner_up(), heap.kAbsent);
+          else
+            ASSERT_EQ(heap.at(heap.runner_up()).id, std::next(reference.begin())->second);
           heap.pop();
           reference.erase(reference.begin());
           key_of[top] = -1;
