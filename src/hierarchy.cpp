@@ -779,11 +779,15 @@ class HierarchyBuilder::Impl {
     __builtin_prefetch(&edges_[next.edge]);
     return next;
   }
-  // Stage 2, after relink(): the slots.
+  // Stage 2, after relink(): the slots and the mesh edges between them.
   void lookahead_slots(Lookahead& next, std::uint32_t slot_a, std::uint32_t slot_b) const {
     if (next.edge == kNone) return;
     const LiveEdge& e = edges_[next.edge];
     if (!e.alive()) return;
+    if (e.combined_shared == kNone)  // the mesh edges between the two clusters
+      __builtin_prefetch(&graph_->edges()[next.edge]);
+    else
+      __builtin_prefetch(&combined_shared_[e.combined_shared]);
     for (int k = 0; k < 2; ++k) {
       const std::uint32_t slot = k == 0 ? e.a : e.b;
       if (slot == slot_a || slot == slot_b) continue;
