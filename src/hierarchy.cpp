@@ -615,6 +615,14 @@ class HierarchyBuilder::Impl {
   bool pair_by_corners(std::uint32_t triangles) const {
     return by_corners_ && triangles <= FaceCorners::kMaxTriangles;
   }
+  // The dual edge between the two faces of the cluster in `slot` if it is a pair read by its
+  // faces' corners (not read: for prefetches), else nullptr.
+  const DualEdge* pair_faces(std::uint32_t slot) const {
+    const std::uint32_t index = slots_[slot].stats;
+    if (index == kNone || !(index & kPairTag) || !pair_by_corners(slots_[slot].triangles))
+      return nullptr;
+    return &graph_->edges()[index & ~kPairTag];
+  }
 
   // Pairs of faces are most of the merged clusters alive at once (all of them at the peak on a
   // subdivided mesh, 40% on a scan): reading them from their two faces saves their statistics'
@@ -751,6 +759,8 @@ class HierarchyBuilder::Impl {
       graph_->prefetch_face(slot);
     else if (!(index & kPairTag))
       prefetch_stats(stats_[index]);
+    else if (const DualEdge* pair = pair_faces(slot))
+      __builtin_prefetch(pair);
     else if (pair_cache_[index % kCachedPairs].key == index)
       prefetch_stats(pair_cache_[index % kCachedPairs].stats);
     queue_.prefetch(id);
@@ -807,8 +817,8 @@ class HierarchyBuilder::Impl {
         const char* bytes = reinterpret_cast<const char*>(&stats_[index]);
         for (std::size_t offset = 0; offset < sizeof(ClusterStats); offset += 64)
           __builtin_prefetch(bytes + offset);
-      } else if (pair_by_corners(slots_[slot].triangles)) {
-        __builtin_prefetch(&graph_->edges()[index & ~kPairTag]);
+      } else if (const DualEdge* pair = pair_faces(slot)) {
+        __builtin_prefetch(pair);
       }  // (a pair by its statistics is in the pair cache)
     }
   }
@@ -816,13 +826,11 @@ class HierarchyBuilder::Impl {
   void lookahead_faces(const Lookahead& next) const {
     for (std::uint32_t slot : next.slots) {
       if (slot == kNone) continue;
-      const std::uint32_t index = slots_[slot].stats;
-      if (index == kNone) {
+      if (slots_[slot].stats == kNone) {
         graph_->prefetch_face_corners(slot);
-      } else if ((index & kPairTag) && pair_by_corners(slots_[slot].triangles)) {
-        const DualEdge& e = graph_->edges()[index & ~kPairTag];
-        graph_->prefetch_face(e.first);
-        graph_->prefetch_face(e.second);
+      } else if (const DualEdge* pair = pair_faces(slot)) {
+        graph_->prefetch_face(pair->first);
+        graph_->prefetch_face(pair->second);
       }
     }
   }
@@ -830,11 +838,9 @@ class HierarchyBuilder::Impl {
   void lookahead_pair_corners(const Lookahead& next) const {
     for (std::uint32_t slot : next.slots) {
       if (slot == kNone) continue;
-      const std::uint32_t index = slots_[slot].stats;
-      if (index != kNone && (index & kPairTag) && pair_by_corners(slots_[slot].triangles)) {
-        const DualEdge& e = graph_->edges()[index & ~kPairTag];
-        graph_->prefetch_face_corners(e.first);
-        graph_->prefetch_face_corners(e.second);
+      if (const DualEdge* pair = pair_faces(slot)) {
+        graph_->prefetch_face_corners(pair->first);
+        graph_->prefetch_face_corners(pair->second);
       }
     }
   }
@@ -1006,11 +1012,16 @@ class HierarchyBuilder::Impl {
       else
         batch_.emplace_back(0.0, false, PrimitiveType::Plane, id);
     }
-    // The faces' corners, now that their triangles have arrived.
+    // The faces' corners, now that their triangles have arrived; a pair's faces' triangles, now
+    // that its dual edge has (their corners come one candidate ahead, in the batch's evaluation).
     for (const QueuedCandidate& queued : batch_) {
-      const LiveEdge& e = edges_[queued.id];
-      const std::uint32_t other = e.a == slot ? e.b : e.a;
-      if (slots_[other].stats == kNone) graph_->prefetch_face_corners(other);
+      const std::uint32_t other = other_end(edges_[queued.id], slot);
+      if (slots_[other].stats == kNone) {
+        graph_->prefetch_face_corners(other);
+      } else if (const DualEdge* pair = pair_faces(other)) {
+        graph_->prefetch_face(pair->first);
+        graph_->prefetch_face(pair->second);
+      }
     }
     lookahead_faces(lookahead_);
     evaluate_and_queue_batch([slot](std::size_t) { return slot; });
@@ -1022,6 +1033,12 @@ class HierarchyBuilder::Impl {
   template <class SlotOf>
   void evaluate_and_queue_batch(SlotOf slot_of) {
     auto evaluate_batch = [&](std::size_t i, unsigned thread) {
+      if (i + 1 < batch_.size())
+        if (const DualEdge* pair =
+                pair_faces(other_end(edges_[batch_[i + 1].id], slot_of(i + 1)))) {
+          graph_->prefetch_face_corners(pair->first);
+          graph_->prefetch_face_corners(pair->second);
+        }
       batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
     };
     pool_.run(batch_.size(), evaluate_batch, parallel_from_);
