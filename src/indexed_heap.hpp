@@ -154,6 +154,9 @@ class IndexedHeap {
       if (first >= n) break;
       std::size_t best = first;
       const std::size_t end = first + kArity < n ? first + kArity : n;
+      // The next level's four groups (one is the path's) while this one is compared.
+      for (std::size_t c = first; c < end && kArity * c + 1 < n; ++c)
+        __builtin_prefetch(&nodes_[kArity * c + 1]);
       for (std::size_t c = first + 1; c < end; ++c)
         if (before_(nodes_[c], nodes_[best])) best = c;
       if (!before_(nodes_[best], node)) break;
