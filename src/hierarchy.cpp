@@ -749,6 +749,14 @@ class HierarchyBuilder::Impl {
   // most: that cluster's statistics if stored (its triangles if a face), the mesh edges between
   // the two clusters, the candidate's place in the queue.
   void prefetch_candidate(std::uint32_t id, std::uint32_t slot) const {
+    prefetch_cluster(slot);
+    queue_.prefetch(id);
+    prefetch_shared_edges(id);
+  }
+
+  // The first link of the chain a cluster's read follows: a stored cluster's (or cached pair's)
+  // statistics, a face's triangles, the dual edge of a pair read by its faces' corners.
+  void prefetch_cluster(std::uint32_t slot) const {
     const std::uint32_t index = slots_[slot].stats;
     auto prefetch_stats = [](const ClusterStats& stats) {
       const char* bytes = reinterpret_cast<const char*>(&stats);
@@ -763,7 +771,25 @@ class HierarchyBuilder::Impl {
       __builtin_prefetch(pair);
     else if (pair_cache_[index % kCachedPairs].key == index)
       prefetch_stats(pair_cache_[index % kCachedPairs].stats);
-    queue_.prefetch(id);
+  }
+  // The next link, once the first has arrived: a face's corners' positions, a pair's triangles.
+  void prefetch_faces(std::uint32_t slot) const {
+    if (slots_[slot].stats == kNone) {
+      graph_->prefetch_face_corners(slot);
+    } else if (const DualEdge* pair = pair_faces(slot)) {
+      graph_->prefetch_face(pair->first);
+      graph_->prefetch_face(pair->second);
+    }
+  }
+  // The last link of a pair's chain: its faces' corners' positions.
+  void prefetch_pair_corners(std::uint32_t slot) const {
+    if (const DualEdge* pair = pair_faces(slot)) {
+      graph_->prefetch_face_corners(pair->first);
+      graph_->prefetch_face_corners(pair->second);
+    }
+  }
+  // The mesh edges between the two clusters of live edge `id` (what shared_edges() reads).
+  void prefetch_shared_edges(std::uint32_t id) const {
     const std::uint32_t pooled = edges_[id].combined_shared;
     if (pooled == kNone)
       __builtin_prefetch(&graph_->edges()[id]);
@@ -794,10 +820,7 @@ class HierarchyBuilder::Impl {
     if (next.edge == kNone) return;
     const LiveEdge& e = edges_[next.edge];
     if (!e.alive()) return;
-    if (e.combined_shared == kNone)  // the mesh edges between the two clusters
-      __builtin_prefetch(&graph_->edges()[next.edge]);
-    else
-      __builtin_prefetch(&combined_shared_[e.combined_shared]);
+    prefetch_shared_edges(next.edge);
     for (int k = 0; k < 2; ++k) {
       const std::uint32_t slot = k == 0 ? e.a : e.b;
       if (slot == slot_a || slot == slot_b) continue;
@@ -805,44 +828,12 @@ class HierarchyBuilder::Impl {
       __builtin_prefetch(&slots_[slot]);
     }
   }
-  // Stage 3, after the merged cluster's fit: a stored cluster's statistics, a face's triangles, a
-  // pair's dual edge.
-  void lookahead_clusters(const Lookahead& next) const {
-    for (std::uint32_t slot : next.slots) {
-      if (slot == kNone) continue;
-      const std::uint32_t index = slots_[slot].stats;
-      if (index == kNone) {
-        graph_->prefetch_face(slot);
-      } else if (!(index & kPairTag)) {
-        const char* bytes = reinterpret_cast<const char*>(&stats_[index]);
-        for (std::size_t offset = 0; offset < sizeof(ClusterStats); offset += 64)
-          __builtin_prefetch(bytes + offset);
-      } else if (const DualEdge* pair = pair_faces(slot)) {
-        __builtin_prefetch(pair);
-      }  // (a pair by its statistics is in the pair cache)
-    }
-  }
-  // Stage 4, before the new cluster's candidates are evaluated: a face's corners, a pair's faces.
-  void lookahead_faces(const Lookahead& next) const {
-    for (std::uint32_t slot : next.slots) {
-      if (slot == kNone) continue;
-      if (slots_[slot].stats == kNone) {
-        graph_->prefetch_face_corners(slot);
-      } else if (const DualEdge* pair = pair_faces(slot)) {
-        graph_->prefetch_face(pair->first);
-        graph_->prefetch_face(pair->second);
-      }
-    }
-  }
-  // Stage 5, after they are: a pair's faces' corners.
-  void lookahead_pair_corners(const Lookahead& next) const {
-    for (std::uint32_t slot : next.slots) {
-      if (slot == kNone) continue;
-      if (const DualEdge* pair = pair_faces(slot)) {
-        graph_->prefetch_face_corners(pair->first);
-        graph_->prefetch_face_corners(pair->second);
-      }
-    }
+  // Stages 3 to 5 (after the merged cluster's fit, before and after its candidates' evaluation):
+  // each link of the clusters' chains in turn.
+  template <class Prefetch>
+  void lookahead(const Lookahead& next, Prefetch prefetch) const {
+    for (std::uint32_t slot : next.slots)
+      if (slot != kNone) (this->*prefetch)(slot);
   }
 
   // Applies the candidate's merge.
@@ -880,7 +871,7 @@ class HierarchyBuilder::Impl {
       }
     };
     pool_.run(2, jobs, parallel_from_);
-    lookahead_clusters(next);
+    lookahead(next, &Impl::prefetch_cluster);
     lookahead_ = next;
     const std::uint32_t node = next_node();
 
@@ -1014,16 +1005,8 @@ class HierarchyBuilder::Impl {
     }
     // The faces' corners, now that their triangles have arrived; a pair's faces' triangles, now
     // that its dual edge has (their corners come one candidate ahead, in the batch's evaluation).
-    for (const QueuedCandidate& queued : batch_) {
-      const std::uint32_t other = other_end(edges_[queued.id], slot);
-      if (slots_[other].stats == kNone) {
-        graph_->prefetch_face_corners(other);
-      } else if (const DualEdge* pair = pair_faces(other)) {
-        graph_->prefetch_face(pair->first);
-        graph_->prefetch_face(pair->second);
-      }
-    }
-    lookahead_faces(lookahead_);
+    for (const QueuedCandidate& queued : batch_) prefetch_faces(other_end(edges_[queued.id], slot));
+    lookahead(lookahead_, &Impl::prefetch_faces);
     evaluate_and_queue_batch([slot](std::size_t) { return slot; });
   }
 
@@ -1034,15 +1017,11 @@ class HierarchyBuilder::Impl {
   void evaluate_and_queue_batch(SlotOf slot_of) {
     auto evaluate_batch = [&](std::size_t i, unsigned thread) {
       if (i + 1 < batch_.size())
-        if (const DualEdge* pair =
-                pair_faces(other_end(edges_[batch_[i + 1].id], slot_of(i + 1)))) {
-          graph_->prefetch_face_corners(pair->first);
-          graph_->prefetch_face_corners(pair->second);
-        }
+        prefetch_pair_corners(other_end(edges_[batch_[i + 1].id], slot_of(i + 1)));
       batch_[i] = evaluate(batch_[i].id, scratch_[thread]);
     };
     pool_.run(batch_.size(), evaluate_batch, parallel_from_);
-    lookahead_pair_corners(lookahead_);
+    lookahead(lookahead_, &Impl::prefetch_pair_corners);
     for (const QueuedCandidate& evaluated : batch_) queue_.prefetch_node(evaluated.id);
     std::uint32_t marked = kNone;
     for (std::size_t i = 0; i < batch_.size(); ++i) {
