@@ -5,7 +5,10 @@
 # laps 0.63 apart; its inner wall is reflex and a lap of the loop clips a few ears: the worst
 # case of ear clipping, fanned past its budget from about 100,000 vertices). Prints,
 # per input, the median over RUNS of wall-clock seconds and peak RSS of `primseg segment` (GNU
-# time); bytes per triangle.
+# time) writing the labels of one cluster; bytes per triangle; and the median seconds and peak
+# RSS of writing the JSON with its border curves at a cluster per face (the book's spine in
+# every border, the fan's centre on every curve); and those of `primseg denoise` at the automatic
+# level (its noise estimate smooths the whole mesh; the spine and the hub are on every face).
 #
 #   bench/pathological.sh BUILD_DIR [N...]     (default N: 10000 100000 1000000; RUNS=3)
 set -euo pipefail
@@ -41,18 +44,28 @@ with open(path, "w") as out:
         out.writelines("3 0 %d %d\n" % (i + 1, (i + 1) % n + 1) for i in range(n))
 PY
 }
-printf "%-7s %9s %10s %12s %14s\n" input n seconds peak_rss_MB bytes_per_tri
+median_of_runs() {  # command...: prints "seconds peak_rss_kb", the median run by time
+  local samples=()
+  for ((r = 0; r < runs; ++r)); do
+    samples+=("$(/usr/bin/time -f "%e %M" "$@" 2>&1 >/dev/null | tail -1)")
+  done
+  printf "%s\n" "${samples[@]}" | sort -n | sed -n "$(((runs + 1) / 2))p"
+}
+printf "%-7s %9s %10s %12s %14s %13s %15s %13s %15s\n" input n seconds peak_rss_MB \
+  bytes_per_tri borders_sec borders_rss_MB denoise_sec denoise_rss_MB
 for n in ${sizes[@]}; do
   for kind in book fan polygon spiral; do
     file=$work/$kind-$n.off
     generate "$kind" "$n" "$file"
-    samples=()
-    for ((r = 0; r < runs; ++r)); do
-      samples+=("$(/usr/bin/time -f "%e %M" "$build/primseg" segment "$file" -q --clusters 1 \
-        --labels "$work/out.labels" 2>&1 >/dev/null | tail -1)")
-    done
-    median=$(printf "%s\n" "${samples[@]}" | sort -n | sed -n "$(((runs + 1) / 2))p")
-    read -r seconds rss_kb <<<"$median"
-    printf "%-7s %9d %10s %12d %14d\n" "$kind" "$n" "$seconds" $((rss_kb / 1024)) $((rss_kb * 1024 / n))
+    read -r seconds rss_kb <<<"$(median_of_runs "$build/primseg" segment "$file" -q --clusters 1 \
+      --labels "$work/out.labels")"
+    faces=$([[ $kind == polygon || $kind == spiral ]] && echo 1 || echo "$n")
+    read -r borders_seconds borders_kb <<<"$(median_of_runs "$build/primseg" segment "$file" -q \
+      --clusters "$faces" --json "$work/out.json")"
+    read -r denoise_seconds denoise_kb <<<"$(median_of_runs "$build/primseg" denoise "$file" -q \
+      --clusters auto -o "$work/out.off")"
+    printf "%-7s %9d %10s %12d %14d %13s %15d %13s %15d\n" "$kind" "$n" "$seconds" \
+      $((rss_kb / 1024)) $((rss_kb * 1024 / n)) "$borders_seconds" $((borders_kb / 1024)) \
+      "$denoise_seconds" $((denoise_kb / 1024))
   done
 done

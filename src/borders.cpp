@@ -18,7 +18,7 @@ using detail::EdgeSide;
 using detail::kNone;
 using namespace shape_detail;  // Vec3 -, cross, dot, norm
 
-// One mesh edge of one border, with the triangle of each cluster on it (the lowest-numbered).
+// One mesh edge of one border, with the two linked triangles of its clusters on it.
 struct BorderEdge {
   std::uint32_t first, second, low, high;
   std::uint32_t first_triangle, second_triangle;  // kNone on the mesh boundary's side
@@ -54,20 +54,18 @@ std::vector<BorderEdge> border_edges(const Mesh& mesh, std::span<const std::uint
   const std::vector<EdgeSide> sides =
       detail::edge_sides(mesh, detail::triangle_labels(mesh, face_labels));
   std::vector<BorderEdge> edges;
+  std::vector<EdgeSide> scratch;
+  std::vector<detail::ClusterLink> links;
   for (std::size_t begin = 0; begin < sides.size();) {
     const std::size_t end = detail::edge_end(sides, begin);
     const std::uint32_t low = sides[begin].low, high = sides[begin].high;
     if (end - begin == 1)
       edges.push_back({sides[begin].label, kMeshBoundary, low, high, sides[begin].triangle, kNone});
-    // Sides are sorted by cluster, then triangle: the first side of a cluster has its lowest
-    // triangle.
-    for (std::size_t i = begin; i < end; ++i) {
-      if (i > begin && sides[i].label == sides[i - 1].label) continue;
-      for (std::size_t j = i + 1; j < end; ++j)
-        if (sides[j].label != sides[i].label && sides[j].label != sides[j - 1].label)
-          edges.push_back(
-              {sides[i].label, sides[j].label, low, high, sides[i].triangle, sides[j].triangle});
-    }
+    links.clear();
+    detail::append_cluster_links({sides.data() + begin, end - begin}, scratch, links);
+    for (const detail::ClusterLink& link : links)
+      edges.push_back({link.first.label, link.second.label, low, high, link.first.triangle,
+                       link.second.triangle});
     begin = end;
   }
   std::sort(edges.begin(), edges.end());
@@ -123,11 +121,22 @@ std::vector<BorderCurve> chain(std::span<const BorderEdge> edges,
     incident.emplace_back(edges[e].high, e);
   }
   std::sort(incident.begin(), incident.end());
-  const auto edges_at = [&incident](std::uint32_t v) {
-    const auto begin = std::lower_bound(incident.begin(), incident.end(), std::make_pair(v, 0u));
-    auto end = begin;
-    while (end != incident.end() && end->first == v) ++end;
-    return std::span<const std::pair<std::uint32_t, std::uint32_t>>(&*begin, end - begin);
+  // The distinct vertices, and where each one's edges start in `incident`: a lookup is a binary
+  // search, so a vertex on d edges costs O(d log) and not O(d²) (a book's spine).
+  std::vector<std::uint32_t> vertices, first_incident;
+  for (std::uint32_t i = 0; i < incident.size(); ++i)
+    if (i == 0 || incident[i].first != incident[i - 1].first) {
+      vertices.push_back(incident[i].first);
+      first_incident.push_back(i);
+    }
+  first_incident.push_back(static_cast<std::uint32_t>(incident.size()));
+  const auto edges_at_index = [&](std::size_t k) {
+    return std::span<const std::pair<std::uint32_t, std::uint32_t>>(
+        incident.data() + first_incident[k], first_incident[k + 1] - first_incident[k]);
+  };
+  const auto edges_at = [&](std::uint32_t v) {
+    return edges_at_index(static_cast<std::size_t>(
+        std::lower_bound(vertices.begin(), vertices.end(), v) - vertices.begin()));
   };
   const auto ends_here = [&](std::uint32_t v) { return junction[v] || edges_at(v).size() != 2; };
   const auto other_end = [&edges](std::uint32_t e, std::uint32_t v) {
@@ -157,9 +166,11 @@ std::vector<BorderCurve> chain(std::span<const BorderEdge> edges,
   };
 
   std::vector<BorderCurve> curves;
-  for (std::size_t i = 0; i < incident.size(); ++i) {
-    const auto [v, e] = incident[i];
-    if (!used[e] && ends_here(v)) curves.push_back(follow(v, e));
+  for (std::size_t k = 0; k < vertices.size(); ++k) {
+    const std::uint32_t v = vertices[k];
+    if (!ends_here(v)) continue;
+    for (const auto& entry : edges_at_index(k))
+      if (!used[entry.second]) curves.push_back(follow(v, entry.second));
   }
   for (std::uint32_t e = 0; e < edges.size(); ++e)
     if (!used[e]) curves.push_back(follow(edges[e].low, e));

@@ -22,6 +22,10 @@
 namespace primseg {
 namespace {
 
+// Relabelling weighs, for each face, the clusters at its corners; a corner at more clusters than
+// this offers none (DenoiseOptions::relabel_passes). Vertices of real meshes are at a handful.
+constexpr std::size_t kMaxRelabelClustersAtVertex = 64;
+
 using detail::to_eigen;
 using detail::to_vec3;
 
@@ -372,26 +376,30 @@ void Denoiser::cluster_vertices(const Segmentation& segmentation, std::size_t cl
   points.assign(cluster_count, {});
   weights.assign(cluster_count, {});
   std::vector<std::pair<std::uint32_t, double>> area_by_cluster;
+  const auto by_cluster = [](const auto& a, const auto& b) { return a.first < b.first; };
   for (std::uint32_t v = 0; v < mesh_.vertex_count(); ++v) {
     area_by_cluster.clear();
     for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i) {
       const std::uint32_t t = vertex_triangles_[i];
-      const std::uint32_t c = segmentation.labels[mesh_.face_of_triangle[t]];
       const Triangle& corners = mesh_.triangles[t];
-      const double area = triangle_normal(to_eigen(mesh_.positions[corners[0]]),
-                                          to_eigen(mesh_.positions[corners[1]]),
-                                          to_eigen(mesh_.positions[corners[2]]))
-                              .norm();
-      auto found = std::find_if(area_by_cluster.begin(), area_by_cluster.end(),
-                                [&](const auto& entry) { return entry.first == c; });
-      if (found == area_by_cluster.end())
-        area_by_cluster.emplace_back(c, area);
-      else
-        found->second += area;
+      area_by_cluster.emplace_back(segmentation.labels[mesh_.face_of_triangle[t]],
+                                   triangle_normal(to_eigen(mesh_.positions[corners[0]]),
+                                                   to_eigen(mesh_.positions[corners[1]]),
+                                                   to_eigen(mesh_.positions[corners[2]]))
+                                       .norm());
     }
-    for (const auto& [c, area] : area_by_cluster) {
+    // Sorted, not searched: a vertex on d triangles of m clusters (a book's spine) costs
+    // O(d log d), not O(d m). Stable, so each cluster's areas add up in triangle order.
+    std::stable_sort(area_by_cluster.begin(), area_by_cluster.end(), by_cluster);
+    for (std::size_t begin = 0; begin < area_by_cluster.size();) {
+      const std::uint32_t c = area_by_cluster[begin].first;
+      double area = area_by_cluster[begin].second;
+      std::size_t end = begin + 1;
+      for (; end < area_by_cluster.size() && area_by_cluster[end].first == c; ++end)
+        area += area_by_cluster[end].second;
       points[c].push_back(mesh_.positions[v]);
       weights[c].push_back(area);
+      begin = end;
     }
   }
 }
@@ -457,16 +465,33 @@ void Denoiser::relabel(const Mesh& judged, std::vector<Primitive>& primitives,
   for (std::uint32_t f = 0; f < mesh_.face_count(); ++f) face_offsets[f + 1] += face_offsets[f];
   const std::vector<Primitive> refit_starts = primitives;  // each pass refits from these
   std::vector<std::uint32_t> near, next;
+  // The clusters at each vertex, each once: vertex v's are [cluster_offsets[v],
+  // cluster_offsets[v + 1]) of clusters_at.
+  std::vector<std::uint32_t> cluster_offsets(mesh_.vertex_count() + 1, 0), clusters_at;
   for (int pass = 0; pass < options_.relabel_passes; ++pass) {
+    clusters_at.clear();
+    for (std::uint32_t v = 0; v < mesh_.vertex_count(); ++v) {
+      const auto begin = static_cast<std::ptrdiff_t>(clusters_at.size());
+      for (std::uint32_t j = vertex_triangle_offsets_[v]; j < vertex_triangle_offsets_[v + 1]; ++j)
+        clusters_at.push_back(labels[mesh_.face_of_triangle[vertex_triangles_[j]]]);
+      std::sort(clusters_at.begin() + begin, clusters_at.end());
+      clusters_at.erase(std::unique(clusters_at.begin() + begin, clusters_at.end()),
+                        clusters_at.end());
+      // A vertex at too many clusters (a book's spine, the hub of a finely cut fan) offers none:
+      // its faces choose among the clusters at their other corners. Otherwise every face on it
+      // would weigh them all, O(d²) on d triangles.
+      if (clusters_at.size() - static_cast<std::size_t>(begin) > kMaxRelabelClustersAtVertex)
+        clusters_at.resize(static_cast<std::size_t>(begin));
+      cluster_offsets[v + 1] = static_cast<std::uint32_t>(clusters_at.size());
+    }
     next = labels;
     bool changed = false;
     for (std::uint32_t f = 0; f < mesh_.face_count(); ++f) {
-      near.clear();
+      near.assign(1, labels[f]);  // its own, even when every corner is at too many clusters
       for (std::uint32_t i = face_offsets[f]; i < face_offsets[f + 1]; ++i)
         for (const std::uint32_t v : mesh_.triangles[i])
-          for (std::uint32_t j = vertex_triangle_offsets_[v]; j < vertex_triangle_offsets_[v + 1];
-               ++j)
-            near.push_back(labels[mesh_.face_of_triangle[vertex_triangles_[j]]]);
+          near.insert(near.end(), clusters_at.begin() + cluster_offsets[v],
+                      clusters_at.begin() + cluster_offsets[v + 1]);
       std::sort(near.begin(), near.end());
       near.erase(std::unique(near.begin(), near.end()), near.end());
       if (near.size() < 2) continue;

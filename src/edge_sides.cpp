@@ -1,6 +1,7 @@
 #include "edge_sides.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace primseg::detail {
 
@@ -32,6 +33,36 @@ std::size_t edge_end(std::span<const EdgeSide> sides, std::size_t begin) {
          sides[end].high == sides[begin].high)
     ++end;
   return end;
+}
+
+void append_cluster_links(std::span<const EdgeSide> edge, std::vector<EdgeSide>& scratch,
+                          std::vector<ClusterLink>& links) {
+  if (edge.size() == 2) {  // sorted by label already
+    if (edge[0].label != edge[1].label) links.push_back({edge[0], edge[1]});
+    return;
+  }
+  scratch.assign(edge.begin(), edge.end());
+  std::sort(scratch.begin(), scratch.end(),
+            [](const EdgeSide& a, const EdgeSide& b) { return a.triangle < b.triangle; });
+  const auto first_new = static_cast<std::ptrdiff_t>(links.size());
+  for (std::size_t i = 0; i + 1 < scratch.size(); ++i) {
+    const EdgeSide& a = scratch[i];
+    const EdgeSide& b = scratch[i + 1];
+    if (a.label != b.label)
+      links.push_back(a.label < b.label ? ClusterLink{a, b} : ClusterLink{b, a});
+  }
+  const auto labels = [](const ClusterLink& link) {
+    return std::pair(link.first.label, link.second.label);
+  };
+  // Stable: the first link of each pair stays.
+  std::stable_sort(
+      links.begin() + first_new, links.end(),
+      [&](const ClusterLink& a, const ClusterLink& b) { return labels(a) < labels(b); });
+  links.erase(std::unique(links.begin() + first_new, links.end(),
+                          [&](const ClusterLink& a, const ClusterLink& b) {
+                            return labels(a) == labels(b);
+                          }),
+              links.end());
 }
 
 }  // namespace primseg::detail

@@ -33,4 +33,19 @@ std::vector<EdgeSide> edge_sides(const Mesh& mesh, std::span<const std::uint32_t
 /// The end of the run of sides of the edge at `begin` (sides sorted as edge_sides() returns them).
 std::size_t edge_end(std::span<const EdgeSide> sides, std::size_t begin);
 
+/// Two sides of one edge whose triangles the dual graph links, of different clusters: `first` has
+/// the lower label.
+struct ClusterLink {
+  EdgeSide first, second;
+};
+
+/// Appends to `links` the links across one edge between triangles of different clusters, as the
+/// dual graph makes them (dual_graph.hpp): across a manifold edge its two triangles; on any other
+/// edge each triangle and the next in index order. So two clusters meet on an edge exactly when
+/// the hierarchy could merge them across it. Each pair of clusters once, by its first link in
+/// that order, sorted by (first label, second label): at most k − 1 links for k sides, never k².
+/// `edge` is the run of sides of one edge (edge_sides() order); `scratch` is reused storage.
+void append_cluster_links(std::span<const EdgeSide> edge, std::vector<EdgeSide>& scratch,
+                          std::vector<ClusterLink>& links);
+
 }  // namespace primseg::detail

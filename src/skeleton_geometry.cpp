@@ -22,30 +22,26 @@ double distance_to_line(const Vec3& x, const Vec3& point, const Vec3& axis) {
 
 std::vector<ClusterPairBoundary> cluster_pair_boundaries(
     const Mesh& mesh, std::span<const std::uint32_t> triangle_labels) {
-  // Every edge with the clusters of its triangles, each cluster once.
-  std::vector<detail::EdgeSide> entries = detail::edge_sides(mesh, triangle_labels);
-  entries.erase(std::unique(entries.begin(), entries.end(),
-                            [](const detail::EdgeSide& a, const detail::EdgeSide& b) {
-                              return a.low == b.low && a.high == b.high && a.label == b.label;
-                            }),
-                entries.end());
-
+  const std::vector<detail::EdgeSide> sides = detail::edge_sides(mesh, triangle_labels);
+  std::vector<detail::EdgeSide> scratch;
+  std::vector<detail::ClusterLink> links;
   std::map<std::pair<std::uint32_t, std::uint32_t>, ClusterPairBoundary> pairs;
-  for (std::size_t begin = 0; begin < entries.size();) {
-    const std::size_t end = detail::edge_end(entries, begin);
-    const std::uint32_t a = entries[begin].low, b = entries[begin].high;
+  for (std::size_t begin = 0; begin < sides.size();) {
+    const std::size_t end = detail::edge_end(sides, begin);
+    const std::uint32_t a = sides[begin].low, b = sides[begin].high;
     const double length = norm(mesh.positions[b] - mesh.positions[a]);
     const Vec3 midpoint = 0.5 * (mesh.positions[a] + mesh.positions[b]);
-    for (std::size_t i = begin; i < end; ++i)
-      for (std::size_t j = i + 1; j < end; ++j) {
-        ClusterPairBoundary& boundary = pairs[{entries[i].label, entries[j].label}];
-        boundary.first = entries[i].label;
-        boundary.second = entries[j].label;
-        boundary.length += length;
-        boundary.weighted_midpoints = boundary.weighted_midpoints + length * midpoint;
-        boundary.vertices.push_back(a);
-        boundary.vertices.push_back(b);
-      }
+    links.clear();
+    detail::append_cluster_links({sides.data() + begin, end - begin}, scratch, links);
+    for (const detail::ClusterLink& link : links) {
+      ClusterPairBoundary& boundary = pairs[{link.first.label, link.second.label}];
+      boundary.first = link.first.label;
+      boundary.second = link.second.label;
+      boundary.length += length;
+      boundary.weighted_midpoints = boundary.weighted_midpoints + length * midpoint;
+      boundary.vertices.push_back(a);
+      boundary.vertices.push_back(b);
+    }
     begin = end;
   }
   std::vector<ClusterPairBoundary> result;

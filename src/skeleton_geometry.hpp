@@ -39,7 +39,8 @@ using detail::triangle_labels;
 void check_face_labels(const Mesh& mesh, const Skeleton& skeleton, std::string_view caller);
 
 /// Every pair of clusters that share a mesh edge (an edge of triangles of both), sorted by
-/// (first, second). On a non-manifold edge every pair of distinct clusters around it counts.
+/// (first, second). On a non-manifold edge, the pairs the dual graph links across it
+/// (edge_sides.hpp: append_cluster_links).
 std::vector<ClusterPairBoundary> cluster_pair_boundaries(
     const Mesh& mesh, std::span<const std::uint32_t> triangle_labels);
 

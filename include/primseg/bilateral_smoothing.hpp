@@ -43,9 +43,12 @@ void validate(const BilateralSmoothingOptions& options);
 /// A copy of `mesh` with the positions smoothed; same vertices, triangles and order. Normals are
 /// compared with the triangles consistently oriented, as DualGraph orients them, so the result
 /// does not depend on how the file orients its faces (up to round-off). Faces of zero area keep
-/// no normal and take no part in the filtering. Deterministic; O((normal_iterations
-/// + vertex_iterations) × Σ ring sizes). Throws InvalidInputError for invalid options or a mesh
-/// that fails Mesh::validate().
+/// no normal and take no part in the filtering. A vertex on more than 64 triangles (a fan's hub,
+/// a book's spine) joins only the faces across each of its edges into a ring, chained at a
+/// non-manifold edge as DualGraph chains them, so that ring sizes stay bounded: all the faces
+/// around it would cost O(valence²) per pass. Deterministic; O((normal_iterations
+/// + vertex_iterations) × Σ ring sizes) with rings of at most about 3 × 64 faces. Throws
+/// InvalidInputError for invalid options or a mesh that fails Mesh::validate().
 Mesh bilateral_smooth(const Mesh& mesh, const BilateralSmoothingOptions& options = {});
 
 }  // namespace primseg

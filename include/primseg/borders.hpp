@@ -50,7 +50,9 @@ struct ClusterBorder {
 };
 
 /// Every border of the clusters `face_labels` assigns, sorted by (first, second). Non-manifold
-/// edges: every pair of distinct clusters among the triangles on an edge shares it. Degenerate
+/// edges (k >= 3 triangles): two clusters share one when the dual graph links a triangle of each
+/// across it (dual_graph.hpp: the triangles in index order, each linked to the next), the pairs
+/// the hierarchy could merge there; so an edge is in at most k − 1 borders, not k². Degenerate
 /// edges (both ends the same vertex) are left out; zero-length ones count. O(T log T).
 /// - `face_labels`: the cluster of each input face, shape (F); any values but kMeshBoundary.
 /// - `primitives`: the clusters' primitives, shape (K) with K above every label, input units; or

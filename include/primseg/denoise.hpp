@@ -72,7 +72,8 @@ struct DenoiseOptions {
   /// better (fandisk with 0.3% noise: RMS 3.3x lower at K = 40 against 2.6x with 5 Taubin steps).
   std::optional<BilateralSmoothingOptions> bilateral_smoothing;
   /// After the refit, each face moves to the cluster, among its own and those of the faces
-  /// sharing a vertex with it, whose primitive its corners are nearest to (sum of squared
+  /// sharing a vertex with it (but for a vertex at more than 64 clusters, such as a non-manifold
+  /// book's spine, which offers none), whose primitive its corners are nearest to (sum of squared
   /// distances, measured on the segmented copy: smoothed when smoothing is on), and the
   /// primitives are refitted; this many passes, fewer when a pass moves nothing. The hierarchy's
   /// borders follow its greedy merges on the smoothed copy and zigzag across blends; the

@@ -400,6 +400,25 @@ TEST(Skinning, PosesThatCannotBeAppliedAreRejected) {
   EXPECT_THROW(compute_skin_weights(s.figure.mesh, s.skeleton, bad), InvalidInputError);
 }
 
+// A book of pages on one spine edge, a cluster per page: consecutive pages (by triangle, as the
+// dual graph links them) meet along the spine, and those boundaries all touch: one locked joint
+// of every bone at the spine's midpoint, and no free end. Every pair of pages meeting would be
+// N(N − 1)/2 boundaries.
+TEST(Skeleton, ABookIsOneJointOnItsSpine) {
+  constexpr std::uint32_t kPages = 3000;
+  std::vector<std::uint32_t> labels(kPages);
+  for (std::uint32_t i = 0; i < kPages; ++i) labels[i] = i;
+  const Skeleton skeleton =
+      extract_skeleton(testing::book(kPages), labels, std::vector<Primitive>(kPages));
+  ASSERT_EQ(skeleton.joints.size(), 1u);
+  const Joint& spine = skeleton.joints[0];
+  EXPECT_EQ(spine.kind, JointKind::Locked);
+  EXPECT_EQ(spine.bones.size(), kPages);
+  EXPECT_NEAR(spine.position[0], 0, 1e-12);
+  EXPECT_NEAR(spine.position[1], 0, 1e-12);
+  EXPECT_NEAR(spine.position[2], 0.5, 1e-12);
+}
+
 // Three clusters of a square meeting at its centre: their boundaries touch there, so they share
 // one locked joint; no bone keeps a movable joint, so all are hidden, and so is the joint.
 TEST(Skeleton, TouchingBoundariesMergeIntoOneLockedJoint) {

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <mutex>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -129,6 +130,17 @@ void transform(Mesh& mesh, const std::array<std::array<double, 3>, 3>& rotation,
 }  // namespace primseg::testing
 
 namespace primseg::testing {
+
+Mesh book(std::uint32_t pages) {
+  std::vector<Vec3> positions = {{0, 0, 0}, {0, 0, 1}};
+  std::vector<Triangle> triangles;
+  for (std::uint32_t i = 0; i < pages; ++i) {
+    const double angle = 2 * std::numbers::pi * i / pages;
+    positions.push_back({std::cos(angle), std::sin(angle), 0.5});
+    triangles.push_back({0, 1, i + 2});
+  }
+  return Mesh::from_triangles(positions, triangles);
+}
 
 Mesh concatenated(const std::vector<Mesh>& parts) {
   std::vector<Vec3> positions;

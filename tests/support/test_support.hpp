@@ -104,6 +104,11 @@ std::vector<PrimitiveType> every_primitive_type();
 /// Several meshes as the components of one (each part's vertices after the previous parts').
 Mesh concatenated(const std::vector<Mesh>& parts);
 
+/// A non-manifold "book": `pages` triangles on one spine edge from vertex 0 at (0, 0, 0) to
+/// vertex 1 at (0, 0, 1); page i is triangle (0, 1, i + 2), its third vertex on the unit circle
+/// at angle 2πi / pages and height 0.5.
+Mesh book(std::uint32_t pages);
+
 /// A generated shape (shape_generator.hpp) in its Uniform tessellation with random vertex motion
 /// and Gaussian noise of 0.3% of its size along the normals: a small scan-like input.
 Mesh noisy_uniform_shape(const std::string& name);

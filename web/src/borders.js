@@ -187,13 +187,6 @@ export class BorderLines {
       const e = edges[i];
       if (e === NO_EDGE || (i > 0 && e === edges[i - 1])) continue;
       const from = sideStart[e], to = sideStart[e + 1];
-      // Only edges on a border: one triangle, or a triangle of another cluster.
-      let others = false;
-      for (let s = from; s < to; ++s) others ||= clusterOf(triangleOf(s)) !== c;
-      if (!others && to - from > 1) continue;
-      // The lowest triangle of each cluster on the edge (sides are sorted by triangle).
-      const first = new Map();
-      for (let s = from; s < to; ++s) if (!first.has(clusterOf(triangleOf(s)))) first.set(clusterOf(triangleOf(s)), triangleOf(s));
       const low = ends[2 * e], high = ends[2 * e + 1];
       const a = point(low), b = point(high);
       const length = norm(sub(b, a));
@@ -201,9 +194,18 @@ export class BorderLines {
         add(-1, length, null);
         continue;
       }
-      const own = first.get(c), ownPrimitive = primitiveOf(c);
-      for (const [other, theirs] of first) {
-        if (other === c) continue;
+      // The clusters the dual graph links c to across the edge (its triangles in index order, each
+      // linked to the next: sides are sorted by triangle), each by its first link.
+      const linked = new Map(); // other cluster -> [c's triangle, theirs]
+      for (let s = from; s + 1 < to; ++s) {
+        const t = triangleOf(s), u = triangleOf(s + 1);
+        const ct = clusterOf(t), cu = clusterOf(u);
+        if (ct === cu || (ct !== c && cu !== c)) continue;
+        const other = ct === c ? cu : ct;
+        if (!linked.has(other)) linked.set(other, ct === c ? [t, u] : [u, t]);
+      }
+      const ownPrimitive = primitiveOf(c);
+      for (const [other, [own, theirs]] of linked) {
         const primitive = primitiveOf(other);
         let angle = null;
         const n1 = listedNormal(own);

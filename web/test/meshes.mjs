@@ -99,3 +99,14 @@ export function figurePose(skeleton) {
     { joint: at([1, 0, 1.2]), axis: [1, 1, 0], degrees: 20 },
   ];
 }
+
+/** A book: n triangles on one spine edge (vertices 0 and 1), page i through vertex i + 2. */
+export function writeBook(path, n) {
+  const vertices = [[0, 0, 0], [0, 0, 1]], triangles = [];
+  for (let i = 0; i < n; ++i) {
+    const angle = (2 * Math.PI * i) / n;
+    vertices.push([Math.cos(angle), Math.sin(angle), 0.5]);
+    triangles.push([0, 1, i + 2]);
+  }
+  writeOff(path, vertices, triangles);
+}
