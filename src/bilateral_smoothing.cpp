@@ -4,10 +4,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <compare>
 #include <cstdint>
+#include <numeric>
 #include <vector>
 
+#include "edge_sides.hpp"
 #include "eigen_conversions.hpp"
 #include "parallel.hpp"
 #include "primseg/dual_graph.hpp"
@@ -28,37 +29,44 @@ using detail::to_vec3;
 constexpr std::uint32_t kMaxRingValence = 64;
 
 // The faces sharing a vertex with each face (itself included), as compressed rows, sorted; at a
-// vertex above kMaxRingValence, only those sharing an edge with it, chained at a non-manifold edge
-// as the dual graph joins them (each to the next in index order).
+// vertex above kMaxRingValence, only those sharing an edge with it, linked at a non-manifold edge
+// as the dual graph links them (append_cluster_links, each triangle its own cluster).
 std::vector<std::vector<std::uint32_t>> face_neighbourhoods(const Mesh& mesh,
                                                             const VertexTriangles& around) {
-  const auto valence = [&](std::uint32_t v) { return around.offsets[v + 1] - around.offsets[v]; };
-  std::vector<std::vector<std::uint32_t>> rings(mesh.triangle_count());
-  // Edges between two high-valence vertices: their triangles would meet in no ring otherwise.
-  struct EdgeTriangle {
-    std::uint32_t low, high, triangle;
-    auto operator<=>(const EdgeTriangle&) const = default;
+  const auto crowded = [&](std::uint32_t v) {
+    return around.offsets[v + 1] - around.offsets[v] > kMaxRingValence;
   };
-  std::vector<EdgeTriangle> crowded_edges;
+  std::vector<std::vector<std::uint32_t>> rings(mesh.triangle_count());
+  bool any_crowded = false;
   for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     std::vector<std::uint32_t>& ring = rings[t];
     ring.push_back(t);
-    const Triangle& corners = mesh.triangles[t];
-    for (int i = 0; i < 3; ++i) {
-      const std::uint32_t v = corners[i], w = corners[(i + 1) % 3];
-      if (valence(v) <= kMaxRingValence)
-        ring.insert(ring.end(), around.triangles.begin() + around.offsets[v],
-                    around.triangles.begin() + around.offsets[v + 1]);
-      else if (valence(w) > kMaxRingValence && v != w)
-        crowded_edges.push_back({std::min(v, w), std::max(v, w), t});
+    for (const std::uint32_t v : mesh.triangles[t]) {
+      if (crowded(v)) {
+        any_crowded = true;
+        continue;
+      }
+      ring.insert(ring.end(), around.triangles.begin() + around.offsets[v],
+                  around.triangles.begin() + around.offsets[v + 1]);
     }
   }
-  std::sort(crowded_edges.begin(), crowded_edges.end());
-  for (std::size_t i = 1; i < crowded_edges.size(); ++i) {
-    const EdgeTriangle &previous = crowded_edges[i - 1], &current = crowded_edges[i];
-    if (previous.low != current.low || previous.high != current.high) continue;
-    rings[previous.triangle].push_back(current.triangle);
-    rings[current.triangle].push_back(previous.triangle);
+  // Across an edge between two crowded vertices, the triangles would meet in no ring otherwise.
+  if (any_crowded) {
+    std::vector<std::uint32_t> own_cluster(mesh.triangle_count());
+    std::iota(own_cluster.begin(), own_cluster.end(), 0u);
+    const std::vector<detail::EdgeSide> sides = detail::edge_sides(mesh, own_cluster);
+    std::vector<detail::EdgeSide> scratch;
+    std::vector<detail::ClusterLink> links;
+    for (std::size_t begin = 0; begin < sides.size();) {
+      const std::size_t end = detail::edge_end(sides, begin);
+      if (crowded(sides[begin].low) && crowded(sides[begin].high))
+        detail::append_cluster_links({sides.data() + begin, end - begin}, scratch, links);
+      begin = end;
+    }
+    for (const detail::ClusterLink& link : links) {
+      rings[link.first.triangle].push_back(link.second.triangle);
+      rings[link.second.triangle].push_back(link.first.triangle);
+    }
   }
   for (std::vector<std::uint32_t>& ring : rings) {
     std::sort(ring.begin(), ring.end());
