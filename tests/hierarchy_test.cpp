@@ -484,6 +484,37 @@ TEST(HierarchyBuilder, SteppingGivesTheOneShotTree) {
   EXPECT_THROW(builder.finish(), Error);
 }
 
+TEST(Hierarchy, LinkageKeepsTheRawCostsThatScipyLinkageMakesMonotone) {
+  ShapeOptions noisy;
+  noisy.noise = 0.004;
+  const Hierarchy h = build_hierarchy(make_shape("box_with_boss", noisy).mesh);
+  const std::vector<std::array<double, 4>> raw = h.linkage();
+  const std::vector<std::array<double, 4>> scipy = scipy_linkage(h);
+  ASSERT_EQ(raw.size(), h.face_count() - 1);
+  ASSERT_EQ(scipy.size(), raw.size());
+  std::size_t drops = 0;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const Merge& m = h.merges()[i];
+    EXPECT_EQ(raw[i], (std::array<double, 4>{double(m.first), double(m.second), m.cost,
+                                             double(m.face_count)}));
+    // The same children and sizes; a height at least the raw cost, above the previous one.
+    EXPECT_EQ(scipy[i][0], raw[i][0]);
+    EXPECT_EQ(scipy[i][1], raw[i][1]);
+    EXPECT_EQ(scipy[i][3], raw[i][3]);
+    EXPECT_GE(scipy[i][2], raw[i][2]);
+    if (i > 0) {
+      EXPECT_GT(scipy[i][2], scipy[i - 1][2]);
+      drops += raw[i][2] < raw[i - 1][2];
+    }
+  }
+  EXPECT_GT(drops, 0u);  // greedy costs do drop after some merges: why the two differ
+
+  // A tree whose merges do not match its mesh is refused.
+  std::vector<Merge> merges(h.merges().begin(), h.merges().end());
+  merges.pop_back();
+  EXPECT_THROW(Hierarchy(h.shared_mesh(), h.options(), merges), InvalidInputError);
+}
+
 TEST(Hierarchy, SingleFaceMeshHasNoMerges) {
   const Mesh mesh = Mesh::from_triangles({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {Triangle{0, 1, 2}});
   const Hierarchy h = build_hierarchy(mesh);

@@ -263,10 +263,15 @@ TEST(Batch, BadArgumentsAreRejectedWithAMessage) {
   const fs::path dir = testing::temp_directory("batch-args");
   const fs::path in = make_data_set(dir);
   const std::string base = "batch '" + in.string() + "' --out '" + (dir / "out").string() + "'";
+  // One file listed twice under two spellings of its path: both would write the same outputs.
+  std::ofstream(dir / "twice.txt") << (in / "box.off").string() << "\n"
+                                   << (in / "." / "box.off").string() << "\n";
   struct Case {
     std::string args, message;
   };
   for (const Case& c : std::vector<Case>{
+           {"batch '" + (dir / "twice.txt").string() + "' --out '" + (dir / "out").string() + "'",
+            "/box.off' would write the same outputs"},
            {base + " --shard 3/3", "--shard: '3/3' is not i/n"},
            {base + " --shard 1", "--shard: '1' is not i/n"},
            {base + " --primitives ellipsoid", "unknown primitive 'ellipsoid'"},

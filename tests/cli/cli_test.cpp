@@ -966,6 +966,30 @@ TEST(Cli, ClustersAutoFindsTheRegionsAndReportsCandidatesAndTheCurve) {
   }
 }
 
+// The console says which rule chose the automatic level: a jump of the error curve, its knee
+// when it has no jump, or one cluster per component when a single cluster fits each exactly.
+TEST(Cli, ClustersAutoSaysWhichRuleChoseTheLevel) {
+  TempDir dir("auto-rules");
+  ShapeOptions noisy;
+  noisy.noise = 0.004;
+  write_mesh(dir / "box.off", make_shape("box").mesh);
+  write_mesh(dir / "countersink.off", make_shape("box_with_countersink", noisy).mesh);
+  write_mesh(dir / "sphere.off", make_shape("sphere").mesh);
+  struct Case {
+    const char* file;
+    const char* line;
+  };
+  for (const Case& c :
+       {Case{"box.off", "automatic level: 6 clusters, where the error curve jumps"},
+        Case{"countersink.off",
+             "automatic level: 8 clusters, the knee of the error curve (no jump)"},
+        Case{"sphere.off", "automatic level: one cluster per component (no jump)"}}) {
+    const CliRun r = run("segment " + dir.q(c.file) + " --clusters auto");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find(c.line), std::string::npos) << c.file << "\n" << r.output;
+  }
+}
+
 TEST(Cli, RefineReportsItsPassesAndKeepsEveryFaceLabelled) {
   TempDir dir("refine");
   ShapeOptions options;
@@ -1671,6 +1695,22 @@ TEST(Cli, UnusualFileNamesWork) {
                            dir.q(name + ".cut.json"));
     EXPECT_EQ(cut.status, 0) << cut.output;
   }
+}
+
+// The page carries the file name in a <script> element: a name that would open a comment and a
+// script there ("<!--<script>" puts the HTML parser in a state where "</script>" no longer ends
+// the element) is escaped, so the data stays inside its element.
+TEST(Cli, ViewEscapesTheFileNameInsideItsScript) {
+  TempDir dir("view-name");
+  const std::string name = "<!--<script>box.off";
+  write_mesh(dir / name, make_shape("box").mesh);
+  const CliRun r = run("view " + dir.q(name) + " --quiet -o " + dir.q("page.html"));
+  if (r.output.find("without the web viewer") != std::string::npos)
+    GTEST_SKIP() << "this primseg has no web viewer";
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string page = testing::file_contents(dir / "page.html");
+  EXPECT_NE(page.find("\\u003c!--\\u003cscript>box.off"), std::string::npos);
+  EXPECT_EQ(page.find("<!--<script>box.off"), std::string::npos);
 }
 
 TEST(Cli, OutputsOverwriteExistingFiles) {

@@ -878,6 +878,12 @@ TEST(Denoise, RejectsBadOptionsAndAMismatchedHierarchy) {
   Denoiser denoiser(box.noisy.mesh);
   const Hierarchy other = build_hierarchy(noisy_shape("box", 0.004, 0.2).noisy.mesh);
   EXPECT_THROW(denoiser.snap(other, cut_by_count(other, 6)), InvalidInputError);
+  // The right tree with a level that does not label every face.
+  const Hierarchy own = build_hierarchy(box.noisy.mesh);
+  Segmentation short_level = cut_by_count(own, 6);
+  short_level.labels.pop_back();
+  EXPECT_THROW(denoiser.snap(own, short_level), InvalidInputError);
+  EXPECT_NO_THROW(denoiser.snap(own, cut_by_count(own, 6)));
 }
 
 }  // namespace

@@ -270,6 +270,41 @@ TEST(ReadPly, BinaryNonFiniteCoordinate) {
                                   {"scan.ply", at(kHeader + 12), "non-finite"});
 }
 
+TEST(ReadPly, BinaryErrorsInRecordsOfVaryingSize) {
+  // An element with a list property is read record by record, not as a block of fixed-size
+  // records: its coordinates and list lengths are checked on that path too.
+  Bytes with_uv;
+  with_uv.text(
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty list uchar float uv\n"
+      "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n");
+  const std::size_t vertices = with_uv.str().size();
+  for (const float z : {0.0f, NAN, 0.0f}) with_uv.put(std::uint8_t{0}).put(0.0f).put(1.0f).put(z);
+  with_uv.put(std::uint8_t{3}).put(std::int32_t{0}).put(std::int32_t{1}).put(std::int32_t{2});
+  // Each vertex record is 13 bytes: an empty uv list and three floats.
+  expect_error<InvalidInputError>(with_uv.str(), MeshFormat::Ply, "scan.ply",
+                                  {"scan.ply", at(vertices + 13), "vertex 1", "non-finite"});
+
+  // A signed list length below zero.
+  std::string header = binary_header("binary_little_endian", 3, 1);
+  header.replace(header.find("uchar"), 5, "char");
+  Bytes negative;
+  negative.text(header);
+  for (int i = 0; i < 9; ++i) negative.put(0.0f);
+  negative.put(std::int8_t{-1}).put(std::int32_t{0});
+  expect_error<ParseError>(
+      negative.str(), MeshFormat::Ply, "scan.ply",
+      {"scan.ply", at(header.size() + 36), "invalid list length -1 in record 0 of element 'face'"});
+}
+
+TEST(ReadPly, FaceIndicesThatAreNotAList) {
+  expect_error<ParseError>(
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n0\n",
+      MeshFormat::Ply, "flat.ply", {"flat.ply", "line 7", "'vertex_indices' is not a list"});
+}
+
 TEST(ReadPly, HugeElementCountsFailFast) {
   Bytes bytes;
   bytes.text(

@@ -398,6 +398,29 @@ TEST(Skinning, PosesThatCannotBeAppliedAreRejected) {
   SkinningOptions bad;
   bad.band = -1;
   EXPECT_THROW(compute_skin_weights(s.figure.mesh, s.skeleton, bad), InvalidInputError);
+  Mesh unknown_vertex = s.figure.mesh;
+  unknown_vertex.triangles[7][2] = static_cast<std::uint32_t>(unknown_vertex.vertex_count());
+  EXPECT_THROW(compute_skin_weights(unknown_vertex, s.skeleton), InvalidInputError);
+}
+
+TEST(Skinning, SkinningChecksItsSizesAndLeavesUnweightedVerticesAtRest) {
+  // Vertex 0 follows bone 1 alone, vertex 1 (used by no triangle) has no bone, vertex 2 is
+  // halfway between bones 0 and 1.
+  SkinWeights weights;
+  weights.offsets = {0, 1, 1, 3};
+  weights.bones = {1, 0, 1};
+  weights.weights = {1.0, 0.5, 0.5};
+  const std::vector<Vec3> rest{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  RigidTransform shift;
+  shift.translation = {0, 0, 2};
+  const std::vector<RigidTransform> transforms{RigidTransform{}, shift};
+  const std::vector<Vec3> posed = skin_positions(rest, weights, transforms);
+  EXPECT_EQ(posed[0], (Vec3{1, 0, 2}));
+  EXPECT_EQ(posed[1], rest[1]);
+  EXPECT_EQ(posed[2], (Vec3{0, 0, 2}));
+
+  EXPECT_THROW(skin_positions({rest.data(), 2}, weights, transforms), InvalidInputError);
+  EXPECT_THROW(skin_positions(rest, weights, {transforms.data(), 1}), InvalidInputError);
 }
 
 // A book of pages on one spine edge, a cluster per page: consecutive pages (by triangle, as the
@@ -500,6 +523,15 @@ TEST(Skeleton, BadInputIsRejected) {
   EXPECT_THROW(extract_skeleton(mesh, std::vector<std::uint32_t>(8, 0), two), InvalidInputError)
       << "cluster 1 has no face";
   EXPECT_THROW(extract_skeleton(mesh, std::vector<std::uint32_t>(8, 2), two), InvalidInputError);
+  // A mesh edited by hand into an inconsistent one is refused before any geometry is read.
+  const std::vector<std::uint32_t> halves{0, 0, 0, 0, 1, 1, 1, 1};
+  EXPECT_NO_THROW(extract_skeleton(mesh, halves, two));
+  Mesh unknown_vertex = mesh;
+  unknown_vertex.triangles[5][1] = static_cast<std::uint32_t>(mesh.vertex_count());
+  EXPECT_THROW(extract_skeleton(unknown_vertex, halves, two), InvalidInputError);
+  Mesh unmapped_triangle = mesh;
+  unmapped_triangle.face_of_triangle.pop_back();
+  EXPECT_THROW(extract_skeleton(unmapped_triangle, halves, two), InvalidInputError);
 }
 
 // A skeleton of another mesh (or edited) is refused by what uses its face labels, naming the
