@@ -67,6 +67,11 @@ TEST(ReadObj, IndexOutOfRange) {
                            {"model.obj", "line 4", "-4", "before the first vertex"});
   expect_error<ParseError>("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n",
                            MeshFormat::Obj, "model.obj", {"model.obj", "line 4"});
+  // A whole number, but beyond what 32-bit vertex ids address: refused where it stands, before
+  // the file's end could show whether it was a forward reference.
+  expect_error<ParseError>("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4294967296\nf 1 2 3\n",
+                           MeshFormat::Obj, "model.obj",
+                           {"model.obj", "line 4", "vertex index 4294967296 is too large"});
 }
 
 TEST(ReadObj, MalformedStatements) {

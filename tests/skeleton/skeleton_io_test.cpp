@@ -113,17 +113,22 @@ TEST(SkeletonIo, MalformedFilesAreRefusedWithTheReason) {
   refused(huge_area, "number overflow");
   refused(edited([](json& s) { s["face_labels"][0] = 8; }), "face label must be an integer in");
   refused(edited([](json& s) { s["root_bone"] = 1; }), "root_bone must be 0");
-  // A joint listing a bone that does not list it back.
-  refused(edited([](json& s) {
-            for (json& bone : s["bones"]) {
-              json& joints = bone["joints"];
-              if (!joints.empty()) {
-                joints.erase(joints.begin());
-                return;
-              }
-            }
-          }),
-          "which does not list it");
+  // One side of a joint-bone link dropped: the first entry of the first non-empty `list` of the
+  // `items`. Without a bone's joint, the joint lists a bone that does not list it back; without a
+  // joint's bone, the bone lists a joint that does not ("bone B lists joint J, ...").
+  const auto unlinked = [&](const char* items, const char* list) {
+    return edited([&](json& s) {
+      for (json& item : s[items]) {
+        json& links = item[list];
+        if (!links.empty()) {
+          links.erase(links.begin());
+          return;
+        }
+      }
+    });
+  };
+  refused(unlinked("bones", "joints"), "which does not list it");
+  refused(unlinked("joints", "bones"), "lists joint");
 }
 
 TEST(SkeletonIo, PosesReadInRadiansAndRefuseWhatIsNotAPose) {

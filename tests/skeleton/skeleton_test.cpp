@@ -594,5 +594,32 @@ TEST(SkeletonRender, DrawsJointsInTheirColoursWhereTheyProject) {
   }
 }
 
+// A locked joint (a hub where touching boundaries met, as a skeleton file may list one) is a grey
+// square in a dark frame: square, so its frame reaches the corners a disc would leave out.
+TEST(SkeletonRender, DrawsALockedJointAsAGreySquareInADarkFrame) {
+  const FigureSkeleton& s = figure_skeleton();
+  Skeleton skeleton = s.skeleton;
+  const auto visible = std::find_if(skeleton.joints.begin(), skeleton.joints.end(),
+                                    [](const Joint& joint) { return joint.visible; });
+  ASSERT_NE(visible, skeleton.joints.end());
+  visible->kind = JointKind::Locked;
+  RenderOptions options;
+  options.width = 640;
+  options.height = 480;
+  const auto rgb = render_skeleton(s.figure.mesh, skeleton, options);
+  const std::vector<Vec3> joint{visible->position};
+  const auto pixel = project_to_picture(s.figure.mesh, joint, options)[0];
+  const auto colour_at = [&](int dx, int dy) {
+    const std::size_t x = static_cast<std::size_t>(std::floor(pixel[0]) + dx);
+    const std::size_t y = static_cast<std::size_t>(std::floor(pixel[1]) + dy);
+    const std::size_t at = (y * 640 + x) * 3;
+    return std::array<int, 3>{rgb[at], rgb[at + 1], rgb[at + 2]};
+  };
+  // The inner square has a half side of 3 pixels, the frame 4.5 (at this size).
+  EXPECT_EQ(colour_at(0, 0), (std::array<int, 3>{110, 110, 110}));
+  EXPECT_EQ(colour_at(4, 4), (std::array<int, 3>{25, 25, 25}));
+  EXPECT_EQ(colour_at(-4, -4), (std::array<int, 3>{25, 25, 25}));
+}
+
 }  // namespace
 }  // namespace primseg
