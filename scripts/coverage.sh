@@ -56,21 +56,20 @@ elif [[ ! -f $profile ]]; then
   exit 1
 fi
 # The CLI and every test program: together they hold all the library code the tests ran.
-objects=("$build/primseg")
+coverage=("$build/primseg" -instr-profile="$profile")
 for binary in "$build"/tests/primseg_test_*; do
-  [[ -f $binary && -x $binary ]] && objects+=(-object "$binary")
+  if [[ -f $binary && -x $binary ]]; then coverage+=(-object "$binary"); fi
 done
-# The tests' own code, system headers, and the viewer page embedded as one string literal.
-ignore="^($PWD/(tests|fuzz|bench)/|/usr/)|viewer_bundle"
+# Not the tests' own code, system headers, nor the viewer page embedded as one string literal.
+coverage+=(-ignore-filename-regex="^($PWD/(tests|fuzz|bench)/|/usr/)|viewer_bundle")
 # A function compiled into several test programs (each a unity build of its own) has one record
 # per program, which llvm-cov warns about and merges: the warning is left out.
 quiet() { "$@" 2> >(grep -v 'functions have mismatched data' >&2); }
 if [[ -n $show ]]; then
   [[ -f $show ]] || { echo "$0: no file '$show' (give it relative to the repository)" >&2; exit 2; }
   # Only the lines with a count of zero, numbered as in the file.
-  annotated=$(quiet llvm-cov show "${objects[@]}" -instr-profile="$profile" \
-    -ignore-filename-regex="$ignore" "$PWD/$show")
+  annotated=$(quiet llvm-cov show "${coverage[@]}" "$PWD/$show")
   grep -E '^ *[0-9]+\| *0\|' <<<"$annotated" || echo "every line of $show ran"
 else
-  quiet llvm-cov report "${objects[@]}" -instr-profile="$profile" -ignore-filename-regex="$ignore"
+  quiet llvm-cov report "${coverage[@]}"
 fi

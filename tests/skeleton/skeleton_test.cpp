@@ -612,7 +612,7 @@ TEST(SkeletonRender, DrawsALockedJointAsAGreySquareInADarkFrame) {
   const auto colour_at = [&](int dx, int dy) {
     const std::size_t x = static_cast<std::size_t>(std::floor(pixel[0]) + dx);
     const std::size_t y = static_cast<std::size_t>(std::floor(pixel[1]) + dy);
-    const std::size_t at = (y * 640 + x) * 3;
+    const std::size_t at = (y * static_cast<std::size_t>(options.width) + x) * 3;
     return std::array<int, 3>{rgb[at], rgb[at + 1], rgb[at + 2]};
   };
   // The inner square has a half side of 3 pixels, the frame 4.5 (at this size).
