@@ -23,6 +23,8 @@ struct DenoiseCommandOptions {
   int relabel_passes = DenoiseOptions{}.relabel_passes;
   double relation_significance = DenoiseOptions{}.relation_significance;
   std::optional<double> noise_factor;
+  int ensemble_members = DenoiseOptions{}.ensemble_members;
+  double ensemble_jitter = DenoiseOptions{}.ensemble_jitter;
   unsigned threads = 0;
   LevelOptions level;
   ResourceLimits limits;
@@ -39,6 +41,8 @@ DenoiseOptions denoise_options(const DenoiseCommandOptions& o) {
   options.relabel_passes = o.relabel_passes;
   options.relation_significance = o.relation_significance;
   options.noise_tolerance_factor = o.noise_factor;
+  options.ensemble_members = o.ensemble_members;
+  options.ensemble_jitter = o.ensemble_jitter;
   options.hierarchy.primitives = parse_primitives(o.primitives);
   options.hierarchy.threads = o.threads;
   validate(options);
@@ -60,10 +64,16 @@ ChosenLevel round_level(const Denoiser& denoiser, const Hierarchy& hierarchy,
 
 // A round's entry of the JSON's "rounds".
 nlohmann::json round_json(const SnapReport& r) {
-  return {{"clusters", r.clusters},   {"boundary_vertices", r.boundary_vertices},
-          {"snapped", r.snapped},     {"moved", r.moved},
-          {"fallbacks", r.fallbacks}, {"blocked", r.blocked},
-          {"mean_move", r.mean_move}, {"max_move", r.max_move}};
+  return {{"clusters", r.clusters},
+          {"boundary_vertices", r.boundary_vertices},
+          {"snapped", r.snapped},
+          {"moved", r.moved},
+          {"fallbacks", r.fallbacks},
+          {"blocked", r.blocked},
+          {"mean_move", r.mean_move},
+          {"max_move", r.max_move},
+          {"ensemble_members", r.ensemble_members},
+          {"reverted", r.reverted}};
 }
 
 // `diagonal`: the input's bounding-box diagonal, which the noise is given as a percentage of too.
@@ -97,6 +107,9 @@ void print_round(int round, const ChosenLevel& level, const SnapReport& r, doubl
       round, count_of(r.clusters, "cluster").c_str(),
       count_of(r.snapped, "vertex", "vertices").c_str(), r.boundary_vertices, r.fallbacks, r.moved,
       r.blocked, r.mean_move, r.max_move);
+  if (r.ensemble_members > 1)
+    std::printf("round %d: the mean of %u snaps (one per hierarchy), %s put back to the first's\n",
+                round, r.ensemble_members, count_of(r.reverted, "vertex", "vertices").c_str());
 }
 
 // Runs `primseg denoise` with its parsed options (quiet once an output goes to standard output).
@@ -116,7 +129,10 @@ void run_denoise(DenoiseCommandOptions& o) {
     hierarchy =
         std::make_unique<Hierarchy>(build_hierarchy(denoiser.segmented_mesh(), options.hierarchy));
     level = round_level(denoiser, *hierarchy, o.level.level, o.stylize);
-    const SnapReport report = denoiser.snap(*hierarchy, level.segmentation);
+    const SnapReport report =
+        denoiser.snap(*hierarchy, level.segmentation, [&](const Hierarchy& member) {
+          return round_level(denoiser, member, o.level.level, o.stylize).segmentation;
+        });
     rounds.push_back(round_json(report));
     if (!o.level.quiet) print_round(i + 1, level, report, diagonal);
   }
@@ -204,6 +220,19 @@ Command add_denoise_command(CLI::App& app) {
                       "With --clusters auto and no jump in the error curve (or one whose clusters "
                       "fit more than 4.5 times worse): clusters within this multiple of the "
                       "estimated noise (default: 1.2, 0.8 with --smooth, 0.4 with --bilateral)");
+  denoise
+      ->add_option("--ensemble", o->ensemble_members,
+                   "Average the snaps onto this many hierarchies, each further one built on a "
+                   "copy jittered by --ensemble-jitter: that many times slower, closer to the "
+                   "clean surface (16: fandisk with 0.3% noise 4.3x -> 5.3x lower RMS)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  denoise
+      ->add_option("--ensemble-jitter", o->ensemble_jitter,
+                   "Jitter of the ensemble's further copies, in estimated noise deviations "
+                   "(added before smoothing)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   denoise->add_option("--primitives", o->primitives, "Primitive types, comma-separated")
       ->capture_default_str();
   denoise->add_option("--threads", o->threads, "Threads for the hierarchy (0: all cores)")

@@ -20,7 +20,8 @@
 //
 // Input layout: byte 0 = options (bit 0: all five primitive types, bit 1: uniform weights,
 // bit 2: denoise on a bilateral copy, bit 3: stylize, bit 4: denoise at the automatic level,
-// bits 5-7: the scale's exponent), byte 1 = K (mod F), then grid_mesh.hpp's layout.
+// bits 5-7: the scale's exponent), byte 1 = K (mod F; its top bit also asks, without bit 3, for
+// an ensemble of two snaps), then grid_mesh.hpp's layout.
 
 #include <algorithm>
 #include <array>
@@ -98,7 +99,10 @@ Settings decode_settings(std::uint8_t flags, std::uint8_t level) {
     bilateral.threads = 1;
     settings.denoise.bilateral_smoothing = bilateral;
   }
-  if (flags & 8) settings.denoise.mode = SnapMode::NearestIncident;
+  if (flags & 8)
+    settings.denoise.mode = SnapMode::NearestIncident;
+  else if (level & 0x80)
+    settings.denoise.ensemble_members = 2;
   settings.automatic_level = (flags & 16) != 0;
   settings.exponent = kExponents[flags >> 5];
   settings.level = level;

@@ -38,6 +38,8 @@ py::dict snap_report_dict(const SnapReport& r) {
   round["blocked"] = r.blocked;
   round["mean_move"] = r.mean_move;
   round["max_move"] = r.max_move;
+  round["ensemble_members"] = r.ensemble_members;
+  round["reverted"] = r.reverted;
   return round;
 }
 
@@ -45,7 +47,7 @@ py::dict snap_report_dict(const SnapReport& r) {
 
 void bind_denoise(py::module_& m) {
   const char* denoise_doc =
-      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, primitives=None, weights=None, threads=0, return_rounds=False, return_level=False, progress=None) -> numpy.ndarray
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, ensemble=1, ensemble_jitter=0.3, primitives=None, weights=None, threads=0, return_rounds=False, return_level=False, progress=None) -> numpy.ndarray
 denoise(V, F, *, ...) -> numpy.ndarray
 denoise(hierarchy, *, ...) -> numpy.ndarray
 
@@ -54,7 +56,7 @@ round segments the previous round's result), and returns the new positions, floa
 the input's vertex order (the faces do not change): the CLI's output mesh, bit for bit. With
 return_rounds=True it returns (V, rounds), rounds a list of dicts like the CLI's --json
 "denoise" "rounds" (clusters, boundary_vertices, snapped, moved, fallbacks, blocked, mean_move,
-max_move). With return_level=True it returns (V, level), or (V, rounds, level) with both: the
+max_move, ensemble_members, reverted). With return_level=True it returns (V, level), or (V, rounds, level) with both: the
 last round's snap (Denoiser::snapped_level) as a dict of "labels" (int32 (F,), the CLI's
 --labels), "clusters", "borders" and "relations" (the CLI's --json entries: the clusters after
 relabelling with the primitives the vertices went onto, their borders on the denoised mesh, and
@@ -75,7 +77,10 @@ incident edge lengths); min_crease_angle: --min-crease-angle (degrees); relabel_
 --relabel-passes (faces moved to the nearest refitted neighbouring primitive);
 relation_significance: --relation-significance (0: no parallel or coaxial relations); smoothing_steps:
 --smooth (Taubin steps on the copy that is segmented); bilateral: --bilateral (that copy
-smoothed by bilateral normal filtering instead, which keeps edges sharp); primitives (default plane, cylinder, sphere) and weights (default "area"): as in
+smoothed by bilateral normal filtering instead, which keeps edges sharp); ensemble and
+ensemble_jitter: --ensemble (the mean of the snaps onto that many hierarchies, the further ones
+built on jittered copies; progress then advances, and Ctrl-C is checked, as each is built) and
+--ensemble-jitter (in estimated noise deviations); primitives (default plane, cylinder, sphere) and weights (default "area"): as in
 segment. The GIL is released while it works; as in segment, Ctrl-C (KeyboardInterrupt) stops a
 round's hierarchy build, and progress, if given, is called during the builds with the fraction
 of all rounds done (0 to 1).
@@ -86,9 +91,9 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
          std::optional<double> tolerance, std::optional<double> relative_tolerance, int iterations,
          int smoothing_steps, bool bilateral, bool stylize, double max_move,
          double min_crease_angle, int relabel_passes, double relation_significance,
-         std::optional<double> noise_tolerance_factor, const py::object& primitives,
-         const py::object& weights, unsigned threads, bool return_rounds, bool return_level,
-         const py::object& progress) -> py::object {
+         std::optional<double> noise_tolerance_factor, int ensemble, double ensemble_jitter,
+         const py::object& primitives, const py::object& weights, unsigned threads,
+         bool return_rounds, bool return_level, const py::object& progress) -> py::object {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
@@ -105,6 +110,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         options.relabel_passes = relabel_passes;
         options.relation_significance = relation_significance;
         options.noise_tolerance_factor = noise_tolerance_factor;
+        options.ensemble_members = ensemble;
+        options.ensemble_jitter = ensemble_jitter;
         options.smoothing_steps = smoothing_steps;
         if (bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
         options.hierarchy = tool_hierarchy_options("denoise", given, primitives, weights, threads,
@@ -136,8 +143,12 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
           Denoiser denoiser(*mesh, options);
           for (int round = 0; round < iterations; ++round) {
             // As `primseg denoise`: each round segments the previous round's result.
+            // The ensemble's members share the round: each reports when its hierarchy is built
+            // (where Ctrl-C is checked), the first during its build too.
+            int member = 0;
             const auto report_round = [&](double fraction) {
-              progress_of_all((round + fraction) / iterations);
+              progress_of_all((round + (member + fraction) / options.ensemble_members) /
+                              iterations);
             };
             const std::shared_ptr<const Hierarchy> hierarchy =
                 round == 0 && given
@@ -147,7 +158,14 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
                               .finish(report_round));
             if (automatic) chosen = denoiser.automatic_level(*hierarchy);
             reports.push_back(denoiser.snap(
-                *hierarchy, automatic ? chosen.segmentation : cut_level(*hierarchy, level)));
+                *hierarchy, automatic ? chosen.segmentation : cut_level(*hierarchy, level),
+                [&](const Hierarchy& jittered) {
+                  ++member;
+                  report_round(0);
+                  return automatic ? denoiser.automatic_level(jittered).segmentation
+                                   : cut_level(jittered, level);
+                }));
+            if (options.ensemble_members > 1) progress_of_all((round + 1.0) / iterations);
           }
           if (return_level) {
             snapped = denoiser.snapped_level();
@@ -199,9 +217,12 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       py::arg("min_crease_angle") = DenoiseOptions{}.min_crease_angle_degrees,
       py::arg("relabel_passes") = DenoiseOptions{}.relabel_passes,
       py::arg("relation_significance") = DenoiseOptions{}.relation_significance,
-      py::arg("noise_tolerance_factor") = py::none(), py::arg("primitives") = py::none(),
-      py::arg("weights") = py::none(), py::arg("threads") = 0u, py::arg("return_rounds") = false,
-      py::arg("return_level") = false, py::arg("progress") = py::none(),
+      py::arg("noise_tolerance_factor") = py::none(),
+      py::arg("ensemble") = DenoiseOptions{}.ensemble_members,
+      py::arg("ensemble_jitter") = DenoiseOptions{}.ensemble_jitter,
+      py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
+      py::arg("return_rounds") = false, py::arg("return_level") = false,
+      py::arg("progress") = py::none(),
       join_docs(
           {denoise_doc, cpp_doc("denoise.hpp", doc::denoise__file),
            cpp_doc("DenoiseOptions::max_move_edge_lengths",
@@ -217,6 +238,10 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
                    doc::denoise__DenoiseOptions__smoothing_steps),
            cpp_doc("DenoiseOptions::bilateral_smoothing",
                    doc::denoise__DenoiseOptions__bilateral_smoothing),
+           cpp_doc("DenoiseOptions::ensemble_members",
+                   doc::denoise__DenoiseOptions__ensemble_members),
+           cpp_doc("DenoiseOptions::ensemble_jitter",
+                   doc::denoise__DenoiseOptions__ensemble_jitter),
            cpp_doc("SnapMode", doc::denoise__SnapMode),
            cpp_doc("SnapReport", doc::denoise__SnapReport),
            cpp_doc("SnappedLevel", doc::denoise__SnappedLevel)})

@@ -13,10 +13,12 @@
 #include "cluster_numbering.hpp"
 #include "eigen_conversions.hpp"
 #include "no_index.hpp"
+#include "orientation_repair.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
 #include "primseg/geometric_fit.hpp"
 #include "regularity.hpp"
+#include "shape_generator/random.hpp"
 #include "vertex_triangles.hpp"
 
 namespace primseg {
@@ -25,6 +27,11 @@ namespace {
 // Relabelling weighs, for each face, the clusters at its corners; a corner at more clusters than
 // this offers none (DenoiseOptions::relabel_passes). Vertices of real meshes are at a handful.
 constexpr std::size_t kMaxRelabelClustersAtVertex = 64;
+
+// DenoiseOptions::ensemble_members at most: each member is a hierarchy and a snap.
+constexpr int kMaxEnsembleMembers = 64;
+// The stream of the ensemble's jitter: member m draws from kEnsembleSeed + m.
+constexpr std::uint64_t kEnsembleSeed = 0x656e73656d626c65ull;
 
 using detail::to_eigen;
 using detail::to_vec3;
@@ -216,6 +223,17 @@ void validate(const DenoiseOptions& options) {
     throw InvalidInputError("denoise: the relabelling passes must be a non-negative count");
   if (options.max_solver_steps < 1)
     throw InvalidInputError("denoise: the solver needs at least one step");
+  if (options.ensemble_members < 1 || options.ensemble_members > kMaxEnsembleMembers)
+    throw InvalidInputError("denoise: the ensemble must have 1 to " +
+                            std::to_string(kMaxEnsembleMembers) + " members, not " +
+                            std::to_string(options.ensemble_members));
+  if (!(options.ensemble_jitter > 0 && options.ensemble_jitter <= 1))
+    throw InvalidInputError(
+        "denoise: the ensemble's jitter must be in (0, 1] estimated noise deviations");
+  if (options.ensemble_members > 1 && options.mode == SnapMode::NearestIncident)
+    throw InvalidInputError(
+        "denoise: an ensemble averages snaps, which would take stylized vertices off their "
+        "primitives; stylize with one member");
   validate(options.hierarchy);
 }
 
@@ -298,15 +316,19 @@ std::shared_ptr<const Mesh> Denoiser::estimate_copy() const {
 }
 
 std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
+  if (options_.bilateral_smoothing && smooths_as_the_estimate(*options_.bilateral_smoothing))
+    return estimate_copy();
+  return segmented_copy(mesh_);
+}
+
+std::shared_ptr<const Mesh> Denoiser::segmented_copy(const Mesh& mesh) const {
   // Taubin's λ|μ smoothing with uniform weights over the edge neighbours: shrinks noise, not the
   // shape. Neighbours come from the triangles around each vertex (each edge seen twice: same
   // weights for all, so the average is unchanged).
-  if (options_.bilateral_smoothing) {
-    if (smooths_as_the_estimate(*options_.bilateral_smoothing)) return estimate_copy();
-    return std::make_shared<Mesh>(bilateral_smooth(mesh_, *options_.bilateral_smoothing));
-  }
+  if (options_.bilateral_smoothing)
+    return std::make_shared<Mesh>(bilateral_smooth(mesh, *options_.bilateral_smoothing));
   constexpr double kLambda = 0.5, kMu = -0.53;
-  auto segmented = std::make_shared<Mesh>(mesh_);
+  auto segmented = std::make_shared<Mesh>(mesh);
   std::vector<Vec3>& positions = segmented->positions;
   std::vector<Vec3> next(positions.size());
   for (int step = 0; step < 2 * options_.smoothing_steps; ++step) {
@@ -366,7 +388,64 @@ DenoiseLevel Denoiser::automatic_level(const Hierarchy& hierarchy) const {
 
 SnapReport Denoiser::iterate(const LevelSelector& level) {
   const Hierarchy hierarchy = build_hierarchy(segmented_mesh(), options_.hierarchy);
-  return snap(hierarchy, level(hierarchy));
+  return snap(hierarchy, level(hierarchy), level);
+}
+
+SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmentation,
+                          const LevelSelector& level) {
+  const int members = options_.ensemble_members;
+  if (members <= 1) return snap(hierarchy, segmentation);
+  const std::vector<Vec3> start = mesh_.positions;
+  // A snap resets the estimate's copy, which stays valid once the positions are put back: the
+  // members' automatic levels need it, and smoothing it again each time would cost a member.
+  const std::shared_ptr<const Mesh> estimate = estimate_copy();
+  const double jitter = options_.ensemble_jitter * noise_from(mesh_, *estimate);
+  SnapReport report = snap(hierarchy, segmentation);
+  const std::vector<Vec3> first = mesh_.positions;
+  SnappedLevel first_level = std::move(snapped_level_);
+  // The members' offsets from the first snap, summed in member order (the mean does not depend
+  // on the threads): where every member agrees, as on a vertex no snap moves, the mean is the
+  // first snap bit for bit.
+  std::vector<Eigen::Vector3d> offset_sum(start.size(), Eigen::Vector3d::Zero());
+  try {
+    for (int member = 1; member < members; ++member) {
+      mesh_.positions = start;
+      shape_detail::SplitMix64 random(kEnsembleSeed + static_cast<std::uint64_t>(member));
+      for (Vec3& p : mesh_.positions)
+        for (double& x : p) x += jitter * random.normal();
+      const Hierarchy jittered = build_hierarchy(segmented_copy(mesh_), hierarchy.options());
+      mesh_.positions = start;
+      estimate_copy_.set(estimate);
+      snap(jittered, level(jittered));
+      for (std::size_t v = 0; v < start.size(); ++v)
+        offset_sum[v] += to_eigen(mesh_.positions[v]) - to_eigen(first[v]);
+    }
+  } catch (...) {
+    // The positions as before the call (`level` may throw: Python's Ctrl-C).
+    mesh_.positions = start;
+    estimate_copy_.set(estimate);
+    snapped_level_ = {};
+    throw;
+  }
+  for (std::size_t v = 0; v < start.size(); ++v)
+    mesh_.positions[v] = to_vec3(to_eigen(first[v]) + offset_sum[v] / members);
+  snapped_level_ = std::move(first_level);
+  report.ensemble_members = static_cast<std::uint32_t>(members);
+  report.reverted =
+      revert_inverted_triangles(mesh_.positions, first, mesh_.triangles, input_normals_);
+
+  report.moved = 0;
+  report.max_move = 0;
+  double move_sum = 0;
+  for (std::size_t v = 0; v < start.size(); ++v) {
+    if (mesh_.positions[v] == start[v]) continue;
+    const double move = (to_eigen(mesh_.positions[v]) - to_eigen(start[v])).norm();
+    ++report.moved;
+    move_sum += move;
+    report.max_move = std::max(report.max_move, move);
+  }
+  report.mean_move = report.moved ? move_sum / report.moved : 0;
+  return report;
 }
 
 void Denoiser::cluster_vertices(const Segmentation& segmentation, std::size_t cluster_count,

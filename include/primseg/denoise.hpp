@@ -106,6 +106,30 @@ struct DenoiseOptions {
   /// Each is the best multiple measured on fandisk, anchor_dense, couplingdown and
   /// mech-holes-shark (libcgal-demo) with Gaussian noise of 0.3% of the diagonal. > 0.
   std::optional<double> noise_tolerance_factor;
+  /// Snaps to average (bagging, Breiman 1996): each round snaps the vertices onto the level of
+  /// this many hierarchies and moves them to the mean of those snaps. The first hierarchy is the
+  /// round's own, built on the segmented copy of mesh(); each further one is built on the
+  /// segmented copy (smoothed the same way) of mesh() with every coordinate moved by Gaussian
+  /// noise of ensemble_jitter × estimate_noise(mesh()), and cut by the same rule
+  /// (Denoiser::snap with a LevelSelector); every snap moves mesh()'s own positions. The greedy
+  /// merge order is unstable under noise: the borders of blends and small fillets move with the
+  /// noise, so each hierarchy misplaces other faces, and the mean keeps what the snaps agree on.
+  /// Fandisk with Gaussian noise of 0.3% of the diagonal along the normals, bilateral copy, five
+  /// noise draws, 16 members: RMS distance to the clean mesh 5.21x to 5.53x lower at the
+  /// automatic level (mean 5.35x, against 4.25x with one), 4.95x to 5.45x at the best of
+  /// K = 20, 30, 40, 60 (mean 5.17x, against 4.06x), Hausdorff distance 0.0092 → 0.0062; with a
+  /// jitter of 0.5, 9 members 5.28x and 32 members 5.38x at the automatic level. It costs one
+  /// smoothing, one hierarchy and one snap per member. The mean of snaps that each keep every
+  /// triangle's orientation may invert one: such a triangle's vertices take the first
+  /// hierarchy's snap (SnapReport::reverted). The level reports (snapped_level) are the first
+  /// hierarchy's, and the vertices are no longer exactly on its primitives. 1 (no ensemble) to
+  /// 64; AllIncident mode only (a stylized vertex belongs on one primitive, not between several).
+  int ensemble_members = 1;
+  /// The jitter of the ensemble's further members, in estimated noise deviations per coordinate,
+  /// added before the segmented copy is smoothed: a partial new draw of the noise, which changes
+  /// the greedy order without making the copy worse. Fandisk as above, 16 members, automatic
+  /// level: 0.3 5.35x, 0.5 5.30x, 0.7 5.24x. In (0, 1].
+  double ensemble_jitter = 0.3;
   /// Gauss–Newton steps for curved primitives (a plane-only system converges in one).
   int max_solver_steps = 20;
   /// Hierarchy options used to segment the mesh at each iteration.
@@ -167,6 +191,12 @@ struct SnapReport {
   std::uint32_t blocked = 0;
   double mean_move = 0;  ///< over moved vertices, input units (0 when none moved)
   double max_move = 0;   ///< input units
+  /// Hierarchies whose snaps were averaged (DenoiseOptions::ensemble_members; 1 without an
+  /// ensemble). The counts above but `moved` and the moves are the first hierarchy's snap's.
+  std::uint32_t ensemble_members = 1;
+  /// Vertices given the first hierarchy's snap instead of the mean, which inverted one of their
+  /// triangles (0 without an ensemble).
+  std::uint32_t reverted = 0;
 };
 
 /// The clusters a snap moved the vertices onto (Denoiser::snapped_level): the level it was given,
@@ -195,7 +225,8 @@ class Denoiser {
   /// Throws InvalidInputError for invalid options or a mesh that fails Mesh::validate().
   explicit Denoiser(Mesh mesh, DenoiseOptions options = {});
 
-  /// One iteration: builds the hierarchy of the current mesh, cuts it with `level` and snaps.
+  /// One iteration: builds the hierarchy of the current mesh, cuts it with `level` and snaps
+  /// (with the ensemble, when DenoiseOptions::ensemble_members > 1).
   SnapReport iterate(const LevelSelector& level);
 
   /// Snaps the current positions onto a segmentation of the current mesh. `hierarchy` must have
@@ -203,6 +234,16 @@ class Denoiser {
   /// others (a smoothed copy); its primitives are refitted on mesh()'s positions unless
   /// refit_outlier_threshold is 0. Throws InvalidInputError when the connectivity differs.
   SnapReport snap(const Hierarchy& hierarchy, const Segmentation& segmentation);
+
+  /// snap(hierarchy, segmentation) and, with DenoiseOptions::ensemble_members > 1, the ensemble:
+  /// each further hierarchy is built (with `hierarchy`'s options) on a jittered copy of
+  /// `hierarchy`'s mesh and cut by `level`, the current positions are snapped onto that cut, and
+  /// the vertices move to the mean of all the snaps. `segmentation` is the caller's cut of
+  /// `hierarchy`, normally level(hierarchy); `level` is called once per further member. The
+  /// result does not depend on the number of threads. Throws as snap(); when `level` throws, the
+  /// positions are put back as they were and snapped_level() is empty.
+  SnapReport snap(const Hierarchy& hierarchy, const Segmentation& segmentation,
+                  const LevelSelector& level);
 
   /// The mesh the next iteration segments: mesh(), smoothed when smoothing_steps > 0 or
   /// bilateral_smoothing is set.
@@ -270,6 +311,9 @@ class Denoiser {
   void relabel(const Mesh& judged, std::vector<Primitive>& primitives,
                Segmentation& segmentation) const;
 
+  // The copy of `mesh` (mesh_'s connectivity, any positions) that a round segments: smoothed as
+  // the options ask, or as it is.
+  std::shared_ptr<const Mesh> segmented_copy(const Mesh& mesh) const;
   // bilateral_smooth(mesh_) with the noise estimate's options: estimate_noise's copy, and the
   // segmented copy too when DenoiseOptions::bilateral_smoothing has those options (up to
   // threads), so that a round smooths the mesh once, not twice.

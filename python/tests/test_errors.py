@@ -219,6 +219,14 @@ def test_denoise_argument_errors():
                    {"k": "auto", "noise_tolerance_factor": 0.0}):
         with pytest.raises(ValueError):
             primseg.denoise(mesh, **option)
+    for bad in (0, 65):
+        with pytest.raises(ValueError, match=f"ensemble must have 1 to 64 members, not {bad}"):
+            primseg.denoise(mesh, ensemble=bad)
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(ValueError, match=r"jitter must be in \(0, 1\]"):
+            primseg.denoise(mesh, ensemble=2, ensemble_jitter=bad)
+    with pytest.raises(ValueError, match="stylize with one member"):
+        primseg.denoise(mesh, ensemble=2, stylize=True)
     with pytest.raises(ValueError, match="unknown primitive 'ellipsoid'"):
         primseg.denoise(mesh, primitives="ellipsoid")
     with pytest.raises(ValueError, match="weights: must be 'area' or 'uniform', not 3"):

@@ -54,7 +54,9 @@ def man_skeleton(man):
      (("--clusters", "30", "--relation-significance", "0"), {"k": 30, "relation_significance": 0}),
      (("--clusters", "auto", "--bilateral", "--relation-significance", "1.5"),
       {"k": "auto", "bilateral": True, "relation_significance": 1.5}),
-     (("--clusters", "auto", "--noise-factor", "2"), {"k": "auto", "noise_tolerance_factor": 2.0})])
+     (("--clusters", "auto", "--noise-factor", "2"), {"k": "auto", "noise_tolerance_factor": 2.0}),
+     (("--clusters", "auto", "--bilateral", "--ensemble", "3", "--ensemble-jitter", "0.5"),
+      {"k": "auto", "bilateral": True, "ensemble": 3, "ensemble_jitter": 0.5})])
 def test_denoise_matches_the_cli(cli, noisy_fandisk, tmp_path, cli_options, python_options):
     run_cli(cli, "denoise", noisy_fandisk, *cli_options, "-o", tmp_path / "out.off",
             "--json", tmp_path / "summary.json", "--labels", tmp_path / "labels.txt", "--quiet")
@@ -155,11 +157,19 @@ def test_denoise_and_skeleton_report_progress(noisy_fandisk, man):
     assert fractions[0] == 0 and fractions[-1] == 1 and fractions == sorted(fractions)
     np.testing.assert_array_equal(skeleton.joint_positions, primseg.skeleton(man, k=10).joint_positions)
 
+    # With an ensemble, each member's hierarchy reports its share of the round once built.
+    fractions = []
+    V = primseg.denoise(noisy_fandisk, k=30, ensemble=4, progress=fractions.append)
+    np.testing.assert_array_equal(V, primseg.denoise(noisy_fandisk, k=30, ensemble=4))
+    assert fractions[-1] == 1 and fractions == sorted(fractions)
+    assert {0.25, 0.5, 0.75} <= set(fractions)
+
     def stop(fraction):
         if fraction > 0.2:
             raise RuntimeError("stopped by the user")
 
     for call in (lambda: primseg.denoise(noisy_fandisk, k=30, progress=stop),
+                 lambda: primseg.denoise(noisy_fandisk, k=30, ensemble=4, progress=stop),
                  lambda: primseg.skeleton(man, k=10, progress=stop)):
         with pytest.raises(RuntimeError, match="stopped by the user"):
             call()

@@ -132,6 +132,34 @@ TEST(CliDenoise, AutomaticLevelReportsTheNoiseAndTheJump) {
   EXPECT_FALSE(stylized.contains("jump_worst_rms"));
 }
 
+// --ensemble: the level it reports is the first hierarchy's, the one a single snap reports;
+// each round says how many snaps it averaged and how many vertices it put back.
+TEST(CliDenoise, EnsembleReportsTheFirstHierarchysLevel) {
+  const Files f = noisy_box();
+  std::string output;
+  nlohmann::json summaries[2];
+  for (const int members : {1, 3}) {
+    const fs::path summary_path = f.dir / ("e" + std::to_string(members) + ".json");
+    ASSERT_EQ(
+        primseg({"denoise", q(f.noisy), "--clusters auto --bilateral --ensemble",
+                 std::to_string(members), "-o", q(f.dir / "e.off"), "--json", q(summary_path)},
+                &output),
+        0)
+        << output;
+    EXPECT_EQ(output.find("the mean of 3 snaps") != std::string::npos, members == 3) << output;
+    std::ifstream json_file(summary_path);
+    summaries[members / 2] = nlohmann::json::parse(json_file);
+  }
+  const nlohmann::json &single = summaries[0], &ensemble = summaries[1];
+  EXPECT_EQ(single["denoise"]["rounds"][0]["ensemble_members"], 1);
+  EXPECT_EQ(ensemble["denoise"]["rounds"][0]["ensemble_members"], 3);
+  EXPECT_EQ(ensemble["denoise"]["rounds"][0]["reverted"], 0);
+  EXPECT_EQ(ensemble["level"], single["level"]);
+  EXPECT_EQ(ensemble["clusters"], single["clusters"]);
+  EXPECT_NE(ensemble["denoise"]["rounds"][0]["mean_move"],
+            single["denoise"]["rounds"][0]["mean_move"]);
+}
+
 TEST(CliDenoise, StylizeToleranceIterationsAndLevelOutputs) {
   const Files f = noisy_box();
   std::string output;
@@ -217,11 +245,14 @@ TEST(CliDenoise, SnappingOptionsAreTheLibrarys) {
     std::string flag;
     DenoiseOptions options;
   };
-  std::vector<Case> cases(2);
+  std::vector<Case> cases(3);
   cases[0].flag = "--max-move 0.25";
   cases[0].options.max_move_edge_lengths = 0.25;
   cases[1].flag = "--min-crease-angle 0";
   cases[1].options.min_crease_angle_degrees = 0;
+  cases[2].flag = "--ensemble 3 --ensemble-jitter 0.5";
+  cases[2].options.ensemble_members = 3;
+  cases[2].options.ensemble_jitter = 0.5;
   for (const Case& c : cases) {
     SCOPED_TRACE(c.flag);
     const fs::path out = f.dir / "snapped.ply";
@@ -328,6 +359,25 @@ TEST(CliDenoise, BadUsageFailsWithAMessage) {
                     &output),
             1);
   EXPECT_NE(output.find("missing.off"), std::string::npos) << output;
+  // The ensemble: a count in range, a jitter in (0, 1], never with --stylize.
+  for (const char* bad : {"--ensemble 0", "--ensemble 65", "--ensemble-jitter 1.5"}) {
+    EXPECT_EQ(
+        primseg({"denoise", q(f.noisy), "--clusters 6", bad, "-o", q(f.dir / "x.off")}, &output), 1)
+        << bad;
+    EXPECT_NE(output.find(std::string(bad).substr(0, std::string(bad).find(' '))),
+              std::string::npos)
+        << output;
+  }
+  EXPECT_EQ(
+      primseg({"denoise", q(f.noisy), "--clusters 6 --ensemble-jitter 0 -o", q(f.dir / "x.off")},
+              &output),
+      1);
+  EXPECT_NE(output.find("jitter must be in (0, 1]"), std::string::npos) << output;
+  EXPECT_EQ(
+      primseg({"denoise", q(f.noisy), "--clusters 6 --stylize --ensemble 2 -o", q(f.dir / "x.off")},
+              &output),
+      1);
+  EXPECT_NE(output.find("stylize with one member"), std::string::npos) << output;
   EXPECT_EQ(primseg({"distance", q(f.noisy), q(f.clean), "--samples 0"}, &output), 1);
   EXPECT_NE(output.find("sample"), std::string::npos) << output;
   EXPECT_EQ(primseg({"distance", q(f.noisy)}, &output), 1);

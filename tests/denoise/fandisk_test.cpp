@@ -48,7 +48,6 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
   std::printf("%8s %12.4g %12.4g\n", "noisy", before.rms, before.hausdorff);
   double best_ratio = 0;
   std::uint32_t best_k = 0;
-  Mesh best;
   // Smoothing of the segmented copy: none, 5 Taubin steps (-5 in the table), bilateral (1).
   for (const int smoothing : {0, -5, 1})
     for (const std::uint32_t k : {20u, 30u, 40u, 60u}) {
@@ -74,12 +73,10 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
       if (before.rms / after.rms > best_ratio) {
         best_ratio = before.rms / after.rms;
         best_k = k;
-        best = denoiser.mesh();
       }
     }
   std::printf("best K %u: RMS %.2fx lower\n", best_k, best_ratio);
-  Mesh automatic;  // denoised at the automatic level, and the clusters it was snapped onto
-  SnappedLevel automatic_level;
+  double automatic_hausdorff = 0;  // one snap at the automatic level
   {
     // --clusters auto: fandisk's curve has no jump, so the level is the tolerance cut at 0.4
     // times the estimated noise on the hierarchy of the bilateral copy (the knee of the curve,
@@ -93,8 +90,6 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
       floor = testing::least_squares_floor(hierarchy, chosen.segmentation, sigma);
       return chosen.segmentation;
     });
-    automatic = denoiser.mesh();
-    automatic_level = denoiser.snapped_level();
     const MeshDistance after = mesh_distance(denoiser.mesh(), clean, measure);
     std::printf("%8s %12.4g %12.4g %8.2f %12s %8.2f   (K = %u: noise %.4g, tolerance %.4g)\n",
                 "auto", after.rms, after.hausdorff, before.rms / after.rms, "bilateral",
@@ -115,6 +110,7 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     std::printf("%8s vertices %.3f floors from the clean surface, ratio bound %.2fx\n", "auto",
                 left / floor, sigma / std::sqrt(2.0) / floor);
     EXPECT_LE(left, 1.2 * floor);
+    automatic_hausdorff = after.hausdorff;
   }
   {
     // The target, 5x, is where even the clean segmentation ends with independent primitives:
@@ -159,12 +155,47 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
       return chosen.segmentation;
     });
   }
-  // The target is 5x. Measured: 3.5x (bilateral smoothing, K = 40), 2.7x (5 Taubin
-  // steps, K = 60); without smoothing, noise fragments the segmentation into small planes and the
-  // gain is at most 1.8x. Snapping the same noisy vertices onto the clean mesh's segmentation
-  // gives 5.5x at K = 30 (above): the gap is the segmentation of the noisy curved parts, and the
-  // parameters its extra clusters cost (see README).
+  // One snap: 3.6x (bilateral smoothing, K = 60), 2.7x (5 Taubin steps, K = 60); without
+  // smoothing, noise fragments the segmentation into small planes and the gain is at most 1.8x.
+  // Snapping the same noisy vertices onto the clean mesh's segmentation gives 5.5x at K = 30
+  // (above): the gap is the segmentation of the noisy curved parts, and the parameters its extra
+  // clusters cost (see docs/method.md).
   EXPECT_GE(best_ratio, 3.3);
+
+  // The target, 5x at the automatic level and at the best of K = 20, 30, 40, 60, with the
+  // ensemble (DenoiseOptions::ensemble_members): the mean of the snaps onto 16 hierarchies, the
+  // further ones built on copies jittered before smoothing, each misplacing other faces.
+  // Measured 5.25x at the automatic level and 5.02x at K = 30 (five noise draws: 5.21x to 5.53x
+  // and 4.95x to 5.45x).
+  Mesh ensemble_automatic;
+  SnappedLevel ensemble_level;
+  {
+    DenoiseOptions options = bilateral_options();
+    options.ensemble_members = 16;
+    double best_ensemble = 0;
+    for (const std::uint32_t k : {20u, 30u, 40u, 60u, 0u}) {
+      Denoiser denoiser(noisy, options);
+      const SnapReport report = denoiser.iterate([&](const Hierarchy& hierarchy) {
+        return k ? cut_by_count(hierarchy, k) : denoiser.automatic_level(hierarchy).segmentation;
+      });
+      const MeshDistance after = mesh_distance(denoiser.mesh(), clean, measure);
+      const std::string name = k ? std::to_string(k) : "auto";
+      std::printf("%8s %12.4g %12.4g %8.2f %12s %8.2f   (K = %u, %u reverted)\n", name.c_str(),
+                  after.rms, after.hausdorff, before.rms / after.rms, "ensemble 16",
+                  before.hausdorff / after.hausdorff, report.clusters, report.reverted);
+      EXPECT_EQ(testing::inverted_triangles(noisy, denoiser.mesh()), 0u);
+      EXPECT_EQ(report.ensemble_members, 16u);
+      if (k) {
+        best_ensemble = std::max(best_ensemble, before.rms / after.rms);
+        continue;
+      }
+      EXPECT_GE(before.rms / after.rms, 5.0);
+      EXPECT_LT(after.hausdorff, automatic_hausdorff);  // measured 0.0070 against 0.0119
+      ensemble_automatic = denoiser.mesh();
+      ensemble_level = denoiser.snapped_level();
+    }
+    EXPECT_GE(best_ensemble, 5.0);
+  }
 
   if (const char* figures = std::getenv("PRIMSEG_FIGURES_DIR")) {
     const std::filesystem::path dir(figures);
@@ -182,13 +213,13 @@ TEST(DenoiseFandisk, NoiseOfAThirdOfAPercentDropsWithASmoothedSegmentation) {
     for (const auto& [name, mesh] :
          {std::pair<const char*, const Mesh*>{"fandisk-clean.png", &clean},
           {"fandisk-noisy.png", &noisy},
-          {"fandisk-denoised.png", &best}})
+          {"fandisk-denoised.png", &ensemble_automatic}})
       write_png(dir / name, *mesh, {}, view);
     // The automatic level's clusters on its denoised mesh, where they meet drawn: the feature
-    // lines the snap recovered (`denoise --png`).
+    // lines the snap recovered (`denoise --ensemble 16 --png`).
     view.borders = true;
-    write_png(dir / "fandisk-feature-lines.png", automatic,
-              group_face_colors(automatic_level.labels), view);
+    write_png(dir / "fandisk-feature-lines.png", ensemble_automatic,
+              group_face_colors(ensemble_level.labels), view);
   }
 }
 
