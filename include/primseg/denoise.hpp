@@ -236,12 +236,12 @@ class Denoiser {
   SnapReport snap(const Hierarchy& hierarchy, const Segmentation& segmentation);
 
   /// snap(hierarchy, segmentation) and, with DenoiseOptions::ensemble_members > 1, the ensemble:
-  /// each further hierarchy is built (with `hierarchy`'s options) on a jittered copy of
-  /// `hierarchy`'s mesh and cut by `level`, the current positions are snapped onto that cut, and
-  /// the vertices move to the mean of all the snaps. `segmentation` is the caller's cut of
-  /// `hierarchy`, normally level(hierarchy); `level` is called once per further member. The
-  /// result does not depend on the number of threads. Throws as snap(); when `level` throws, the
-  /// positions are put back as they were and snapped_level() is empty.
+  /// each further hierarchy is built (with `hierarchy`'s options) on the segmented copy of a
+  /// jittered mesh() (smoothed as segmented_mesh() is) and cut by `level`, the current positions
+  /// are snapped onto that cut, and the vertices move to the mean of all the snaps. `segmentation`
+  /// is the caller's cut of `hierarchy`, normally level(hierarchy); `level` is called once per
+  /// further member. The result does not depend on the number of threads. Throws as snap(); when
+  /// `level` throws, the positions are put back as they were and snapped_level() is empty.
   SnapReport snap(const Hierarchy& hierarchy, const Segmentation& segmentation,
                   const LevelSelector& level);
 
