@@ -41,6 +41,21 @@ Eigen::Vector3d triangle_normal(const Eigen::Vector3d& a, const Eigen::Vector3d&
   return (b - a).cross(c - a);
 }
 
+// The report's moved vertices (those whose position changed) and their mean and largest move.
+void measure_moves(std::span<const Vec3> start, std::span<const Vec3> end, SnapReport& report) {
+  report.moved = 0;
+  report.max_move = 0;
+  double move_sum = 0;
+  for (std::size_t v = 0; v < start.size(); ++v) {
+    if (end[v] == start[v]) continue;
+    const double move = (to_eigen(end[v]) - to_eigen(start[v])).norm();
+    ++report.moved;
+    move_sum += move;
+    report.max_move = std::max(report.max_move, move);
+  }
+  report.mean_move = report.moved ? move_sum / report.moved : 0;
+}
+
 // Unit normal of the primitive's surface at `on_surface` (one of its closest points), or zero
 // where the surface has none (a cone's apex, an axis point of a degenerate fit).
 Eigen::Vector3d surface_normal(const Primitive& primitive, const Eigen::Vector3d& on_surface) {
@@ -407,13 +422,15 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   // on the threads): where every member agrees, as on a vertex no snap moves, the mean is the
   // first snap bit for bit.
   std::vector<Eigen::Vector3d> offset_sum(start.size(), Eigen::Vector3d::Zero());
+  Mesh jittered_input = mesh_;
   try {
     for (int member = 1; member < members; ++member) {
-      mesh_.positions = start;
       shape_detail::SplitMix64 random(kEnsembleSeed + static_cast<std::uint64_t>(member));
-      for (Vec3& p : mesh_.positions)
-        for (double& x : p) x += jitter * random.normal();
-      const Hierarchy jittered = build_hierarchy(segmented_copy(mesh_), hierarchy.options());
+      for (std::size_t v = 0; v < start.size(); ++v)
+        for (int d = 0; d < 3; ++d)
+          jittered_input.positions[v][d] = start[v][d] + jitter * random.normal();
+      const Hierarchy jittered =
+          build_hierarchy(segmented_copy(jittered_input), hierarchy.options());
       mesh_.positions = start;
       estimate_copy_.set(estimate);
       snap(jittered, level(jittered));
@@ -433,18 +450,7 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   report.ensemble_members = static_cast<std::uint32_t>(members);
   report.reverted =
       revert_inverted_triangles(mesh_.positions, first, mesh_.triangles, input_normals_);
-
-  report.moved = 0;
-  report.max_move = 0;
-  double move_sum = 0;
-  for (std::size_t v = 0; v < start.size(); ++v) {
-    if (mesh_.positions[v] == start[v]) continue;
-    const double move = (to_eigen(mesh_.positions[v]) - to_eigen(start[v])).norm();
-    ++report.moved;
-    move_sum += move;
-    report.max_move = std::max(report.max_move, move);
-  }
-  report.mean_move = report.moved ? move_sum / report.moved : 0;
+  measure_moves(start, mesh_.positions, report);
   return report;
 }
 
@@ -729,8 +735,7 @@ bool Denoiser::keeps_orientation(std::uint32_t v, const Vec3& target) const {
       const std::uint32_t u = mesh_.triangles[t][k];
       corner[k] = to_eigen(u == v ? target : mesh_.positions[u]);
     }
-    if (triangle_normal(corner[0], corner[1], corner[2]).dot(to_eigen(input_normals_[t])) < 0)
-      return false;
+    if (turned_over(corner[0], corner[1], corner[2], input_normals_[t])) return false;
   }
   return true;
 }
@@ -797,7 +802,6 @@ SnapReport Denoiser::move_vertices(const Segmentation& labelled,
     if (!changed && !last_sweep) sweep = kSweeps - 2;  // nothing more to gain: fall back now
   }
 
-  double move_sum = 0;
   for (std::uint32_t v = 0; v < n; ++v) {
     if (settled[v] == 2) continue;
     if (!settled[v]) {
@@ -807,13 +811,8 @@ SnapReport Denoiser::move_vertices(const Segmentation& labelled,
     ++report.snapped;
     if (used_primitive_count[v] < incident_count[v] && options_.mode == SnapMode::AllIncident)
       ++report.fallbacks;
-    const double move = (to_eigen(mesh_.positions[v]) - to_eigen(start[v])).norm();
-    if (move == 0) continue;
-    ++report.moved;
-    move_sum += move;
-    report.max_move = std::max(report.max_move, move);
   }
-  report.mean_move = report.moved ? move_sum / report.moved : 0;
+  measure_moves(start, mesh_.positions, report);
   return report;
 }
 
