@@ -32,6 +32,10 @@ inline constexpr std::uint64_t kViewBytesPerFace = 1280;
 /// denoise: a second copy of the mesh to segment, refits and, with --iterations, a tree per
 /// round: 764 to 1,207 bytes per face, 1,424 with two rounds on fandisk.
 inline constexpr std::uint64_t kDenoiseBytesPerFace = 1536;
+/// denoise --ensemble on two threads or more, which builds two members' hierarchies at once and
+/// keeps up to three ahead of its snaps: 1,870 to 2,400 bytes per face (fandisk, bunny00; 1,160 to
+/// 1,250 on one thread).
+inline constexpr std::uint64_t kDenoiseEnsembleBytesPerFace = 3072;
 /// info, distance (per face of both meshes), deform, cut (beside its tree file's bytes): the mesh
 /// and its adjacency, search tree, skinning weights or level: 222 to 633 bytes per face, 130 to
 /// 400 per face of distance's two meshes, 339 to 748 for cut (its tree file has 154 per face).

@@ -13,6 +13,7 @@
 #include "cluster_numbering.hpp"
 #include "eigen_conversions.hpp"
 #include "no_index.hpp"
+#include "ordered_pipeline.hpp"
 #include "orientation_repair.hpp"
 #include "parallel.hpp"
 #include "primseg/error.hpp"
@@ -32,6 +33,8 @@ constexpr std::size_t kMaxRelabelClustersAtVertex = 64;
 constexpr int kMaxEnsembleMembers = 64;
 // The stream of the ensemble's jitter: member m draws from kEnsembleSeed + m.
 constexpr std::uint64_t kEnsembleSeed = 0x656e73656d626c65ull;
+// Thrown into a member's build made ahead when the ensemble stops early (an error, Ctrl-C).
+struct EnsembleStopped {};
 
 using detail::to_eigen;
 using detail::to_vec3;
@@ -336,23 +339,26 @@ std::shared_ptr<const Mesh> Denoiser::segmented_mesh() const {
   return segmented_copy(mesh_);
 }
 
-std::shared_ptr<const Mesh> Denoiser::segmented_copy(const Mesh& mesh) const {
+std::shared_ptr<const Mesh> Denoiser::segmented_copy(const Mesh& mesh, unsigned threads) const {
   // Taubin's λ|μ smoothing with uniform weights over the edge neighbours: shrinks noise, not the
   // shape. Neighbours come from the triangles around each vertex (each edge seen twice: same
   // weights for all, so the average is unchanged).
-  if (options_.bilateral_smoothing)
-    return std::make_shared<Mesh>(bilateral_smooth(mesh, *options_.bilateral_smoothing));
+  if (options_.bilateral_smoothing) {
+    BilateralSmoothingOptions smoothing = *options_.bilateral_smoothing;
+    if (threads > 0) smoothing.threads = threads;
+    return std::make_shared<Mesh>(bilateral_smooth(mesh, smoothing));
+  }
   constexpr double kLambda = 0.5, kMu = -0.53;
   auto segmented = std::make_shared<Mesh>(mesh);
   std::vector<Vec3>& positions = segmented->positions;
   std::vector<Vec3> next(positions.size());
   for (int step = 0; step < 2 * options_.smoothing_steps; ++step) {
     const double factor = step % 2 == 0 ? kLambda : kMu;
-    for (std::uint32_t v = 0; v < mesh_.vertex_count(); ++v) {
+    for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       int count = 0;
       for (std::uint32_t i = vertex_triangle_offsets_[v]; i < vertex_triangle_offsets_[v + 1]; ++i)
-        for (const std::uint32_t u : mesh_.triangles[vertex_triangles_[i]])
+        for (const std::uint32_t u : mesh.triangles[vertex_triangles_[i]])
           if (u != v) {
             sum += to_eigen(positions[u]);
             ++count;
@@ -415,6 +421,30 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   // members' automatic levels need it, and smoothing it again each time would cost a member.
   const std::shared_ptr<const Mesh> estimate = estimate_copy();
   const double jitter = options_.ensemble_jitter * noise_from(mesh_, *estimate);
+  // The members' hierarchies are built on a helper thread and on this one while this one snaps
+  // (which calls `level`, perhaps into Python) member by member; each build then runs on one
+  // thread, as two builds side by side keep both cores busier than one build on two. A member's
+  // tree is a function of its number alone, so the mean does not depend on the threads.
+  const bool on_two_threads = detail::thread_count(options_.hierarchy.threads) > 1;
+  HierarchyOptions member_options = hierarchy.options();
+  const unsigned member_threads = on_two_threads ? 1 : 0;
+  if (on_two_threads) member_options.threads = 1;
+  const Mesh unjittered = mesh_;
+  const auto build_member = [&](std::size_t index, const std::atomic<bool>& stop) {
+    Mesh jittered = unjittered;
+    shape_detail::SplitMix64 random(kEnsembleSeed + index + 1);
+    for (std::size_t v = 0; v < start.size(); ++v)
+      for (int d = 0; d < 3; ++d) jittered.positions[v][d] = start[v][d] + jitter * random.normal();
+    return HierarchyBuilder(segmented_copy(jittered, member_threads), member_options)
+        .finish([&stop](double) {
+          if (stop) throw EnsembleStopped{};
+        });
+  };
+  // The helper starts on the first members while this thread makes the first snap. At most three
+  // hierarchies are made ahead of the one being snapped (two left the helper idle during snaps:
+  // fandisk with 16 members 1.45 s against 1.31 s).
+  detail::OrderedPipeline<Hierarchy> members_ahead(static_cast<std::size_t>(members - 1), 3,
+                                                   on_two_threads, build_member);
   SnapReport report = snap(hierarchy, segmentation);
   const std::vector<Vec3> first = mesh_.positions;
   SnappedLevel first_level = std::move(snapped_level_);
@@ -422,15 +452,9 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   // on the threads): where every member agrees, as on a vertex no snap moves, the mean is the
   // first snap bit for bit.
   std::vector<Eigen::Vector3d> offset_sum(start.size(), Eigen::Vector3d::Zero());
-  Mesh jittered_input = mesh_;
   try {
     for (int member = 1; member < members; ++member) {
-      shape_detail::SplitMix64 random(kEnsembleSeed + static_cast<std::uint64_t>(member));
-      for (std::size_t v = 0; v < start.size(); ++v)
-        for (int d = 0; d < 3; ++d)
-          jittered_input.positions[v][d] = start[v][d] + jitter * random.normal();
-      const Hierarchy jittered =
-          build_hierarchy(segmented_copy(jittered_input), hierarchy.options());
+      const Hierarchy jittered = members_ahead.take();
       mesh_.positions = start;
       estimate_copy_.set(estimate);
       snap(jittered, level(jittered));

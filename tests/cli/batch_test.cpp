@@ -404,6 +404,11 @@ TEST(Limits, EveryCommandThatReadsAMeshHasThemAndItsEstimateBoundsItsPeak) {
         out("d.ply")},
        1536,
        mesh_bytes},
+      // Two members' hierarchies built side by side.
+      {{"denoise", mesh, "--clusters", "auto", "--bilateral", "--ensemble", "4", "--threads", "2",
+        "-q", "-o", out("e.ply")},
+       3072,
+       mesh_bytes},
       {{"skeleton", mesh, "--clusters", "auto", "-q", "-o", out("s.json"), "--skin-weights",
         out("w.txt")},
        1024,

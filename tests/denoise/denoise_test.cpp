@@ -825,11 +825,13 @@ TEST(Denoise, EnsembleAveragesSnapsWithinTheSafeguards) {
 }
 
 // A level rule that throws in the middle of the ensemble (Python's Ctrl-C) leaves the positions
-// as they were.
+// as they were, and stops the members being built ahead on the second thread.
 TEST(Denoise, EnsembleInterruptedLeavesThePositions) {
   const NoisyShape box = noisy_shape("box", 0.004, 0.08);
   DenoiseOptions options;
-  options.ensemble_members = 3;
+  options.ensemble_members = 5;
+  options.smoothing_steps = 2;  // Taubin's copy, made beside the snaps on two threads
+  options.hierarchy.threads = 2;
   Denoiser denoiser(box.noisy.mesh, options);
   int calls = 0;
   const LevelSelector level = [&](const Hierarchy& hierarchy) {
@@ -842,7 +844,8 @@ TEST(Denoise, EnsembleInterruptedLeavesThePositions) {
   EXPECT_TRUE(denoiser.snapped_level().labels.empty());
   calls = -100;  // and it goes on as if nothing had happened
   const SnapReport report = denoiser.iterate(level);
-  EXPECT_EQ(report.ensemble_members, 3u);
+  EXPECT_EQ(report.ensemble_members, 5u);
+  options.hierarchy.threads = 1;  // each member built in turn: the same bits
   Denoiser fresh(box.noisy.mesh, options);
   fresh.iterate(level_by_count(6));
   EXPECT_EQ(denoiser.mesh().positions, fresh.mesh().positions);
