@@ -33,7 +33,7 @@ class OrderedPipeline {
         items_(count),
         errors_(count),
         done_(count, 0) {
-    if (!helper || count < 2) return;
+    if (!helper || count == 0) return;
     try {
       helper_ = std::thread([this] { help(); });
     } catch (const std::system_error&) {
