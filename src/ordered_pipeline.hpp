@@ -12,6 +12,7 @@
 #include <functional>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <system_error>
 #include <thread>
 #include <utility>
@@ -53,10 +54,12 @@ class OrderedPipeline {
     if (helper_.joinable()) helper_.join();
   }
 
-  /// The next item in order; rethrows what producing it threw. At most count calls.
+  /// The next item in order; rethrows what producing it threw. Throws std::out_of_range once all
+  /// count items are taken.
   T take() {
     std::unique_lock lock(mutex_);
     const std::size_t wanted = next_take_;
+    if (wanted >= items_.size()) throw std::out_of_range("OrderedPipeline::take: no item left");
     while (!done_[wanted]) {
       std::size_t index;
       if (claim(index)) {

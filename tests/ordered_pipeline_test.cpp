@@ -34,6 +34,7 @@ TEST(OrderedPipeline, TakesEveryItemInOrderWithOrWithoutTheHelper) {
         for (std::size_t i = 0; i < count; ++i)
           EXPECT_EQ(pipeline.take(), std::string(i + 1, 'x'))
               << "helper " << helper << ", lookahead " << lookahead << ", count " << count;
+        EXPECT_THROW(pipeline.take(), std::out_of_range);
       }
 }
 
