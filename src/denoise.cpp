@@ -416,7 +416,9 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
                           const LevelSelector& level) {
   const int members = options_.ensemble_members;
   if (members <= 1) return snap(hierarchy, segmentation);
-  const std::vector<Vec3> start = mesh_.positions;
+  // The mesh before the snaps, which the members' builds read while this thread snaps.
+  const Mesh unjittered = mesh_;
+  const std::vector<Vec3>& start = unjittered.positions;
   // A snap resets the estimate's copy, which stays valid once the positions are put back: the
   // members' automatic levels need it, and smoothing it again each time would cost a member.
   const std::shared_ptr<const Mesh> estimate = estimate_copy();
@@ -429,7 +431,6 @@ SnapReport Denoiser::snap(const Hierarchy& hierarchy, const Segmentation& segmen
   HierarchyOptions member_options = hierarchy.options();
   const unsigned member_threads = on_two_threads ? 1 : 0;
   if (on_two_threads) member_options.threads = 1;
-  const Mesh unjittered = mesh_;
   const auto build_member = [&](std::size_t index, const std::atomic<bool>& stop) {
     Mesh jittered = unjittered;
     shape_detail::SplitMix64 random(kEnsembleSeed + index + 1);

@@ -13,10 +13,11 @@
 #include <mutex>
 #include <optional>
 #include <stdexcept>
-#include <system_error>
 #include <thread>
 #include <utility>
 #include <vector>
+
+#include "parallel.hpp"
 
 namespace primseg::detail {
 
@@ -32,13 +33,10 @@ class OrderedPipeline {
       : produce_(std::move(produce)),
         lookahead_(lookahead < 1 ? 1 : lookahead),
         items_(count),
-        errors_(count),
-        done_(count, 0) {
+        errors_(count) {
     if (!helper || count == 0) return;
-    try {
-      helper_ = std::thread([this] { help(); });
-    } catch (const std::system_error&) {
-    }
+    helper_.reserve(1);
+    start_threads(helper_, 2, [this](unsigned) { help(); });
   }
 
   OrderedPipeline(const OrderedPipeline&) = delete;
@@ -51,7 +49,7 @@ class OrderedPipeline {
       stop_ = true;  // under the lock, so that a helper about to wait sees it
     }
     changed_.notify_all();
-    if (helper_.joinable()) helper_.join();
+    for (std::thread& helper : helper_) helper.join();
   }
 
   /// The next item in order; rethrows what producing it threw. Throws std::out_of_range once all
@@ -60,7 +58,7 @@ class OrderedPipeline {
     std::unique_lock lock(mutex_);
     const std::size_t wanted = next_take_;
     if (wanted >= items_.size()) throw std::out_of_range("OrderedPipeline::take: no item left");
-    while (!done_[wanted]) {
+    while (!done(wanted)) {
       std::size_t index;
       if (claim(index)) {
         produce_unlocked(index, lock);
@@ -77,6 +75,9 @@ class OrderedPipeline {
   }
 
  private:
+  // Under the lock: whether item `index` is made (or failed).
+  bool done(std::size_t index) const { return items_[index].has_value() || errors_[index]; }
+
   // Under the lock: the next index to produce, if one is left within the lookahead.
   bool claim(std::size_t& index) {
     if (next_claim_ >= items_.size() || next_claim_ >= next_take_ + lookahead_) return false;
@@ -97,7 +98,6 @@ class OrderedPipeline {
     lock.lock();
     items_[index] = std::move(item);
     errors_[index] = error;
-    done_[index] = 1;
     changed_.notify_all();
   }
 
@@ -120,10 +120,9 @@ class OrderedPipeline {
   std::condition_variable changed_;
   std::vector<std::optional<T>> items_;
   std::vector<std::exception_ptr> errors_;
-  std::vector<char> done_;
   std::size_t next_claim_ = 0, next_take_ = 0;
-  std::atomic<bool> stop_{false};  // also polled by produce() without the lock
-  std::thread helper_;
+  std::atomic<bool> stop_{false};    // also polled by produce() without the lock
+  std::vector<std::thread> helper_;  // none, or the one that started
 };
 
 }  // namespace primseg::detail
