@@ -12,7 +12,7 @@ Command add_segment_command(CLI::App& app) {
   struct Options {
     std::string mesh_path, primitives = "plane,cylinder,sphere", weights = "area";
     bool exact_costs = false, eager = false;
-    unsigned threads = 0;
+    unsigned threads = 0, regions = 1;
     double merge_batch_tolerance = 0;
     LevelOptions level;
     ResourceLimits limits;
@@ -40,6 +40,14 @@ Command add_segment_command(CLI::App& app) {
       "--eager", o->eager,
       "Reference mode: evaluate every candidate at once (same tree as the default lazy mode)");
   add_merge_batch_option(*segment, o->merge_batch_tolerance);
+  segment
+      ->add_option("--regions", o->regions,
+                   "Approximate, faster on several cores (1: the exact greedy order): the mesh "
+                   "is cut into N regions merged side by side until each has a 32nd of its "
+                   "faces as clusters, then the exact order goes on over the whole mesh; 2 on "
+                   "two cores")
+      ->check(CLI::Range(1u, 256u))
+      ->capture_default_str();
   segment->add_flag("--exact-costs", o->exact_costs,
                     "Reference mode: exact Euclidean errors, O(cluster size) per candidate");
 
@@ -52,6 +60,7 @@ Command add_segment_command(CLI::App& app) {
         options.threads = o->threads;
         options.evaluation = o->eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
         options.merge_batch_tolerance = o->merge_batch_tolerance;
+        options.regions = o->regions;
         validate(options);
         validate_level_outputs(o->level);
         const auto read_start = Clock::now();

@@ -5,9 +5,9 @@
 //   primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]  (generated, Uniform tessellation)
 //
 // OPTIONS: --exact-costs, --threads N (HierarchyOptions::threads, default 0: all),
-// --merge-batch-tolerance T (default 0: the exact order), --read-only (read the input, print
-// read_seconds, build nothing; bench/read_speed.sh) and --face-order auto|spatial|as-listed
-// (HierarchyOptions::face_order, default auto).
+// --merge-batch-tolerance T (default 0: the exact order), --regions N (default 1: the exact
+// order), --read-only (read the input, print read_seconds, build nothing; bench/read_speed.sh)
+// and --face-order auto|spatial|as-listed (HierarchyOptions::face_order, default auto).
 //
 // Prints one line of key=value pairs:
 //   faces             input faces F
@@ -44,12 +44,13 @@
 namespace {
 
 int usage() {
-  std::fprintf(stderr,
-               "usage: primseg_bench_memory MESH_FILE [OPTIONS]\n"
-               "       primseg_bench_memory --cgal NAME [OPTIONS]\n"
-               "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
-               "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T --read-only\n"
-               "         --face-order auto|spatial|as-listed\n");
+  std::fprintf(
+      stderr,
+      "usage: primseg_bench_memory MESH_FILE [OPTIONS]\n"
+      "       primseg_bench_memory --cgal NAME [OPTIONS]\n"
+      "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
+      "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T --regions N --read-only\n"
+      "         --face-order auto|spatial|as-listed\n");
   return 2;
 }
 
@@ -93,6 +94,11 @@ int run(int argc, char** argv) {
       options.threads = static_cast<unsigned>(threads);
     } else if (arg == "--merge-batch-tolerance" && i + 1 < argc) {
       options.merge_batch_tolerance = number(arg, argv[++i]);
+    } else if (arg == "--regions" && i + 1 < argc) {
+      const double regions = number(arg, argv[++i]);
+      if (!(regions >= 1 && regions <= 256 && regions == static_cast<unsigned>(regions)))
+        throw std::invalid_argument("--regions: not a region count from 1 to 256");
+      options.regions = static_cast<unsigned>(regions);
     } else if (arg == "--face-order" && i + 1 < argc) {
       const std::string order = argv[++i];
       if (order == "auto")

@@ -205,7 +205,7 @@ PyMesh mesh_from_state(const py::tuple& state) {
 
 HierarchyOptions hierarchy_options(const py::object& primitives, const std::string& weights,
                                    unsigned threads, bool exact_costs, bool eager,
-                                   double merge_batch_tolerance) {
+                                   double merge_batch_tolerance, unsigned regions) {
   HierarchyOptions options;
   options.primitives = parse_primitives(primitives);
   if (weights != "area" && weights != "uniform")
@@ -215,6 +215,7 @@ HierarchyOptions hierarchy_options(const py::object& primitives, const std::stri
   options.exact_costs = exact_costs;
   options.evaluation = eager ? CandidateEvaluation::Eager : CandidateEvaluation::Lazy;
   options.merge_batch_tolerance = merge_batch_tolerance;
+  options.regions = regions;
   validate(options);
   return options;
 }

@@ -127,11 +127,11 @@ struct PyHierarchy {
 py::tuple mesh_state(const PyMesh& self);
 PyMesh mesh_from_state(const py::tuple& state);
 
-// The HierarchyOptions of segment's primitives, weights, threads, exact_costs, eager and
-// merge_batch_tolerance, checked (InvalidInputError naming the bad one).
+// The HierarchyOptions of segment's primitives, weights, threads, exact_costs, eager,
+// merge_batch_tolerance and regions, checked (InvalidInputError naming the bad one).
 HierarchyOptions hierarchy_options(const py::object& primitives, const std::string& weights,
                                    unsigned threads, bool exact_costs, bool eager,
-                                   double merge_batch_tolerance = 0);
+                                   double merge_batch_tolerance = 0, unsigned regions = 1);
 
 // Thrown from a build's progress callback to stop it once Python has an exception to raise: a
 // signal's (Ctrl-C: KeyboardInterrupt) or the user's progress callable's. The Python error stays

@@ -201,7 +201,7 @@ negative or NaN tolerance.)";
 
 void bind_segment(py::module_& m) {
   const char* segment_doc =
-      R"(segment(mesh, *, primitives=("plane", "cylinder", "sphere"), weights="area", threads=0, exact_costs=False, eager=False, merge_batch_tolerance=0.0, progress=None) -> Hierarchy
+      R"(segment(mesh, *, primitives=("plane", "cylinder", "sphere"), weights="area", threads=0, exact_costs=False, eager=False, merge_batch_tolerance=0.0, regions=1, progress=None) -> Hierarchy
 segment(V, F, *, ...) -> Hierarchy
 
 Builds the whole hierarchy, with the GIL released. About every percent of the merges it takes the
@@ -213,22 +213,23 @@ Fortran-ordered, read in place without a converted copy (labels are per row of F
 primitives: names or one name ("plane", "cylinder", "sphere"); weights: "area" or "uniform";
 threads: 0 for all cores (the tree does not depend on it); exact_costs: slow reference mode;
 eager: evaluate every candidate at once (reference mode, the same tree);
-merge_batch_tolerance: above 0, an approximate merge order, faster (0.1 is a good start).
+merge_batch_tolerance: above 0, an approximate merge order, faster (0.1 is a good start);
+regions: above 1, an approximate merge order, faster on several cores (2 on two cores).
 Raises InvalidInputError (a ValueError) for bad arrays (shape, dtype, NaN or infinite
 coordinates, index out of range, no faces) or bad options.)";
   m.def(
       "segment",
       [](const py::object& first, const py::object& faces, const py::object& primitives,
          const std::string& weights, unsigned threads, bool exact_costs, bool eager,
-         double merge_batch_tolerance, const py::object& progress) {
+         double merge_batch_tolerance, unsigned regions, const py::object& progress) {
         const HierarchyOptions options = hierarchy_options(
-            primitives, weights, threads, exact_costs, eager, merge_batch_tolerance);
+            primitives, weights, threads, exact_costs, eager, merge_batch_tolerance, regions);
         return segment_mesh(mesh_argument("segment", first, faces), options, progress);
       },
       py::arg("mesh_or_V"), py::arg("F") = py::none(), py::kw_only(),
       py::arg("primitives") = py::make_tuple("plane", "cylinder", "sphere"),
       py::arg("weights") = "area", py::arg("threads") = 0u, py::arg("exact_costs") = false,
-      py::arg("eager") = false, py::arg("merge_batch_tolerance") = 0.0,
+      py::arg("eager") = false, py::arg("merge_batch_tolerance") = 0.0, py::arg("regions") = 1u,
       py::arg("progress") = py::none(),
       join_docs(
           {segment_doc, cpp_doc("build_hierarchy", doc::hierarchy__build_hierarchy_2),
@@ -238,7 +239,8 @@ coordinates, index out of range, no faces) or bad options.)";
            cpp_doc("HierarchyOptions::evaluation", doc::hierarchy__HierarchyOptions__evaluation),
            cpp_doc("HierarchyOptions::exact_costs", doc::hierarchy__HierarchyOptions__exact_costs),
            cpp_doc("HierarchyOptions::merge_batch_tolerance",
-                   doc::hierarchy__HierarchyOptions__merge_batch_tolerance)})
+                   doc::hierarchy__HierarchyOptions__merge_batch_tolerance),
+           cpp_doc("HierarchyOptions::regions", doc::hierarchy__HierarchyOptions__regions)})
           .c_str());
 }
 

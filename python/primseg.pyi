@@ -189,6 +189,7 @@ def segment(
     exact_costs: bool = False,
     eager: bool = False,
     merge_batch_tolerance: float = 0.0,
+    regions: int = 1,
     progress: _Progress = None,
 ) -> Hierarchy: ...
 def render(

@@ -8,8 +8,10 @@
 #include <limits>
 #include <numeric>
 #include <type_traits>
+#include <utility>
 
 #include "batch_pool.hpp"
+#include "hierarchy_regions.hpp"
 #include "huge_pages.hpp"
 #include "indexed_heap.hpp"
 #include "model_selection.hpp"
@@ -263,12 +265,24 @@ class HierarchyBuilder::Impl {
     if (!mesh_) throw InvalidInputError("no mesh");
     mesh_->validate();
     check_geometric_range(*mesh_);
-    graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, options_.threads);
+    // With regions, the tree's first merges are theirs, and the whole mesh's graph is made by
+    // the thread that finishes its region first.
     const std::uint32_t f = mesh_->face_count();
+    detail::reserve_huge(merges_, f - 1);
+    if (options_.regions > 1 && f >= 2 * detail::kMinRegionFaces) {
+      evaluations_ = detail::region_merges(*mesh_, options_, merges_, [this] {
+        graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, 1);
+      });
+    }
+    if (!graph_) graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, options_.threads);
+    // Where a region chained a non-manifold edge's triangles otherwise than the whole mesh, the
+    // regions' merges are no tree of this graph: the exact order then, from the faces.
+    if (!merges_.empty() && !detail::merges_join_linked_clusters(*graph_, merges_)) merges_.clear();
     // The loop may run on the graph in a spatial order. Node ids stay the input's faces, so the
     // queue's ties are the input's, and so are each dual edge's sides, so every union is summed
-    // in the input's order: the tree is the same, bit for bit.
-    if (merges_in_spatial_order(options_.face_order, selector_, *graph_)) {
+    // in the input's order: the tree is the same, bit for bit. (From the regions' clusters, as
+    // listed: start_from() keeps each cluster in the slot of its lowest input face.)
+    if (merges_.empty() && merges_in_spatial_order(options_.face_order, selector_, *graph_)) {
       SpatialOrder order = graph_->in_spatial_order();
       graph_ = std::move(order.graph);
       original_face_ = std::move(order.original_face);
@@ -276,7 +290,6 @@ class HierarchyBuilder::Impl {
     // Statistics are stored for clusters of three faces or more only (at most F / 3 live at
     // once); a single face's or a pair's are recomputed when needed (see store_pair()).
     detail::reserve_huge(stats_, f / 3 + 1);  // address space: touched as clusters form
-    detail::reserve_huge(merges_, f - 1);
     detail::resize_huge(slots_, f);
     detail::resize_huge(pair_cache_, kCachedPairs);  // (half a megabyte: its pages at once)
     for (std::uint32_t face = 0; face < f; ++face)
@@ -324,6 +337,7 @@ class HierarchyBuilder::Impl {
     // so made the build 30% slower than one thread (docs/method.md, "Threads in the merge loop").
     parallel_from_ = options_.exact_costs || !selector_.closed_form() ? 2 : kParallelBatch;
     max_penalty_ = *std::max_element(options_.type_penalty.begin(), options_.type_penalty.end());
+    if (!merges_.empty()) start_from();
     // Every candidate's cost and first degree is independent of the others: all in parallel.
     // In chunks of consecutive edges: those of a face to its higher neighbours follow each other,
     // and the face's statistics stay in the thread's cache.
@@ -334,16 +348,25 @@ class HierarchyBuilder::Impl {
       const std::size_t end = std::min(edges_.size(), (chunk + 1) * kChunk);
       for (std::size_t id = chunk * kChunk; id < end; ++id) {
         QueuedCandidate& c = candidates[id];
+        if (!edges_[id].alive()) {
+          c.id = kNone;  // inside a region's cluster, or combined with another edge
+          continue;
+        }
         c = evaluate(static_cast<std::uint32_t>(id), scratch_[thread]);
         if (c.cost == 0) c.set_degree(first_merged_degree(edges_[id].a, edges_[id].b));
       }
     };
     pool_.run((edges_.size() + kChunk - 1) / kChunk, first_evaluation);
-    evaluations_ = candidates.size();
     detail::resize_huge(queued_pairs_, edges_.size());
-    for (std::size_t id = 0; id < edges_.size(); ++id)
-      queued_pairs_[id] = {input_face(dual_edges[id].first),
-                           input_face(dual_edges[id].second)};  // first < second in the input
+    if (merges_.empty()) {
+      for (std::size_t id = 0; id < edges_.size(); ++id)
+        queued_pairs_[id] = {input_face(dual_edges[id].first),
+                             input_face(dual_edges[id].second)};  // first < second in the input
+    } else {
+      std::erase_if(candidates, [](const QueuedCandidate& c) { return c.id == kNone; });
+      for (const QueuedCandidate& c : candidates) queued_pairs_[c.id] = node_pair(edges_[c.id]);
+    }
+    evaluations_ += candidates.size();
     queue_ = CandidateQueue(static_cast<std::uint32_t>(edges_.size()), ComesFirst{&queued_pairs_});
     queue_.assign(candidates);
     total_merges_ = f - graph_->component_count();
@@ -356,6 +379,140 @@ class HierarchyBuilder::Impl {
                     kWarmLead);
     else
       detail::populate_pages(merges_.data(), merges_.capacity() * sizeof(Merge));
+  }
+
+  // Starts from the clusters the regions' merges made (HierarchyOptions::regions): each lives in
+  // the slot of its lowest face, its statistics summed from its faces', its edges to each
+  // neighbour combined into one, the mesh edges between them summed in edge order. The merges
+  // are the tree's first, with weights summed as the whole mesh weighs its faces.
+  void start_from() {
+    std::vector<Merge>& prefix = merges_;
+    const auto f = static_cast<std::uint32_t>(slots_.size());
+    // (The arrays sized by faces ask for huge pages and are faulted in at once: a first touch
+    // of each 4 KB page costs more than filling it.)
+    std::vector<std::uint32_t> slot_of_node, parent, cluster;
+    std::vector<double> weight;
+    detail::resize_huge(slot_of_node, f + prefix.size());
+    detail::resize_huge(parent, f);
+    detail::resize_huge(cluster, f);
+    detail::resize_huge(weight, f + prefix.size());
+    std::iota(slot_of_node.begin(), slot_of_node.begin() + f, 0u);
+    std::iota(parent.begin(), parent.end(), 0u);
+    detail::parallel_for(f, pool_.thread_count(), [&](std::size_t face) {
+      for (std::uint32_t t = graph_->first_triangle(static_cast<std::uint32_t>(face));
+           t < graph_->first_triangle(static_cast<std::uint32_t>(face) + 1); ++t)
+        for (const double w : graph_->corner_weights(t)) weight[face] += w;
+    });
+    for (std::uint32_t i = 0; i < prefix.size(); ++i) {
+      Merge& m = prefix[i];
+      const std::uint32_t a = slot_of_node[m.first], b = slot_of_node[m.second];
+      const std::uint32_t kept = std::min(a, b), gone = std::max(a, b);
+      parent[gone] = kept;
+      slot_of_node[f + i] = kept;
+      m.weight = weight[f + i] = weight[m.first] + weight[m.second];
+      Slot& slot = slots_[kept];
+      slot.node = f + i;
+      slot.faces = m.face_count;
+      slot.triangles += slots_[gone].triangles;
+      slot.min_face = kept;
+      slots_[gone].node = kNone;
+      max_cost_ = std::max(max_cost_, m.cost);
+    }
+    for (std::uint32_t face = 0; face < f; ++face) {
+      std::uint32_t root = face;
+      while (parent[root] != root) root = parent[root];
+      cluster[face] = root;
+      for (std::uint32_t x = face; parent[x] != root;) x = std::exchange(parent[x], root);
+    }
+
+    // Edges inside a cluster die (their mesh edges go to its statistics); the first edge between
+    // two clusters is kept, the others' mesh edges are added to it.
+    std::vector<std::uint32_t> merged, merged_index;  // clusters of two faces or more
+    detail::resize_huge(merged_index, f);
+    for (std::uint32_t slot = 0; slot < f; ++slot)
+      if (slots_[slot].node != kNone && slots_[slot].faces >= 2) {
+        merged_index[slot] = static_cast<std::uint32_t>(merged.size());
+        merged.push_back(slot);
+      } else {
+        merged_index[slot] = kNone;
+      }
+    const std::vector<DualEdge>& dual_edges = graph_->edges();
+    std::vector<EdgeStats> inside(merged.size());
+    std::vector<std::uint32_t> pair_edge(merged.size(), kNone);
+    std::vector<std::array<std::uint32_t, 3>> between;  // (lower slot, higher slot, edge)
+    detail::reserve_huge(between, dual_edges.size());
+    for (std::uint32_t id = 0; id < dual_edges.size(); ++id) {
+      const std::uint32_t a = cluster[dual_edges[id].first], b = cluster[dual_edges[id].second];
+      edges_[id] = {a, b};
+      if (a == b) {
+        inside[merged_index[a]] += dual_edges[id].shared;
+        pair_edge[merged_index[a]] = id;
+        edges_[id].a = edges_[id].b = kNone;
+      } else {
+        between.push_back({std::min(a, b), std::max(a, b), id});
+      }
+    }
+    std::sort(between.begin(), between.end());
+    for (std::size_t i = 1, kept = 0; i < between.size(); ++i) {
+      if (between[i][0] != between[kept][0] || between[i][1] != between[kept][1]) {
+        kept = i;
+        continue;
+      }
+      combine_shared_edges(between[kept][2], between[i][2]);
+      edges_[between[i][2]].a = edges_[between[i][2]].b = kNone;
+    }
+    for (Slot& slot : slots_) slot.first_link = kNone;
+    for (std::size_t id = dual_edges.size(); id-- > 0;)
+      if (edges_[id].alive())
+        for (std::uint32_t side = 0; side < 2; ++side) {
+          const std::uint32_t slot = side == 0 ? edges_[id].a : edges_[id].b;
+          const auto link = static_cast<std::uint32_t>(2 * id + side);
+          next_link_[link] = slots_[slot].first_link;
+          slots_[slot].first_link = link;
+        }
+
+    // Statistics of the clusters of two faces or more, from their faces in increasing order.
+    std::vector<std::uint32_t> first_face, faces;
+    detail::resize_huge(first_face, std::size_t{f} + 1);
+    detail::resize_huge(faces, f);
+    for (std::uint32_t face = 0; face < f; ++face) ++first_face[cluster[face] + 1];
+    std::partial_sum(first_face.begin(), first_face.end(), first_face.begin());
+    {
+      std::vector<std::uint32_t> fill(first_face.begin(), first_face.end() - 1);
+      for (std::uint32_t face = 0; face < f; ++face) faces[fill[cluster[face]]++] = face;
+    }
+    std::vector<ClusterStats> stats(merged.size());
+    const bool samples = selector_.needs_samples();
+    detail::parallel_for_threads(merged.size(), pool_.thread_count(), [&](std::size_t i, unsigned) {
+      const std::uint32_t slot = merged[i];
+      graph_->face_stats(faces[first_face[slot]], stats[i], samples, 4);
+      FaceCorners corners;
+      for (std::uint32_t k = first_face[slot] + 1; k < first_face[slot + 1]; ++k)
+        if (by_corners_ && graph_->face_corners(faces[k], corners))
+          stats[i].add(corners, 4);
+        else
+          stats[i].merge(graph_->face_stats(faces[k], samples, 4), EdgeStats{}, 4);
+      stats[i].edges += inside[i];
+      stats[i] = stats[i].centred(4);  // as the merge loop stores them
+    });
+    // Stored clusters have three faces or more, but for those pairs: room for them all, ahead of
+    // the page warmer, which reads where the pool is.
+    const auto unpaired = static_cast<std::size_t>(
+        std::count_if(merged.begin(), merged.end(), [&](std::uint32_t slot) {
+          return slots_[slot].faces == 2 && pair_edge[merged_index[slot]] == kNone;
+        }));
+    detail::reserve_huge(stats_, f / 3 + 1 + unpaired);
+    for (std::size_t i = 0; i < merged.size(); ++i) {
+      const std::uint32_t slot = merged[i];
+      // (A region's pair joined across a non-manifold edge may have no dual edge of the whole
+      // mesh between its faces, whose triangles there are chained in another order: it keeps
+      // its statistics then, as a larger cluster.)
+      if (slots_[slot].faces == 2 && pair_edge[i] != kNone)
+        store_pair(slot, pair_edge[i], slots_[slot].triangles, std::move(stats[i]));
+      else
+        store_stats(slot, std::move(stats[i]));
+    }
+    merges_used_.store(merges_.size() * sizeof(Merge), std::memory_order_relaxed);
   }
 
   bool step() {
@@ -378,6 +535,7 @@ class HierarchyBuilder::Impl {
   std::uint32_t merge_count() const { return static_cast<std::uint32_t>(merges_.size()); }
   std::uint32_t total_merge_count() const { return total_merges_; }
   std::uint64_t evaluation_count() const { return evaluations_; }
+  std::span<const Merge> merges() const { return merges_; }
 
   struct Parts {
     std::shared_ptr<const Mesh> mesh;
@@ -1188,6 +1346,9 @@ std::uint32_t HierarchyBuilder::total_merge_count() const {
 }
 std::uint64_t HierarchyBuilder::evaluation_count() const {
   return impl_->evaluation_count();
+}
+std::span<const Merge> HierarchyBuilder::merges() const {
+  return impl_->merges();
 }
 Hierarchy HierarchyBuilder::finish(const std::function<void(double)>& progress) {
   Impl::Parts parts = impl_->finish(progress);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "primseg/error.hpp"
 
@@ -27,6 +28,11 @@ void validate(const HierarchyOptions& options) {
     throw InvalidInputError("zero_cost_tolerance must be non-negative and finite");
   if (!(options.merge_batch_tolerance >= 0) || !std::isfinite(options.merge_batch_tolerance))
     throw InvalidInputError("merge_batch_tolerance must be non-negative and finite");
+  if (options.regions < 1 || options.regions > 256)
+    throw InvalidInputError("regions must be from 1 to 256, not " +
+                            std::to_string(options.regions));
+  if (options.regions > 1 && options.exact_costs)
+    throw InvalidInputError("regions cannot be combined with exact_costs (a reference mode)");
 }
 
 namespace detail {

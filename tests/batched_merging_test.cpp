@@ -18,6 +18,7 @@
 namespace primseg {
 namespace {
 
+using testing::level_rms;
 using testing::score_at_true_count;
 
 constexpr double kTolerance = 0.1;  // the value the CLI's help suggests
@@ -39,16 +40,6 @@ HierarchyOptions with_types(std::vector<PrimitiveType> types) {
   HierarchyOptions options;
   options.primitives = std::move(types);
   return options;
-}
-
-// sqrt(Σ error / Σ weight) over the clusters of the level with k clusters (working units).
-double level_rms(const Hierarchy& h, std::uint32_t k) {
-  double error = 0, weight = 0;
-  for (std::uint32_t node : cut_by_count(h, k).nodes) {
-    error += h.error(node);
-    weight += h.weight(node);
-  }
-  return std::sqrt(error / weight);
 }
 
 // With planes only, a union's cost is at least its parts' (the smallest eigenvalue of a sum of

@@ -108,6 +108,17 @@ struct HierarchyOptions {
   /// regions tie exactly (flat or exactly curved regions of many triangles), not on scans. Not
   /// stored in tree files (a tree read back reports 0). Must be finite and non-negative.
   double merge_batch_tolerance = 0;
+  /// Approximate, for speed on two cores or more; 1 (the default) is the exact greedy order over
+  /// the whole mesh. Above 1 the mesh is cut into this many regions of nearly equal face counts
+  /// (recursive cuts at the median of the face centroids, along the longest side), each region
+  /// is merged by itself, on its own thread (`threads` of them at once), until it has a 32nd of
+  /// its faces as clusters, and the exact greedy order then goes on over the whole mesh from
+  /// the regions' clusters. The tree's first merges are the regions', interleaved by cost, so
+  /// the levels of more than F / 32 clusters have no cluster across a cut; coarser levels are
+  /// merged as usual, from slightly other clusters. Deterministic, and the same for any number
+  /// of threads. Regions have at least 4,096 faces: a smaller mesh gets fewer regions, or one.
+  /// Not with exact_costs; not stored in tree files (a tree read back reports 1). At most 256.
+  unsigned regions = 1;
   /// The order the merge loop keeps faces in memory (never the tree: see FaceOrder).
   FaceOrder face_order = FaceOrder::Automatic;
 };
@@ -208,6 +219,9 @@ class HierarchyBuilder {
   std::uint32_t merge_count() const;
   /// Number of real merges the build will make: F − number of components.
   std::uint32_t total_merge_count() const;
+  /// The merges applied so far: the first merge_count() merges of the tree finish() returns.
+  /// Valid until the next step() or finish().
+  std::span<const Merge> merges() const;
   /// Candidate merges evaluated so far (fits of a union of two clusters, including the first
   /// evaluation of every dual edge): what lazy evaluation saves.
   std::uint64_t evaluation_count() const;

@@ -490,17 +490,27 @@ def test_deterministic_for_any_thread_count(fandisk_tree):
     np.testing.assert_array_equal(primseg.segment(mesh, eager=True).linkage(), fandisk_tree.linkage())
 
 
-def test_merge_batch_tolerance_gives_the_approximate_order(fandisk_tree):
+@pytest.mark.parametrize("option, bad_values", [
+    ({"merge_batch_tolerance": 0.1}, (-0.1, float("nan"))),
+    ({"regions": 2}, (0, 257)),
+])
+def test_an_approximate_order_is_the_same_for_any_thread_count(fandisk_tree, option, bad_values):
     mesh = fandisk_tree.mesh
-    batched = primseg.segment(mesh, merge_batch_tolerance=0.1, threads=1)
+    approximate = primseg.segment(mesh, threads=1, **option)
     np.testing.assert_array_equal(
-        primseg.segment(mesh, merge_batch_tolerance=0.1, threads=2).linkage(), batched.linkage())
-    assert not np.array_equal(batched.linkage(), fandisk_tree.linkage())
+        primseg.segment(mesh, threads=2, **option).linkage(), approximate.linkage())
+    assert not np.array_equal(approximate.linkage(), fandisk_tree.linkage())
     # The coarse levels are the exact order's.
-    np.testing.assert_array_equal(batched.cut(10), fandisk_tree.cut(10))
-    for bad in (-0.1, float("nan")):
-        with pytest.raises(primseg.InvalidInputError, match="merge_batch_tolerance"):
-            primseg.segment(mesh, merge_batch_tolerance=bad)
+    np.testing.assert_array_equal(approximate.cut(10), fandisk_tree.cut(10))
+    (name,) = option
+    for bad in bad_values:
+        with pytest.raises(primseg.InvalidInputError, match=name):
+            primseg.segment(mesh, **{name: bad})
+
+
+def test_regions_are_no_reference_mode(fandisk_tree):
+    with pytest.raises(primseg.InvalidInputError, match="regions"):
+        primseg.segment(fandisk_tree.mesh, regions=2, exact_costs=True)
 
 
 def test_segment_releases_the_gil(fandisk_tree):

@@ -394,6 +394,10 @@ TEST(Limits, EveryCommandThatReadsAMeshHasThemAndItsEstimateBoundsItsPeak) {
        mesh_bytes,
        1,
        buffers},
+      // Two regions' hierarchies built side by side.
+      {{"segment", mesh, "--regions", "2", "--threads", "2", "-q", "--tree", out("r.tree")},
+       1024,
+       mesh_bytes},
       {{"cut", out("fandisk.tree"), "--clusters", "30", "--refine", "3", "-q", "--json",
         out("c.json"), "--png", out("c.png")},
        512,

@@ -1888,25 +1888,52 @@ TEST(Cli, ThreadCountDoesNotChangeTheTree) {
   EXPECT_EQ(testing::file_contents(dir / "t1.tree"), testing::file_contents(dir / "t3.tree"));
 }
 
-// --merge-batch-tolerance builds the library's batched tree (another tree than the exact order's,
-// the same for any thread count), and a bad value is refused before the mesh is read.
-TEST(Cli, MergeBatchToleranceBuildsTheBatchedTree) {
-  TempDir dir("batched");
+// `segment --quiet` with an approximate option (`option`, the library's `options`) writes the
+// library's tree, the same for any thread count and not the exact order's.
+void expect_the_librarys_approximate_tree(const std::string& option,
+                                          const HierarchyOptions& options) {
+  TempDir dir("approximate");
   const Mesh mesh = read_mesh(testing::cgal_mesh("fandisk.off"));
   write_mesh(dir / "in.off", mesh);
   for (const char* threads : {"1", "2"})
-    ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --merge-batch-tolerance 0.1" +
-                       " --threads " + threads + " --tree " + dir.q(std::string("b") + threads)));
+    ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet " + option + " --threads " +
+                       threads + " --tree " + dir.q(std::string("t") + threads)));
   ASSERT_EXIT_OK(run("segment " + dir.q("in.off") + " --quiet --tree " + dir.q("exact")));
-  const std::string batched = testing::file_contents(dir / "b1");
-  EXPECT_EQ(testing::file_contents(dir / "b2"), batched);
-  EXPECT_NE(testing::file_contents(dir / "exact"), batched);
+  const std::string approximate = testing::file_contents(dir / "t1");
+  EXPECT_EQ(testing::file_contents(dir / "t2"), approximate) << option;
+  EXPECT_NE(testing::file_contents(dir / "exact"), approximate) << option;
+  EXPECT_EQ(serialize_tree(build_hierarchy(read_mesh(dir / "in.off"), options)), approximate)
+      << option;
+}
+
+// --merge-batch-tolerance builds the library's batched tree, and a bad value is refused before the
+// mesh is read.
+TEST(Cli, MergeBatchToleranceBuildsTheBatchedTree) {
   HierarchyOptions options;
   options.merge_batch_tolerance = 0.1;
-  EXPECT_EQ(serialize_tree(build_hierarchy(read_mesh(dir / "in.off"), options)), batched);
+  expect_the_librarys_approximate_tree("--merge-batch-tolerance 0.1", options);
   const CliRun refused = run("segment missing.off --merge-batch-tolerance -1");
   EXPECT_NE(refused.status, 0);
   EXPECT_NE(refused.output.find("--merge-batch-tolerance"), std::string::npos) << refused.output;
+}
+
+// --regions builds the library's tree in regions; a bad count, or regions with --exact-costs, is
+// refused.
+TEST(Cli, RegionsBuildTheTreeInRegions) {
+  HierarchyOptions options;
+  options.regions = 2;
+  expect_the_librarys_approximate_tree("--regions 2", options);
+  for (const char* bad : {"--regions 0", "--regions 257", "--regions two"}) {
+    const CliRun refused = run(std::string("segment missing.off ") + bad);
+    EXPECT_NE(refused.status, 0) << bad;
+    EXPECT_NE(refused.output.find("--regions"), std::string::npos) << refused.output;
+  }
+  TempDir dir("regions");
+  write_mesh(dir / "in.off", make_shape("box_with_hole").mesh);
+  const CliRun exact_costs =
+      run("segment " + dir.q("in.off") + " --quiet --regions 2 --exact-costs");
+  EXPECT_EQ(exact_costs.status, 1);
+  EXPECT_NE(exact_costs.output.find("exact_costs"), std::string::npos) << exact_costs.output;
 }
 
 TEST(Cli, LinkageIsAValidScipyLinkageMatrixOfTheWholeTree) {

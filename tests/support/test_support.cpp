@@ -200,6 +200,15 @@ ClusterStats part_stats(const DualGraph& graph, const std::vector<bool>& in_part
   return stats->centred();
 }
 
+double level_rms(const Hierarchy& hierarchy, std::uint32_t k) {
+  double error = 0, weight = 0;
+  for (std::uint32_t node : cut_by_count(hierarchy, k).nodes) {
+    error += hierarchy.error(node);
+    weight += hierarchy.weight(node);
+  }
+  return std::sqrt(error / weight);
+}
+
 SegmentationScore score_at_true_count(const GroundTruthShape& shape, const Hierarchy& hierarchy) {
   const Segmentation segmentation =
       cut_by_count(hierarchy, static_cast<std::uint32_t>(shape.regions.size()));

@@ -146,4 +146,8 @@ using primseg::SegmentationScore;
 /// cluster typed by its reported (geometric) fit, faces weighted by their area.
 SegmentationScore score_at_true_count(const GroundTruthShape& shape, const Hierarchy& hierarchy);
 
+/// sqrt(Σ error / Σ weight) over the clusters of the hierarchy's level with k clusters (working
+/// units): how well a level fits, to compare two trees of one mesh.
+double level_rms(const Hierarchy& hierarchy, std::uint32_t k);
+
 }  // namespace primseg::testing
