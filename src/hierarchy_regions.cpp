@@ -10,6 +10,7 @@
 #include "no_index.hpp"
 #include "parallel.hpp"
 #include "primseg/dual_graph.hpp"
+#include "primseg/error.hpp"
 
 namespace primseg::detail {
 namespace {
@@ -131,28 +132,34 @@ std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
   HierarchyOptions region_options = options;
   region_options.regions = 1;
   region_options.threads = 1;
-  parallel_for_threads(
-      regions.size() + 1, thread_count(options.threads), [&](std::size_t r, unsigned) {
-        if (r == regions.size()) return then();
-        const auto faces = static_cast<std::uint32_t>(regions[r].size());
-        auto region = std::make_shared<const Mesh>(region_mesh(mesh, regions[r]));
-        built[r].exponent = working_frame_for(*region).exponent;
-        HierarchyBuilder builder(std::move(region), region_options);
-        const std::uint32_t kept =
-            std::min(builder.total_merge_count(),
-                     faces - (faces + kRegionFacesPerCluster - 1) / kRegionFacesPerCluster);
-        while (builder.merge_count() < kept && builder.step()) {
-        }
-        const std::span<const Merge> made = builder.merges();
-        for (std::size_t i = 0; i < made.size(); i += kChunk) {
-          const std::size_t size = std::min(kChunk, made.size() - i);
-          std::vector<Merge>& chunk = built[r].chunks.emplace_back();
-          reserve_huge_to_fill(chunk, size);
-          chunk.assign(made.begin() + i, made.begin() + i + size);
-        }
-        built[r].size = made.size();
-        built[r].evaluations = builder.evaluation_count();
-      });
+  auto build_region = [&](std::size_t r, unsigned) {
+    if (r == regions.size()) return then();
+    const auto faces = static_cast<std::uint32_t>(regions[r].size());
+    auto region = std::make_shared<const Mesh>(region_mesh(mesh, regions[r]));
+    built[r].exponent = working_frame_for(*region).exponent;
+    HierarchyBuilder builder(std::move(region), region_options);
+    const std::uint32_t kept =
+        std::min(builder.total_merge_count(),
+                 faces - (faces + kRegionFacesPerCluster - 1) / kRegionFacesPerCluster);
+    while (builder.merge_count() < kept && builder.step()) {
+    }
+    const std::span<const Merge> made = builder.merges();
+    for (std::size_t i = 0; i < made.size(); i += kChunk) {
+      const std::size_t size = std::min(kChunk, made.size() - i);
+      std::vector<Merge>& chunk = built[r].chunks.emplace_back();
+      reserve_huge_to_fill(chunk, size);
+      chunk.assign(made.begin() + i, made.begin() + i + size);
+    }
+    built[r].size = made.size();
+    built[r].evaluations = builder.evaluation_count();
+  };
+  // A region can fail a check the whole mesh passes (every face of one region within 1e-32 of
+  // each other, below the geometric range): the whole mesh is then merged in the exact order.
+  try {
+    parallel_for_threads(regions.size() + 1, thread_count(options.threads), build_region);
+  } catch (const InvalidInputError&) {
+    return 0;
+  }
 
   // Costs and errors into the mesh's frame: lengths scale by a power of two, errors as weight ×
   // length² (weights are areas, or uniform).

@@ -36,8 +36,9 @@ Mesh region_mesh(const Mesh& mesh, const std::vector<std::uint32_t>& faces);
 /// node F + i), interleaved in order of cost, costs and errors in the mesh's working frame.
 /// Weights are left as the regions computed them (near the cuts, uniform weights count other
 /// valences). `then` runs on the first thread left without a region (the regions rarely take
-/// equal times). Returns the candidate evaluations the regions made; 0, with nothing appended and
-/// `then` not called, when the mesh has too few faces for two regions of kMinRegionFaces.
+/// equal times). Returns the candidate evaluations the regions made; 0, with nothing appended,
+/// when the mesh has too few faces for two regions of kMinRegionFaces (`then` not called) or a
+/// region fails a check of its own (InvalidInputError: `then` may have run).
 std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
                             std::vector<Merge>& merges, const std::function<void()>& then);
 

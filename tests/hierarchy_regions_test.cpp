@@ -182,6 +182,23 @@ TEST(HierarchyRegions, HandlesNonManifoldEdgesAndUniformWeights) {
   }
 }
 
+// A region may be too small for the geometric range a whole mesh must span (here every face of
+// one region lies within 1e-33 of the origin): the exact order then, not an error.
+TEST(HierarchyRegions, ARegionOutsideTheGeometricRangeFallsBackToTheExactOrder) {
+  GroundTruthShape shape = large_shape("box_with_hole", 0.002);
+  for (Vec3& p : shape.mesh.positions) p[0] += 10;
+  const std::uint32_t strip = shape.mesh.face_count() + 100;  // more than half the faces
+  std::vector<Vec3> positions;
+  std::vector<Triangle> triangles;
+  for (std::uint32_t i = 0; i < strip + 2; ++i)
+    positions.push_back({1e-38 * i, 1e-38 * (i % 2), 0});
+  for (std::uint32_t i = 0; i < strip; ++i) triangles.push_back({i, i + 1, i + 2});
+  const auto mesh = std::make_shared<const Mesh>(testing::concatenated(
+      {Mesh::from_triangles(std::move(positions), std::move(triangles)), shape.mesh}));
+  EXPECT_EQ(serialize_tree(build_hierarchy(mesh, in_regions(2))),
+            serialize_tree(build_hierarchy(mesh)));
+}
+
 TEST(HierarchyRegions, OneRegionOrASmallMeshIsTheExactOrder) {
   const auto mesh = std::make_shared<const Mesh>(large_shape("box_with_boss", 0.002).mesh);
   const std::string exact = serialize_tree(build_hierarchy(mesh));

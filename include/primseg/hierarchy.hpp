@@ -117,6 +117,9 @@ struct HierarchyOptions {
   /// the levels of more than F / 32 clusters have no cluster across a cut; coarser levels are
   /// merged as usual, from slightly other clusters. Deterministic, and the same for any number
   /// of threads. Regions have at least 4,096 faces: a smaller mesh gets fewer regions, or one.
+  /// Where a region cannot stand for its part of the mesh (it links the triangles on a
+  /// non-manifold edge otherwise than the whole mesh does, or its faces span less than the
+  /// geometric range allows), the whole mesh is merged in the exact order.
   /// Not with exact_costs; not stored in tree files (a tree read back reports 1). At most 256.
   unsigned regions = 1;
   /// The order the merge loop keeps faces in memory (never the tree: see FaceOrder).
