@@ -62,6 +62,17 @@ double number(const std::string& option, const char* text) {
   return value;
 }
 
+// The whole of `text` as a whole number from `low` to `high` (a count of `what`s), or an error
+// naming the option.
+unsigned count(const std::string& option, const char* text, unsigned low, unsigned high,
+               const std::string& what) {
+  const double value = number(option, text);
+  if (!(value >= low && value <= high && value == static_cast<unsigned>(value)))
+    throw std::invalid_argument(option + ": not a " + what + " count from " + std::to_string(low) +
+                                " to " + std::to_string(high));
+  return static_cast<unsigned>(value);
+}
+
 struct BuildFigures {
   std::size_t merges = 0;
   std::uint64_t evaluations = 0;
@@ -88,17 +99,11 @@ int run(int argc, char** argv) {
     } else if (arg == "--exact-costs") {
       options.exact_costs = true;
     } else if (arg == "--threads" && i + 1 < argc) {
-      const double threads = number(arg, argv[++i]);
-      if (!(threads >= 0 && threads <= 1024 && threads == static_cast<unsigned>(threads)))
-        throw std::invalid_argument("--threads: not a thread count from 0 to 1024");
-      options.threads = static_cast<unsigned>(threads);
+      options.threads = count(arg, argv[++i], 0, 1024, "thread");
     } else if (arg == "--merge-batch-tolerance" && i + 1 < argc) {
       options.merge_batch_tolerance = number(arg, argv[++i]);
     } else if (arg == "--regions" && i + 1 < argc) {
-      const double regions = number(arg, argv[++i]);
-      if (!(regions >= 1 && regions <= 256 && regions == static_cast<unsigned>(regions)))
-        throw std::invalid_argument("--regions: not a region count from 1 to 256");
-      options.regions = static_cast<unsigned>(regions);
+      options.regions = count(arg, argv[++i], 1, 256, "region");
     } else if (arg == "--face-order" && i + 1 < argc) {
       const std::string order = argv[++i];
       if (order == "auto")

@@ -269,11 +269,10 @@ class HierarchyBuilder::Impl {
     // the thread that finishes its region first.
     const std::uint32_t f = mesh_->face_count();
     detail::reserve_huge(merges_, f - 1);
-    if (options_.regions > 1 && f >= 2 * detail::kMinRegionFaces) {
+    if (options_.regions > 1)
       evaluations_ = detail::region_merges(*mesh_, options_, merges_, [this] {
         graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, 1);
       });
-    }
     if (!graph_) graph_ = std::make_unique<DualGraph>(*mesh_, options_.weights, options_.threads);
     // Where a region chained a non-manifold edge's triangles otherwise than the whole mesh, the
     // regions' merges are no tree of this graph: the exact order then, from the faces.

@@ -15,15 +15,6 @@
 namespace primseg::detail {
 namespace {
 
-// The first triangle of each face, shape (F + 1): face_of_triangle is non-decreasing.
-std::vector<std::uint32_t> first_triangles(const Mesh& mesh) {
-  std::vector<std::uint32_t> first;
-  resize_huge(first, std::size_t{mesh.face_count()} + 1);
-  for (const std::uint32_t face : mesh.face_of_triangle) ++first[face + 1];
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  return first;
-}
-
 void split(std::vector<std::uint32_t>::iterator begin, std::vector<std::uint32_t>::iterator end,
            unsigned count, const std::vector<std::array<double, 3>>& centroid,
            std::vector<std::vector<std::uint32_t>>& regions) {
@@ -53,16 +44,27 @@ void split(std::vector<std::uint32_t>::iterator begin, std::vector<std::uint32_t
 
 }  // namespace
 
+std::vector<std::uint32_t> first_triangles(const Mesh& mesh) {
+  std::vector<std::uint32_t> first;
+  resize_huge(first, std::size_t{mesh.face_count()} + 1);
+  for (const std::uint32_t face : mesh.face_of_triangle) ++first[face + 1];
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  return first;
+}
+
 std::vector<std::vector<std::uint32_t>> split_into_regions(const Mesh& mesh, unsigned count) {
   const std::uint32_t f = mesh.face_count();
-  const std::vector<std::uint32_t> first = first_triangles(mesh);
   std::vector<std::array<double, 3>> centroid;
   resize_huge(centroid, f);
-  for (std::uint32_t face = 0; face < f; ++face) {
-    const Triangle& t = mesh.triangles[first[face]];
+  // Each face's first triangle: face_of_triangle is non-decreasing.
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::uint32_t face = mesh.face_of_triangle[t];
+    if (t > 0 && mesh.face_of_triangle[t - 1] == face) continue;
+    const Triangle& corners = mesh.triangles[t];
     for (int a = 0; a < 3; ++a)
-      centroid[face][a] =
-          (mesh.positions[t[0]][a] + mesh.positions[t[1]][a] + mesh.positions[t[2]][a]) / 3;
+      centroid[face][a] = (mesh.positions[corners[0]][a] + mesh.positions[corners[1]][a] +
+                           mesh.positions[corners[2]][a]) /
+                          3;
   }
   std::vector<std::uint32_t> faces;
   resize_huge(faces, f);
@@ -72,8 +74,8 @@ std::vector<std::vector<std::uint32_t>> split_into_regions(const Mesh& mesh, uns
   return regions;
 }
 
-Mesh region_mesh(const Mesh& mesh, const std::vector<std::uint32_t>& faces) {
-  const std::vector<std::uint32_t> first = first_triangles(mesh);
+Mesh region_mesh(const Mesh& mesh, const std::vector<std::uint32_t>& first,
+                 const std::vector<std::uint32_t>& faces) {
   std::vector<std::uint32_t> vertex;
   resize_huge(vertex, mesh.vertex_count());
   std::fill(vertex.begin(), vertex.end(), kNone);
@@ -117,6 +119,7 @@ std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
   const unsigned count = std::min<unsigned>(options.regions, f / kMinRegionFaces);
   if (count <= 1) return 0;
   const std::vector<std::vector<std::uint32_t>> regions = split_into_regions(mesh, count);
+  const std::vector<std::uint32_t> first = first_triangles(mesh);
 
   // A region's merges in its node ids and working frame, in chunks that the interleaving below
   // frees as it goes (they would otherwise double the tree's records at the peak).
@@ -135,7 +138,7 @@ std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
   auto build_region = [&](std::size_t r, unsigned) {
     if (r == regions.size()) return then();
     const auto faces = static_cast<std::uint32_t>(regions[r].size());
-    auto region = std::make_shared<const Mesh>(region_mesh(mesh, regions[r]));
+    auto region = std::make_shared<const Mesh>(region_mesh(mesh, first, regions[r]));
     built[r].exponent = working_frame_for(*region).exponent;
     HierarchyBuilder builder(std::move(region), region_options);
     const std::uint32_t kept =

@@ -86,7 +86,7 @@ TEST(RegionMesh, KeepsThePolygonsTheirTrianglesAndPositions) {
   const Mesh mesh = Mesh::from_polygons(
       {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0}, {2, 1, 0}, {3, 0, 0}}, {0, 4, 8, 11},
       {0, 1, 2, 3, 1, 4, 5, 2, 4, 6, 5});
-  const Mesh region = detail::region_mesh(mesh, {1, 2});
+  const Mesh region = detail::region_mesh(mesh, detail::first_triangles(mesh), {1, 2});
   region.validate();
   ASSERT_EQ(region.face_count(), 2u);
   EXPECT_EQ(region.vertex_count(), 5u);  // only the vertices the faces use
