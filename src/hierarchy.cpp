@@ -535,6 +535,11 @@ class HierarchyBuilder::Impl {
   std::uint32_t total_merge_count() const { return total_merges_; }
   std::uint64_t evaluation_count() const { return evaluations_; }
   std::span<const Merge> merges() const { return merges_; }
+  std::vector<Merge> take_merges() {
+    if (!graph_) throw Error("HierarchyBuilder::finish() was already called");
+    warmer_.stop();  // (it reads the records' counter)
+    return std::move(merges_);
+  }
 
   struct Parts {
     std::shared_ptr<const Mesh> mesh;
@@ -1334,23 +1339,32 @@ class HierarchyBuilder::Impl {
 HierarchyBuilder::HierarchyBuilder(std::shared_ptr<const Mesh> mesh, HierarchyOptions options)
     : impl_(std::make_unique<Impl>(std::move(mesh), std::move(options))) {}
 HierarchyBuilder::~HierarchyBuilder() = default;
+HierarchyBuilder::Impl& HierarchyBuilder::impl() const {
+  if (!impl_) throw Error("HierarchyBuilder: the build was ended by take_merges()");
+  return *impl_;
+}
 bool HierarchyBuilder::step() {
-  return impl_->step();
+  return impl().step();
 }
 std::uint32_t HierarchyBuilder::merge_count() const {
-  return impl_->merge_count();
+  return impl().merge_count();
 }
 std::uint32_t HierarchyBuilder::total_merge_count() const {
-  return impl_->total_merge_count();
+  return impl().total_merge_count();
 }
 std::uint64_t HierarchyBuilder::evaluation_count() const {
-  return impl_->evaluation_count();
+  return impl().evaluation_count();
 }
 std::span<const Merge> HierarchyBuilder::merges() const {
-  return impl_->merges();
+  return impl().merges();
+}
+std::vector<Merge> HierarchyBuilder::take_merges() {
+  std::vector<Merge> merges = impl().take_merges();
+  impl_.reset();
+  return merges;
 }
 Hierarchy HierarchyBuilder::finish(const std::function<void(double)>& progress) {
-  Impl::Parts parts = impl_->finish(progress);
+  Impl::Parts parts = impl().finish(progress);
   return Hierarchy(std::move(parts.mesh), std::move(parts.options), std::move(parts.merges),
                    std::move(parts.graph));
 }

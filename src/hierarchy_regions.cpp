@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 #include <span>
+#include <type_traits>
 
 #include "huge_pages.hpp"
 #include "no_index.hpp"
@@ -121,15 +122,13 @@ std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
   const std::vector<std::vector<std::uint32_t>> regions = split_into_regions(mesh, count);
   const std::vector<std::uint32_t> first = first_triangles(mesh);
 
-  // A region's merges in its node ids and working frame, in chunks that the interleaving below
-  // frees as it goes (they would otherwise double the tree's records at the peak).
-  constexpr std::size_t kChunk = std::size_t{1} << 16;  // 8 MB: mostly huge pages
+  // A region's merges in its node ids and working frame.
+  static_assert(std::is_trivially_destructible_v<Merge>);  // (release_pages below)
+  constexpr std::size_t kReleaseEvery = (std::size_t{2} << 20) / sizeof(Merge);
   struct Built {
-    std::vector<std::vector<Merge>> chunks;
-    std::size_t size = 0;
+    std::vector<Merge> merges;
     std::uint64_t evaluations = 0;
     int exponent = 0;  // of the region's working frame
-    Merge& operator[](std::size_t i) { return chunks[i / kChunk][i % kChunk]; }
   };
   std::vector<Built> built(regions.size());
   HierarchyOptions region_options = options;
@@ -146,15 +145,9 @@ std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
                  faces - (faces + kRegionFacesPerCluster - 1) / kRegionFacesPerCluster);
     while (builder.merge_count() < kept && builder.step()) {
     }
-    const std::span<const Merge> made = builder.merges();
-    for (std::size_t i = 0; i < made.size(); i += kChunk) {
-      const std::size_t size = std::min(kChunk, made.size() - i);
-      std::vector<Merge>& chunk = built[r].chunks.emplace_back();
-      reserve_huge_to_fill(chunk, size);
-      chunk.assign(made.begin() + i, made.begin() + i + size);
-    }
-    built[r].size = made.size();
     built[r].evaluations = builder.evaluation_count();
+    // Taken, not copied: the builder's arrays go now, while another region may still be built.
+    built[r].merges = builder.take_merges();
   };
   // A region can fail a check the whole mesh passes (every face of one region within 1e-32 of
   // each other, below the geometric range): the whole mesh is then merged in the exact order.
@@ -171,12 +164,11 @@ std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
   std::uint64_t evaluations = 0;
   std::size_t total = 0;
   for (Built& region : built) {
-    for (std::vector<Merge>& chunk : region.chunks)
-      for (Merge& m : chunk) {
-        m.cost = std::ldexp(m.cost, power * (region.exponent - exponent));
-        m.error = std::ldexp(m.error, power * (region.exponent - exponent));
-      }
-    total += region.size;
+    for (Merge& m : region.merges) {
+      m.cost = std::ldexp(m.cost, power * (region.exponent - exponent));
+      m.error = std::ldexp(m.error, power * (region.exponent - exponent));
+    }
+    total += region.merges.size();
     evaluations += region.evaluations;
   }
   // Interleaved by cost (ties to the lower region), each region's in its own order: a level
@@ -184,17 +176,19 @@ std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
   const auto first_node = static_cast<std::uint32_t>(f + merges.size());
   std::vector<std::size_t> next(regions.size(), 0);
   std::vector<std::vector<std::uint32_t>> node_of(regions.size());  // region's merge → node
-  for (std::size_t r = 0; r < regions.size(); ++r) reserve_huge_to_fill(node_of[r], built[r].size);
+  for (std::size_t r = 0; r < regions.size(); ++r)
+    reserve_huge_to_fill(node_of[r], built[r].merges.size());
   reserve_huge(merges, merges.size() + total);
   for (std::size_t done = 0; done < total; ++done) {
     std::size_t r = regions.size();
     for (std::size_t k = 0; k < regions.size(); ++k)
-      if (next[k] < built[k].size &&
-          (r == regions.size() || built[k][next[k]].cost < built[r][next[r]].cost))
+      if (next[k] < built[k].merges.size() &&
+          (r == regions.size() || built[k].merges[next[k]].cost < built[r].merges[next[r]].cost))
         r = k;
-    Merge m = built[r][next[r]++];
-    if (next[r] % kChunk == 0 || next[r] == built[r].size)
-      std::vector<Merge>().swap(built[r].chunks[(next[r] - 1) / kChunk]);
+    Merge m = built[r].merges[next[r]++];
+    // The records read so far go back, 2 MB at a time: the tree's records are not held twice.
+    if (next[r] % kReleaseEvery == 0)
+      release_pages(built[r].merges.data(), next[r] * sizeof(Merge));
     const auto faces = static_cast<std::uint32_t>(regions[r].size());
     auto global = [&](std::uint32_t node) {
       return node < faces ? regions[r][node] : node_of[r][node - faces];

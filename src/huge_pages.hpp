@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -20,18 +21,40 @@
 
 namespace primseg::detail {
 
+#if defined(__linux__)
+/// The 2 MB-aligned part of [data, data + bytes), as madvise takes it: its start and length (0
+/// when there is none).
+inline std::pair<void*, std::size_t> whole_huge_pages(const void* data, std::size_t bytes) {
+  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+  const auto begin = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t last = (begin + bytes) & ~(kHugePage - 1);
+  void* start = reinterpret_cast<void*>(first);  // NOLINT(performance-no-int-to-ptr)
+  return {start, last > first ? last - first : 0};
+}
+#endif
+
 /// Advises the kernel to back the 2 MB-aligned part of [data, data + bytes) with huge pages
 /// (Linux; elsewhere nothing). Only pages not yet touched are affected. Errors are ignored: the
 /// advice is an optimisation (kernels without THP refuse it).
 inline void advise_huge_pages(const void* data, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-  const auto begin = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t last = (begin + bytes) & ~(kHugePage - 1);
-  if (last <= first) return;
-  void* start = reinterpret_cast<void*>(first);  // NOLINT(performance-no-int-to-ptr)
-  madvise(start, last - first, MADV_HUGEPAGE);
+  const auto [start, length] = whole_huge_pages(data, bytes);
+  if (length > 0) madvise(start, length, MADV_HUGEPAGE);
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
+
+/// Gives the 2 MB-aligned part of [data, data + bytes) back to the system (Linux: madvise
+/// MADV_DONTNEED; elsewhere nothing), for the consumed part of a large array of trivially
+/// destructible elements that will not be read again: read, it would hold zeros. The array's own
+/// storage only, and its first and last partial huge pages stay, so no huge page is split.
+inline void release_pages(const void* data, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_DONTNEED)
+  const auto [start, length] = whole_huge_pages(data, bytes);
+  if (length > 0) madvise(start, length, MADV_DONTNEED);
 #else
   (void)data;
   (void)bytes;

@@ -484,6 +484,31 @@ TEST(HierarchyBuilder, SteppingGivesTheOneShotTree) {
   EXPECT_THROW(builder.finish(), Error);
 }
 
+// A build stopped early hands over its merges so far: the one-shot tree's first ones.
+TEST(HierarchyBuilder, TakeMergesEndsTheBuildWithTheMergesSoFar) {
+  const GroundTruthShape shape = make_shape("box_with_blind_hole", {});
+  auto mesh = std::make_shared<const Mesh>(shape.mesh);
+  const Hierarchy whole = build_hierarchy(mesh);
+  HierarchyBuilder builder(mesh);
+  for (int i = 0; i < 100; ++i) ASSERT_TRUE(builder.step());
+  const std::vector<Merge> taken = builder.take_merges();
+  ASSERT_EQ(taken.size(), 100u);
+  for (std::size_t i = 0; i < taken.size(); ++i) {
+    EXPECT_EQ(taken[i].first, whole.merges()[i].first) << i;
+    EXPECT_EQ(taken[i].second, whole.merges()[i].second) << i;
+    EXPECT_EQ(taken[i].cost, whole.merges()[i].cost) << i;
+  }
+  EXPECT_THROW(builder.step(), Error);
+  EXPECT_THROW((void)builder.merge_count(), Error);
+  EXPECT_THROW((void)builder.merges(), Error);
+  EXPECT_THROW(builder.take_merges(), Error);
+  EXPECT_THROW(builder.finish(), Error);
+
+  HierarchyBuilder finished(mesh);
+  (void)finished.finish();
+  EXPECT_THROW(finished.take_merges(), Error);
+}
+
 TEST(Hierarchy, LinkageKeepsTheRawCostsThatScipyLinkageMakesMonotone) {
   ShapeOptions noisy;
   noisy.noise = 0.004;

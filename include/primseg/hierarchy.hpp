@@ -232,9 +232,15 @@ class HierarchyBuilder {
   /// given, is called now and then with the fraction done (0..1). Call it once: a second call
   /// throws Error.
   Hierarchy finish(const std::function<void(double)>& progress = {});
+  /// Ends the build where it stands and hands over the merges applied so far, as merges() shows
+  /// them (no trailing merges: a partial tree, for a build stopped at a level of the caller's
+  /// choosing), without copying them. Every working array is freed at once. Afterwards every
+  /// call but the destructor throws Error.
+  std::vector<Merge> take_merges();
 
  private:
   class Impl;
+  Impl& impl() const;
   std::unique_ptr<Impl> impl_;
 };
 
