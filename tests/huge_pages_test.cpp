@@ -67,6 +67,39 @@ TEST(HugePages, PopulatingMakesExactlyTheRangesPagesResidentAndKeepsTheirContent
 }
 #endif
 
+#if defined(__linux__) && defined(MADV_DONTNEED)
+// Releasing gives back the whole 2 MB blocks inside the range (they read zeros and are no longer
+// resident) and keeps every byte outside them.
+TEST(HugePages, ReleasingGivesBackTheAlignedInsideOfARangeOnly) {
+  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  constexpr std::size_t kHuge = std::size_t{2} << 20;
+  void* block =
+      mmap(nullptr, 4 * kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(block, MAP_FAILED);
+  auto* bytes = static_cast<char*>(block);
+  std::fill(bytes, bytes + 4 * kHuge, char{7});
+  const auto base = reinterpret_cast<std::uintptr_t>(block);
+  const std::size_t aligned = ((base + kHuge - 1) & ~(kHuge - 1)) - base;  // offset in block
+  auto resident = [&](std::size_t offset) {
+    unsigned char flag = 0;
+    return mincore(bytes + offset / page * page, page, &flag) == 0 && (flag & 1) != 0;
+  };
+  // From 100 bytes before an aligned address to 100 bytes after the next one.
+  release_pages(bytes + aligned - 100, kHuge + 200);
+  EXPECT_FALSE(resident(aligned));
+  EXPECT_FALSE(resident(aligned + kHuge - 1));
+  EXPECT_TRUE(std::all_of(bytes + aligned, bytes + aligned + kHuge, [](char c) { return c == 0; }));
+  EXPECT_TRUE(std::all_of(bytes, bytes + aligned, [](char c) { return c == 7; }));
+  EXPECT_TRUE(
+      std::all_of(bytes + aligned + kHuge, bytes + 4 * kHuge, [](char c) { return c == 7; }));
+  // A range with no whole block inside: nothing is released.
+  release_pages(bytes + aligned + kHuge + 1, kHuge);
+  EXPECT_TRUE(
+      std::all_of(bytes + aligned + kHuge, bytes + 4 * kHuge, [](char c) { return c == 7; }));
+  munmap(block, 4 * kHuge);
+}
+#endif
+
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
 // The VmFlags of the mapping that holds `address`, from /proc/self/smaps.
 std::string vm_flags_at(const void* address) {
