@@ -185,6 +185,17 @@ void add_merge_batch_option(CLI::App& command, double& tolerance) {
       ->capture_default_str();
 }
 
+void add_regions_option(CLI::App& command, unsigned& regions) {
+  command
+      .add_option("--regions", regions,
+                  "Approximate, faster on several cores (1: the exact greedy order): the mesh "
+                  "is cut into N regions merged side by side until each has a 32nd of its "
+                  "faces as clusters, then the exact order goes on over the whole mesh; 2 on "
+                  "two cores")
+      ->check(CLI::Range(1u, 256u))
+      ->capture_default_str();
+}
+
 void add_fit_options(CLI::App& command, LevelOptions& options) {
   command
       .add_option("--refine", options.refine,

@@ -127,6 +127,8 @@ void add_fit_options(CLI::App& command, LevelOptions& options);
 /// Adds --merge-batch-tolerance (HierarchyOptions::merge_batch_tolerance) to a command that builds
 /// a hierarchy.
 void add_merge_batch_option(CLI::App& command, double& tolerance);
+/// --regions N (HierarchyOptions::regions): the approximate merge order on several cores.
+void add_regions_option(CLI::App& command, unsigned& regions);
 /// Adds --relation-significance, --max-relation-angle, --relation-angle-tolerance,
 /// --relation-length-tolerance and --max-radius-difference (the RelationOptions of --regularize),
 /// checked by validate_relation_options() when the command runs.

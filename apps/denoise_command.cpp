@@ -26,7 +26,7 @@ struct DenoiseCommandOptions {
   std::optional<double> noise_factor;
   int ensemble_members = DenoiseOptions{}.ensemble_members;
   double ensemble_jitter = DenoiseOptions{}.ensemble_jitter;
-  unsigned threads = 0;
+  unsigned threads = 0, regions = 1;
   LevelOptions level;
   ResourceLimits limits;
 };
@@ -46,6 +46,7 @@ DenoiseOptions denoise_options(const DenoiseCommandOptions& o) {
   options.ensemble_jitter = o.ensemble_jitter;
   options.hierarchy.primitives = parse_primitives(o.primitives);
   options.hierarchy.threads = o.threads;
+  options.hierarchy.regions = o.regions;
   validate(options);
   return options;
 }
@@ -242,6 +243,7 @@ Command add_denoise_command(CLI::App& app) {
       ->capture_default_str();
   denoise->add_option("--threads", o->threads, "Threads for the hierarchy (0: all cores)")
       ->capture_default_str();
+  add_regions_option(*denoise, o->regions);
   add_limit_options(*denoise, o->limits, kDenoiseBytesPerFace);
 
   return {denoise, [o] { run_denoise(*o); }};

@@ -25,9 +25,9 @@ inline constexpr std::uint64_t kPictureBytes = 24ull << 20;
 /// view's page: the viewer's code and the JSON of the tree, levels and skeleton it embeds (the
 /// per-face part is in kViewBytesPerFace).
 inline constexpr std::uint64_t kViewerPageBytes = 24ull << 20;
-/// segment, batch, skeleton: 542 to 933 bytes per face; segment --regions 2 on two threads, whose
-/// two regions' builds overlap the whole mesh's graph: 624 to 1,087 (fandisk's within the 8 MiB
-/// every estimate adds).
+/// segment, batch, skeleton: 542 to 933 bytes per face; --regions 2 on two threads, whose two
+/// regions' builds overlap the whole mesh's graph: 606 to 1,036 (fandisk's within the 8 MiB every
+/// estimate adds).
 inline constexpr std::uint64_t kHierarchyBytesPerFace = 1024;
 /// view (with --skeleton): 807 to 2,821 bytes per face, kViewerPageBytes included.
 inline constexpr std::uint64_t kViewBytesPerFace = 1280;

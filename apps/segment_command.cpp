@@ -40,14 +40,7 @@ Command add_segment_command(CLI::App& app) {
       "--eager", o->eager,
       "Reference mode: evaluate every candidate at once (same tree as the default lazy mode)");
   add_merge_batch_option(*segment, o->merge_batch_tolerance);
-  segment
-      ->add_option("--regions", o->regions,
-                   "Approximate, faster on several cores (1: the exact greedy order): the mesh "
-                   "is cut into N regions merged side by side until each has a 32nd of its "
-                   "faces as clusters, then the exact order goes on over the whole mesh; 2 on "
-                   "two cores")
-      ->check(CLI::Range(1u, 256u))
-      ->capture_default_str();
+  add_regions_option(*segment, o->regions);
   segment->add_flag("--exact-costs", o->exact_costs,
                     "Reference mode: exact Euclidean errors, O(cluster size) per candidate");
 

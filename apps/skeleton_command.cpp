@@ -25,7 +25,7 @@ struct SkeletonCommandOptions {
   LevelChoice level;
   double band = SkinningOptions{}.band;
   std::string joints{to_string(SkeletonOptions{}.joints)};
-  unsigned threads = 0;
+  unsigned threads = 0, regions = 1;
   bool quiet = false;
   ResourceLimits limits;
 };
@@ -35,6 +35,7 @@ void run_skeleton(const SkeletonCommandOptions& o) {
   HierarchyOptions options;
   options.primitives = parse_primitives(o.primitives);
   options.threads = o.threads;
+  options.regions = o.regions;
   validate(options);
   const SkeletonOptions skeleton_choice = skeleton_options(o.joints);
   const SkinningOptions skinning = skinning_options(o.band);
@@ -119,6 +120,7 @@ Command add_skeleton_command(CLI::App& app) {
       ->capture_default_str();
   o->picture.add_options(*command, "the skeleton over the clusters");
   command->add_option("--threads", o->threads, "Threads (0: all cores)")->capture_default_str();
+  add_regions_option(*command, o->regions);
   command->add_flag("--quiet,-q", o->quiet, "No summary or progress output");
   add_limit_options(*command, o->limits, kHierarchyBytesPerFace);
 

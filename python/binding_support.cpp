@@ -382,12 +382,15 @@ py::array positions_array(std::vector<Vec3>&& positions) {
 
 HierarchyOptions tool_hierarchy_options(const std::string& function, const PyHierarchy* given,
                                         const py::object& primitives, const py::object& weights,
-                                        unsigned threads, const py::object& default_primitives) {
+                                        unsigned threads, unsigned regions,
+                                        const py::object& default_primitives) {
   if (given) {
     if (!primitives.is_none() || !weights.is_none())
       throw InvalidInputError(function + "(hierarchy): primitives and weights are the hierarchy's");
     HierarchyOptions options = given->hierarchy->options();
     options.threads = threads;
+    options.regions = regions;
+    validate(options);
     return options;
   }
   if (!weights.is_none() && !py::isinstance<py::str>(weights))
@@ -395,7 +398,7 @@ HierarchyOptions tool_hierarchy_options(const std::string& function, const PyHie
                             py::repr(weights).cast<std::string>());
   return hierarchy_options(primitives.is_none() ? default_primitives : primitives,
                            weights.is_none() ? std::string("area") : weights.cast<std::string>(),
-                           threads, false, false);
+                           threads, false, false, 0, regions);
 }
 
 }  // namespace primseg::python

@@ -202,9 +202,11 @@ std::uint64_t unsigned_argument(const py::handle& value, const std::string& what
 py::array positions_array(std::vector<Vec3>&& positions);
 
 // The hierarchy options of denoise and skeleton: those of a given Hierarchy (primitives and
-// weights must then be None), else the arguments with `default_primitives`.
+// weights must then be None) with these threads and regions, else the arguments with
+// `default_primitives`.
 HierarchyOptions tool_hierarchy_options(const std::string& function, const PyHierarchy* given,
                                         const py::object& primitives, const py::object& weights,
-                                        unsigned threads, const py::object& default_primitives);
+                                        unsigned threads, unsigned regions,
+                                        const py::object& default_primitives);
 
 }  // namespace primseg::python

@@ -47,7 +47,7 @@ py::dict snap_report_dict(const SnapReport& r) {
 
 void bind_denoise(py::module_& m) {
   const char* denoise_doc =
-      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, ensemble=1, ensemble_jitter=0.3, primitives=None, weights=None, threads=0, return_rounds=False, return_level=False, progress=None) -> numpy.ndarray
+      R"(denoise(mesh, *, k=None, tolerance=None, relative_tolerance=None, iterations=1, smoothing_steps=0, bilateral=False, stylize=False, max_move=4.0, min_crease_angle=10.0, relabel_passes=2, relation_significance=3.0, noise_tolerance_factor=None, ensemble=1, ensemble_jitter=0.3, primitives=None, weights=None, threads=0, regions=1, return_rounds=False, return_level=False, progress=None) -> numpy.ndarray
 denoise(V, F, *, ...) -> numpy.ndarray
 denoise(hierarchy, *, ...) -> numpy.ndarray
 
@@ -81,7 +81,7 @@ smoothed by bilateral normal filtering instead, which keeps edges sharp); ensemb
 ensemble_jitter: --ensemble (the mean of the snaps onto that many hierarchies, the further ones
 built on jittered copies; progress then advances, and Ctrl-C is checked, as each is built) and
 --ensemble-jitter (in estimated noise deviations); primitives (default plane, cylinder, sphere) and weights (default "area"): as in
-segment. The GIL is released while it works; as in segment, Ctrl-C (KeyboardInterrupt) stops a
+segment; regions: --regions, as in segment (each round's hierarchy in the approximate order). The GIL is released while it works; as in segment, Ctrl-C (KeyboardInterrupt) stops a
 round's hierarchy build, and progress, if given, is called during the builds with the fraction
 of all rounds done (0 to 1).
 Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)";
@@ -93,7 +93,8 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
          double min_crease_angle, int relabel_passes, double relation_significance,
          std::optional<double> noise_tolerance_factor, int ensemble, double ensemble_jitter,
          const py::object& primitives, const py::object& weights, unsigned threads,
-         bool return_rounds, bool return_level, const py::object& progress) -> py::object {
+         unsigned regions, bool return_rounds, bool return_level,
+         const py::object& progress) -> py::object {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
@@ -114,8 +115,9 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
         options.ensemble_jitter = ensemble_jitter;
         options.smoothing_steps = smoothing_steps;
         if (bilateral) options.bilateral_smoothing = BilateralSmoothingOptions{};
-        options.hierarchy = tool_hierarchy_options("denoise", given, primitives, weights, threads,
-                                                   py::make_tuple("plane", "cylinder", "sphere"));
+        options.hierarchy =
+            tool_hierarchy_options("denoise", given, primitives, weights, threads, regions,
+                                   py::make_tuple("plane", "cylinder", "sphere"));
         validate(options);
         if (iterations < 1 || iterations > 100)
           throw InvalidInputError("iterations must be between 1 and 100 (the CLI's range), not " +
@@ -221,7 +223,7 @@ Raises InvalidInputError (a ValueError) for bad arrays or options out of range.)
       py::arg("ensemble") = DenoiseOptions{}.ensemble_members,
       py::arg("ensemble_jitter") = DenoiseOptions{}.ensemble_jitter,
       py::arg("primitives") = py::none(), py::arg("weights") = py::none(), py::arg("threads") = 0u,
-      py::arg("return_rounds") = false, py::arg("return_level") = false,
+      py::arg("regions") = 1u, py::arg("return_rounds") = false, py::arg("return_level") = false,
       py::arg("progress") = py::none(),
       join_docs(
           {denoise_doc, cpp_doc("denoise.hpp", doc::denoise__file),

@@ -406,7 +406,7 @@ the CLI's --max-influences (0 keeps every weight).)",
       [](const py::object& first, const py::object& faces, ClusterCount k,
          std::optional<double> tolerance, std::optional<double> relative_tolerance,
          const py::object& primitives, const py::object& weights, const std::string& joints,
-         unsigned threads, const py::object& progress) {
+         unsigned threads, unsigned regions, const py::object& progress) {
         const LevelArguments level{std::move(k), tolerance, relative_tolerance};
         const PyHierarchy* given =
             py::isinstance<PyHierarchy>(first) ? &first.cast<const PyHierarchy&>() : nullptr;
@@ -418,7 +418,7 @@ the CLI's --max-influences (0 keeps every weight).)",
           throw InvalidInputError("skeleton: joints='" + joints + "' is not 'paper' or 'limbs'");
         skeleton_options.joints = *rule;
         const HierarchyOptions options = tool_hierarchy_options(
-            "skeleton", given, primitives, weights, threads, py::make_tuple("cylinder"));
+            "skeleton", given, primitives, weights, threads, regions, py::make_tuple("cylinder"));
         const std::shared_ptr<const Mesh> mesh =
             given ? given->hierarchy->shared_mesh() : mesh_argument("skeleton", first, faces);
         validate_level(level, mesh->face_count());
@@ -439,9 +439,9 @@ the CLI's --max-influences (0 keeps every weight).)",
       py::arg("tolerance") = py::none(), py::arg("relative_tolerance") = py::none(),
       py::arg("primitives") = py::none(), py::arg("weights") = py::none(),
       py::arg("joints") = std::string(to_string(SkeletonOptions{}.joints)), py::arg("threads") = 0u,
-      py::arg("progress") = py::none(),
+      py::arg("regions") = 1u, py::arg("progress") = py::none(),
       join_docs(
-          {R"(skeleton(mesh, *, k=None, tolerance=None, relative_tolerance=None, primitives=None, weights=None, joints="paper", threads=0, progress=None) -> Skeleton
+          {R"(skeleton(mesh, *, k=None, tolerance=None, relative_tolerance=None, primitives=None, weights=None, joints="paper", threads=0, regions=1, progress=None) -> Skeleton
 skeleton(V, F, *, ...) -> Skeleton
 skeleton(hierarchy, *, ...) -> Skeleton
 
@@ -450,7 +450,7 @@ Mesh, arrays V and F, or a Hierarchy (its tree, not built again). Level: k (coun
 tolerance or relative_tolerance as in Hierarchy.cut (the CLI asks for --clusters K|auto).
 primitives: cylinders only by default, as the CLI (and the paper) do; weights: "area" by
 default. joints: "paper" (touching boundaries merge into locked hubs) or "limbs" (a protruding
-part also turns where it is attached), as the CLI's --joints. The GIL is released while it works; Ctrl-C (KeyboardInterrupt) stops the hierarchy's
+part also turns where it is attached), as the CLI's --joints. regions: --regions, as in segment. The GIL is released while it works; Ctrl-C (KeyboardInterrupt) stops the hierarchy's
 build, and progress, if given, is called during it with the fraction done, as in segment.)",
            cpp_doc("skeleton.hpp", doc::skeleton__file)})
           .c_str());

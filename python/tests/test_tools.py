@@ -196,6 +196,37 @@ def test_denoise_restores_a_noisy_cylinder_and_its_sharp_rims():
     assert np.max(np.minimum(abs(z), abs(z - 5.0))) < 0.01
 
 
+def test_denoise_and_skeleton_in_regions(cli, noisy_fandisk, fandisk, man, man_skeleton, tmp_path):
+    """regions=2, the CLI's --regions 2: each hierarchy in the approximate order of two regions
+    side by side; the CLI's results bit for bit, as close to the clean part as the exact order's."""
+    mesh = primseg.read_mesh(noisy_fandisk)
+    run_cli(cli, "denoise", noisy_fandisk, "--clusters", "30", "--regions", "2", "-o",
+            tmp_path / "out.off", "--quiet")
+    V = primseg.denoise(mesh, k=30, regions=2)
+    np.testing.assert_array_equal(V, primseg.read_mesh(tmp_path / "out.off").V)
+    exact = primseg.denoise(mesh, k=30)
+    assert not np.array_equal(V, exact)  # another tree
+
+    def rms_to_clean(W):
+        return primseg.distance((W, mesh.F), primseg.read_mesh(fandisk))["symmetric"]["rms"]
+
+    assert rms_to_clean(V) < 1.05 * rms_to_clean(exact)
+    assert rms_to_clean(V) < 0.5 * rms_to_clean(mesh.V)
+
+    run_cli(cli, "skeleton", man, "--clusters", "20", "--regions", "2", "-o", tmp_path / "s.json",
+            "--quiet")
+    expected = json.loads((tmp_path / "s.json").read_text())
+    skeleton = primseg.skeleton(primseg.read_mesh(man), k=20, regions=2)
+    assert skeleton.bones == expected["bones"] and skeleton.joints == expected["joints"]
+    assert not np.array_equal(skeleton.face_labels, man_skeleton.face_labels)
+    assert len(skeleton.bones) == len(man_skeleton.bones)
+    assert len(skeleton.joints) == len(man_skeleton.joints)
+    with pytest.raises(primseg.InvalidInputError, match="regions"):
+        primseg.denoise(mesh, k=30, regions=0)
+    with pytest.raises(primseg.InvalidInputError, match="regions"):
+        primseg.skeleton(man_skeleton.mesh, k=20, regions=257)
+
+
 # ----------------------------------------------------------------------------------------------
 # skeleton
 
