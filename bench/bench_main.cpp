@@ -254,6 +254,15 @@ void register_benchmarks() {
   configure(benchmark::RegisterBenchmark("hierarchy_batched/box_with_hole_uniform_0.01", hierarchy,
                                          shape, batched))
       ->Iterations(1);
+  // Two regions side by side (the approximate order for two cores), on all threads.
+  HierarchyOptions regions;
+  regions.regions = 2;
+  configure(
+      benchmark::RegisterBenchmark("hierarchy_regions/fandisk", hierarchy, "fandisk.off", regions))
+      ->Iterations(1);
+  configure(
+      benchmark::RegisterBenchmark("hierarchy_regions/bunny00", hierarchy, "bunny00.off", regions))
+      ->Iterations(1);
   configure(benchmark::RegisterBenchmark("read_mesh/fandisk", read, "fandisk.off"));
   configure(benchmark::RegisterBenchmark("read_mesh/bunny00", read, "bunny00.off"));
   configure(benchmark::RegisterBenchmark("cut_describe_k30/fandisk", cut_and_describe,

@@ -55,7 +55,8 @@ echo "== timings (load average: $(cut -d' ' -f1-3 /proc/loadavg))" >&2
 echo "== peak memory" >&2
 : >"$memory"
 for input in "--cgal fandisk.off" "--cgal bunny00.off" "--shape box_with_hole 0.01" \
-             "--cgal fandisk.off --exact-costs"; do
+             "--cgal fandisk.off --exact-costs" "--cgal fandisk.off --regions 2" \
+             "--cgal bunny00.off --regions 2"; do
   # shellcheck disable=SC2086  # the input is several words on purpose
   echo "$input $("$build/bench/primseg_bench_memory" $input)" | tee -a "$memory" >&2
 done
@@ -107,6 +108,10 @@ rows = [
     ("bunny00.off, `--merge-batch-tolerance 0.1`", "hierarchy_batched/bunny00/", None, None),
     ("box_with_hole, `--merge-batch-tolerance 0.1`",
      "hierarchy_batched/box_with_hole_uniform_0.01/", None, None),
+    ("fandisk.off, `--regions 2` (approximate order, two cores)", "hierarchy_regions/fandisk/",
+     None, "--cgal fandisk.off --regions 2"),
+    ("bunny00.off, `--regions 2`", "hierarchy_regions/bunny00/", None,
+     "--cgal bunny00.off --regions 2"),
 ]
 
 print("| input | faces | full hierarchy, median of 5 (ms) | faces/s | peak RSS (MB) "
@@ -131,7 +136,8 @@ for label, hierarchy, read, mem in rows:
                  f"{' exact' if 'exact' in hierarchy else ''}"
                  f"{' all types' if 'all_types' in hierarchy else ''}"
                  f"{' one thread' if 'one_thread' in hierarchy else ''}"
-                 f"{' batched' if 'batched' in hierarchy else ''}: CPU {ms(median, 'cpu_time'):,.0f} ms,"
+                 f"{' batched' if 'batched' in hierarchy else ''}"
+                 f"{' regions' if 'regions' in hierarchy else ''}: CPU {ms(median, 'cpu_time'):,.0f} ms,"
                  f" CV {100 * cv['real_time']:.0f}%")
 
 cut = aggregate("cut_describe_k30/fandisk/", "median")
