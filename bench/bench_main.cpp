@@ -217,52 +217,32 @@ void register_benchmarks() {
   HierarchyOptions all_types;
   all_types.primitives = {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere,
                           PrimitiveType::Cone, PrimitiveType::Torus};
-  configure(benchmark::RegisterBenchmark("hierarchy/fandisk", hierarchy, "fandisk.off",
-                                         HierarchyOptions{}))
-      ->Iterations(1);
-  configure(benchmark::RegisterBenchmark("hierarchy/bunny00", hierarchy, "bunny00.off",
-                                         HierarchyOptions{}))
-      ->Iterations(1);
-  configure(benchmark::RegisterBenchmark("hierarchy/box_with_hole_uniform_0.01", hierarchy, shape,
-                                         HierarchyOptions{}))
-      ->Iterations(1);
-  configure(benchmark::RegisterBenchmark("hierarchy_exact_costs/fandisk", hierarchy, "fandisk.off",
-                                         exact_costs))
-      ->Iterations(1);
-  configure(benchmark::RegisterBenchmark("hierarchy_all_types/fandisk", hierarchy, "fandisk.off",
-                                         all_types))
-      ->Iterations(1);
+  auto build = [](const std::string& name, const std::string& input,
+                  const HierarchyOptions& options) {
+    configure(benchmark::RegisterBenchmark(name.c_str(), hierarchy, input, options))->Iterations(1);
+  };
+  build("hierarchy/fandisk", "fandisk.off", {});
+  build("hierarchy/bunny00", "bunny00.off", {});
+  build("hierarchy/box_with_hole_uniform_0.01", shape, {});
+  build("hierarchy_exact_costs/fandisk", "fandisk.off", exact_costs);
+  build("hierarchy_all_types/fandisk", "fandisk.off", all_types);
   // One thread against the default (all cores): whether the second core pays (it did not when a
   // merge's few cheap candidates were shared between cores that share no cache).
   HierarchyOptions one_thread;
   one_thread.threads = 1;
-  configure(benchmark::RegisterBenchmark("hierarchy_one_thread/fandisk", hierarchy, "fandisk.off",
-                                         one_thread))
-      ->Iterations(1);
-  configure(benchmark::RegisterBenchmark("hierarchy_one_thread/bunny00", hierarchy, "bunny00.off",
-                                         one_thread))
-      ->Iterations(1);
+  build("hierarchy_one_thread/fandisk", "fandisk.off", one_thread);
+  build("hierarchy_one_thread/bunny00", "bunny00.off", one_thread);
   // The approximate merge order at the tolerance the CLI's help suggests.
   HierarchyOptions batched;
   batched.merge_batch_tolerance = 0.1;
-  configure(
-      benchmark::RegisterBenchmark("hierarchy_batched/fandisk", hierarchy, "fandisk.off", batched))
-      ->Iterations(1);
-  configure(
-      benchmark::RegisterBenchmark("hierarchy_batched/bunny00", hierarchy, "bunny00.off", batched))
-      ->Iterations(1);
-  configure(benchmark::RegisterBenchmark("hierarchy_batched/box_with_hole_uniform_0.01", hierarchy,
-                                         shape, batched))
-      ->Iterations(1);
+  build("hierarchy_batched/fandisk", "fandisk.off", batched);
+  build("hierarchy_batched/bunny00", "bunny00.off", batched);
+  build("hierarchy_batched/box_with_hole_uniform_0.01", shape, batched);
   // Two regions side by side (the approximate order for two cores), on all threads.
   HierarchyOptions regions;
   regions.regions = 2;
-  configure(
-      benchmark::RegisterBenchmark("hierarchy_regions/fandisk", hierarchy, "fandisk.off", regions))
-      ->Iterations(1);
-  configure(
-      benchmark::RegisterBenchmark("hierarchy_regions/bunny00", hierarchy, "bunny00.off", regions))
-      ->Iterations(1);
+  build("hierarchy_regions/fandisk", "fandisk.off", regions);
+  build("hierarchy_regions/bunny00", "bunny00.off", regions);
   configure(benchmark::RegisterBenchmark("read_mesh/fandisk", read, "fandisk.off"));
   configure(benchmark::RegisterBenchmark("read_mesh/bunny00", read, "bunny00.off"));
   configure(benchmark::RegisterBenchmark("cut_describe_k30/fandisk", cut_and_describe,

@@ -9,6 +9,7 @@
 #include <tuple>
 #include <utility>
 
+#include "face_triangles.hpp"
 #include "huge_pages.hpp"
 #include "no_index.hpp"
 #include "parallel.hpp"
@@ -604,9 +605,7 @@ DualGraph::DualGraph(const Mesh& mesh, VertexWeights weights, unsigned threads)
   frame_ = working_frame_of_used(mesh, valence_);
   positions_ = working_positions(mesh, frame_);
 
-  detail::resize_huge(first_triangle_, std::size_t{face_count} + 1);
-  for (std::uint32_t f : mesh.face_of_triangle) ++first_triangle_[f + 1];
-  std::partial_sum(first_triangle_.begin(), first_triangle_.end(), first_triangle_.begin());
+  first_triangle_ = detail::first_triangles(mesh);
 
   // Ranges of faces for threads (see below), and the triangles they start at.
   const std::size_t chunk_count = std::min<std::size_t>(threads, face_count / 16384 + 1);

@@ -7,6 +7,7 @@
 #include <span>
 #include <type_traits>
 
+#include "face_triangles.hpp"
 #include "huge_pages.hpp"
 #include "no_index.hpp"
 #include "parallel.hpp"
@@ -44,14 +45,6 @@ void split(std::vector<std::uint32_t>::iterator begin, std::vector<std::uint32_t
 }
 
 }  // namespace
-
-std::vector<std::uint32_t> first_triangles(const Mesh& mesh) {
-  std::vector<std::uint32_t> first;
-  resize_huge(first, std::size_t{mesh.face_count()} + 1);
-  for (const std::uint32_t face : mesh.face_of_triangle) ++first[face + 1];
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  return first;
-}
 
 std::vector<std::vector<std::uint32_t>> split_into_regions(const Mesh& mesh, unsigned count) {
   const std::uint32_t f = mesh.face_count();
@@ -186,7 +179,9 @@ std::uint64_t region_merges(const Mesh& mesh, const HierarchyOptions& options,
           (r == regions.size() || built[k].merges[next[k]].cost < built[r].merges[next[r]].cost))
         r = k;
     Merge m = built[r].merges[next[r]++];
-    // The records read so far go back, 2 MB at a time: the tree's records are not held twice.
+    // The records read so far go back, 2 MB at a time, so that the tree's records are not held
+    // twice. (The whole prefix each time: 2 MB of records need not hold an aligned huge page, and
+    // pages already given back cost the call nothing.)
     if (next[r] % kReleaseEvery == 0)
       release_pages(built[r].merges.data(), next[r] * sizeof(Merge));
     const auto faces = static_cast<std::uint32_t>(regions[r].size());

@@ -26,12 +26,8 @@ inline constexpr std::uint32_t kMinRegionFaces = 4096;
 /// lists its faces in increasing order; together they are every face once.
 std::vector<std::vector<std::uint32_t>> split_into_regions(const Mesh& mesh, unsigned count);
 
-/// The first triangle of each face of `mesh`, shape (F + 1): face f has triangles
-/// [first[f], first[f + 1]).
-std::vector<std::uint32_t> first_triangles(const Mesh& mesh);
-
 /// The mesh made of the given faces of `mesh` (in that order), their vertices numbered by first
-/// use; `first` is first_triangles(mesh), made once for every region.
+/// use; `first` is first_triangles(mesh) (face_triangles.hpp), made once for every region.
 Mesh region_mesh(const Mesh& mesh, const std::vector<std::uint32_t>& first,
                  const std::vector<std::uint32_t>& faces);
 

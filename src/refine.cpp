@@ -5,12 +5,12 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <numeric>
 #include <span>
 #include <string>
 
 #include "cluster_triangles.hpp"
 #include "face_adjacency.hpp"
+#include "face_triangles.hpp"
 #include "geometric_models.hpp"
 #include "model_selection.hpp"
 #include "no_index.hpp"
@@ -328,10 +328,7 @@ RefinedLevel refine_boundaries(const Hierarchy& hierarchy, const Segmentation& s
   if (!(options.pooling_gap >= 0) || !std::isfinite(options.pooling_gap))
     throw InvalidInputError("refine_boundaries: the pooling gap must be a non-negative number");
   const Adjacency adjacency(hierarchy.graph());
-  std::vector<std::uint32_t> first_triangle(f_count + 1, 0);
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t)
-    ++first_triangle[mesh.face_of_triangle[t] + 1];
-  std::partial_sum(first_triangle.begin(), first_triangle.end(), first_triangle.begin());
+  const std::vector<std::uint32_t> first_triangle = detail::first_triangles(mesh);
 
   RefinedLevel result;
   result.segmentation = segmentation;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <set>
 
+#include "face_triangles.hpp"
 #include "primseg/cut.hpp"
 #include "primseg/dual_graph.hpp"
 #include "primseg/error.hpp"
