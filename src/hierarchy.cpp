@@ -968,9 +968,9 @@ class HierarchyBuilder::Impl {
   struct Lookahead {
     std::uint32_t edge = kNone;
     std::array<std::uint32_t, 2> slots{kNone, kNone};  // kNone: none, or one the merge just read
-    // Per slot, the link of its list asked for last (kNone: the list's end), once begun.
-    std::array<std::uint32_t, 2> links{kNone, kNone};
-    std::array<bool, 2> begun{false, false};
+    // Per slot, where the next link of its adjacency list is to be read (its slot's first_link,
+    // then the last link's next_link_ entry); null: none, or the list's end.
+    std::array<const std::uint32_t*, 2> next_link{nullptr, nullptr};
   };
   // Stage 1, as the merge starts: the edge.
   Lookahead lookahead_edge() const {
@@ -991,29 +991,28 @@ class HierarchyBuilder::Impl {
       const std::uint32_t slot = k == 0 ? e.a : e.b;
       if (slot == slot_a || slot == slot_b) continue;
       next.slots[k] = slot;
+      next.next_link[k] = &slots_[slot].first_link;  // (read at stage 3, once the slot is here)
       __builtin_prefetch(&slots_[slot]);
     }
   }
   // Stages 3 to 5 (after the merged cluster's fit, before and after its candidates' evaluation):
-  // each link of the clusters' chains in turn, and one more link of each adjacency list (its
-  // first, read from the slot, at stage 3). The lists are about six links each and these three
-  // stages ask for half of them: bunny00's build 3% faster (the relinking 15 -> 9% of the time).
+  // each link of the clusters' chains in turn, and one more link of each adjacency list. The
+  // lists are about six links each and these three stages ask for half of them (about 3% of
+  // bunny00's build: docs/method.md).
   template <class Prefetch>
   void lookahead(Lookahead& next, Prefetch prefetch) const {
-    for (int k = 0; k < 2; ++k) {
-      const std::uint32_t slot = next.slots[k];
-      if (slot == kNone) continue;
-      (this->*prefetch)(slot);
-      std::uint32_t& link = next.links[k];
-      if (!next.begun[k])
-        link = slots_[slot].first_link;
-      else if (link != kNone)
-        link = next_link_[link];
-      next.begun[k] = true;
-      if (link != kNone) {
-        __builtin_prefetch(&next_link_[link]);
-        __builtin_prefetch(&edges_[link / 2]);
+    for (std::uint32_t slot : next.slots)
+      if (slot != kNone) (this->*prefetch)(slot);
+    for (const std::uint32_t*& at : next.next_link) {
+      if (!at) continue;
+      const std::uint32_t link = *at;
+      if (link == kNone) {
+        at = nullptr;
+        continue;
       }
+      __builtin_prefetch(&next_link_[link]);
+      __builtin_prefetch(&edges_[link / 2]);
+      at = &next_link_[link];
     }
   }
 
