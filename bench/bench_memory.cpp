@@ -23,6 +23,9 @@
 //   read_seconds      wall-clock time of read_mesh, in this fresh process (a mesh file only; 0
 //                     for a generated shape), page faults of its arrays included as a user meets
 //                     them
+//   setup_seconds     of build_seconds, the HierarchyBuilder constructor: the dual graph, the
+//                     first evaluation of every candidate and the queue
+//   merge_seconds     of build_seconds, finish(): the merge loop and the tree's arrays
 // One build per process, so that ru_maxrss is this build's peak and nothing else's. The build is
 // the function build_and_destroy_tree alone, so that bench/instructions.sh can count its
 // instructions (valgrind --toggle-collect) without reading or generating the input.
@@ -76,14 +79,23 @@ unsigned count(const std::string& option, const char* text, unsigned low, unsign
 struct BuildFigures {
   std::size_t merges = 0;
   std::uint64_t evaluations = 0;
+  /// The builder's constructor (dual graph, first evaluation of every candidate, queue) and
+  /// finish() (the merge loop), in seconds.
+  double setup_seconds = 0;
+  double merge_seconds = 0;
 };
 
 // Not inlined: bench/instructions.sh counts the instructions of this function alone.
 [[gnu::noinline]] BuildFigures build_and_destroy_tree(std::shared_ptr<const primseg::Mesh> mesh,
                                                       const primseg::HierarchyOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   primseg::HierarchyBuilder builder(std::move(mesh), options);
+  const auto built = std::chrono::steady_clock::now();
   const primseg::Hierarchy tree = builder.finish();
-  return {tree.merges().size(), builder.evaluation_count()};
+  const auto merged = std::chrono::steady_clock::now();
+  return {tree.merges().size(), builder.evaluation_count(),
+          std::chrono::duration<double>(built - start).count(),
+          std::chrono::duration<double>(merged - built).count()};
 }
 
 int run(int argc, char** argv) {
@@ -161,12 +173,13 @@ int run(int argc, char** argv) {
   std::printf(
       "input=%s faces=%u merges=%zu baseline_rss=%zu input_rss=%zu peak_rss=%zu "
       "bytes_per_face=%.0f hierarchy_bytes_per_face=%.0f build_seconds=%.3f evaluations=%llu "
-      "evaluations_per_face=%.3f read_seconds=%.4f\n",
+      "evaluations_per_face=%.3f read_seconds=%.4f setup_seconds=%.3f merge_seconds=%.3f\n",
       name.c_str(), mesh->face_count(), build.merges, baseline, input, peak,
       static_cast<double>(peak) / faces,
       static_cast<double>(peak > input ? peak - input : 0) / faces, seconds,
       static_cast<unsigned long long>(build.evaluations),
-      static_cast<double>(build.evaluations) / faces, read_seconds);
+      static_cast<double>(build.evaluations) / faces, read_seconds, build.setup_seconds,
+      build.merge_seconds);
   return 0;
 }
 
