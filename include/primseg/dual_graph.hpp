@@ -151,8 +151,6 @@ class DualGraph {
   Eigen::Vector3d face_origin(std::uint32_t f, const Eigen::Vector3d& weighted_sum,
                               double weight) const;
   EdgeStats internal_edges_of(std::uint32_t f) const;
-  // face_corners() of a face whose only triangle is t.
-  void triangle_corners(std::uint32_t t, FaceCorners& corners) const;
 
   // The triangles corners() reads: the mesh's, or in_spatial_order()'s renumbered own.
   std::span<const Triangle> triangles() const {
