@@ -34,7 +34,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <exception>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -42,7 +41,6 @@
 #include "bench_support.hpp"
 #include "primseg/hierarchy.hpp"
 #include "primseg/mesh_io.hpp"
-#include "primseg/shape_generator.hpp"
 
 namespace {
 
@@ -100,8 +98,7 @@ struct BuildFigures {
 
 int run(int argc, char** argv) {
   using namespace primseg;
-  std::string source, name;
-  double edge_length = 0.01;
+  bench::InputArgument input;
   HierarchyOptions options;
   bool read_only = false;
   for (int i = 1; i < argc; ++i) {
@@ -126,39 +123,27 @@ int run(int argc, char** argv) {
         options.face_order = FaceOrder::AsListed;
       else
         throw std::invalid_argument("--face-order: auto, spatial or as-listed");
-    } else if ((arg == "--cgal" || arg == "--shape") && i + 1 < argc && source.empty()) {
-      source = arg;
-      name = argv[++i];
-      if (arg == "--shape" && i + 1 < argc && argv[i + 1][0] != '-')
-        edge_length = number("EDGE_LENGTH", argv[++i]);
-    } else if (!arg.starts_with("-") && source.empty()) {
-      source = "file";
-      name = arg;
-    } else {
+    } else if (!input.take(argc, argv, i)) {
       return usage();
     }
   }
-  if (source.empty()) return usage();
+  if (input.kind == bench::InputArgument::Kind::None) return usage();
 
   const std::size_t baseline = bench::current_rss_bytes();
   std::shared_ptr<const Mesh> mesh;
   double read_seconds = 0;
-  if (source == "--shape") {
-    ShapeOptions shape_options;
-    shape_options.tessellation = Tessellation::Uniform;
-    shape_options.edge_length = edge_length;
-    mesh = std::make_shared<const Mesh>(make_shape(name, shape_options).mesh);
+  if (input.kind == bench::InputArgument::Kind::Shape) {
+    mesh = std::make_shared<const Mesh>(input.load());
   } else {
-    const std::filesystem::path path =
-        source == "--cgal" ? bench::cgal_mesh(name) : std::filesystem::path(name);
+    const std::filesystem::path path = input.file();
     const auto read_start = std::chrono::steady_clock::now();
     mesh = std::make_shared<const Mesh>(read_mesh(path));
     read_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
   }
-  const std::size_t input = bench::current_rss_bytes();
+  const std::size_t input_rss = bench::current_rss_bytes();
   if (read_only) {
-    std::printf("input=%s faces=%u read_seconds=%.4f\n", name.c_str(), mesh->face_count(),
+    std::printf("input=%s faces=%u read_seconds=%.4f\n", input.name.c_str(), mesh->face_count(),
                 read_seconds);
     return 0;
   }
@@ -174,9 +159,9 @@ int run(int argc, char** argv) {
       "input=%s faces=%u merges=%zu baseline_rss=%zu input_rss=%zu peak_rss=%zu "
       "bytes_per_face=%.0f hierarchy_bytes_per_face=%.0f build_seconds=%.3f evaluations=%llu "
       "evaluations_per_face=%.3f read_seconds=%.4f setup_seconds=%.3f merge_seconds=%.3f\n",
-      name.c_str(), mesh->face_count(), build.merges, baseline, input, peak,
+      input.name.c_str(), mesh->face_count(), build.merges, baseline, input_rss, peak,
       static_cast<double>(peak) / faces,
-      static_cast<double>(peak > input ? peak - input : 0) / faces, seconds,
+      static_cast<double>(peak > input_rss ? peak - input_rss : 0) / faces, seconds,
       static_cast<unsigned long long>(build.evaluations),
       static_cast<double>(build.evaluations) / faces, read_seconds, build.setup_seconds,
       build.merge_seconds);
@@ -186,10 +171,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "primseg_bench_memory: %s\n", e.what());
-    return 1;
-  }
+  return primseg::bench::main_reporting_errors("primseg_bench_memory", run, argc, argv);
 }

@@ -3,11 +3,16 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <fstream>
 #include <mutex>
 #include <stdexcept>
 #include <system_error>
+
+#include "primseg/mesh_io.hpp"
+#include "primseg/shape_generator.hpp"
 
 namespace primseg::bench {
 namespace {
@@ -73,6 +78,50 @@ std::size_t current_rss_bytes() {
   std::size_t pages = 0, resident = 0;
   if (!(statm >> pages >> resident)) return 0;
   return resident * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+}
+
+bool InputArgument::take(int argc, char** argv, int& i) {
+  if (kind != Kind::None) return false;
+  const std::string arg = argv[i];
+  if ((arg == "--cgal" || arg == "--shape") && i + 1 < argc) {
+    kind = arg == "--cgal" ? Kind::Cgal : Kind::Shape;
+    name = argv[++i];
+    if (kind == Kind::Shape && i + 1 < argc && argv[i + 1][0] != '-') {
+      const char* text = argv[++i];
+      char* end = nullptr;
+      edge_length = std::strtod(text, &end);
+      if (end == text || *end != '\0')
+        throw std::invalid_argument(std::string("EDGE_LENGTH: not a number: ") + text);
+    }
+    return true;
+  }
+  if (arg.starts_with("-")) return false;
+  kind = Kind::File;
+  name = arg;
+  return true;
+}
+
+std::filesystem::path InputArgument::file() const {
+  if (kind == Kind::File) return name;
+  return kind == Kind::Cgal ? cgal_mesh(name) : std::filesystem::path();
+}
+
+Mesh InputArgument::load() const {
+  if (kind == Kind::None) throw std::invalid_argument("no input named");
+  if (kind != Kind::Shape) return read_mesh(file());
+  ShapeOptions options;
+  options.tessellation = Tessellation::Uniform;
+  options.edge_length = edge_length;
+  return make_shape(name, options).mesh;
+}
+
+int main_reporting_errors(const char* tool, int (*run)(int, char**), int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", tool, e.what());
+    return 1;
+  }
 }
 
 }  // namespace primseg::bench

@@ -1,9 +1,12 @@
 #pragma once
-// Shared helpers of the benchmarks: the CGAL sample meshes and the process's memory figures.
+// Shared helpers of the benchmarks: the CGAL sample meshes, the input a command line names and
+// the process's memory figures.
 
 #include <cstddef>
 #include <filesystem>
 #include <string>
+
+#include "primseg/mesh.hpp"
 
 namespace primseg::bench {
 
@@ -15,6 +18,29 @@ namespace primseg::bench {
 /// goes to a private directory and is renamed into place, so a concurrent reader never sees a
 /// partial file. Throws std::runtime_error when the mesh cannot be found or extracted.
 std::filesystem::path cgal_mesh(const std::string& name);
+
+/// The mesh a benchmark's command line names: `MESH_FILE`, `--cgal NAME` (cgal_mesh()) or
+/// `--shape NAME [EDGE_LENGTH]` (a generated shape in its Uniform tessellation, edges of
+/// EDGE_LENGTH times its size, default 0.01).
+struct InputArgument {
+  enum class Kind { None, File, Cgal, Shape };
+  Kind kind = Kind::None;
+  std::string name;
+  double edge_length = 0.01;
+
+  /// Takes argv[i] (and what follows it) if it names the input and none was named yet, moving i
+  /// to its last word; false otherwise. Throws std::invalid_argument for an EDGE_LENGTH that is
+  /// not a number.
+  bool take(int argc, char** argv, int& i);
+  /// The file to read (extracted by cgal_mesh() for --cgal); empty for a shape.
+  std::filesystem::path file() const;
+  /// Reads file() or generates the shape.
+  Mesh load() const;
+};
+
+/// A tool's main(): run(argc, argv), or a message "TOOL: what()" on stderr and exit status 1 if
+/// it throws.
+int main_reporting_errors(const char* tool, int (*run)(int, char**), int argc, char** argv);
 
 /// High-water mark of the resident set size of this process (getrusage ru_maxrss), bytes.
 std::size_t peak_rss_bytes();

@@ -17,6 +17,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "bench_support.hpp"
 #include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
 
@@ -157,10 +158,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "primseg_subdivide: %s\n", e.what());
-    return 1;
-  }
+  return primseg::bench::main_reporting_errors("primseg_subdivide", run, argc, argv);
 }

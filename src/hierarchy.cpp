@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "batch_pool.hpp"
+#include "evaluation_tape.hpp"
 #include "hierarchy_regions.hpp"
 #include "huge_pages.hpp"
 #include "indexed_heap.hpp"
@@ -265,6 +266,11 @@ class HierarchyBuilder::Impl {
     if (!mesh_) throw InvalidInputError("no mesh");
     mesh_->validate();
     check_geometric_range(*mesh_);
+    if (detail::evaluation_tape.mode != detail::EvaluationTape::Mode::Off) {
+      if (pool_.thread_count() != 1 || options_.regions > 1)
+        throw Error("an evaluation tape needs one thread and no regions");
+      tape_ = &detail::evaluation_tape;
+    }
     // With regions, the tree's first merges are theirs, and the whole mesh's graph is made by
     // the thread that finishes its region first.
     const std::uint32_t f = mesh_->face_count();
@@ -848,13 +854,25 @@ class HierarchyBuilder::Impl {
   // edge's bound (safe in parallel over distinct edges).
   QueuedCandidate evaluate(std::uint32_t id, Scratch& scratch) {
     LiveEdge& e = edges_[id];
+    if (tape_ && tape_->mode == detail::EvaluationTape::Mode::Replay) return replay(e, id);
     const int degree = selector_.moment_degree(slots_[e.a].triangles + slots_[e.b].triangles);
     const ClusterPart a = part_of(e.a, scratch, 0, degree);  // (part 0 first)
     const ClusterPart b = part_of(e.b, scratch, 1, degree);
     const ClusterView cluster(a, b, shared_edges(id));
     const detail::SelectedModel model = select(cluster, e);
     if (lazy_) e.raise_cost_bound(model.superset_cost_bound);
+    if (tape_)
+      tape_->outcomes.push_back({model.cost, model.superset_cost_bound, model.fit.primitive.type});
     return {model.cost, true, model.fit.primitive.type, id};
+  }
+
+  // The next recorded outcome instead of an evaluation (the benchmark's evaluation_tape.hpp).
+  QueuedCandidate replay(LiveEdge& e, std::uint32_t id) {
+    if (tape_->next == tape_->outcomes.size())
+      throw Error("evaluation tape: the build evaluates more candidates than it recorded");
+    const detail::EvaluationOutcome& outcome = tape_->outcomes[tape_->next++];
+    if (lazy_) e.raise_cost_bound(outcome.superset_cost_bound);
+    return {outcome.cost, true, outcome.type, id};
   }
 
   // The edge's cost bound if it holds for the current union, else 0. A cost that would snap to
@@ -1334,6 +1352,7 @@ class HierarchyBuilder::Impl {
   std::uint32_t total_merges_ = 0;
   double max_cost_ = 0;
   std::uint64_t evaluations_ = 0;
+  detail::EvaluationTape* tape_ = nullptr;  // null unless a benchmark records or replays
   bool lazy_ = false;
   Lookahead lookahead_;  // the last merge's guess at the next one
   // Batched merging only (see HierarchyOptions::merge_batch_tolerance): per slot, the merge
