@@ -853,26 +853,37 @@ class HierarchyBuilder::Impl {
   // A candidate's queue entry, without its degree. Reads shared state and writes only this
   // edge's bound (safe in parallel over distinct edges).
   QueuedCandidate evaluate(std::uint32_t id, Scratch& scratch) {
+    if (tape_) [[unlikely]]
+      return taped_evaluation(id, scratch);
     LiveEdge& e = edges_[id];
-    if (tape_ && tape_->mode == detail::EvaluationTape::Mode::Replay) return replay(e, id);
     const int degree = selector_.moment_degree(slots_[e.a].triangles + slots_[e.b].triangles);
     const ClusterPart a = part_of(e.a, scratch, 0, degree);  // (part 0 first)
     const ClusterPart b = part_of(e.b, scratch, 1, degree);
     const ClusterView cluster(a, b, shared_edges(id));
     const detail::SelectedModel model = select(cluster, e);
     if (lazy_) e.raise_cost_bound(model.superset_cost_bound);
-    if (tape_)
-      tape_->outcomes.push_back({model.cost, model.superset_cost_bound, model.fit.primitive.type});
     return {model.cost, true, model.fit.primitive.type, id};
   }
 
-  // The next recorded outcome instead of an evaluation (the benchmark's evaluation_tape.hpp).
-  QueuedCandidate replay(LiveEdge& e, std::uint32_t id) {
-    if (tape_->next == tape_->outcomes.size())
-      throw Error("evaluation tape: the build evaluates more candidates than it recorded");
-    const detail::EvaluationOutcome& outcome = tape_->outcomes[tape_->next++];
-    if (lazy_) e.raise_cost_bound(outcome.superset_cost_bound);
-    return {outcome.cost, true, outcome.type, id};
+  // evaluate() for a benchmark's tape (evaluation_tape.hpp): the next recorded outcome instead of
+  // an evaluation, or an evaluation recorded. Out of line, so that the loop's code stays as
+  // without it.
+  [[gnu::noinline, gnu::cold]] QueuedCandidate taped_evaluation(std::uint32_t id,
+                                                                Scratch& scratch) {
+    LiveEdge& e = edges_[id];
+    if (tape_->mode == detail::EvaluationTape::Mode::Replay) {
+      if (tape_->next == tape_->outcomes.size())
+        throw Error("evaluation tape: the build evaluates more candidates than it recorded");
+      const detail::EvaluationOutcome& outcome = tape_->outcomes[tape_->next++];
+      if (lazy_) e.raise_cost_bound(outcome.superset_cost_bound);
+      return {outcome.cost, true, outcome.type, id};
+    }
+    detail::EvaluationTape* const tape = std::exchange(tape_, nullptr);
+    const QueuedCandidate evaluated = evaluate(id, scratch);
+    tape_ = tape;
+    // The edge's bound as raised (raising it again to that on replay gives the same bound).
+    tape_->outcomes.push_back({evaluated.cost, e.cost_bound, evaluated.type()});
+    return evaluated;
   }
 
   // The edge's cost bound if it holds for the current union, else 0. A cost that would snap to
