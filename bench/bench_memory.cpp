@@ -33,7 +33,6 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -53,25 +52,6 @@ int usage() {
       "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T --regions N --read-only\n"
       "         --face-order auto|spatial|as-listed\n");
   return 2;
-}
-
-// The whole of `text` as a number, or an error naming the option.
-double number(const std::string& option, const char* text) {
-  char* end = nullptr;
-  const double value = std::strtod(text, &end);
-  if (end == text || *end != '\0') throw std::invalid_argument(option + ": not a number: " + text);
-  return value;
-}
-
-// The whole of `text` as a whole number from `low` to `high` (a count of `what`s), or an error
-// naming the option.
-unsigned count(const std::string& option, const char* text, unsigned low, unsigned high,
-               const std::string& what) {
-  const double value = number(option, text);
-  if (!(value >= low && value <= high && value == static_cast<unsigned>(value)))
-    throw std::invalid_argument(option + ": not a " + what + " count from " + std::to_string(low) +
-                                " to " + std::to_string(high));
-  return static_cast<unsigned>(value);
 }
 
 struct BuildFigures {
@@ -108,11 +88,11 @@ int run(int argc, char** argv) {
     } else if (arg == "--exact-costs") {
       options.exact_costs = true;
     } else if (arg == "--threads" && i + 1 < argc) {
-      options.threads = count(arg, argv[++i], 0, 1024, "thread");
+      options.threads = bench::count_argument(arg, argv[++i], 0, 1024, "thread");
     } else if (arg == "--merge-batch-tolerance" && i + 1 < argc) {
-      options.merge_batch_tolerance = number(arg, argv[++i]);
+      options.merge_batch_tolerance = bench::number_argument(arg, argv[++i]);
     } else if (arg == "--regions" && i + 1 < argc) {
-      options.regions = count(arg, argv[++i], 1, 256, "region");
+      options.regions = bench::count_argument(arg, argv[++i], 1, 256, "region");
     } else if (arg == "--face-order" && i + 1 < argc) {
       const std::string order = argv[++i];
       if (order == "auto")

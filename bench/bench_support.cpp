@@ -80,19 +80,30 @@ std::size_t current_rss_bytes() {
   return resident * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
 }
 
+double number_argument(const std::string& option, const char* text) {
+  char* end = nullptr;
+  const double value = std::strtod(text, &end);
+  if (end == text || *end != '\0') throw std::invalid_argument(option + ": not a number: " + text);
+  return value;
+}
+
+unsigned count_argument(const std::string& option, const char* text, unsigned low, unsigned high,
+                        const std::string& what) {
+  const double value = number_argument(option, text);
+  if (!(value >= low && value <= high && value == static_cast<unsigned>(value)))
+    throw std::invalid_argument(option + ": not a " + what + " count from " + std::to_string(low) +
+                                " to " + std::to_string(high));
+  return static_cast<unsigned>(value);
+}
+
 bool InputArgument::take(int argc, char** argv, int& i) {
   if (kind != Kind::None) return false;
   const std::string arg = argv[i];
   if ((arg == "--cgal" || arg == "--shape") && i + 1 < argc) {
     kind = arg == "--cgal" ? Kind::Cgal : Kind::Shape;
     name = argv[++i];
-    if (kind == Kind::Shape && i + 1 < argc && argv[i + 1][0] != '-') {
-      const char* text = argv[++i];
-      char* end = nullptr;
-      edge_length = std::strtod(text, &end);
-      if (end == text || *end != '\0')
-        throw std::invalid_argument(std::string("EDGE_LENGTH: not a number: ") + text);
-    }
+    if (kind == Kind::Shape && i + 1 < argc && argv[i + 1][0] != '-')
+      edge_length = number_argument("EDGE_LENGTH", argv[++i]);
     return true;
   }
   if (arg.starts_with("-")) return false;

@@ -19,6 +19,13 @@ namespace primseg::bench {
 /// partial file. Throws std::runtime_error when the mesh cannot be found or extracted.
 std::filesystem::path cgal_mesh(const std::string& name);
 
+/// The whole of `text` as a number, or std::invalid_argument naming the option.
+double number_argument(const std::string& option, const char* text);
+/// The whole of `text` as a whole number from `low` to `high` (a count of `what`s), or
+/// std::invalid_argument naming the option.
+unsigned count_argument(const std::string& option, const char* text, unsigned low, unsigned high,
+                        const std::string& what);
+
 /// The mesh a benchmark's command line names: `MESH_FILE`, `--cgal NAME` (cgal_mesh()) or
 /// `--shape NAME [EDGE_LENGTH]` (a generated shape in its Uniform tessellation, edges of
 /// EDGE_LENGTH times its size, default 0.01).

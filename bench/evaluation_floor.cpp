@@ -18,7 +18,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -89,8 +88,7 @@ int run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--runs" && i + 1 < argc) {
-      runs = static_cast<unsigned>(std::strtoul(argv[++i], nullptr, 10));
-      if (runs < 1 || runs > 1000) throw std::invalid_argument("--runs: 1 to 1000");
+      runs = bench::count_argument(arg, argv[++i], 1, 1000, "run");
     } else if (!input.take(argc, argv, i)) {
       return usage();
     }

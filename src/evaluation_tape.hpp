@@ -20,7 +20,7 @@ namespace primseg::detail {
 /// What a candidate's evaluation gives the merge loop.
 struct EvaluationOutcome {
   double cost = 0;
-  double superset_cost_bound = 0;  // the edge's lazy bound as the evaluation left it
+  double cost_bound = 0;  // the edge's lazy bound as the evaluation left it
   PrimitiveType type = PrimitiveType::Plane;
 };
 

@@ -875,7 +875,7 @@ class HierarchyBuilder::Impl {
       if (tape_->next == tape_->outcomes.size())
         throw Error("evaluation tape: the build evaluates more candidates than it recorded");
       const detail::EvaluationOutcome& outcome = tape_->outcomes[tape_->next++];
-      if (lazy_) e.raise_cost_bound(outcome.superset_cost_bound);
+      if (lazy_) e.raise_cost_bound(outcome.cost_bound);
       return {outcome.cost, true, outcome.type, id};
     }
     detail::EvaluationTape* const tape = std::exchange(tape_, nullptr);
