@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <type_traits>
 #include <utility>
 
@@ -886,21 +887,86 @@ class HierarchyBuilder::Impl {
     return evaluated;
   }
 
-  // The edge's cost bound if it holds for the current union, else 0. A cost that would snap to
-  // zero (at most zero_cost_tolerance × the union's spread, for the cheapest type) can be below
-  // any bound from a subset, so the bound holds only above that level. The union's spread is
-  // exact from the parts' (Σ w |x − c|² adds a w_a w_b / (w_a + w_b) |c_a − c_b|² term); the
-  // factor 2 covers round-off.
-  double queued_bound(const LiveEdge& e) {
+  // What a bound's check reads of a cluster: its weight, centroid and spread Σ w |x − c|².
+  struct PartSpread {
+    double weight = 0;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    double spread = 0;
+  };
+  static PartSpread spread_of(const ClusterStats& stats) {
+    return {stats.moments.weight(), stats.moments.origin(), stats.moments.second_moment().trace()};
+  }
+  // The union of two parts' spreads: Σ w |x − c|² adds w_a w_b / (w_a + w_b) |c_a − c_b|², a sum
+  // symmetric in a and b to the last bit. Weight 0 if either part has none (then no bound).
+  static PartSpread united(const PartSpread& a, const PartSpread& b) {
+    if (!(a.weight > 0) || !(b.weight > 0)) return {};
+    const double weight = a.weight + b.weight;
+    return {weight, (a.weight * a.centroid + b.weight * b.centroid) / weight,
+            a.spread + b.spread +
+                a.weight * b.weight / weight * (a.centroid - b.centroid).squaredNorm()};
+  }
+  // A face's spread from its corners alone: a quarter of the instructions of a full read
+  // (face_corners(), with normals and offsets), which the check needs for each neighbour of every
+  // new cluster. In two passes about the centroid, as the reads' (a one-pass Σ w |x|² − w |c|²
+  // would lose the spread of a small face far from the origin); the round-off differs from
+  // theirs by far less than the check's margin.
+  PartSpread face_spread(std::uint32_t face) const {
+    const std::uint32_t begin = graph_->first_triangle(face);
+    const std::uint32_t count = graph_->first_triangle(face + 1) - begin;
+    if (count > FaceCorners::kMaxTriangles)  // (a polygon of many triangles: rare)
+      return spread_of(graph_->face_stats(face, false, 2).centred(2));
+    std::array<Triangle, FaceCorners::kMaxTriangles> corners;
+    std::array<std::array<double, 3>, FaceCorners::kMaxTriangles> weights;
+    PartSpread result;
+    Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
+    for (std::uint32_t i = 0; i < count; ++i) {
+      corners[i] = graph_->corners(begin + i);
+      weights[i] = graph_->corner_weights(begin + i);
+      for (int k = 0; k < 3; ++k) {
+        weighted_sum += weights[i][k] * graph_->position(corners[i][k]);
+        result.weight += weights[i][k];
+      }
+    }
+    if (!(result.weight > 0)) return {};
+    result.centroid = weighted_sum / result.weight;
+    for (std::uint32_t i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k)
+        result.spread +=
+            weights[i][k] * (graph_->position(corners[i][k]) - result.centroid).squaredNorm();
+    return result;
+  }
+  // The spread of the cluster in `slot`: a stored cluster's from its statistics, a face's and a
+  // pair's from their corners (or a pair's cached statistics).
+  PartSpread part_spread(std::uint32_t slot) const {
+    const std::uint32_t index = slots_[slot].stats;
+    if (index == kNone) return face_spread(slot);
+    if (index & kPairTag) {
+      if (!pair_by_corners(slots_[slot].triangles)) {
+        const CachedPair& cached = pair_cache_[index % kCachedPairs];
+        if (cached.key == index) return spread_of(cached.stats);
+      }
+      const DualEdge& pair = graph_->edges()[index & ~kPairTag];
+      return united(face_spread(pair.first), face_spread(pair.second));
+    }
+    return spread_of(stats_[index]);
+  }
+
+  // The cost bound of live edge `e`, between the new cluster in `merged_slot` and a neighbour, if
+  // it holds for their union, else 0. The new cluster's spread is read once for all its edges,
+  // into `merged` on first use. A cost that would snap to zero (at most zero_cost_tolerance × the
+  // union's spread, for the cheapest type) can be below any bound from a subset, so the bound
+  // holds only above that level. The union's spread is exact from the parts' (united()); the
+  // factor 2 covers round-off. A check that fails for round-off costs an evaluation, never another
+  // tree.
+  double queued_bound(const LiveEdge& e, std::uint32_t merged_slot,
+                      std::optional<PartSpread>& merged) const {
     if (!(e.cost_bound > 0)) return 0;
-    const ClusterPart a = part_of(e.a, scratch_[0], 0, 2);
-    const ClusterPart b = part_of(e.b, scratch_[0], 1, 2);
-    const double wa = a.weight(), wb = b.weight();
-    if (!(wa > 0) || !(wb > 0)) return 0;
-    const double spread = a.second_moment().trace() + b.second_moment().trace() +
-                          wa * wb / (wa + wb) * (a.centroid() - b.centroid()).squaredNorm();
-    return e.cost_bound > 2 * max_penalty_ * options_.zero_cost_tolerance * spread ? e.cost_bound
-                                                                                   : 0.0;
+    if (!merged) merged = part_spread(merged_slot);
+    const PartSpread pair = united(*merged, part_spread(other_end(e, merged_slot)));
+    if (!(pair.weight > 0)) return 0;
+    return e.cost_bound > 2 * max_penalty_ * options_.zero_cost_tolerance * pair.spread
+               ? e.cost_bound
+               : 0.0;
   }
 
   // Moves b's edges to a's slot, where two edges to a common neighbour become one (their mesh
@@ -1204,9 +1270,10 @@ class HierarchyBuilder::Impl {
     // bound would reach the top before the next merge anyway), the others are evaluated, on all
     // threads, and queued in list order.
     batch_.clear();
+    std::optional<PartSpread> merged;
     for (std::uint32_t link = head; link != kNone; link = next_link_[link]) {
       const std::uint32_t id = link / 2;
-      const double bound = lazy_ ? queued_bound(edges_[id]) : 0;
+      const double bound = lazy_ ? queued_bound(edges_[id], slot, merged) : 0;
       if (bound > 0)
         requeue({bound, false, PrimitiveType::Plane, id});
       else

@@ -189,8 +189,8 @@ TEST(GreedyReference, CleanMeshesSettleTheirZeroCostTiesAsTheNaiveGreedyOrder) {
 
 // Polygon faces: quads (two triangles, read by their corners, and pairs of them too), hexagons
 // (four triangles: a face by its corners, its pairs by their statistics) and octagons (six: by
-// their statistics), on a noisy curved sheet; and with the torus enabled, which reads every
-// cluster by its statistics (samples).
+// their statistics), on a noisy curved sheet; with planes and spheres only (lazy bounds); and with
+// the torus enabled, which reads every cluster by its statistics (samples).
 TEST(GreedyReference, PolygonMeshesMergeInTheNaiveGreedyOrder) {
   const int n = 14;
   std::mt19937_64 rng(11);
@@ -239,6 +239,10 @@ TEST(GreedyReference, PolygonMeshesMergeInTheNaiveGreedyOrder) {
   ASSERT_GT(hexagons, 3u);
   ASSERT_GT(octagons, 3u);
   expect_naive_greedy(mesh, "polygon sheet");
+  // Planes and spheres: candidates wait under bounds, checked with each neighbour's spread from
+  // its corners (the octagons' from their statistics).
+  expect_naive_greedy(mesh, "polygon sheet with planes and spheres",
+                      {PrimitiveType::Plane, PrimitiveType::Sphere});
   expect_naive_greedy(
       mesh, "polygon sheet with tori",
       {PrimitiveType::Plane, PrimitiveType::Cylinder, PrimitiveType::Sphere, PrimitiveType::Torus});

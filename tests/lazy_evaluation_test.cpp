@@ -60,6 +60,41 @@ TEST(LazyEvaluation, SameTreeAsEagerOnNoisyGeneratedShapes) {
   }
 }
 
+// A flat n × n grid of unit squares (two triangles each) with the given vertices raised by
+// `height` off the plane.
+Mesh flat_grid(std::uint32_t n, double height,
+               const std::vector<std::array<std::uint32_t, 2>>& raised) {
+  std::vector<Vec3> positions;
+  for (std::uint32_t j = 0; j <= n; ++j)
+    for (std::uint32_t i = 0; i <= n; ++i) positions.push_back({double(i), double(j), 0.0});
+  for (const auto& [i, j] : raised) positions[j * (n + 1) + i][2] = height;
+  std::vector<Triangle> triangles;
+  for (std::uint32_t j = 0; j < n; ++j)
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const std::uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 2, d = a + n + 1;
+      triangles.push_back({a, b, c});
+      triangles.push_back({a, c, d});
+    }
+  return Mesh::from_triangles(std::move(positions), std::move(triangles));
+}
+
+// A bound from two small clusters near a raised vertex (whose plane fits err by about 1e-8 of
+// their spread) is far above the zero level of a union with a large flat cluster (1e-12 of a
+// spread thousands of times theirs), whose cost snaps to zero: a candidate under that bound would
+// wait behind the zero-cost merges the eager order ranks it among. The check against the union's
+// spread evaluates it instead (without that check, every case here builds another tree).
+TEST(LazyEvaluation, SameTreeAsEagerWhereAUnionSnapsToZeroBelowItsBound) {
+  for (const std::uint32_t n : {20u, 30u})
+    for (const auto& raised : std::vector<std::vector<std::array<std::uint32_t, 2>>>{
+             {{n / 2, n / 2}}, {{3, 4}}, {{n / 2, n / 2}, {n / 3, 2 * n / 3}}}) {
+      const Mesh mesh = flat_grid(n, 1e-4, raised);
+      const std::string what = std::to_string(n) + "x" + std::to_string(n) + " grid, " +
+                               std::to_string(raised.size()) + " raised";
+      expect_lazy_equals_eager(mesh, {PrimitiveType::Plane}, what + ", plane", false);
+      expect_lazy_equals_eager(mesh, kPlaneSphere, what + ", plane+sphere", false);
+    }
+}
+
 TEST(LazyEvaluation, SameTreeAsEagerOnFandiskAndBunny) {
   const Mesh fandisk = read_mesh(testing::cgal_mesh("fandisk.off"));
   expect_lazy_equals_eager(fandisk, kAll, "fandisk all types", false);
