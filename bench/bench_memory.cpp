@@ -7,7 +7,8 @@
 // OPTIONS: --exact-costs, --threads N (HierarchyOptions::threads, default 0: all),
 // --merge-batch-tolerance T (default 0: the exact order), --regions N (default 1: the exact
 // order), --read-only (read the input, print read_seconds, build nothing; bench/read_speed.sh)
-// and --face-order auto|spatial|as-listed (HierarchyOptions::face_order, default auto).
+// --face-order auto|spatial|as-listed (HierarchyOptions::face_order, default auto) and
+// --primitives LIST (HierarchyOptions::primitives, comma-separated, default plane,cylinder,sphere).
 //
 // Prints one line of key=value pairs:
 //   faces             input faces F
@@ -50,7 +51,7 @@ int usage() {
       "       primseg_bench_memory --cgal NAME [OPTIONS]\n"
       "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
       "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T --regions N --read-only\n"
-      "         --face-order auto|spatial|as-listed\n");
+      "         --face-order auto|spatial|as-listed --primitives LIST\n");
   return 2;
 }
 
@@ -91,6 +92,8 @@ int run(int argc, char** argv) {
       options.threads = bench::count_argument(arg, argv[++i], 0, 1024, "thread");
     } else if (arg == "--merge-batch-tolerance" && i + 1 < argc) {
       options.merge_batch_tolerance = bench::number_argument(arg, argv[++i]);
+    } else if (arg == "--primitives" && i + 1 < argc) {
+      options.primitives = bench::primitives_argument(arg, argv[++i]);
     } else if (arg == "--regions" && i + 1 < argc) {
       options.regions = bench::count_argument(arg, argv[++i], 1, 256, "region");
     } else if (arg == "--face-order" && i + 1 < argc) {

@@ -3,11 +3,13 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <system_error>
 
@@ -94,6 +96,19 @@ unsigned count_argument(const std::string& option, const char* text, unsigned lo
     throw std::invalid_argument(option + ": not a " + what + " count from " + std::to_string(low) +
                                 " to " + std::to_string(high));
   return static_cast<unsigned>(value);
+}
+
+std::vector<PrimitiveType> primitives_argument(const std::string& option, const std::string& text) {
+  std::vector<PrimitiveType> types;
+  for (std::size_t begin = 0;;) {
+    const std::size_t end = std::min(text.find(',', begin), text.size());
+    const std::string name = text.substr(begin, end - begin);
+    const std::optional<PrimitiveType> type = primitive_type_from_string(name);
+    if (!type) throw std::invalid_argument(option + ": unknown primitive type '" + name + "'");
+    types.push_back(*type);
+    if (end == text.size()) return types;
+    begin = end + 1;
+  }
 }
 
 bool InputArgument::take(int argc, char** argv, int& i) {

@@ -5,8 +5,10 @@
 #include <cstddef>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "primseg/mesh.hpp"
+#include "primseg/primitive.hpp"
 
 namespace primseg::bench {
 
@@ -25,6 +27,9 @@ double number_argument(const std::string& option, const char* text);
 /// std::invalid_argument naming the option.
 unsigned count_argument(const std::string& option, const char* text, unsigned low, unsigned high,
                         const std::string& what);
+/// A comma-separated list of primitive type names ("plane,sphere") as HierarchyOptions::primitives,
+/// or std::invalid_argument naming the option and the unknown name.
+std::vector<PrimitiveType> primitives_argument(const std::string& option, const std::string& text);
 
 /// The mesh a benchmark's command line names: `MESH_FILE`, `--cgal NAME` (cgal_mesh()) or
 /// `--shape NAME [EDGE_LENGTH]` (a generated shape in its Uniform tessellation, edges of

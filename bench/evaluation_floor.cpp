@@ -4,11 +4,12 @@
 // recorded outcomes instead of evaluating (timed): that build still makes the dual graph, relinks,
 // keeps the queue, fits and sums each merged cluster and writes the tree. Its tree must be the
 // first one, byte for byte, or the tool fails. On one thread (the tape follows the evaluations'
-// order), default types and options.
+// order), default options but for the primitive types (--primitives, default
+// plane,cylinder,sphere).
 //
-//   primseg_bench_evaluation_floor MESH_FILE [--runs R]
-//   primseg_bench_evaluation_floor --cgal NAME [--runs R]
-//   primseg_bench_evaluation_floor --shape NAME [EDGE_LENGTH] [--runs R]
+//   primseg_bench_evaluation_floor MESH_FILE [--runs R] [--primitives LIST]
+//   primseg_bench_evaluation_floor --cgal NAME [--runs R] [--primitives LIST]
+//   primseg_bench_evaluation_floor --shape NAME [EDGE_LENGTH] [--runs R] [--primitives LIST]
 //
 // Prints one line of key=value pairs: the medians over R runs (default 5) of the real build
 // (build_seconds, with build_setup_seconds for the builder's constructor and build_merge_seconds
@@ -34,9 +35,10 @@ using Mode = primseg::detail::EvaluationTape::Mode;
 
 int usage() {
   std::fprintf(stderr,
-               "usage: primseg_bench_evaluation_floor MESH_FILE [--runs R]\n"
-               "       primseg_bench_evaluation_floor --cgal NAME [--runs R]\n"
-               "       primseg_bench_evaluation_floor --shape NAME [EDGE_LENGTH] [--runs R]\n");
+               "usage: primseg_bench_evaluation_floor MESH_FILE [OPTIONS]\n"
+               "       primseg_bench_evaluation_floor --cgal NAME [OPTIONS]\n"
+               "       primseg_bench_evaluation_floor --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
+               "OPTIONS: --runs R --primitives LIST\n");
   return 2;
 }
 
@@ -46,8 +48,8 @@ struct Build {
   primseg::Hierarchy tree;
 };
 
-Build build(const std::shared_ptr<const primseg::Mesh>& mesh, Mode mode) {
-  primseg::HierarchyOptions options;
+Build build(const std::shared_ptr<const primseg::Mesh>& mesh, primseg::HierarchyOptions options,
+            Mode mode) {
   options.threads = 1;
   auto& tape = primseg::detail::evaluation_tape;
   tape.mode = mode;
@@ -68,11 +70,13 @@ Build build(const std::shared_ptr<const primseg::Mesh>& mesh, Mode mode) {
 
 // The two timed builds by name, so that a profiler can take one alone (valgrind
 // --toggle-collect='*replaying_build*', perf report --parent=replaying_build).
-[[gnu::noinline]] Build evaluating_build(const std::shared_ptr<const primseg::Mesh>& mesh) {
-  return build(mesh, Mode::Off);
+[[gnu::noinline]] Build evaluating_build(const std::shared_ptr<const primseg::Mesh>& mesh,
+                                         const primseg::HierarchyOptions& options) {
+  return build(mesh, options, Mode::Off);
 }
-[[gnu::noinline]] Build replaying_build(const std::shared_ptr<const primseg::Mesh>& mesh) {
-  return build(mesh, Mode::Replay);
+[[gnu::noinline]] Build replaying_build(const std::shared_ptr<const primseg::Mesh>& mesh,
+                                        const primseg::HierarchyOptions& options) {
+  return build(mesh, options, Mode::Replay);
 }
 
 double median(std::vector<double> values) {
@@ -85,10 +89,13 @@ int run(int argc, char** argv) {
   using namespace primseg;
   bench::InputArgument input;
   unsigned runs = 5;
+  HierarchyOptions options;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--runs" && i + 1 < argc) {
       runs = bench::count_argument(arg, argv[++i], 1, 1000, "run");
+    } else if (arg == "--primitives" && i + 1 < argc) {
+      options.primitives = bench::primitives_argument(arg, argv[++i]);
     } else if (!input.take(argc, argv, i)) {
       return usage();
     }
@@ -99,9 +106,9 @@ int run(int argc, char** argv) {
   std::vector<double> build_setup, build_merge, build_total, floor_setup, floor_merge, floor_total;
   std::uint64_t evaluations = 0;
   for (unsigned run = 0; run < runs; ++run) {
-    const Build real = evaluating_build(mesh);
-    build(mesh, Mode::Record);
-    const Build replayed = replaying_build(mesh);
+    const Build real = evaluating_build(mesh, options);
+    build(mesh, options, Mode::Record);
+    const Build replayed = replaying_build(mesh, options);
     if (serialize_tree(replayed.tree) != serialize_tree(real.tree))
       throw std::runtime_error("the replaying build made another tree than the real one");
     evaluations = real.evaluations;
