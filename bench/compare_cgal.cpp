@@ -7,11 +7,12 @@
 // "shape:box_with_hole" (generated, Uniform tessellation, edge length 0.01) or a path to a mesh
 // file primseg reads. Default: fandisk.off bunny00.off shape:box_with_hole.
 //
-// Per input, three measurements, each the median of N (default 5) wall-clock runs; the runs of
-// the three are interleaved (primseg, region growing, VSA, primseg, ...) so that load on the
-// machine affects all three alike:
+// Per input, four measurements, each the median of N (default 5) wall-clock runs; the runs of
+// the four are interleaved (primseg, primseg planes only, region growing, VSA, primseg, ...) so
+// that load on the machine affects all four alike:
 //   1. primseg: build_hierarchy(mesh) with the default options (plane + cylinder + sphere): the
-//      whole merge tree, every K at once (destroying the tree included);
+//      whole merge tree, every K at once (destroying the tree included); and the same with
+//      planes only, like for like with region growing;
 //   2. CGAL region growing on the faces of a CGAL::Surface_mesh, planes only: one segmentation
 //      (neighbour query, least-squares plane region, seed sorting by fit quality, detection);
 //   3. CGAL Variational Shape Approximation, approximate_triangle_mesh with
@@ -129,9 +130,13 @@ double median(std::vector<double> values) {
   return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-/// primseg: the whole tree. Returns the number of merges (to keep the work observable).
-std::size_t run_primseg(const std::shared_ptr<const primseg::Mesh>& mesh) {
-  const primseg::Hierarchy tree = primseg::build_hierarchy(mesh);
+/// primseg: the whole tree with these types. Returns the number of merges (to keep the work
+/// observable).
+std::size_t run_primseg(const std::shared_ptr<const primseg::Mesh>& mesh,
+                        std::vector<primseg::PrimitiveType> primitives) {
+  primseg::HierarchyOptions options;
+  options.primitives = std::move(primitives);
+  const primseg::Hierarchy tree = primseg::build_hierarchy(mesh, options);
   return tree.merges().size();
 }
 
@@ -205,7 +210,7 @@ std::shared_ptr<const primseg::Mesh> load_input(const std::string& input) {
 struct Row {
   std::string input;
   std::size_t faces = 0, triangles = 0, rejected = 0;
-  Timing primseg, region_growing, vsa;  // medians
+  Timing primseg, primseg_planes, region_growing, vsa;  // medians
   std::size_t regions = 0, proxies = 0;
 };
 
@@ -281,11 +286,13 @@ int main(int argc, char** argv) {
       row.rejected = converted.rejected_faces;
       const double max_distance = kMaxDistanceFraction * converted.diagonal;
 
-      std::vector<double> wall[3], cpu[3];
+      std::vector<double> wall[4], cpu[4];
       for (int r = 0; r < repetitions; ++r) {
         std::cerr << input << ": run " << (r + 1) << "/" << repetitions << "\r" << std::flush;
-        Timing t = timed([&] { (void)run_primseg(mesh); });
+        Timing t = timed([&] { (void)run_primseg(mesh, primseg::HierarchyOptions{}.primitives); });
         wall[0].push_back(t.wall_ms), cpu[0].push_back(t.cpu_ms);
+        t = timed([&] { (void)run_primseg(mesh, {primseg::PrimitiveType::Plane}); });
+        wall[3].push_back(t.wall_ms), cpu[3].push_back(t.cpu_ms);
         t = timed([&] { row.regions = run_region_growing(converted.mesh, max_distance); });
         wall[1].push_back(t.wall_ms), cpu[1].push_back(t.cpu_ms);
         std::vector<std::size_t> proxy_of_face;
@@ -297,6 +304,7 @@ int main(int argc, char** argv) {
       row.primseg = {median(wall[0]), median(cpu[0])};
       row.region_growing = {median(wall[1]), median(cpu[1])};
       row.vsa = {median(wall[2]), median(cpu[2])};
+      row.primseg_planes = {median(wall[3]), median(cpu[3])};
       rows.push_back(row);
     }
   } catch (const std::exception& e) {
@@ -304,25 +312,28 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  std::cout << "| input | faces | primseg full tree (ms) | CGAL region growing (ms) | regions "
-               "| CGAL VSA "
+  std::cout << "| input | faces | primseg full tree (ms) | primseg full tree, planes only (ms) "
+               "| CGAL region growing (ms) | regions | CGAL VSA "
             << kProxies
-            << " proxies (ms) | primseg / region growing "
+            << " proxies (ms) | primseg / region growing | primseg planes only / region growing "
                "| VSA / primseg |\n"
-               "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+               "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Row& row : rows) {
     std::cout << "| " << row.input << " | " << grouped(row.faces) << " | "
-              << fixed(row.primseg.wall_ms, 1) << " | " << fixed(row.region_growing.wall_ms, 1)
-              << " | " << row.regions << " | " << fixed(row.vsa.wall_ms, 1) << " | "
+              << fixed(row.primseg.wall_ms, 1) << " | " << fixed(row.primseg_planes.wall_ms, 1)
+              << " | " << fixed(row.region_growing.wall_ms, 1) << " | " << row.regions << " | "
+              << fixed(row.vsa.wall_ms, 1) << " | "
               << fixed(row.primseg.wall_ms / row.region_growing.wall_ms, 2) << " | "
+              << fixed(row.primseg_planes.wall_ms / row.region_growing.wall_ms, 2) << " | "
               << fixed(row.vsa.wall_ms / row.primseg.wall_ms, 1) << " |\n";
   }
   std::cout << "\nWall-clock medians of " << repetitions
             << " interleaved runs in one process. Median process CPU time (ms), "
-               "primseg / region growing / VSA:";
+               "primseg / primseg planes only / region growing / VSA:";
   for (const Row& row : rows)
     std::cout << " " << row.input << " " << fixed(row.primseg.cpu_ms, 1) << " / "
-              << fixed(row.region_growing.cpu_ms, 1) << " / " << fixed(row.vsa.cpu_ms, 1) << ";";
+              << fixed(row.primseg_planes.cpu_ms, 1) << " / " << fixed(row.region_growing.cpu_ms, 1)
+              << " / " << fixed(row.vsa.cpu_ms, 1) << ";";
   std::cout << " hardware threads: " << std::thread::hardware_concurrency()
             << "; load average before / after: " << load_before << " / " << load_average() << ".\n";
   std::cout << "Region growing: planes, max distance " << kMaxDistanceFraction * 100
