@@ -528,7 +528,16 @@ class HierarchyBuilder::Impl {
       if (!top.exact()) {
         // A bound reached the top: evaluate the candidate. (Its cost is above the bound, so
         // never zero: no degree.)
-        queue_.update(evaluate(top.id, scratch_[0]));
+        const std::uint32_t p = queue_.runner_up();
+        const std::uint32_t next = p == CandidateQueue::kAbsent ? kNone : queue_.at(p).id;
+        if (next != kNone) __builtin_prefetch(&edges_[next]);
+        const QueuedCandidate evaluated = evaluate(top.id, scratch_[0]);
+        if (next != kNone && !queue_.at(p).exact()) {
+          const LiveEdge& e = edges_[next];
+          prefetch_candidate(next, e.a);
+          prefetch_cluster(e.b);
+        }
+        queue_.update(evaluated);
         ++evaluations_;
         continue;
       }
