@@ -528,11 +528,15 @@ class HierarchyBuilder::Impl {
       if (!top.exact()) {
         // A bound reached the top: evaluate the candidate. (Its cost is above the bound, so
         // never zero: no degree.)
+        // A bound runner-up is most often the next one evaluated here, cold: its edge is asked
+        // for now, its clusters' first reads once the edge has arrived. (An exact runner-up is the
+        // next merge's, which asks for its own.)
         const std::uint32_t p = queue_.runner_up();
-        const std::uint32_t next = p == CandidateQueue::kAbsent ? kNone : queue_.at(p).id;
+        const std::uint32_t next =
+            p != CandidateQueue::kAbsent && !queue_.at(p).exact() ? queue_.at(p).id : kNone;
         if (next != kNone) __builtin_prefetch(&edges_[next]);
         const QueuedCandidate evaluated = evaluate(top.id, scratch_[0]);
-        if (next != kNone && !queue_.at(p).exact()) {
+        if (next != kNone) {
           const LiveEdge& e = edges_[next];
           prefetch_candidate(next, e.a);
           prefetch_cluster(e.b);
