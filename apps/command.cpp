@@ -109,21 +109,11 @@ std::vector<std::string> split_comma_list(const std::string& list) {
 }
 
 std::vector<PrimitiveType> parse_primitives(const std::string& list) {
-  std::vector<PrimitiveType> types;
-  for (const std::string& name : split_comma_list(list)) {
-    const auto type = primitive_type_from_string(name);
-    if (!type || !has_fitter(*type)) {
-      std::string known;
-      for (int t = 0; t < kPrimitiveTypeCount; ++t)
-        if (has_fitter(static_cast<PrimitiveType>(t)))
-          known +=
-              (known.empty() ? "" : ", ") + std::string(to_string(static_cast<PrimitiveType>(t)));
-      throw InvalidInputError("--primitives: unknown primitive '" + name +
-                              "' (available: " + known + ")");
-    }
-    types.push_back(*type);
+  try {
+    return fittable_types_from_list(list);
+  } catch (const InvalidInputError& error) {
+    throw InvalidInputError(std::string("--primitives: ") + error.what());
   }
-  return types;
 }
 
 Progress::Progress(const char* what, bool quiet) : what_(what), enabled_(!quiet && ::isatty(2)) {}

@@ -75,8 +75,8 @@ Hierarchy read_input_tree(const std::filesystem::path& path, std::uint64_t* byte
 /// The items of a comma-separated list, empty ones included ("" gives one empty item).
 std::vector<std::string> split_comma_list(const std::string& list);
 
-/// Parses "plane,sphere,cylinder" into types that have a fitter; throws InvalidInputError
-/// naming the unknown one and the available ones.
+/// Parses "plane,sphere,cylinder" (fittable_types_from_list()); its InvalidInputError, naming
+/// the unknown type and the available ones, starts with "--primitives: ".
 std::vector<PrimitiveType> parse_primitives(const std::string& list);
 
 /// A one-line progress indicator on stderr, only when stderr is a terminal and not --quiet.

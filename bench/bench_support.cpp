@@ -13,7 +13,9 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "primseg/error.hpp"
 #include "primseg/mesh_io.hpp"
+#include "primseg/primitives/primitive_fitter.hpp"
 #include "primseg/shape_generator.hpp"
 
 namespace primseg::bench {
@@ -99,15 +101,10 @@ unsigned count_argument(const std::string& option, const char* text, unsigned lo
 }
 
 std::vector<PrimitiveType> primitives_argument(const std::string& option, const std::string& text) {
-  std::vector<PrimitiveType> types;
-  for (std::size_t begin = 0;;) {
-    const std::size_t end = std::min(text.find(',', begin), text.size());
-    const std::string name = text.substr(begin, end - begin);
-    const std::optional<PrimitiveType> type = primitive_type_from_string(name);
-    if (!type) throw std::invalid_argument(option + ": unknown primitive type '" + name + "'");
-    types.push_back(*type);
-    if (end == text.size()) return types;
-    begin = end + 1;
+  try {
+    return fittable_types_from_list(text);
+  } catch (const InvalidInputError& error) {
+    throw std::invalid_argument(option + ": " + error.what());
   }
 }
 

@@ -94,18 +94,10 @@ std::vector<PrimitiveType> parse_primitives(const py::object& names) {
       list.push_back(name.cast<std::string>());
     }
   std::vector<PrimitiveType> types;
-  for (const std::string& name : list) {
-    const auto type = primitive_type_from_string(name);
-    if (!type || !has_fitter(*type)) {
-      std::string known;
-      for (int t = 0; t < kPrimitiveTypeCount; ++t)
-        if (has_fitter(static_cast<PrimitiveType>(t)))
-          known += (known.empty() ? "'" : ", '") +
-                   std::string(to_string(static_cast<PrimitiveType>(t))) + "'";
-      throw InvalidInputError("primitives: unknown primitive '" + name + "' (available: " + known +
-                              ")");
-    }
-    types.push_back(*type);
+  try {
+    for (const std::string& name : list) types.push_back(fittable_type_from_string(name));
+  } catch (const InvalidInputError& error) {
+    throw InvalidInputError(std::string("primitives: ") + error.what());
   }
   return types;
 }

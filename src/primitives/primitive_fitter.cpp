@@ -1,5 +1,7 @@
 #include "primseg/primitives/primitive_fitter.hpp"
 
+#include <algorithm>
+#include <optional>
 #include <string>
 
 #include "primseg/error.hpp"
@@ -38,6 +40,28 @@ const PrimitiveFitter* find_fitter(PrimitiveType type) {
 
 bool has_fitter(PrimitiveType type) {
   return find_fitter(type) != nullptr;
+}
+
+PrimitiveType fittable_type_from_string(std::string_view name) {
+  const std::optional<PrimitiveType> type = primitive_type_from_string(name);
+  if (type && has_fitter(*type)) return *type;
+  std::string available;
+  for (int t = 0; t < kPrimitiveTypeCount; ++t)
+    if (has_fitter(static_cast<PrimitiveType>(t)))
+      available += (available.empty() ? "'" : ", '") +
+                   std::string(to_string(static_cast<PrimitiveType>(t))) + "'";
+  throw InvalidInputError("unknown primitive '" + std::string(name) + "' (available: " + available +
+                          ")");
+}
+
+std::vector<PrimitiveType> fittable_types_from_list(std::string_view list) {
+  std::vector<PrimitiveType> types;
+  for (std::size_t begin = 0;;) {
+    const std::size_t end = std::min(list.find(',', begin), list.size());
+    types.push_back(fittable_type_from_string(list.substr(begin, end - begin)));
+    if (end == list.size()) return types;
+    begin = end + 1;
+  }
 }
 
 const PrimitiveFitter& fitter_for(PrimitiveType type) {

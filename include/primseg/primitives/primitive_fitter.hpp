@@ -5,6 +5,8 @@
 
 #include <cstdint>
 #include <limits>
+#include <string_view>
+#include <vector>
 
 #include "primseg/cluster_stats.hpp"
 #include "primseg/cluster_view.hpp"
@@ -79,6 +81,17 @@ const PrimitiveFitter& fitter_for(PrimitiveType type);
 
 /// Whether a type has a fitter in this build.
 bool has_fitter(PrimitiveType type);
+
+/// The type named `name` (to_string()'s spelling, lower case), for a type with a fitter. The one
+/// parser of type names for the CLI, the Python module and the benchmarks.
+/// Throws InvalidInputError "unknown primitive 'NAME' (available: 'plane', 'cylinder', ...)",
+/// listing the types with a fitter in enum order, for any other name (an empty one included).
+PrimitiveType fittable_type_from_string(std::string_view name);
+
+/// The types named in a comma-separated list ("plane,sphere"), in its order, each as
+/// fittable_type_from_string() reads it: an empty list or an empty item is an unknown name ''.
+/// Repeated types are kept (HierarchyOptions' validation refuses them).
+std::vector<PrimitiveType> fittable_types_from_list(std::string_view list);
 
 /// Flips a unit direction so that its largest-magnitude component is positive (first such
 /// component on ties): the canonical sign of cylinder, cone and torus axes.
