@@ -4,7 +4,8 @@
 //   primseg_bench_memory --cgal NAME [OPTIONS]            (a libcgal-demo mesh, e.g. fandisk.off)
 //   primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]  (generated, Uniform tessellation)
 //
-// OPTIONS: --exact-costs, --threads N (HierarchyOptions::threads, default 0: all),
+// OPTIONS: --exact-costs, --eager (CandidateEvaluation::Eager: lazy evaluation's reference, the
+// same tree), --threads N (HierarchyOptions::threads, default 0: all),
 // --merge-batch-tolerance T (default 0: the exact order), --regions N (default 1: the exact
 // order), --read-only (read the input, print read_seconds, build nothing; bench/read_speed.sh)
 // --face-order auto|spatial|as-listed (HierarchyOptions::face_order, default auto) and
@@ -45,13 +46,12 @@
 namespace {
 
 int usage() {
-  std::fprintf(
-      stderr,
-      "usage: primseg_bench_memory MESH_FILE [OPTIONS]\n"
-      "       primseg_bench_memory --cgal NAME [OPTIONS]\n"
-      "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
-      "OPTIONS: --exact-costs --threads N --merge-batch-tolerance T --regions N --read-only\n"
-      "         --face-order auto|spatial|as-listed --primitives LIST\n");
+  std::fprintf(stderr,
+               "usage: primseg_bench_memory MESH_FILE [OPTIONS]\n"
+               "       primseg_bench_memory --cgal NAME [OPTIONS]\n"
+               "       primseg_bench_memory --shape NAME [EDGE_LENGTH] [OPTIONS]\n"
+               "OPTIONS: --exact-costs --eager --threads N --merge-batch-tolerance T --regions N\n"
+               "         --read-only --face-order auto|spatial|as-listed --primitives LIST\n");
   return 2;
 }
 
@@ -88,6 +88,8 @@ int run(int argc, char** argv) {
       read_only = true;
     } else if (arg == "--exact-costs") {
       options.exact_costs = true;
+    } else if (arg == "--eager") {
+      options.evaluation = CandidateEvaluation::Eager;
     } else if (arg == "--threads" && i + 1 < argc) {
       options.threads = bench::count_argument(arg, argv[++i], 0, 1024, "thread");
     } else if (arg == "--merge-batch-tolerance" && i + 1 < argc) {
