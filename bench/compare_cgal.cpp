@@ -130,6 +130,13 @@ double median(std::vector<double> values) {
   return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
+/// The median wall-clock and the median CPU time of a measurement's runs, each on its own.
+Timing median(const std::vector<Timing>& runs) {
+  std::vector<double> wall, cpu;
+  for (const Timing& run : runs) wall.push_back(run.wall_ms), cpu.push_back(run.cpu_ms);
+  return {median(std::move(wall)), median(std::move(cpu))};
+}
+
 /// primseg: the whole tree with these types. Returns the number of merges (to keep the work
 /// observable).
 std::size_t run_primseg(const std::shared_ptr<const primseg::Mesh>& mesh,
@@ -286,25 +293,24 @@ int main(int argc, char** argv) {
       row.rejected = converted.rejected_faces;
       const double max_distance = kMaxDistanceFraction * converted.diagonal;
 
-      std::vector<double> wall[4], cpu[4];
+      std::vector<Timing> primseg_runs, planes_runs, region_growing_runs, vsa_runs;
       for (int r = 0; r < repetitions; ++r) {
         std::cerr << input << ": run " << (r + 1) << "/" << repetitions << "\r" << std::flush;
-        Timing t = timed([&] { (void)run_primseg(mesh, primseg::HierarchyOptions{}.primitives); });
-        wall[0].push_back(t.wall_ms), cpu[0].push_back(t.cpu_ms);
-        t = timed([&] { (void)run_primseg(mesh, {primseg::PrimitiveType::Plane}); });
-        wall[3].push_back(t.wall_ms), cpu[3].push_back(t.cpu_ms);
-        t = timed([&] { row.regions = run_region_growing(converted.mesh, max_distance); });
-        wall[1].push_back(t.wall_ms), cpu[1].push_back(t.cpu_ms);
+        primseg_runs.push_back(
+            timed([&] { (void)run_primseg(mesh, primseg::HierarchyOptions{}.primitives); }));
+        planes_runs.push_back(
+            timed([&] { (void)run_primseg(mesh, {primseg::PrimitiveType::Plane}); }));
+        region_growing_runs.push_back(
+            timed([&] { row.regions = run_region_growing(converted.mesh, max_distance); }));
         std::vector<std::size_t> proxy_of_face;
-        t = timed([&] { proxy_of_face = run_vsa(converted.mesh); });
-        wall[2].push_back(t.wall_ms), cpu[2].push_back(t.cpu_ms);
+        vsa_runs.push_back(timed([&] { proxy_of_face = run_vsa(converted.mesh); }));
         row.proxies = distinct(proxy_of_face);
       }
       std::cerr << "\n";
-      row.primseg = {median(wall[0]), median(cpu[0])};
-      row.region_growing = {median(wall[1]), median(cpu[1])};
-      row.vsa = {median(wall[2]), median(cpu[2])};
-      row.primseg_planes = {median(wall[3]), median(cpu[3])};
+      row.primseg = median(primseg_runs);
+      row.primseg_planes = median(planes_runs);
+      row.region_growing = median(region_growing_runs);
+      row.vsa = median(vsa_runs);
       rows.push_back(row);
     }
   } catch (const std::exception& e) {

@@ -972,15 +972,15 @@ class HierarchyBuilder::Impl {
   }
 
   // The cost bound of live edge `e`, between the new cluster in `merged_slot` and a neighbour, if
-  // it holds for their union, else 0. The new cluster's spread is read once for all its edges,
-  // into `merged` on first use. A cost that would snap to zero (at most zero_cost_tolerance × the
-  // union's spread, for the cheapest type) can be below any bound from a subset, so the bound
-  // holds only above that level. The union's spread is exact from the parts' (united()); the
-  // factor 2 covers round-off. A check that fails for round-off costs an evaluation, never another
-  // tree.
-  double queued_bound(const LiveEdge& e, std::uint32_t merged_slot,
+  // it is above `defer_above` (see kDeferFactor) and holds for their union, else 0. The new
+  // cluster's spread is read once for all its edges, into `merged` on first use. A cost that would
+  // snap to zero (at most zero_cost_tolerance × the union's spread, for the cheapest type) can be
+  // below any bound from a subset, so the bound holds only above that level. The union's spread
+  // is exact from the parts' (united()); the factor 2 covers round-off. A check that fails for
+  // round-off costs an evaluation, never another tree.
+  double queued_bound(const LiveEdge& e, std::uint32_t merged_slot, double defer_above,
                       std::optional<PartSpread>& merged) const {
-    if (!(e.cost_bound > 0)) return 0;
+    if (!(e.cost_bound > defer_above)) return 0;  // (a zero bound too: defer_above >= 0)
     if (!merged) merged = part_spread(merged_slot);
     const PartSpread pair = united(*merged, part_spread(other_end(e, merged_slot)));
     if (!(pair.weight > 0)) return 0;
@@ -1295,8 +1295,7 @@ class HierarchyBuilder::Impl {
     const double defer_above = queue_.empty() ? 0 : kDeferFactor * queue_.top().cost;
     for (std::uint32_t link = head; link != kNone; link = next_link_[link]) {
       const std::uint32_t id = link / 2;
-      const double bound =
-          lazy_ && edges_[id].cost_bound > defer_above ? queued_bound(edges_[id], slot, merged) : 0;
+      const double bound = lazy_ ? queued_bound(edges_[id], slot, defer_above, merged) : 0;
       if (bound > 0)
         requeue({bound, false, PrimitiveType::Plane, id});
       else
