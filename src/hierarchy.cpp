@@ -496,17 +496,18 @@ class HierarchyBuilder::Impl {
     }
     std::vector<ClusterStats> stats(merged.size());
     const bool samples = selector_.needs_samples();
+    const int degree = selector_.stored_moment_degree();
     detail::parallel_for_threads(merged.size(), pool_.thread_count(), [&](std::size_t i, unsigned) {
       const std::uint32_t slot = merged[i];
-      graph_->face_stats(faces[first_face[slot]], stats[i], samples, 4);
+      graph_->face_stats(faces[first_face[slot]], stats[i], samples, degree);
       FaceCorners corners;
       for (std::uint32_t k = first_face[slot] + 1; k < first_face[slot + 1]; ++k)
         if (by_corners_ && graph_->face_corners(faces[k], corners))
-          stats[i].add(corners, 4);
+          stats[i].add(corners, degree);
         else
-          stats[i].merge(graph_->face_stats(faces[k], samples, 4), EdgeStats{}, 4);
+          stats[i].merge(graph_->face_stats(faces[k], samples, degree), EdgeStats{}, degree);
       stats[i].edges += inside[i];
-      stats[i] = stats[i].centred(4);  // as the merge loop stores them
+      stats[i] = stats[i].centred(degree);  // as the merge loop stores them
     });
     // Stored clusters have three faces or more, but for those pairs: room for them all, ahead of
     // the page warmer, which reads where the pool is.
@@ -1141,8 +1142,9 @@ class HierarchyBuilder::Impl {
     const std::uint32_t triangles = slots_[slot_a].triangles + slots_[slot_b].triangles;
     // A copy: combining edges in relink() may move the pool it is in.
     const EdgeStats shared = shared_edges(edge_id);
-    const ClusterPart part_a = part_of(slot_a, scratch_[0], 0, 4);  // (part 0 first)
-    const ClusterPart part_b = part_of(slot_b, scratch_[0], 1, 4);
+    const int degree = selector_.stored_moment_degree();
+    const ClusterPart part_a = part_of(slot_a, scratch_[0], 0, degree);  // (part 0 first)
+    const ClusterPart part_b = part_of(slot_b, scratch_[0], 1, degree);
     const ClusterView cluster(part_a, part_b, shared);
     // Two independent jobs: the new cluster's edges, and its fit and statistics (the type is
     // known: only its fit is needed, and it has the candidate's cost exactly). On two threads
@@ -1162,7 +1164,7 @@ class HierarchyBuilder::Impl {
       } else {
         model = options_.exact_costs ? select(cluster, edge)
                                      : selector_.refit(cluster, candidate.type());
-        if (!(faces == 2 && pair_by_corners(triangles))) merged_ = cluster.stats(4);
+        if (!(faces == 2 && pair_by_corners(triangles))) merged_ = cluster.stats(degree);
       }
     };
     pool_.run(2, jobs, parallel_from_);

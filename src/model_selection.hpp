@@ -33,6 +33,9 @@ class ModelSelector {
   int moment_degree(std::uint32_t triangle_count) const {
     return triangle_count >= min_curved_triangles_ ? 4 : 2;
   }
+  /// Highest moment degree a stored cluster needs: 4 when a curved type is enabled (the cluster
+  /// may join a union that type fits), else 2 (the plane reads the second moment only).
+  int stored_moment_degree() const { return min_curved_triangles_ == UINT32_MAX ? 2 : 4; }
   /// Whether some enabled type reads ClusterStats::samples (DualGraph::face_stats must fill them).
   bool needs_samples() const { return needs_samples_; }
   /// Whether every enabled type's fit is a closed form (PrimitiveFitter::closed_form).
