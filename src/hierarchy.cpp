@@ -914,6 +914,7 @@ class HierarchyBuilder::Impl {
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     double spread = 0;
   };
+  static constexpr double kNotRead = std::numeric_limits<double>::quiet_NaN();
   static PartSpread spread_of(const ClusterStats& stats) {
     return {stats.moments.weight(), stats.moments.origin(), stats.moments.second_moment().trace()};
   }
@@ -956,18 +957,30 @@ class HierarchyBuilder::Impl {
             weights[i][k] * (graph_->position(corners[i][k]) - result.centroid).squaredNorm();
     return result;
   }
+  // A face's spread, read once: a face is checked as the neighbour of about five new clusters
+  // (bunny00 with planes: 3% fewer build instructions, for 40 bytes a face). The table is made at
+  // the first check, so never when some enabled type gives no bound (the cylinder).
+  PartSpread cached_face_spread(std::uint32_t face) {
+    if (face_spreads_.empty()) {
+      detail::resize_huge(face_spreads_, graph_->face_count());
+      std::fill(face_spreads_.begin(), face_spreads_.end(), PartSpread{kNotRead, {}, 0});
+    }
+    PartSpread& cached = face_spreads_[face];
+    if (std::isnan(cached.weight)) cached = face_spread(face);
+    return cached;
+  }
   // The spread of the cluster in `slot`: a stored cluster's from its statistics, a face's and a
-  // pair's from their corners (or a pair's cached statistics).
-  PartSpread part_spread(std::uint32_t slot) const {
+  // pair's from their faces' (or a pair's cached statistics).
+  PartSpread part_spread(std::uint32_t slot) {
     const std::uint32_t index = slots_[slot].stats;
-    if (index == kNone) return face_spread(slot);
+    if (index == kNone) return cached_face_spread(slot);
     if (index & kPairTag) {
       if (!pair_by_corners(slots_[slot].triangles)) {
         const CachedPair& cached = pair_cache_[index % kCachedPairs];
         if (cached.key == index) return spread_of(cached.stats);
       }
       const DualEdge& pair = graph_->edges()[index & ~kPairTag];
-      return united(face_spread(pair.first), face_spread(pair.second));
+      return united(cached_face_spread(pair.first), cached_face_spread(pair.second));
     }
     return spread_of(stats_[index]);
   }
@@ -980,7 +993,7 @@ class HierarchyBuilder::Impl {
   // is exact from the parts' (united()); the factor 2 covers round-off. A check that fails for
   // round-off costs an evaluation, never another tree.
   double queued_bound(const LiveEdge& e, std::uint32_t merged_slot, double defer_above,
-                      std::optional<PartSpread>& merged) const {
+                      std::optional<PartSpread>& merged) {
     if (!(e.cost_bound > defer_above)) return 0;  // (a zero bound too: defer_above >= 0)
     if (!merged) merged = part_spread(merged_slot);
     const PartSpread pair = united(*merged, part_spread(other_end(e, merged_slot)));
@@ -1390,6 +1403,7 @@ class HierarchyBuilder::Impl {
     release(evaluated_at_);
     release(dirty_slots_);
     release(batch_slots_);
+    release(face_spreads_);
   }
 
   // Components are joined in the order of their lowest face, each trailing merge costed above
@@ -1456,6 +1470,8 @@ class HierarchyBuilder::Impl {
   std::uint64_t evaluations_ = 0;
   detail::EvaluationTape* tape_ = nullptr;  // null unless a benchmark records or replays
   bool lazy_ = false;
+  // Per face, for lazy bounds (see cached_face_spread()); weight kNotRead until read.
+  std::vector<PartSpread> face_spreads_;
   Lookahead lookahead_;  // the last merge's guess at the next one
   // Batched merging only (see HierarchyOptions::merge_batch_tolerance): per slot, the merge
   // count just after its cluster formed; per edge, the merge count when its cost was taken.
