@@ -962,8 +962,8 @@ class HierarchyBuilder::Impl {
   // the first check, so never when some enabled type gives no bound (the cylinder).
   PartSpread cached_face_spread(std::uint32_t face) {
     if (face_spreads_.empty()) {
-      detail::resize_huge(face_spreads_, graph_->face_count());
-      std::fill(face_spreads_.begin(), face_spreads_.end(), PartSpread{kNotRead, {}, 0});
+      detail::reserve_huge_to_fill(face_spreads_, graph_->face_count());
+      face_spreads_.assign(graph_->face_count(), PartSpread{kNotRead, Eigen::Vector3d::Zero(), 0});
     }
     PartSpread& cached = face_spreads_[face];
     if (std::isnan(cached.weight)) cached = face_spread(face);
