@@ -100,12 +100,25 @@ ClusterView::ClusterView(ClusterPart a, ClusterPart b, const EdgeStats& shared)
   second_moment_ += placement.second_moment_gain;
 }
 
-const ClusterView::Eigenpair& ClusterView::smallest_eigenpair() const {
-  if (!smallest_) {
-    const detail::Eigenpair e = detail::smallest_eigenpair(second_moment_);
-    smallest_ = Eigenpair{e.value, e.vector};
+void ClusterView::compute_smallest_eigenpair() const {
+  detail::Eigenpair e;
+  eigen_steps_.count = detail::smallest_eigenpair(second_moment_, &e, &eigen_steps_.isolated,
+                                                  &eigen_steps_.orthogonal);
+  smallest_ = Eigenpair{e.value, e.vector};
+}
+
+const ClusterView::Eigensystem& ClusterView::second_moment_eigensystem() const {
+  if (!eigensystem_) {
+    // The plane's smallest pair has most often been asked for: its steps are most of the way.
+    smallest_eigenpair();
+    const detail::SymmetricEigen3 e =
+        eigen_steps_.count > 0
+            ? detail::symmetric_eigen3_from(second_moment_, eigen_steps_.count,
+                                            eigen_steps_.isolated, eigen_steps_.orthogonal)
+            : detail::symmetric_eigen3(second_moment_);
+    eigensystem_ = Eigensystem{e.values, e.vectors};
   }
-  return *smallest_;
+  return *eigensystem_;
 }
 
 Eigen::Matrix3d ClusterView::edge_tensor() const {

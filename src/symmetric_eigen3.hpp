@@ -79,10 +79,25 @@ struct IsolatedRoot {
   double shifted() const { return 2 * p * (low ? -x : x); }
 };
 
-inline IsolatedRoot isolated_root(const Eigen::Matrix3d& a) {
+// max |a_ij| of the symmetric a.
+inline double max_entry(const Eigen::Matrix3d& a) {
+  return std::max({std::abs(a(0, 0)), std::abs(a(1, 1)), std::abs(a(2, 2)), std::abs(a(0, 1)),
+                   std::abs(a(0, 2)), std::abs(a(1, 2))});
+}
+
+// a / scale − mean I, with mean the mean eigenvalue of a / scale.
+inline Eigen::Matrix3d scaled_and_shifted(const Eigen::Matrix3d& a, double scale, double* mean) {
+  Eigen::Matrix3d b = a * (1 / scale);
+  *mean = b.trace() / 3;
+  b.diagonal().array() -= *mean;
+  return b;
+}
+
+// (Forced inline, as the compiler chose while it had fewer callers: returned through memory from
+// a call, the root cost bunny00's build 0.2% more instructions.)
+inline __attribute__((always_inline)) IsolatedRoot isolated_root(const Eigen::Matrix3d& a) {
   IsolatedRoot root;
-  root.scale = std::max({std::abs(a(0, 0)), std::abs(a(1, 1)), std::abs(a(2, 2)), std::abs(a(0, 1)),
-                         std::abs(a(0, 2)), std::abs(a(1, 2))});
+  root.scale = max_entry(a);
   // (std::max passes a NaN over: the sum of the entries does not.)
   if (!std::isfinite(root.scale + a(0, 0) + a(1, 1) + a(2, 2) + a(0, 1) + a(0, 2) + a(1, 2))) {
     root.kind = IsolatedRoot::kNotFinite;
@@ -92,11 +107,8 @@ inline IsolatedRoot isolated_root(const Eigen::Matrix3d& a) {
     root.kind = IsolatedRoot::kZero;
     return root;
   }
-  // Scaled to entries of magnitude at most 1, shifted by the mean eigenvalue.
   Eigen::Matrix3d& b = root.b;
-  b = a * (1 / root.scale);
-  root.mean = b.trace() / 3;
-  b.diagonal().array() -= root.mean;
+  b = scaled_and_shifted(a, root.scale, &root.mean);
   const double off = b(0, 1) * b(0, 1) + b(0, 2) * b(0, 2) + b(1, 2) * b(1, 2);
   const double p2 = (b(0, 0) * b(0, 0) + b(1, 1) * b(1, 1) + b(2, 2) * b(2, 2) + 2 * off) / 6;
   if (!(p2 > 0)) {
@@ -150,25 +162,11 @@ inline Eigen::Vector3d smaller_orthogonal_eigenvector(const Eigen::Matrix3d& b,
   return (cu * u + cv * v) * (1 / std::sqrt(length2));
 }
 
-// The full decomposition from the isolated root.
-inline SymmetricEigen3 complete(const Eigen::Matrix3d& a, const IsolatedRoot& root) {
+// The full decomposition from the isolated eigenvalue's vector `first` and the smaller
+// eigenvector orthogonal to it, `second`.
+inline SymmetricEigen3 from_vectors(const Eigen::Matrix3d& a, const Eigen::Vector3d& first,
+                                    const Eigen::Vector3d& second) {
   SymmetricEigen3 result;
-  result.vectors = Eigen::Matrix3d::Identity();
-  switch (root.kind) {
-    case IsolatedRoot::kNotFinite:
-      result.values = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-      return result;
-    case IsolatedRoot::kZero:
-      result.values = Eigen::Vector3d::Zero();  // every vector is an eigenvector
-      return result;
-    case IsolatedRoot::kScalar:
-      result.values = Eigen::Vector3d::Constant(a(0, 0));
-      return result;
-    case IsolatedRoot::kFound:
-      break;
-  }
-  const Eigen::Vector3d first = eigenvector_of(root.b, root.shifted());
-  const Eigen::Vector3d second = smaller_orthogonal_eigenvector(root.b, first);
   result.vectors.col(0) = first;
   result.vectors.col(1) = second;
   result.vectors.col(2) = first.cross(second);
@@ -187,6 +185,27 @@ inline SymmetricEigen3 complete(const Eigen::Matrix3d& a, const IsolatedRoot& ro
   return result;
 }
 
+// The full decomposition from the isolated root.
+inline SymmetricEigen3 complete(const Eigen::Matrix3d& a, const IsolatedRoot& root) {
+  SymmetricEigen3 result;
+  result.vectors = Eigen::Matrix3d::Identity();
+  switch (root.kind) {
+    case IsolatedRoot::kNotFinite:
+      result.values = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+      return result;
+    case IsolatedRoot::kZero:
+      result.values = Eigen::Vector3d::Zero();  // every vector is an eigenvector
+      return result;
+    case IsolatedRoot::kScalar:
+      result.values = Eigen::Vector3d::Constant(a(0, 0));
+      return result;
+    case IsolatedRoot::kFound:
+      break;
+  }
+  const Eigen::Vector3d first = eigenvector_of(root.b, root.shifted());
+  return from_vectors(a, first, smaller_orthogonal_eigenvector(root.b, first));
+}
+
 }  // namespace eigen3_detail
 
 /// Eigen-decomposition of the symmetric matrix a. Input with a non-finite entry gives NaN
@@ -201,19 +220,53 @@ struct Eigenpair {
   Eigen::Vector3d vector = Eigen::Vector3d::UnitX();
 };
 
+/// smallest_eigenpair(a), also giving the vectors found on the way, from which
+/// symmetric_eigen3_from() goes on: the isolated eigenvalue's unit vector and, when that eigenvalue
+/// is the largest, the smaller one orthogonal to it. Returns how many it found: 0 for a zero,
+/// scalar or non-finite matrix, else 1 or 2.
+/// (Forced inline: the merge loop's plane fit calls it through ClusterView.)
+inline __attribute__((always_inline)) int smallest_eigenpair(const Eigen::Matrix3d& a,
+                                                             Eigenpair* smallest,
+                                                             Eigen::Vector3d* isolated,
+                                                             Eigen::Vector3d* orthogonal) {
+  const eigen3_detail::IsolatedRoot root = eigen3_detail::isolated_root(a);
+  if (root.kind != eigen3_detail::IsolatedRoot::kFound) {
+    const SymmetricEigen3 all = eigen3_detail::complete(a, root);
+    *smallest = {all.values(0), all.vectors.col(0)};
+    return 0;
+  }
+  *isolated = eigen3_detail::eigenvector_of(root.b, root.shifted());
+  if (root.low) {
+    *smallest = {isolated->dot(a * *isolated), *isolated};
+    return 1;
+  }
+  *orthogonal = eigen3_detail::smaller_orthogonal_eigenvector(root.b, *isolated);
+  *smallest = {orthogonal->dot(a * *orthogonal), *orthogonal};
+  return 2;
+}
+
 /// The smallest eigenvalue of the symmetric matrix a and its eigenvector: the first column of
 /// symmetric_eigen3(a) (but where round-off would order two nearly equal eigenvalues the other
 /// way), at about half its cost: the isolated eigenvalue's vector when it is the smallest, else
 /// the smaller one of the 2x2 problem orthogonal to it.
 inline Eigenpair smallest_eigenpair(const Eigen::Matrix3d& a) {
-  const eigen3_detail::IsolatedRoot root = eigen3_detail::isolated_root(a);
-  if (root.kind != eigen3_detail::IsolatedRoot::kFound) {
-    const SymmetricEigen3 all = eigen3_detail::complete(a, root);
-    return {all.values(0), all.vectors.col(0)};
-  }
-  Eigen::Vector3d v = eigen3_detail::eigenvector_of(root.b, root.shifted());
-  if (!root.low) v = eigen3_detail::smaller_orthogonal_eigenvector(root.b, v);
-  return {v.dot(a * v), v};
+  Eigenpair smallest;
+  Eigen::Vector3d isolated, orthogonal;
+  smallest_eigenpair(a, &smallest, &isolated, &orthogonal);
+  return smallest;
+}
+
+/// symmetric_eigen3(a), the same bits, from what smallest_eigenpair(a, ...) found (`count` vectors,
+/// at least 1; `orthogonal` is read when count is 2).
+inline SymmetricEigen3 symmetric_eigen3_from(const Eigen::Matrix3d& a, int count,
+                                             const Eigen::Vector3d& isolated,
+                                             const Eigen::Vector3d& orthogonal) {
+  if (count >= 2) return eigen3_detail::from_vectors(a, isolated, orthogonal);
+  double mean = 0;
+  const Eigen::Matrix3d b =
+      eigen3_detail::scaled_and_shifted(a, eigen3_detail::max_entry(a), &mean);
+  return eigen3_detail::from_vectors(a, isolated,
+                                     eigen3_detail::smaller_orthogonal_eigenvector(b, isolated));
 }
 
 /// The eigenvalue of largest magnitude of the symmetric matrix a (the largest on a tie) and its

@@ -9,9 +9,11 @@
 #include <numeric>
 #include <random>
 
+#include "primitives/pratt_fit.hpp"
 #include "primseg/dual_graph.hpp"
 #include "primseg/shape_generator.hpp"
 #include "support/test_support.hpp"
+#include "symmetric_eigen3.hpp"
 
 namespace primseg {
 namespace {
@@ -261,6 +263,57 @@ TEST(ClusterView, PolygonFacesByTheirCorners) {
     EXPECT_GT(face.edges.tensor_matrix().cwiseAbs().maxCoeff(), 0) << f;
     expect_near(face.second_moment, stats.moments.second_moment(), 1e-15, "second moment");
   }
+}
+
+// The sphere's fit reads the second moment's whole decomposition from the view, which goes on from
+// the plane's smallest pair: it must be the decomposition computed anew, bit for bit, whether the
+// pair was asked for first or not, and the sphere's fit the same as from the moments alone.
+TEST(ClusterView, SecondMomentDecompositionAndSphereFitAreThoseComputedAnew) {
+  const Mesh mesh = testing::noisy_uniform_shape("cylinder_with_sphere_cap");
+  const DualGraph graph(mesh, VertexWeights::Area);
+  std::mt19937_64 rng(11);
+  int solved = 0, beaten = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const std::vector<std::uint32_t> all = shuffled_faces(graph, rng);
+    const std::vector<std::uint32_t> a(all.begin(), all.begin() + 4 + trial * 13);
+    const ClusterStats stats = stats_of(graph, a);
+    FaceCorners face;
+    ASSERT_TRUE(graph.face_corners(all[200], face));
+    const EdgeStats shared;
+    const ClusterView reference(stats, face, shared);
+    const detail::SymmetricEigen3 anew = detail::symmetric_eigen3(reference.second_moment());
+    for (bool smallest_first : {true, false}) {
+      const ClusterView view(stats, face, shared);
+      if (smallest_first) {
+        EXPECT_EQ(view.smallest_eigenvalue(), reference.smallest_eigenvalue());
+      }
+      const ClusterView::Eigensystem& e = view.second_moment_eigensystem();
+      EXPECT_EQ(e.values, anew.values) << trial;
+      EXPECT_EQ(e.vectors, anew.vectors) << trial;
+    }
+    detail::CentredMomentsND<3> moments;
+    moments.weight = reference.weight();
+    moments.second = reference.second_moment();
+    moments.third = reference.radial_moments().third;
+    moments.fourth = reference.radial_moments().fourth;
+    const double minimum = detail::pratt_fit(moments).objective_minimum;
+    for (double factor : {std::numeric_limits<double>::infinity(), 2.0, 0.5}) {
+      const double beat = factor * minimum;
+      const detail::PrattResult<3> from_moments =
+          detail::pratt_fit(moments, beat, reference.smallest_eigenvalue());
+      const ClusterView view(stats, face, shared);
+      const detail::PrattResult<3> from_view = detail::pratt_fit(view, beat);
+      EXPECT_EQ(from_view.valid, from_moments.valid);
+      EXPECT_EQ(from_view.beaten, from_moments.beaten);
+      EXPECT_EQ(from_view.error, from_moments.error);
+      EXPECT_EQ(from_view.objective_minimum, from_moments.objective_minimum);
+      EXPECT_EQ(from_view.radius, from_moments.radius);
+      EXPECT_EQ(from_view.centre, from_moments.centre);
+      ++(from_view.beaten ? beaten : solved);
+    }
+  }
+  EXPECT_GT(solved, 40);
+  EXPECT_GT(beaten, 20);
 }
 
 }  // namespace

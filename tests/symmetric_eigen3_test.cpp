@@ -100,6 +100,39 @@ TEST(SymmetricEigen3, SmallestAndDominantPairsAreThoseOfTheFullDecomposition) {
   }
 }
 
+// The sphere's fit asks for the whole decomposition after the plane's smallest pair: going on
+// from the pair's vectors must give what the whole decomposition alone gives, bit for bit, or
+// the trees would change.
+TEST(SymmetricEigen3, GoingOnFromTheSmallestPairGivesTheSameBits) {
+  std::vector<Case> cases = hard_cases();
+  for (const Eigen::Matrix3d& m :
+       {Eigen::Matrix3d(Eigen::Matrix3d::Zero()),
+        Eigen::Matrix3d(2.5 * Eigen::Matrix3d::Identity()),
+        Eigen::Matrix3d(Eigen::Vector3d(1, 2, 2) * Eigen::Vector3d(1, 2, 2).transpose())})
+    cases.push_back({m, "degenerate"});
+  int counts[3] = {0, 0, 0};
+  for (const Case& c : cases) {
+    Eigenpair smallest;
+    Eigen::Vector3d isolated, orthogonal;
+    const int count = smallest_eigenpair(c.matrix, &smallest, &isolated, &orthogonal);
+    ASSERT_GE(count, 0);
+    ASSERT_LE(count, 2);
+    ++counts[count];
+    const Eigenpair alone = smallest_eigenpair(c.matrix);
+    EXPECT_EQ(smallest.value, alone.value) << c.kind;
+    EXPECT_EQ(smallest.vector, alone.vector) << c.kind;
+    if (count == 0) continue;
+    const SymmetricEigen3 from = symmetric_eigen3_from(c.matrix, count, isolated, orthogonal);
+    const SymmetricEigen3 whole = symmetric_eigen3(c.matrix);
+    EXPECT_EQ(from.values, whole.values) << c.kind;
+    EXPECT_EQ(from.vectors, whole.vectors) << c.kind;
+  }
+  // Each path is taken: degenerate matrices, and the isolated eigenvalue the smallest or not.
+  EXPECT_GT(counts[0], 0);
+  EXPECT_GT(counts[1], 1000);
+  EXPECT_GT(counts[2], 1000);
+}
+
 TEST(SymmetricEigen3, SmallEigenvaluesOfScatterMatricesHaveTheIterativeSolversAccuracy) {
   // A scatter matrix of points near a plane: its smallest eigenvalue is the plane's whole error,
   // and must not carry more round-off than the iterative solver's (a few ulps of the norm).

@@ -78,6 +78,15 @@ class ClusterView {
   /// use, then kept): the plane's error and normal.
   double smallest_eigenvalue() const { return smallest_eigenpair().value; }
   const Eigen::Vector3d& smallest_eigenvector() const { return smallest_eigenpair().vector; }
+  /// Eigenvalues in ascending order and unit eigenvectors (columns, in the same order).
+  struct Eigensystem {
+    Eigen::Vector3d values;
+    Eigen::Matrix3d vectors;
+  };
+  /// The eigen-decomposition of second_moment() (computed on first use, then kept; it goes on
+  /// from what smallest_eigenvalue() computed). Where two eigenvalues are equal to round-off, its
+  /// first column may be the other one than smallest_eigenvector().
+  const Eigensystem& second_moment_eigensystem() const;
 
   std::uint32_t triangle_count() const { return triangle_count_; }
   /// Σ triangle area.
@@ -145,10 +154,23 @@ class ClusterView {
     Eigen::Vector3d vector;
   };
   mutable std::optional<Eigenpair> smallest_;
+  // The vectors the smallest pair's solver found on the way (src/symmetric_eigen3.hpp), from
+  // which the whole decomposition goes on: how many, the isolated eigenvalue's, the other.
+  struct EigenSteps {
+    int count = 0;
+    Eigen::Vector3d isolated, orthogonal;
+  };
+  mutable EigenSteps eigen_steps_;
+  mutable std::optional<Eigensystem> eigensystem_;
   mutable std::optional<RadialMoments> radial_;
   mutable std::optional<Eigen::Matrix3d> normal_position_;  // Σ (c − centroid)(A n)ᵀ
   mutable std::optional<ClusterStats> union_stats_;
-  const Eigenpair& smallest_eigenpair() const;
+  // (The check inline: most calls find the pair computed.)
+  const Eigenpair& smallest_eigenpair() const {
+    if (!smallest_) compute_smallest_eigenpair();
+    return *smallest_;
+  }
+  void compute_smallest_eigenpair() const;
 };
 
 }  // namespace primseg

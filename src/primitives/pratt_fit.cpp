@@ -126,11 +126,11 @@ struct SecularEquation {
   }
 };
 
-}  // namespace
-
-template <int D>
-PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to_beat,
-                         double smallest_eigenvalue) {
+// pratt_fit(), with the eigen-decomposition of moments.second from eigensystem_of_second(),
+// asked for only when the fit needs it.
+template <int D, class EigensystemSource>
+PrattResult<D> fit(const CentredMomentsND<D>& moments, double objective_to_beat,
+                   double smallest_eigenvalue, EigensystemSource eigensystem_of_second) {
   using Vector = Eigen::Matrix<double, D, 1>;
   PrattResult<D> result;
   const double w = moments.weight;
@@ -164,7 +164,7 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to
     return result;
   }
 
-  const Eigensystem<D> second = eigensystem_of(moments.second);
+  const Eigensystem<D> second = eigensystem_of_second();
   const SecularEquation<D> secular{second.values * scale2, second.vectors.transpose() * t, f, s, w};
   const Vector& lambda = secular.lambda;
   const Vector& tau = secular.tau;
@@ -184,6 +184,28 @@ PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to
   result.centre = -b / 2 / scale;
   result.radius = relative_radius / scale;
   return result;
+}
+
+}  // namespace
+
+template <int D>
+PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments, double objective_to_beat,
+                         double smallest_eigenvalue) {
+  return fit(moments, objective_to_beat, smallest_eigenvalue,
+             [&] { return eigensystem_of(moments.second); });
+}
+
+PrattResult<3> pratt_fit(const ClusterView& cluster, double objective_to_beat) {
+  const ClusterView::RadialMoments& radial = cluster.radial_moments();
+  CentredMomentsND<3> moments;
+  moments.weight = cluster.weight();
+  moments.second = cluster.second_moment();
+  moments.third = radial.third;
+  moments.fourth = radial.fourth;
+  return fit(moments, objective_to_beat, cluster.smallest_eigenvalue(), [&] {
+    const ClusterView::Eigensystem& second = cluster.second_moment_eigensystem();
+    return Eigensystem<3>{second.values, second.vectors};
+  });
 }
 
 template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, double, double);

@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <limits>
 
+#include "primseg/cluster_view.hpp"
+
 namespace primseg::detail {
 
 template <int D>
@@ -46,6 +48,11 @@ template <int D>
 PrattResult<D> pratt_fit(const CentredMomentsND<D>& moments,
                          double objective_to_beat = std::numeric_limits<double>::infinity(),
                          double smallest_eigenvalue = std::numeric_limits<double>::quiet_NaN());
+
+/// The sphere of a cluster: pratt_fit() of its moments, with the smallest eigenvalue and the
+/// eigen-decomposition of its second moment from the view, which computes them once for every fit
+/// that reads them (the plane's smallest pair takes most of the steps of the whole decomposition).
+PrattResult<3> pratt_fit(const ClusterView& cluster, double objective_to_beat);
 
 extern template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, double, double);
 extern template PrattResult<3> pratt_fit<3>(const CentredMomentsND<3>&, double, double);

@@ -15,15 +15,7 @@ PrimitiveFit SphereFitter::fit(const ClusterView& cluster, double error_to_beat)
   PrimitiveFit result;
   result.primitive.type = PrimitiveType::Sphere;
   if (cluster.triangle_count() < min_triangles()) return result;
-  const ClusterView::RadialMoments& radial = cluster.radial_moments();
-  detail::CentredMomentsND<3> moments;
-  moments.weight = cluster.weight();
-  moments.second = cluster.second_moment();
-  moments.third = radial.third;
-  moments.fourth = radial.fourth;
-  // The plane's smallest eigenvalue of the same second moment, shared.
-  const detail::PrattResult<3> sphere =
-      detail::pratt_fit(moments, error_to_beat, cluster.smallest_eigenvalue());
+  const detail::PrattResult<3> sphere = detail::pratt_fit(cluster, error_to_beat);
   result.superset_error_bound = sphere.objective_minimum;
   result.beaten = sphere.beaten;
   if (!sphere.valid) return result;
