@@ -111,11 +111,8 @@ const ClusterView::Eigensystem& ClusterView::second_moment_eigensystem() const {
   if (!eigensystem_) {
     // The plane's smallest pair has most often been asked for: its steps are most of the way.
     smallest_eigenpair();
-    const detail::SymmetricEigen3 e =
-        eigen_steps_.count > 0
-            ? detail::symmetric_eigen3_from(second_moment_, eigen_steps_.count,
-                                            eigen_steps_.isolated, eigen_steps_.orthogonal)
-            : detail::symmetric_eigen3(second_moment_);
+    const detail::SymmetricEigen3 e = detail::symmetric_eigen3_from(
+        second_moment_, eigen_steps_.count, eigen_steps_.isolated, eigen_steps_.orthogonal);
     eigensystem_ = Eigensystem{e.values, e.vectors};
   }
   return *eigensystem_;

@@ -256,12 +256,15 @@ inline Eigenpair smallest_eigenpair(const Eigen::Matrix3d& a) {
   return smallest;
 }
 
-/// symmetric_eigen3(a), the same bits, from what smallest_eigenpair(a, ...) found (`count` vectors,
-/// at least 1; `orthogonal` is read when count is 2).
+/// symmetric_eigen3(a), the same bits, from what smallest_eigenpair(a, ...) found: `count` (its
+/// result) vectors, `orthogonal` read only when it is 2.
 inline SymmetricEigen3 symmetric_eigen3_from(const Eigen::Matrix3d& a, int count,
                                              const Eigen::Vector3d& isolated,
                                              const Eigen::Vector3d& orthogonal) {
-  if (count >= 2) return eigen3_detail::from_vectors(a, isolated, orthogonal);
+  if (count == 0) return symmetric_eigen3(a);
+  if (count == 2) return eigen3_detail::from_vectors(a, isolated, orthogonal);
+  // The shifted matrix as isolated_root() makes it (a few operations: the root was the costly
+  // part).
   double mean = 0;
   const Eigen::Matrix3d b =
       eigen3_detail::scaled_and_shifted(a, eigen3_detail::max_entry(a), &mean);

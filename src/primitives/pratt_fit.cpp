@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "primseg/cluster_view.hpp"
 #include "symmetric_eigen3.hpp"
 
 namespace primseg::detail {
@@ -164,7 +165,7 @@ PrattResult<D> fit(const CentredMomentsND<D>& moments, double objective_to_beat,
     return result;
   }
 
-  const Eigensystem<D> second = eigensystem_of_second();
+  const auto& second = eigensystem_of_second();  // (values ascending, vectors as columns)
   const SecularEquation<D> secular{second.values * scale2, second.vectors.transpose() * t, f, s, w};
   const Vector& lambda = secular.lambda;
   const Vector& tau = secular.tau;
@@ -202,10 +203,9 @@ PrattResult<3> pratt_fit(const ClusterView& cluster, double objective_to_beat) {
   moments.second = cluster.second_moment();
   moments.third = radial.third;
   moments.fourth = radial.fourth;
-  return fit(moments, objective_to_beat, cluster.smallest_eigenvalue(), [&] {
-    const ClusterView::Eigensystem& second = cluster.second_moment_eigensystem();
-    return Eigensystem<3>{second.values, second.vectors};
-  });
+  return fit(
+      moments, objective_to_beat, cluster.smallest_eigenvalue(),
+      [&]() -> const ClusterView::Eigensystem& { return cluster.second_moment_eigensystem(); });
 }
 
 template PrattResult<2> pratt_fit<2>(const CentredMomentsND<2>&, double, double);

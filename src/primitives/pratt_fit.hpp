@@ -9,7 +9,9 @@
 #include <Eigen/Core>
 #include <limits>
 
-#include "primseg/cluster_view.hpp"
+namespace primseg {
+class ClusterView;
+}
 
 namespace primseg::detail {
 
