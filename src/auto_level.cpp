@@ -173,17 +173,22 @@ std::vector<ErrorCurvePoint> error_curve(const Hierarchy& hierarchy) {
 AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& options) {
   if (!(options.rms_floor >= 0) || !std::isfinite(options.rms_floor))
     throw InvalidInputError("auto level: the RMS floor must be a non-negative number");
+  if (!(options.knee_rms_floor >= 0) || !std::isfinite(options.knee_rms_floor))
+    throw InvalidInputError("auto level: the knee's RMS floor must be a non-negative number");
   if (!(options.min_score >= 1) || !std::isfinite(options.min_score))
     throw InvalidInputError("auto level: the minimum score must be a number >= 1");
   if (options.max_candidates < 1)
     throw InvalidInputError("auto level: at least one candidate must be asked for");
   const std::vector<ErrorCurvePoint> curve = error_curve(hierarchy);
   const double diagonal = bounding_box_diagonal(hierarchy.mesh());
-  const double floor = options.rms_floor * diagonal;
-  // The smallest normal double keeps the ratios finite on a degenerate (zero-size) mesh.
-  auto floored = [&](double rms) {
-    return std::max({rms, floor, std::numeric_limits<double>::min()});
+  // RMS values raised to a fraction of the diagonal; the smallest normal double keeps the ratios
+  // finite on a degenerate (zero-size) mesh.
+  auto floor_at = [diagonal](double fraction) {
+    return [floor = fraction * diagonal](double rms) {
+      return std::max({rms, floor, std::numeric_limits<double>::min()});
+    };
   };
+  const auto floored = floor_at(options.rms_floor);
   const std::uint32_t c = hierarchy.component_count(), f = hierarchy.face_count();
   // Level k (c < k <= f) and the jump of the cluster its next merge makes (merges[f - k]: the
   // first f - k merges give level k, all of them real).
@@ -227,7 +232,8 @@ AutoLevel choose_level(const Hierarchy& hierarchy, const AutoLevelOptions& optio
   // No jump: the knee of log rms against K. Real parts with blends descend steadily while
   // merges join different surfaces, and flatten once they only join pieces of one surface.
   if (rule == AutoLevelRule::Components && options.knee_fallback) {
-    const std::optional<std::uint32_t> knee = curve_knee(curve, c, finest, floored, options);
+    const std::optional<std::uint32_t> knee =
+        curve_knee(curve, c, finest, floor_at(options.knee_rms_floor), options);
     if (knee) {
       chosen = *knee;
       rule = AutoLevelRule::Knee;

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <tuple>
 
 #include "primseg/cut.hpp"
 #include "primseg/dual_graph.hpp"
@@ -344,6 +346,48 @@ TEST(AutoLevel, TheBendAfterTheFirstLevelIsFoundAndTooSmall) {
   EXPECT_EQ(level.clusters, 1u);
 }
 
+// A fine tessellation of a part whose clusters fit a little better as they shrink (as
+// fandisk_large below): the curve falls steeply to its surfaces (K = 25), then gently on, and
+// crosses the jumps' floor (1e-4 of the diagonal) at K = 1,205, within the knee's first range
+// (F / 10 = 2,000). Floored there, it would be flat from 1,205 on, and that bend, the floor's own,
+// is the one the L-method finds.
+TEST(AutoLevel, ACurveGlidingIntoTheFloorKeepsTheKneeOfItsSurfaces) {
+  constexpr std::uint32_t kFaces = 20000;
+  const Hierarchy fine = hierarchy_with_curve(bent_curve(25, 0.165, 0.0025, kFaces / 2), kFaces);
+  const double floor = 1e-4 * bounding_box_diagonal(fine.mesh());
+  const std::vector<ErrorCurvePoint> curve = error_curve(fine);
+  const auto onset = std::find_if(curve.begin(), curve.end(),
+                                  [&](const ErrorCurvePoint& p) { return p.rms <= floor; });
+  ASSERT_NE(onset, curve.end());
+  EXPECT_GT(onset->clusters, 1000u);
+  EXPECT_LT(onset->clusters, kFaces / 10);
+  const AutoLevel level = choose_level(fine);
+  EXPECT_EQ(level.rule, AutoLevelRule::Knee);
+  EXPECT_GE(level.clusters, 24u);  // K = 25 is on both lines
+  EXPECT_LE(level.clusters, 25u);
+  // The knee floored as the jumps are: the floor's bend.
+  AutoLevelOptions floored;
+  floored.knee_rms_floor = floored.rms_floor;
+  const AutoLevel at_the_floor = choose_level(fine, floored);
+  EXPECT_EQ(at_the_floor.rule, AutoLevelRule::Knee);
+  EXPECT_GT(at_the_floor.clusters, onset->clusters - 50);
+  EXPECT_LE(at_the_floor.clusters, onset->clusters);
+}
+
+// The same on real meshes of libcgal-demo: fandisk_large (31,682 faces, its curve 10 times the
+// floor at K = 25 and reaching it at 1,342) and rotor_small (4,800 faces, a coarse tessellation
+// whose every facet is a plane: at 202 clusters, one a facet) get their surfaces, not the level
+// where the curve meets the floor (they got 1,272 and 202 when the knee was floored at 1e-4).
+TEST(AutoLevel, FineTessellationsGetTheKneeOfTheirSurfaces) {
+  for (const auto& [name, lowest, highest] :
+       {std::tuple{"fandisk_large.off", 20u, 30u}, std::tuple{"rotor_small.off", 10u, 15u}}) {
+    const AutoLevel level = choose_level(build_hierarchy(read_mesh(testing::cgal_mesh(name))));
+    EXPECT_EQ(level.rule, AutoLevelRule::Knee) << name;
+    EXPECT_GE(level.clusters, lowest) << name;
+    EXPECT_LE(level.clusters, highest) << name;
+  }
+}
+
 TEST(AutoLevel, RulesHaveNames) {
   EXPECT_EQ(to_string(AutoLevelRule::Jump), "jump");
   EXPECT_EQ(to_string(AutoLevelRule::Knee), "knee");
@@ -364,6 +408,9 @@ TEST(AutoLevel, RejectsUnusableOptions) {
   const Hierarchy h = build_hierarchy(make_shape("box").mesh);
   AutoLevelOptions bad;
   bad.rms_floor = -1;
+  EXPECT_THROW(choose_level(h, bad), InvalidInputError);
+  bad = {};
+  bad.knee_rms_floor = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(choose_level(h, bad), InvalidInputError);
   bad = {};
   bad.min_score = 0.5;

@@ -34,6 +34,13 @@ struct AutoLevelOptions {
   /// and such wavering must not look like a jump. 1e-4 stays well below the noise of scanned
   /// parts, and far below any error a reverse engineer would call a different surface.
   double rms_floor = 1e-4;
+  /// The same floor for the knee (AutoLevelRule::Knee), a fraction of the diagonal too: the
+  /// round-off and first-order-fit level only. A curve that falls gently into rms_floor within the
+  /// knee's search range (a finely tessellated part whose clusters fit a little better as they
+  /// shrink, down to a few dozen triangles each) would be flat from there on, and the L-method
+  /// would take that made-up bend for the knee: fandisk_large.off of libcgal-demo (31,682 faces)
+  /// got 1,272 clusters instead of its 25 surfaces.
+  double knee_rms_floor = 1e-6;
   /// A jump is significant when its score is at least this.
   double min_score = 2.0;
   /// Candidates reported besides the chosen level (the best-scored ones).
@@ -60,9 +67,10 @@ enum class AutoLevelRule {
   /// cluster within 0.2% of the bounding-box diagonal (twice 0.1%) is never such a jump: that
   /// small a misfit of an exact surface is tessellation, not a second surface.
   Jump,
-  /// No significant jump: the knee of log rms against K, by the L-method (Salvador and Chan
-  /// 2004): two least-squares lines, one through the coarse levels and one through the fine
-  /// ones, fitted for every split; the chosen K ends the coarse line of the best-fitting split.
+  /// No significant jump: the knee of log rms against K (rms floored at knee_rms_floor), by the
+  /// L-method (Salvador and Chan 2004): two least-squares lines, one through the coarse levels and
+  /// one through the fine ones, fitted for every split; the chosen K ends the coarse line of the
+  /// best-fitting split.
   /// The range of K is then cut to three times the knee (at least 20 levels) and the search
   /// repeated until the knee stops moving to coarser levels, so that a long flat tail does not
   /// pull it to the right.
