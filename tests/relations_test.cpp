@@ -923,15 +923,16 @@ Groups equal_radii(const std::vector<ClusterReport>& reports, double tolerance) 
   return groups;
 }
 
-// The hole patterns of two libcgal-demo parts with the borders refined (as `segment --refine 2`),
-// anchor_dense at its automatic level and couplingdown at 44 clusters (its automatic level until
-// session 87; at 48, the level since, the seven spheres along z form no coaxial set, with a new
-// sphere piece of 160 faces, fitted at 4.3e-4, centred 3e-4 off their line): couplingdown (an exact
-// tessellation: radii agree to 1e-5) has bolt
+// The hole patterns of two libcgal-demo parts at their automatic levels with the borders refined
+// (as `segment --refine 2`), and couplingdown's at 44 clusters too (its automatic level until
+// session 87, 48 since): couplingdown (an exact tessellation: radii agree to 1e-5) has bolt
 // circles of 3, 3 and 4 holes, spherical seats of 4 and 3 and two pairs of spheres; anchor_dense
 // (remeshed: to 1%) two circles of 4 holes. Each pattern is one equal-radius relation, and no
 // other cylinder or sphere joins one. The spheres centred on a cylinder's axis are centred on it,
-// and couplingdown's seven spheres centred on one line with no cylinder are one coaxial set.
+// and couplingdown's spheres centred on one line along z with no cylinder (7 at 44 clusters, 10 of
+// the 11 at 48, where a sphere piece of 160 faces fitted at 4.3e-4 lies 3e-4 off the line; until
+// a leaving sphere was the one without which the others fit best, that piece pulled the line off
+// the exact ones, which left one by one) are one coaxial set.
 TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
   struct Part {
     const char* name;
@@ -939,8 +940,10 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
     std::uint32_t clusters;  // 0: the automatic level
   };
   for (const auto& [name, tolerance, clusters] :
-       {Part{"couplingdown.off", 1e-5, 44}, Part{"anchor_dense.off", 1e-2, 0}}) {
+       {Part{"couplingdown.off", 1e-5, 44}, Part{"couplingdown.off", 1e-5, 0},
+        Part{"anchor_dense.off", 1e-2, 0}}) {
     SCOPED_TRACE(name);
+    SCOPED_TRACE(clusters);
     const RegularizedPart part = regularized_part(name, {}, clusters);
     const std::vector<ClusterReport>& before = part.level.reports;
     const std::vector<ClusterReport>& after = part.after;
@@ -988,7 +991,7 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
           break;
         }
     }
-    std::size_t spheres_alone = 0;
+    std::size_t spheres_alone = 0, largest_alone = 0;
     for (const auto& set : clusters_of(relations, ClusterRelation::Kind::Coaxial)) {
       const auto cylinder = std::find_if(set.begin(), set.end(), [&](std::uint32_t c) {
         return after[c].primitive.type == PrimitiveType::Cylinder;
@@ -999,6 +1002,7 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
         line = after[*cylinder].primitive;
       } else {
         ++spheres_alone;
+        largest_alone = std::max(largest_alone, set.size());
         const Vec3 &first = after[set.front()].primitive.point,
                    &last = after[set.back()].primitive.point;
         line.point = first;
@@ -1015,8 +1019,12 @@ TEST(Relations, HolePatternsOfRealPartsShareOneRadius) {
                 on_axis.size());
     EXPECT_TRUE(std::includes(on_axis.begin(), on_axis.end(), centred.begin(), centred.end()));
     EXPECT_GE(centred.size() + 1, on_axis.size());
-    // couplingdown's seven spheres centred on one line along z, with no cylinder there: one set.
-    EXPECT_EQ(spheres_alone, name == std::string("couplingdown.off") ? 1u : 0u);
+    // couplingdown's spheres centred on one line along z, with no cylinder there: one set.
+    const bool couplingdown = name == std::string("couplingdown.off");
+    EXPECT_EQ(spheres_alone, couplingdown ? 1u : 0u);
+    if (couplingdown) {
+      EXPECT_GE(largest_alone, 7u);
+    }
 
     // Coplanar: exactly the planes whose own fits are one plane (normals within 1e-6 radians up
     // to their side, offsets within 1e-9 of the diagonal: couplingdown's faces cut apart by its
