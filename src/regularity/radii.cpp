@@ -307,27 +307,36 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
                     std::vector<Relation>& relations, std::size_t fewest = 1) {
   std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
   std::optional<JointFit> fit;
-  while (spheres.size() >= fewest) {
-    SpheresOnLine all = spheres_on_line(settled, l, cylinders, spheres, options, points, weights);
+  if (spheres.size() < fewest) return false;
+  // The fit of the spheres left: after a sphere leaves, the one made while choosing it.
+  SpheresOnLine all = spheres_on_line(settled, l, cylinders, spheres, options, points, weights);
+  while (true) {
     if (!(all.excess.worst > 1)) {
       fit = std::move(all.fit);
       break;
     }
     std::size_t leaving = all.excess.worst_sphere;
     double least = std::numeric_limits<double>::infinity();
+    std::optional<SpheresOnLine> without_leaving;
     std::vector<std::size_t> others;
     for (std::size_t j = 0; j < spheres.size(); ++j) {
       others = spheres;
       others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
-      const double worst =
-          spheres_on_line(settled, l, cylinders, others, options, points, weights).excess.worst;
+      SpheresOnLine without =
+          spheres_on_line(settled, l, cylinders, others, options, points, weights);
       // (Of equals, the sphere whose own excess is largest.)
-      if (worst < least || (worst == least && j == all.excess.worst_sphere)) {
-        least = worst;
+      if (without.excess.worst < least ||
+          (without.excess.worst == least && j == all.excess.worst_sphere)) {
+        least = without.excess.worst;
         leaving = j;
+        without_leaving = std::move(without);
       }
     }
     spheres.erase(spheres.begin() + static_cast<std::ptrdiff_t>(leaving));
+    if (spheres.size() < fewest) break;
+    all = without_leaving
+              ? std::move(*without_leaving)
+              : spheres_on_line(settled, l, cylinders, spheres, options, points, weights);
   }
   if (!fit) return false;
   std::vector<std::size_t> own_centre(spheres.size());  // a centre each
