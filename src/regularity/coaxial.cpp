@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <tuple>
@@ -73,9 +74,10 @@ std::vector<std::vector<std::size_t>> coaxial_sets(const std::vector<AlignedCyli
 // tilt covariance `direction_covariance`; sorted here, best-located first), each with its joint
 // fit (none for a lone cylinder): coaxial_sets(), then the joint fit `fit_set(set)` (an optional
 // fit whose `rms` are its members', in the set's order) must explain each member as its own fit
-// did, within the significance corrected for the number of members: a member whose residual sum
-// rises by more than guard_bound() of the 2 degrees of freedom it loses times its residual
-// variance leaves the set, the worst first, and starts one of its own.
+// did, within the significance corrected for the number of members: while some member's residual
+// sum rises by more than guard_bound() of the 2 degrees of freedom it loses times its residual
+// variance, a member leaves the set (member_that_leaves()); those that leave a set are a set of
+// their own, tested in turn.
 template <class FitSet>
 auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& direction_covariance,
                       std::vector<AlignedCylinder>& cylinders, const RegularityOptions& options,
@@ -89,34 +91,73 @@ auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& d
   std::vector<std::vector<std::size_t>> sets =
       coaxial_sets(cylinders, tilt_in_frame(direction, direction_covariance),
                    chi_square_bound(significance, 2), options.length_tolerance);
+  // A set's joint fit, its members' largest residual excess (at least 1; infinite without a fit)
+  // and whose it is.
+  struct Assessed {
+    Fit fit;
+    double worst = 1;
+    std::size_t worst_member = 0;
+    std::size_t failing = 0;  // members above 1
+  };
+  const auto assess = [&](const std::vector<std::size_t>& set) {
+    Assessed result;
+    result.fit = fit_set(set);
+    // A member gives up its own axis line: 2 degrees of freedom.
+    const double bound = guard_bound(significance, set.size(), 2);
+    for (std::size_t j = 0; j < set.size(); ++j) {
+      const AlignedCylinder& member = cylinders[set[j]];
+      const double excess = result.fit ? residual_excess(member.fit.rms[0], result.fit->rms[j],
+                                                         points[member.cluster].size(), bound, 3,
+                                                         options.length_tolerance)
+                                       : std::numeric_limits<double>::infinity();
+      if (excess > 1) ++result.failing;
+      if (excess > result.worst) {
+        result.worst = excess;
+        result.worst_member = j;
+      }
+    }
+    return result;
+  };
   std::vector<std::pair<std::vector<std::size_t>, Fit>> fitted;
   for (std::size_t s = 0; s < sets.size(); ++s) {
     Fit joint;
+    // The fit of the members left: after a member leaves, the one made while choosing it.
+    std::optional<Assessed> all;
+    std::vector<std::size_t> left;  // the members that leave: a set of their own, tested in turn
     while (sets[s].size() > 1) {
-      Fit fit = fit_set(sets[s]);
-      // A member gives up its own axis line: 2 degrees of freedom.
-      const double bound = guard_bound(significance, sets[s].size(), 2);
-      std::size_t worst = sets[s].size();
-      double worst_excess = 1;
-      for (std::size_t j = 0; j < sets[s].size(); ++j) {
-        const AlignedCylinder& member = cylinders[sets[s][j]];
-        const double excess =
-            fit ? residual_excess(member.fit.rms[0], fit->rms[j], points[member.cluster].size(),
-                                  bound, 3, options.length_tolerance)
-                : std::numeric_limits<double>::infinity();
-        if (excess > worst_excess) {
-          worst_excess = excess;
-          worst = j;
-        }
-      }
-      if (worst == sets[s].size()) {
-        joint = std::move(fit);
+      if (!all) all = assess(sets[s]);
+      if (!(all->worst > 1)) {
+        joint = std::move(all->fit);
         break;
       }
-      sets.push_back({sets[s][worst]});
-      sets[s].erase(sets[s].begin() + static_cast<std::ptrdiff_t>(worst));
+      std::vector<std::size_t> candidates(sets[s].size());
+      std::iota(candidates.begin(), candidates.end(), 0);
+      auto [leaving, without_leaving] = member_that_leaves(
+          candidates, all->worst_member,
+          [&](std::size_t j) {
+            if (!all->fit) return std::numeric_limits<double>::quiet_NaN();
+            const AlignedCylinder& member = cylinders[sets[s][j]];
+            const double n = static_cast<double>(points[member.cluster].size());
+            return n * n *
+                   (all->fit->rms[j] * all->fit->rms[j] - member.fit.rms[0] * member.fit.rms[0]);
+          },
+          [&](std::size_t j) {
+            std::vector<std::size_t> others = sets[s];
+            others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
+            return assess(others);
+          },
+          [](const Assessed& without) {
+            return GuardExcess{without.failing, without.worst};
+          });
+      left.push_back(sets[s][leaving]);
+      sets[s].erase(sets[s].begin() + static_cast<std::ptrdiff_t>(leaving));
+      all = std::move(without_leaving);
     }
     fitted.emplace_back(sets[s], std::move(joint));
+    if (!left.empty()) {
+      std::sort(left.begin(), left.end());  // best located first
+      sets.push_back(std::move(left));
+    }
   }
   return fitted;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <utility>
@@ -116,44 +117,78 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
     sets[joined].information += 1 / planes[i].variance;
     sets[joined].weighted += planes[i].offset / planes[i].variance;
   }
+  // One plane through a set's members' inliers (the weighted mean of their offsets), and how it
+  // moves them: their largest excess (at least 1) and whose it is.
+  struct Assessed {
+    double shared = 0, worst = 1;
+    std::size_t worst_member = 0;
+    std::size_t failing = 0;  // members above 1
+  };
+  const auto assess = [&](const std::vector<std::size_t>& set) {
+    double weight = 0, weighted = 0;
+    Eigen::Vector3d middle = Eigen::Vector3d::Zero();  // where the shared plane pivots
+    for (const std::size_t i : set) {
+      weight += planes[i].weight;
+      weighted += planes[i].weight * planes[i].offset;
+      middle += planes[i].weight * planes[i].centroid;
+    }
+    Assessed result;
+    result.shared = weighted / weight;
+    middle /= weight;
+    const double member_bound = family_significance(significance, set.size());
+    for (std::size_t j = 0; j < set.size(); ++j) {
+      // The member's residual sum rises by its weight times the move², against the bound times
+      // its residual variance: the move against its offset's standard deviation, with the
+      // direction's tilt over its distance from where the shared plane pivots.
+      const AlignedPlane& plane = planes[set[j]];
+      const double moved = plane.offset - result.shared;
+      const Eigen::Vector3d apart = plane.centroid - middle;
+      const double excess =
+          tolerated(moved * moved /
+                        (member_bound * member_bound *
+                         (plane.variance + apart.dot(direction_covariance * apart))),
+                    1, std::abs(moved), options.length_tolerance);
+      if (excess > 1) ++result.failing;
+      if (excess > result.worst) {
+        result.worst = excess;
+        result.worst_member = j;
+      }
+    }
+    return result;
+  };
   std::vector<std::vector<std::size_t>> coplanar;
   for (std::size_t s = 0; s < sets.size(); ++s) {
-    // Moved out: a member that leaves starts a set of its own, which may reallocate `sets`.
+    // Moved out: the members that leave are a set of their own, which may reallocate `sets`.
     std::vector<std::size_t> set = std::move(sets[s].planes);
+    // The plane of the members left: after a member leaves, the one found while choosing it.
+    std::optional<Assessed> all;
+    std::vector<std::size_t> left;  // the members that leave: a set of their own, tested in turn
     while (set.size() > 1) {
-      // One plane through all the members' inliers: the weighted mean of their offsets.
-      double weight = 0, weighted = 0;
-      Eigen::Vector3d middle = Eigen::Vector3d::Zero();  // where the shared plane pivots
-      for (const std::size_t i : set) {
-        weight += planes[i].weight;
-        weighted += planes[i].weight * planes[i].offset;
-        middle += planes[i].weight * planes[i].centroid;
-      }
-      const double shared = weighted / weight;
-      middle /= weight;
-      const double member_bound = family_significance(significance, set.size());
-      std::size_t worst = set.size();
-      double worst_excess = 1;
-      for (std::size_t j = 0; j < set.size(); ++j) {
-        // The member's residual sum rises by its weight times the move², against the bound
-        // times its residual variance: the move against its offset's standard deviation, with
-        // the direction's tilt over its distance from where the shared plane pivots.
-        const AlignedPlane& plane = planes[set[j]];
-        const double moved = plane.offset - shared;
-        const Eigen::Vector3d apart = plane.centroid - middle;
-        const double excess =
-            tolerated(moved * moved /
-                          (member_bound * member_bound *
-                           (plane.variance + apart.dot(direction_covariance * apart))),
-                      1, std::abs(moved), options.length_tolerance);
-        if (excess > worst_excess) {
-          worst_excess = excess;
-          worst = j;
-        }
-      }
-      if (worst == set.size()) break;
-      sets.push_back({{set[worst]}});
-      set.erase(set.begin() + static_cast<std::ptrdiff_t>(worst));
+      if (!all) all = assess(set);
+      if (!(all->worst > 1)) break;
+      std::vector<std::size_t> candidates(set.size());
+      std::iota(candidates.begin(), candidates.end(), 0);
+      auto [leaving, without_leaving] = member_that_leaves(
+          candidates, all->worst_member,
+          [&](std::size_t j) {
+            const double force = planes[set[j]].weight * (planes[set[j]].offset - all->shared);
+            return force * force;
+          },
+          [&](std::size_t j) {
+            std::vector<std::size_t> others = set;
+            others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
+            return assess(others);
+          },
+          [](const Assessed& without) {
+            return GuardExcess{without.failing, without.worst};
+          });
+      left.push_back(set[leaving]);
+      set.erase(set.begin() + static_cast<std::ptrdiff_t>(leaving));
+      all = without_leaving;
+    }
+    if (!left.empty()) {
+      std::sort(left.begin(), left.end());  // best located first
+      sets.push_back({std::move(left)});
     }
     if (set.size() < 2) continue;
     std::vector<std::size_t>& clusters = coplanar.emplace_back();

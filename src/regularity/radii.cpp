@@ -221,16 +221,25 @@ double tilt_allowance(const SettledSurfaces& settled, std::size_t l, std::size_t
   return std::isfinite(added) ? 1 + std::clamp(added, 0.0, 2.0) / 2 : 1;
 }
 
+// How hard a joint fit pulls a surface from its own fit (member_that_leaves()), `joint_rms` its RMS
+// in the joint fit: its point count times its residual sum's rise.
+double residual_pull(const SettledSurfaces::Surface& surface, double joint_rms,
+                     const std::vector<std::vector<Vec3>>& points) {
+  const double n = static_cast<double>(points[surface.cluster].size());
+  return n * n * (joint_rms * joint_rms - surface.rms * surface.rms);
+}
+
 // How line l's fit `fit` (none: it failed) explains its members, `cylinders` then `spheres`
 // (indices into settled.surfaces), against their own fits: the largest residual_excess() at the
 // significance corrected for their number (at least 1; infinite without a fit), a cylinder's own
 // fit having 3 parameters and a sphere's `sphere_parameters`, of which the line takes
 // `sphere_lost` (the cylinders, already on it, are held to one degree of freedom), sphere j's
-// bound scaled by allowance(j), and which sphere (an index into `spheres`) of those `may_leave`
-// accepts has the largest.
+// bound scaled by allowance(j), which sphere (an index into `spheres`) of those `may_leave`
+// accepts has the largest, and how many members fail.
 struct LineExcess {
   double worst = 1;
   std::size_t worst_sphere = 0;
+  std::size_t failing = 0;  // members whose excess is above 1
 };
 template <class Allowance, class MayLeave>
 LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size_t> cylinders,
@@ -254,6 +263,7 @@ LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size
                   is_sphere ? sphere_parameters : 3, options.length_tolerance)
             : std::numeric_limits<double>::infinity();
     result.worst = std::max(result.worst, excess);
+    if (excess > 1) ++result.failing;
     if (is_sphere && may_leave(j - cylinders.size()) && excess > worst_sphere_excess) {
       worst_sphere_excess = excess;
       result.worst_sphere = j - cylinders.size();
@@ -292,13 +302,12 @@ SpheresOnLine spheres_on_line(const SettledSurfaces& settled, std::size_t l,
 
 // Refits line l with its cylinders and the spheres `spheres` (indices into settled.surfaces) on
 // it, each sphere one parameter along it: while any member's residual sum rises by more than the
-// significance, corrected for the number of members, allows, a sphere leaves: the one without
-// which the others' largest excess is least. (Not simply the one whose own excess is largest: a
-// member fitted poorly moves its centre cheaply and pulls the line off the exact ones, whose
-// excesses then lead, and they left one by one until none was left: couplingdown's ten spheres on
-// its z axis, at 48 clusters beside a sphere piece fitted at 4.3e-4.) Writes the line, its members
-// and their primitives back, and adds the spheres to the line's coaxial relation (started when it
-// has none), unless fewer spheres than `fewest` stay. Returns whether it did.
+// significance, corrected for the number of members, allows, a sphere leaves
+// (member_that_leaves(): couplingdown's ten spheres on its z axis left one by one, at 48 clusters
+// beside a sphere piece fitted at 4.3e-4, when the sphere of the largest own excess left). Writes
+// the line, its members and their primitives back, and adds the spheres to the line's coaxial
+// relation (started when it has none), unless fewer spheres than `fewest` stay. Returns whether it
+// did.
 bool settle_on_line(SettledSurfaces& settled, std::size_t l,
                     const std::vector<std::size_t>& cylinders, std::vector<std::size_t> spheres,
                     const RegularityOptions& options, std::vector<Primitive>& primitives,
@@ -315,23 +324,23 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
       fit = std::move(all.fit);
       break;
     }
-    std::size_t leaving = all.excess.worst_sphere;
-    double least = std::numeric_limits<double>::infinity();
-    std::optional<SpheresOnLine> without_leaving;
-    std::vector<std::size_t> others;
-    for (std::size_t j = 0; j < spheres.size(); ++j) {
-      others = spheres;
-      others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
-      SpheresOnLine without =
-          spheres_on_line(settled, l, cylinders, others, options, points, weights);
-      // (Of equals, the sphere whose own excess is largest.)
-      if (without.excess.worst < least ||
-          (without.excess.worst == least && j == all.excess.worst_sphere)) {
-        least = without.excess.worst;
-        leaving = j;
-        without_leaving = std::move(without);
-      }
-    }
+    std::vector<std::size_t> candidates(spheres.size());
+    std::iota(candidates.begin(), candidates.end(), 0);
+    auto [leaving, without_leaving] = member_that_leaves(
+        candidates, all.excess.worst_sphere,
+        [&](std::size_t j) {
+          return all.fit ? residual_pull(surfaces[spheres[j]], all.fit->rms[cylinders.size() + j],
+                                         points)
+                         : std::numeric_limits<double>::quiet_NaN();
+        },
+        [&](std::size_t j) {
+          std::vector<std::size_t> others = spheres;
+          others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
+          return spheres_on_line(settled, l, cylinders, others, options, points, weights);
+        },
+        [](const SpheresOnLine& without) {
+          return GuardExcess{without.excess.failing, without.excess.worst};
+        });
     spheres.erase(spheres.begin() + static_cast<std::ptrdiff_t>(leaving));
     if (spheres.size() < fewest) break;
     all = without_leaving
@@ -542,50 +551,80 @@ std::vector<CoaxialMember> sphere_members(const SettledSurfaces& settled,
   return members;
 }
 
-// The member of `set` that `fit` explains worse than its own fit beyond the significance
-// corrected for their number, or set.size() for none.
-std::size_t worst_sphere(const SettledSurfaces& settled, const std::vector<std::size_t>& set,
-                         const ConcentricFit& fit, const RegularityOptions& options,
-                         const std::vector<std::vector<Vec3>>& points) {
+// The spheres `set` (indices into settled.surfaces) refitted with one centre, and how it explains
+// them against their own fits: their largest residual_excess() at the significance corrected for
+// their number (at least 1; infinite without a fit), and whose it is (an index into `set`).
+struct CentreOfSet {
+  std::optional<ConcentricFit> fit;
+  double worst = std::numeric_limits<double>::infinity();
+  std::size_t worst_member = 0;
+  std::size_t failing = std::numeric_limits<std::size_t>::max();  // members above 1
+};
+CentreOfSet centre_of_set(const SettledSurfaces& settled, const std::vector<std::size_t>& set,
+                          const RegularityOptions& options,
+                          const std::vector<std::vector<Vec3>>& points,
+                          const std::vector<std::vector<double>>& weights) {
+  PooledPosition<3> pooled;
+  for (const std::size_t k : set) {
+    const std::size_t centre = settled.surfaces[k].centre;
+    pooled.add(settled.centres[centre], settled.centre_covariances[centre]);
+  }
+  CentreOfSet result;
+  result.fit = fit_concentric(pooled.centre(), sphere_members(settled, set, points, weights));
+  if (!result.fit) return result;
   // A sphere gives up its centre: 3 degrees of freedom.
   const double bound = guard_bound(options.significance, set.size(), 3);
-  double worst_excess = 1;
-  std::size_t worst = set.size();
+  result.worst = 1;
+  result.failing = 0;
   for (std::size_t j = 0; j < set.size(); ++j) {
     const SettledSurfaces::Surface& sphere = settled.surfaces[set[j]];
     // A sphere's own fit has 4 parameters.
-    const double excess = residual_excess(sphere.rms, fit.rms[j], points[sphere.cluster].size(),
-                                          bound, 4, options.length_tolerance);
-    if (excess > worst_excess) {
-      worst_excess = excess;
-      worst = j;
+    const double excess =
+        residual_excess(sphere.rms, result.fit->rms[j], points[sphere.cluster].size(), bound, 4,
+                        options.length_tolerance);
+    if (excess > 1) ++result.failing;
+    if (excess > result.worst) {
+      result.worst = excess;
+      result.worst_member = j;
     }
   }
-  return worst;
+  return result;
 }
 
 // The spheres `set` refitted with one centre; while a member's residual sum rises by more than
-// the significance, corrected for their number, allows, the worst leaves `set`. Nothing when
-// fewer than two stay or a fit fails.
+// the significance, corrected for their number, allows, a member leaves `set`
+// (member_that_leaves()). Nothing when fewer than two stay or a fit fails.
 std::optional<ConcentricFit> one_centre(const SettledSurfaces& settled,
                                         std::vector<std::size_t>& set,
                                         const RegularityOptions& options,
                                         const std::vector<std::vector<Vec3>>& points,
                                         const std::vector<std::vector<double>>& weights) {
-  while (set.size() >= 2) {
-    PooledPosition<3> pooled;
-    for (const std::size_t k : set) {
-      const std::size_t centre = settled.surfaces[k].centre;
-      pooled.add(settled.centres[centre], settled.centre_covariances[centre]);
-    }
-    std::optional<ConcentricFit> fit =
-        fit_concentric(pooled.centre(), sphere_members(settled, set, points, weights));
-    if (!fit) return std::nullopt;
-    const std::size_t worst = worst_sphere(settled, set, *fit, options, points);
-    if (worst == set.size()) return fit;
-    set.erase(set.begin() + static_cast<std::ptrdiff_t>(worst));
+  if (set.size() < 2) return std::nullopt;
+  // The fit of the spheres left: after a sphere leaves, the one made while choosing it.
+  CentreOfSet all = centre_of_set(settled, set, options, points, weights);
+  while (true) {
+    if (!all.fit) return std::nullopt;
+    if (!(all.worst > 1)) return std::move(all.fit);
+    if (set.size() == 2) return std::nullopt;  // one would stay
+    std::vector<std::size_t> candidates(set.size());
+    std::iota(candidates.begin(), candidates.end(), 0);
+    auto [leaving, without_leaving] = member_that_leaves(
+        candidates, all.worst_member,
+        [&](std::size_t j) {
+          return residual_pull(settled.surfaces[set[j]], all.fit->rms[j], points);
+        },
+        [&](std::size_t j) {
+          std::vector<std::size_t> others = set;
+          others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
+          return centre_of_set(settled, others, options, points, weights);
+        },
+        [](const CentreOfSet& without) {
+          return GuardExcess{without.failing, without.worst};
+        });
+    set.erase(set.begin() + static_cast<std::ptrdiff_t>(leaving));
+    all = without_leaving ? std::move(*without_leaving)
+                          : centre_of_set(settled, set, options, points, weights);
   }
-  return std::nullopt;
 }
 
 // Refits the spheres `set` (indices into settled.surfaces) with one centre (one_centre()). Writes
@@ -615,11 +654,56 @@ void settle_concentric(SettledSurfaces& settled, std::vector<std::size_t> set,
   std::sort(concentric.members.begin(), concentric.members.end());
 }
 
-// Line l refitted with its cylinders and spheres, the spheres of each of `sets` on one centre:
-// while a member's residual sum rises by more than the significance, corrected for the number of
-// members, allows, the worst sphere of a set leaves it (a set left with one member dissolves).
-// Writes the line, its members and their primitives back and appends a Concentric relation per
-// set, unless no set stays.
+// Line l refitted with its cylinders and spheres, the spheres of each of `sets` (those of two
+// or more members) on one centre, and how it explains them (line_excess(), of which only a sphere
+// of a set may leave): the sets, and for each sphere its centre's index in the fit.
+struct SetsOnLine {
+  std::vector<std::vector<std::size_t>> sets;
+  std::vector<std::size_t> centre_of;
+  std::optional<JointFit> fit;
+  LineExcess excess{std::numeric_limits<double>::infinity(), 0,
+                    std::numeric_limits<std::size_t>::max()};
+};
+SetsOnLine sets_on_line(const SettledSurfaces& settled, std::size_t l,
+                        const std::vector<std::size_t>& cylinders,
+                        const std::vector<std::size_t>& spheres,
+                        std::vector<std::vector<std::size_t>> sets,
+                        const RegularityOptions& options,
+                        const std::vector<std::vector<Vec3>>& points,
+                        const std::vector<std::vector<double>>& weights) {
+  const std::vector<SettledSurfaces::Surface>& surfaces = settled.surfaces;
+  SetsOnLine result;
+  std::erase_if(sets, [](const std::vector<std::size_t>& set) { return set.size() < 2; });
+  result.sets = std::move(sets);
+  if (result.sets.empty()) return result;
+  // The sets' centres first, started from their first members', then one per other sphere.
+  std::vector<Eigen::Vector3d> centres;
+  std::map<std::size_t, std::size_t> set_centre;  // a set's surfaces: their centre's index
+  for (const std::vector<std::size_t>& set : result.sets) {
+    for (const std::size_t k : set) set_centre[k] = centres.size();
+    centres.push_back(settled.centres[surfaces[set[0]].centre]);
+  }
+  result.centre_of.resize(spheres.size());
+  for (std::size_t j = 0; j < spheres.size(); ++j) {
+    const auto shared = set_centre.find(spheres[j]);
+    result.centre_of[j] = shared != set_centre.end() ? shared->second : centres.size();
+    if (shared == set_centre.end()) centres.push_back(settled.centres[surfaces[spheres[j]].centre]);
+  }
+  result.fit = fit_line(settled, l, cylinders, spheres, result.centre_of, centres, points, weights);
+  // On the line a sphere has 2 parameters of its own (as worst_member counts), and a set shares
+  // its place; only a sphere of a set may leave.
+  result.excess = line_excess(
+      settled, cylinders, spheres, result.fit ? &*result.fit : nullptr, 2, 1,
+      [](std::size_t) { return 1.0; }, options, points,
+      [&](std::size_t j) { return set_centre.contains(spheres[j]); });
+  return result;
+}
+
+// Line l refitted with its cylinders and spheres, the spheres of each of `sets` on one centre
+// (sets_on_line()): while a member's residual sum rises by more than the significance, corrected
+// for the number of members, allows, a sphere of a set leaves it (member_that_leaves(); a set left
+// with one member dissolves). Writes the line, its members and their primitives back and appends a
+// Concentric relation per set, unless no set stays or a fit fails.
 void share_centres_on_line(SettledSurfaces& settled, std::size_t l,
                            std::vector<std::vector<std::size_t>> sets,
                            const RegularityOptions& options, std::vector<Primitive>& primitives,
@@ -630,36 +714,40 @@ void share_centres_on_line(SettledSurfaces& settled, std::size_t l,
   std::vector<std::size_t> cylinders, spheres;
   for (std::size_t k = 0; k < surfaces.size(); ++k)
     if (surfaces[k].line == l) (surfaces[k].sphere ? spheres : cylinders).push_back(k);
-  std::optional<JointFit> fit;
-  std::vector<std::size_t> centre_of(spheres.size());
+  // The fit of the sets left: after a sphere leaves, the one made while choosing it.
+  SetsOnLine all =
+      sets_on_line(settled, l, cylinders, spheres, std::move(sets), options, points, weights);
   while (true) {
-    std::erase_if(sets, [](const std::vector<std::size_t>& set) { return set.size() < 2; });
-    if (sets.empty()) return;
-    // The sets' centres first, started from their first members', then one per other sphere.
-    std::vector<Eigen::Vector3d> centres;
-    std::map<std::size_t, std::size_t> set_centre;  // a set's surfaces: their centre's index
-    for (const std::vector<std::size_t>& set : sets) {
-      for (const std::size_t k : set) set_centre[k] = centres.size();
-      centres.push_back(settled.centres[surfaces[set[0]].centre]);
-    }
-    for (std::size_t j = 0; j < spheres.size(); ++j) {
-      const auto shared = set_centre.find(spheres[j]);
-      centre_of[j] = shared != set_centre.end() ? shared->second : centres.size();
-      if (shared == set_centre.end())
-        centres.push_back(settled.centres[surfaces[spheres[j]].centre]);
-    }
-    fit = fit_line(settled, l, cylinders, spheres, centre_of, centres, points, weights);
-    if (!fit) return;
-    // On the line a sphere has 2 parameters of its own (as worst_member counts), and a set shares
-    // its place; only a sphere of a set may leave.
-    const LineExcess excess = line_excess(
-        settled, cylinders, spheres, &*fit, 2, 1, [](std::size_t) { return 1.0; }, options, points,
-        [&](std::size_t j) { return set_centre.contains(spheres[j]); });
-    if (!(excess.worst > 1)) break;
-    for (std::vector<std::size_t>& set : sets) std::erase(set, spheres[excess.worst_sphere]);
+    if (all.sets.empty() || !all.fit) return;
+    if (!(all.excess.worst > 1)) break;
+    std::vector<std::size_t> candidates;  // the spheres of the sets, indices into `spheres`
+    for (std::size_t j = 0; j < spheres.size(); ++j)
+      if (std::ranges::any_of(all.sets, [&](const std::vector<std::size_t>& set) {
+            return std::ranges::count(set, spheres[j]) > 0;
+          }))
+        candidates.push_back(j);
+    const auto without = [&](std::size_t j) {
+      std::vector<std::vector<std::size_t>> fewer = all.sets;
+      for (std::vector<std::size_t>& set : fewer) std::erase(set, spheres[j]);
+      return fewer;
+    };
+    auto [leaving, without_leaving] = member_that_leaves(
+        candidates, all.excess.worst_sphere,
+        [&](std::size_t j) {
+          return residual_pull(surfaces[spheres[j]], all.fit->rms[cylinders.size() + j], points);
+        },
+        [&](std::size_t j) {
+          return sets_on_line(settled, l, cylinders, spheres, without(j), options, points, weights);
+        },
+        [](const SetsOnLine& fewer) {
+          return GuardExcess{fewer.excess.failing, fewer.excess.worst};
+        });
+    all = without_leaving ? std::move(*without_leaving)
+                          : sets_on_line(settled, l, cylinders, spheres, without(leaving), options,
+                                         points, weights);
   }
-  write_line(settled, l, cylinders, spheres, centre_of, *fit, primitives);
-  for (const std::vector<std::size_t>& set : sets) {
+  write_line(settled, l, cylinders, spheres, all.centre_of, *all.fit, primitives);
+  for (const std::vector<std::size_t>& set : all.sets) {
     Relation& concentric = relations.emplace_back(Relation{Relation::Kind::Concentric, {}, {}});
     for (const std::size_t k : set) {
       surfaces[k].centre = surfaces[set[0]].centre;
@@ -805,13 +893,36 @@ RadiusProblem radius_problem(const SettledSurfaces& settled,
   return problem;
 }
 
-// The member of a class of two or more (an index into `component`) that the joint `fit` explains
-// worst beyond the significance corrected for their number, or component.size() for none.
-std::size_t worst_member(const SettledSurfaces& settled, const std::vector<std::size_t>& component,
-                         const std::vector<std::size_t>& class_of,
-                         const std::vector<std::size_t>& class_size, const RadiusProblem& problem,
-                         const JointFit& fit, const RegularityOptions& options,
-                         const std::vector<std::vector<Vec3>>& points) {
+// A component's joint fit (radius_problem()), and how it explains the members of classes of two or
+// more against their own fits: their largest residual_excess() at the significance corrected for
+// their number (at least 1; infinite without a fit), and whose it is (an index into `component`).
+struct RadiusFit {
+  RadiusProblem problem;
+  std::optional<JointFit> fit;
+  double worst = std::numeric_limits<double>::infinity();
+  std::size_t worst_member = 0;
+  std::size_t failing = std::numeric_limits<std::size_t>::max();  // members above 1
+
+  // The index of the component's member j among fit->rms.
+  std::size_t term(const SettledSurfaces& settled, const std::vector<std::size_t>& component,
+                   std::size_t j) const {
+    return settled.surfaces[component[j]].sphere ? problem.terms.size() + problem.term_of[j]
+                                                 : problem.term_of[j];
+  }
+};
+RadiusFit fit_radii(const SettledSurfaces& settled, const std::vector<std::size_t>& component,
+                    const std::vector<std::size_t>& class_of,
+                    const std::vector<std::size_t>& class_size, const RegularityOptions& options,
+                    const std::vector<std::vector<Vec3>>& points,
+                    const std::vector<std::vector<double>>& weights, JointNumbering& numbering) {
+  RadiusFit result;
+  result.problem =
+      radius_problem(settled, component, class_of, class_size, points, weights, numbering);
+  const RadiusProblem& problem = result.problem;
+  result.fit =
+      fit_cylinders_and_spheres(problem.directions, problem.centres, problem.sphere_centres,
+                                problem.radii, problem.terms, problem.spheres, false);
+  if (!result.fit) return result;
   // One test per member: at the significance each, a plate of a hundred equal holes would lose
   // one in four times.
   const std::size_t tested = static_cast<std::size_t>(
@@ -819,23 +930,34 @@ std::size_t worst_member(const SettledSurfaces& settled, const std::vector<std::
                     [&](std::size_t k) { return class_size[class_of[k]] >= 2; }));
   // A member of a class gives up its radius: 1 degree of freedom.
   const double bound = guard_bound(options.significance, tested, 1);
-  std::size_t worst = component.size();
-  double worst_excess = 1;
+  result.worst = 1;
+  result.failing = 0;
   for (std::size_t j = 0; j < component.size(); ++j) {
     const SettledSurfaces::Surface& surface = settled.surfaces[component[j]];
     if (class_size[class_of[component[j]]] < 2) continue;
-    const double rms =
-        fit.rms[surface.sphere ? problem.terms.size() + problem.term_of[j] : problem.term_of[j]];
     // A sphere's own fit has 4 parameters (2 on a line), a cylinder's (on its direction) 3.
     const int parameters = !surface.sphere ? 3 : surface.line == kNoLine ? 4 : 2;
-    const double excess = residual_excess(surface.rms, rms, points[surface.cluster].size(), bound,
-                                          parameters, options.length_tolerance);
-    if (excess > worst_excess) {
-      worst_excess = excess;
-      worst = j;
+    const double excess = residual_excess(
+        surface.rms, result.fit->rms[result.term(settled, component, j)],
+        points[surface.cluster].size(), bound, parameters, options.length_tolerance);
+    if (excess > 1) ++result.failing;
+    if (excess > result.worst) {
+      result.worst = excess;
+      result.worst_member = j;
     }
   }
-  return worst;
+  return result;
+}
+
+// Surface k leaves its class for one of its own, under the first unused number; returns its class.
+std::size_t leave_class(std::size_t k, std::vector<std::size_t>& class_of,
+                        std::vector<std::size_t>& class_size) {
+  const std::size_t left = class_of[k];
+  --class_size[left];
+  const auto free_class = std::find(class_size.begin(), class_size.end(), 0);
+  class_of[k] = static_cast<std::size_t>(free_class - class_size.begin());
+  *free_class = 1;
+  return left;
 }
 
 // Writes the joint `fit` back: the members of classes of two or more, and the surfaces on their
@@ -900,26 +1022,43 @@ void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& opt
     if (std::none_of(component.begin(), component.end(),
                      [&](std::size_t k) { return class_size[class_of[k]] >= 2; }))
       continue;
-    // While the joint fit explains a member worse than its own beyond the significance, the
-    // worst takes a class of its own, under any unused number.
-    while (true) {
-      const RadiusProblem problem =
-          radius_problem(settled, component, class_of, class_size, points, weights, numbering);
-      const std::optional<JointFit> fit =
-          fit_cylinders_and_spheres(problem.directions, problem.centres, problem.sphere_centres,
-                                    problem.radii, problem.terms, problem.spheres, false);
-      if (!fit) break;
-      const std::size_t worst =
-          worst_member(settled, component, class_of, class_size, problem, *fit, options, points);
-      if (worst == component.size()) {
-        write_equal_radii(settled, component, class_of, class_size, problem, *fit, primitives,
-                          relations);
+    // While the joint fit explains a member worse than its own beyond the significance, a member
+    // takes a class of its own (member_that_leaves()). The fit of the classes left: after a
+    // member leaves, the one made while choosing it.
+    RadiusFit all =
+        fit_radii(settled, component, class_of, class_size, options, points, weights, numbering);
+    while (all.fit) {
+      if (!(all.worst > 1)) {
+        write_equal_radii(settled, component, class_of, class_size, all.problem, *all.fit,
+                          primitives, relations);
         break;
       }
-      --class_size[class_of[component[worst]]];
-      const auto free_class = std::find(class_size.begin(), class_size.end(), 0);
-      class_of[component[worst]] = static_cast<std::size_t>(free_class - class_size.begin());
-      *free_class = 1;
+      std::vector<std::size_t> candidates;
+      for (std::size_t j = 0; j < component.size(); ++j)
+        if (class_size[class_of[component[j]]] >= 2) candidates.push_back(j);
+      auto [leaving, without_leaving] = member_that_leaves(
+          candidates, all.worst_member,
+          [&](std::size_t j) {
+            return residual_pull(settled.surfaces[component[j]],
+                                 all.fit->rms[all.term(settled, component, j)], points);
+          },
+          [&](std::size_t j) {
+            const std::size_t k = component[j];
+            const std::size_t left = leave_class(k, class_of, class_size);
+            RadiusFit without = fit_radii(settled, component, class_of, class_size, options, points,
+                                          weights, numbering);
+            class_size[class_of[k]] = 0;  // back
+            class_of[k] = left;
+            ++class_size[left];
+            return without;
+          },
+          [](const RadiusFit& without) {
+            return GuardExcess{without.failing, without.worst};
+          });
+      leave_class(component[leaving], class_of, class_size);
+      all = without_leaving ? std::move(*without_leaving)
+                            : fit_radii(settled, component, class_of, class_size, options, points,
+                                        weights, numbering);
     }
   }
 }

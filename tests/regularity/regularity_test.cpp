@@ -1026,5 +1026,93 @@ TEST(Regularity, ALengthToleranceRelatesExactSurfacesOffByLessThanIt) {
   }
 }
 
+// Three exact surfaces (noise 1e-7 of their size) in a relation, and a fourth in it too but fitted
+// poorly (noise 2e-3): cylinders on one axis, fragments of one plane, holes of one radius,
+// concentric spheres. The joint least squares weigh every point alike, so the poor member pulls
+// the shared line, offset, radius or centre off the exact ones, whose excesses then lead; when the
+// member of the largest own excess left, the exact ones left one by one and no relation stayed.
+// The one that leaves is the one without which the others fit best (member_that_leaves()): the
+// exact three stay related, on their true line, plane, radius or centre.
+TEST(Regularity, APoorlyFittedMemberSendsNoExactOneAway) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ(), x = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d centre(0.2, -0.1, 0.3);
+  const double exact = 1e-7, poor = 2e-3;
+  const std::vector<std::size_t> exact_ones{0, 1, 2};
+  const auto related = [&](const Relations& relations, Kind kind) {
+    return has_relation(relations, kind, exact_ones) || has_relation(relations, kind, {0, 1, 2, 3});
+  };
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    {
+      SCOPED_TRACE("coaxial");
+      const std::vector<Cluster> clusters{noisy_cylinder(z, {0, 0, 0}, 0.3, 1, exact, rng),
+                                          noisy_cylinder(z, {0, 0, 1.2}, 0.4, 1, exact, rng),
+                                          noisy_cylinder(z, {0, 0, 2.4}, 0.5, 1, exact, rng),
+                                          noisy_cylinder(z, {0, 0, 3.6}, 0.35, 1, poor, rng)};
+      std::vector<Primitive> primitives{fitted_cylinder(clusters[0], z, {0, 0, 0}, 0.3),
+                                        fitted_cylinder(clusters[1], z, {0, 0, 1.2}, 0.4),
+                                        fitted_cylinder(clusters[2], z, {0, 0, 2.4}, 0.5),
+                                        fitted_cylinder(clusters[3], z, {0, 0, 3.6}, 0.35)};
+      EXPECT_TRUE(related(regularize(primitives, clusters), Kind::Coaxial));
+      const Primitive true_axis{PrimitiveType::Cylinder, {0, 0, 0}, {0, 0, 1}};
+      for (const std::size_t k : exact_ones) EXPECT_LT(axis_offset(primitives[k], true_axis), 1e-6);
+    }
+    {
+      SCOPED_TRACE("coplanar");
+      const std::vector<Cluster> clusters{
+          noisy_plane(z, {0, 0, 0}, 1, exact, rng), noisy_plane(z, {1.5, 0, 0}, 1, exact, rng),
+          noisy_plane(z, {0, 1.5, 0}, 1, exact, rng), noisy_plane(z, {1.5, 1.5, 0}, 1, poor, rng)};
+      std::vector<Primitive> primitives;
+      for (const Cluster& cluster : clusters) primitives.push_back(fitted_plane(cluster));
+      EXPECT_TRUE(related(regularize(primitives, clusters), Kind::Coplanar));
+      for (const std::size_t k : exact_ones) EXPECT_NEAR(primitives[k].point[2], 0, 1e-6);
+    }
+    {
+      // Two poor fragments of a face 5e-5 above two exact ones (within their own offsets'
+      // uncertainty): both leave, and as the set of those that left, they are one plane too.
+      SCOPED_TRACE("coplanar, two leaving");
+      const std::vector<Cluster> clusters{noisy_plane(z, {0, 0, 0}, 1, 0, rng),
+                                          noisy_plane(z, {1.5, 0, 0}, 1, 0, rng),
+                                          noisy_plane(z, {0, 1.5, 5e-5}, 1, poor, rng),
+                                          noisy_plane(z, {1.5, 1.5, 5e-5}, 1, poor, rng)};
+      std::vector<Primitive> primitives;
+      for (const Cluster& cluster : clusters) primitives.push_back(fitted_plane(cluster));
+      const Relations relations = regularize(primitives, clusters);
+      EXPECT_TRUE(has_relation(relations, Kind::Coplanar, {0, 1}));
+      EXPECT_TRUE(has_relation(relations, Kind::Coplanar, {2, 3}));
+      EXPECT_NEAR(primitives[0].point[2], 0, 1e-12);
+      EXPECT_NEAR(to_eigen(primitives[2].axis)
+                      .dot(to_eigen(primitives[3].point) - to_eigen(primitives[2].point)),
+                  0, 1e-14);
+    }
+    {
+      SCOPED_TRACE("equal radii");
+      std::vector<Cluster> clusters;
+      std::vector<Primitive> primitives;
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d hole(k, 0, 0);
+        clusters.push_back(noisy_cylinder(z, hole, 0.2, 1, k < 3 ? exact : poor, rng));
+        primitives.push_back(fitted_cylinder(clusters.back(), z, hole, 0.2));
+      }
+      EXPECT_TRUE(related(regularize(primitives, clusters), Kind::EqualRadius));
+      for (const std::size_t k : exact_ones) EXPECT_NEAR(primitives[k].radius, 0.2, 1e-6);
+    }
+    {
+      SCOPED_TRACE("concentric");
+      const std::vector<Cluster> clusters{noisy_sphere_cap(centre, 0.5, z, 1.2, exact, rng),
+                                          noisy_sphere_cap(centre, 0.53, -z, 1.0, exact, rng),
+                                          noisy_sphere_cap(centre, 0.6, x, 1.0, exact, rng),
+                                          noisy_sphere_cap(centre, 0.7, -x, 1.2, poor, rng)};
+      std::vector<Primitive> primitives{
+          fitted_sphere(clusters[0], centre, 0.5), fitted_sphere(clusters[1], centre, 0.53),
+          fitted_sphere(clusters[2], centre, 0.6), fitted_sphere(clusters[3], centre, 0.7)};
+      EXPECT_TRUE(related(regularize(primitives, clusters), Kind::Concentric));
+      for (const std::size_t k : exact_ones)
+        EXPECT_LT((to_eigen(primitives[k].point) - centre).norm(), 1e-6);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace primseg
