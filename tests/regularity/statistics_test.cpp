@@ -1,14 +1,18 @@
 // The tests regularize()'s stages share (src/regularity/statistics.cpp), against their
 // definitions: χ² quantiles against the exact tail, Bonferroni corrections against the normal
-// tail, tolerated scores and residual excesses at their bounds.
+// tail, tolerated scores and residual excesses at their bounds; and which member a guard sends
+// back (member_that_leaves()).
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
+#include <numeric>
 #include <utility>
+#include <vector>
 
 #include "orthonormal_pair.hpp"
 #include "regularity/stages.hpp"
@@ -18,6 +22,10 @@ namespace {
 
 using detail::chi_square_bound;
 using detail::family_significance;
+using detail::GuardExcess;
+using detail::kLeavingSetSize;
+using detail::kLeavingTrials;
+using detail::member_that_leaves;
 using detail::residual_excess;
 using detail::tolerated;
 using detail::within_tolerance;
@@ -145,6 +153,70 @@ TEST(RegularityStatistics, TiltInFrameIsTheCovarianceInTheAxisFrame) {
   EXPECT_NEAR(in_frame(1, 1), 9, 1e-12);
   EXPECT_NEAR(in_frame(0, 1), 0, 1e-12);
   EXPECT_NEAR(in_frame(1, 0), 0, 1e-12);
+}
+
+// A guard of n members, member `worst` of the largest excess: what each member's absence leaves
+// (`left[j]`), each member's pull, and which members member_that_leaves() refitted without.
+struct Guard {
+  std::vector<GuardExcess> left;
+  std::vector<double> pull;
+  std::vector<std::size_t> refitted;
+
+  std::pair<std::size_t, std::size_t> leave(std::size_t worst) {
+    std::vector<std::size_t> candidates(left.size());
+    std::iota(candidates.begin(), candidates.end(), 0);
+    refitted.clear();
+    auto [leaving, without] = member_that_leaves(
+        candidates, worst, [&](std::size_t j) { return pull[j]; },
+        [&](std::size_t j) {
+          refitted.push_back(j);
+          return j;
+        },
+        [&](std::size_t j) { return left[j]; });
+    EXPECT_TRUE(without.has_value());
+    return {leaving, without.value_or(left.size())};
+  }
+};
+
+TEST(RegularityGuard, TheWorstLeavesWhenItsAbsenceLeavesNoneFailing) {
+  Guard guard{{{1, 50}, {1, 40}, {0, 1}, {1, 30}}, {9, 8, 1, 7}, {}};
+  EXPECT_EQ(guard.leave(2), (std::pair<std::size_t, std::size_t>{2, 2}));
+  EXPECT_EQ(guard.refitted, std::vector<std::size_t>{2});  // nothing else refitted
+}
+
+TEST(RegularityGuard, AMemberThatPullsHarderLeavesWhenItsAbsenceLeavesFewerFailing) {
+  // The worst (3, pull 2) leaves two others failing; without member 1, which pulls hardest, none
+  // fails; member 0, pulling harder too, leaves one.
+  Guard guard{{{1, 5}, {0, 1}, {2, 3}, {2, 90}}, {4, 6, 1, 2}, {}};
+  EXPECT_EQ(guard.leave(3).first, 1u);
+  // The worst first, then those pulling harder, in the members' order.
+  EXPECT_EQ(guard.refitted, (std::vector<std::size_t>{3, 0, 1}));
+  // Of members leaving as many failing, the smallest largest excess.
+  guard.left = {{1, 5}, {1, 4}, {2, 3}, {2, 90}};
+  EXPECT_EQ(guard.leave(3).first, 1u);
+}
+
+TEST(RegularityGuard, TheWorstStaysTheChoiceUnlessAnotherLeavesFewerFailing) {
+  // Member 0's absence lowers the largest excess but fixes no one: the worst leaves.
+  Guard guard{{{2, 3}, {2, 9}, {2, 80}}, {5, 1, 2}, {}};
+  EXPECT_EQ(guard.leave(2).first, 2u);
+  // Members pulling less than the worst are not refitted without.
+  EXPECT_EQ(guard.refitted, (std::vector<std::size_t>{2, 0}));
+}
+
+TEST(RegularityGuard, AtMostTheTrialsThatPullHardestAndNoneInLargeSets) {
+  const std::size_t n = kLeavingSetSize;
+  Guard guard{std::vector<GuardExcess>(n, {3, 10}), std::vector<double>(n), {}};
+  for (std::size_t j = 0; j < n; ++j) guard.pull[j] = static_cast<double>(j);
+  guard.leave(0);
+  // The worst, then the kLeavingTrials pulling hardest, in the members' order.
+  std::vector<std::size_t> expected{0};
+  for (std::size_t j = n - kLeavingTrials; j < n; ++j) expected.push_back(j);
+  EXPECT_EQ(guard.refitted, expected);
+  guard.left.push_back({3, 10});
+  guard.pull.push_back(100);
+  EXPECT_EQ(guard.leave(0).first, 0u);
+  EXPECT_EQ(guard.refitted, std::vector<std::size_t>{0});
 }
 
 }  // namespace
