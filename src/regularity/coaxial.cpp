@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
-#include <numeric>
 #include <optional>
 #include <span>
 #include <tuple>
@@ -91,13 +90,10 @@ auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& d
   std::vector<std::vector<std::size_t>> sets =
       coaxial_sets(cylinders, tilt_in_frame(direction, direction_covariance),
                    chi_square_bound(significance, 2), options.length_tolerance);
-  // A set's joint fit, its members' largest residual excess (at least 1; infinite without a fit)
-  // and whose it is.
+  // A set's joint fit, and how it explains its members.
   struct Assessed {
     Fit fit;
-    double worst = 1;
-    std::size_t worst_member = 0;
-    std::size_t failing = 0;  // members above 1
+    GuardExcess excess;
   };
   const auto assess = [&](const std::vector<std::size_t>& set) {
     Assessed result;
@@ -106,15 +102,11 @@ auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& d
     const double bound = guard_bound(significance, set.size(), 2);
     for (std::size_t j = 0; j < set.size(); ++j) {
       const AlignedCylinder& member = cylinders[set[j]];
-      const double excess = result.fit ? residual_excess(member.fit.rms[0], result.fit->rms[j],
-                                                         points[member.cluster].size(), bound, 3,
-                                                         options.length_tolerance)
-                                       : std::numeric_limits<double>::infinity();
-      if (excess > 1) ++result.failing;
-      if (excess > result.worst) {
-        result.worst = excess;
-        result.worst_member = j;
-      }
+      result.excess.add(result.fit ? residual_excess(member.fit.rms[0], result.fit->rms[j],
+                                                     points[member.cluster].size(), bound, 3,
+                                                     options.length_tolerance)
+                                   : std::numeric_limits<double>::infinity(),
+                        j);
     }
     return result;
   };
@@ -126,28 +118,22 @@ auto fit_coaxial_sets(const Eigen::Vector3d& direction, const Eigen::Matrix3d& d
     std::vector<std::size_t> left;  // the members that leave: a set of their own, tested in turn
     while (sets[s].size() > 1) {
       if (!all) all = assess(sets[s]);
-      if (!(all->worst > 1)) {
+      if (!(all->excess.largest > 1)) {
         joint = std::move(all->fit);
         break;
       }
-      std::vector<std::size_t> candidates(sets[s].size());
-      std::iota(candidates.begin(), candidates.end(), 0);
       auto [leaving, without_leaving] = member_that_leaves(
-          candidates, all->worst_member,
+          every_member(sets[s].size()), all->excess.worst,
           [&](std::size_t j) {
-            if (!all->fit) return std::numeric_limits<double>::quiet_NaN();
             const AlignedCylinder& member = cylinders[sets[s][j]];
-            const double n = static_cast<double>(points[member.cluster].size());
-            return n * n *
-                   (all->fit->rms[j] * all->fit->rms[j] - member.fit.rms[0] * member.fit.rms[0]);
+            return all->fit ? residual_pull(member.fit.rms[0], all->fit->rms[j],
+                                            points[member.cluster].size())
+                            : std::numeric_limits<double>::quiet_NaN();
           },
           [&](std::size_t j) {
             std::vector<std::size_t> others = sets[s];
             others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
             return assess(others);
-          },
-          [](const Assessed& without) {
-            return GuardExcess{without.failing, without.worst};
           });
       left.push_back(sets[s][leaving]);
       sets[s].erase(sets[s].begin() + static_cast<std::ptrdiff_t>(leaving));

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <numeric>
 #include <optional>
 #include <span>
 #include <utility>
@@ -118,11 +117,10 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
     sets[joined].weighted += planes[i].offset / planes[i].variance;
   }
   // One plane through a set's members' inliers (the weighted mean of their offsets), and how it
-  // moves them: their largest excess (at least 1) and whose it is.
+  // moves them.
   struct Assessed {
-    double shared = 0, worst = 1;
-    std::size_t worst_member = 0;
-    std::size_t failing = 0;  // members above 1
+    double shared = 0;
+    GuardExcess excess;
   };
   const auto assess = [&](const std::vector<std::size_t>& set) {
     double weight = 0, weighted = 0;
@@ -148,11 +146,7 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
                         (member_bound * member_bound *
                          (plane.variance + apart.dot(direction_covariance * apart))),
                     1, std::abs(moved), options.length_tolerance);
-      if (excess > 1) ++result.failing;
-      if (excess > result.worst) {
-        result.worst = excess;
-        result.worst_member = j;
-      }
+      result.excess.add(excess, j);
     }
     return result;
   };
@@ -165,11 +159,9 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
     std::vector<std::size_t> left;  // the members that leave: a set of their own, tested in turn
     while (set.size() > 1) {
       if (!all) all = assess(set);
-      if (!(all->worst > 1)) break;
-      std::vector<std::size_t> candidates(set.size());
-      std::iota(candidates.begin(), candidates.end(), 0);
+      if (!(all->excess.largest > 1)) break;
       auto [leaving, without_leaving] = member_that_leaves(
-          candidates, all->worst_member,
+          every_member(set.size()), all->excess.worst,
           [&](std::size_t j) {
             const double force = planes[set[j]].weight * (planes[set[j]].offset - all->shared);
             return force * force;
@@ -178,9 +170,6 @@ std::vector<std::vector<std::size_t>> coplanar_sets(const Eigen::Matrix3d& direc
             std::vector<std::size_t> others = set;
             others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
             return assess(others);
-          },
-          [](const Assessed& without) {
-            return GuardExcess{without.failing, without.worst};
           });
       left.push_back(set[leaving]);
       set.erase(set.begin() + static_cast<std::ptrdiff_t>(leaving));

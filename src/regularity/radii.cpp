@@ -221,12 +221,10 @@ double tilt_allowance(const SettledSurfaces& settled, std::size_t l, std::size_t
   return std::isfinite(added) ? 1 + std::clamp(added, 0.0, 2.0) / 2 : 1;
 }
 
-// How hard a joint fit pulls a surface from its own fit (member_that_leaves()), `joint_rms` its RMS
-// in the joint fit: its point count times its residual sum's rise.
-double residual_pull(const SettledSurfaces::Surface& surface, double joint_rms,
-                     const std::vector<std::vector<Vec3>>& points) {
-  const double n = static_cast<double>(points[surface.cluster].size());
-  return n * n * (joint_rms * joint_rms - surface.rms * surface.rms);
+// Surface `surface`'s residual_pull() on a joint fit in which its RMS is `joint_rms`.
+double surface_pull(const SettledSurfaces::Surface& surface, double joint_rms,
+                    const std::vector<std::vector<Vec3>>& points) {
+  return residual_pull(surface.rms, joint_rms, points[surface.cluster].size());
 }
 
 // How line l's fit `fit` (none: it failed) explains its members, `cylinders` then `spheres`
@@ -235,23 +233,17 @@ double residual_pull(const SettledSurfaces::Surface& surface, double joint_rms,
 // fit having 3 parameters and a sphere's `sphere_parameters`, of which the line takes
 // `sphere_lost` (the cylinders, already on it, are held to one degree of freedom), sphere j's
 // bound scaled by allowance(j), which sphere (an index into `spheres`) of those `may_leave`
-// accepts has the largest, and how many members fail.
-struct LineExcess {
-  double worst = 1;
-  std::size_t worst_sphere = 0;
-  std::size_t failing = 0;  // members whose excess is above 1
-};
+// accepts has the largest (`worst`), and how many members fail.
 template <class Allowance, class MayLeave>
-LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size_t> cylinders,
-                       std::span<const std::size_t> spheres, const JointFit* fit,
-                       int sphere_parameters, std::size_t sphere_lost, const Allowance& allowance,
-                       const RegularityOptions& options,
-                       const std::vector<std::vector<Vec3>>& points, const MayLeave& may_leave) {
+GuardExcess line_excess(const SettledSurfaces& settled, std::span<const std::size_t> cylinders,
+                        std::span<const std::size_t> spheres, const JointFit* fit,
+                        int sphere_parameters, std::size_t sphere_lost, const Allowance& allowance,
+                        const RegularityOptions& options,
+                        const std::vector<std::vector<Vec3>>& points, const MayLeave& may_leave) {
   const std::size_t members = cylinders.size() + spheres.size();
   const double cylinder_bound = guard_bound(options.significance, members, 1);
   const double sphere_bound = guard_bound(options.significance, members, sphere_lost);
-  LineExcess result;
-  double worst_sphere_excess = -std::numeric_limits<double>::infinity();
+  GuardExcess result;
   for (std::size_t j = 0; j < members; ++j) {
     const bool is_sphere = j >= cylinders.size();
     const SettledSurfaces::Surface& surface =
@@ -262,12 +254,8 @@ LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size
                   is_sphere ? sphere_bound * allowance(j - cylinders.size()) : cylinder_bound,
                   is_sphere ? sphere_parameters : 3, options.length_tolerance)
             : std::numeric_limits<double>::infinity();
-    result.worst = std::max(result.worst, excess);
-    if (excess > 1) ++result.failing;
-    if (is_sphere && may_leave(j - cylinders.size()) && excess > worst_sphere_excess) {
-      worst_sphere_excess = excess;
-      result.worst_sphere = j - cylinders.size();
-    }
+    result.add(excess, is_sphere ? j - cylinders.size() : 0,
+               is_sphere && may_leave(j - cylinders.size()));
   }
   return result;
 }
@@ -276,7 +264,7 @@ LineExcess line_excess(const SettledSurfaces& settled, std::span<const std::size
 // sphere with a centre of its own on it; nullopt for the fit when it fails.
 struct SpheresOnLine {
   std::optional<JointFit> fit;
-  LineExcess excess;
+  GuardExcess excess;
 };
 SpheresOnLine spheres_on_line(const SettledSurfaces& settled, std::size_t l,
                               const std::vector<std::size_t>& cylinders,
@@ -320,32 +308,25 @@ bool settle_on_line(SettledSurfaces& settled, std::size_t l,
   // The fit of the spheres left: after a sphere leaves, the one made while choosing it.
   SpheresOnLine all = spheres_on_line(settled, l, cylinders, spheres, options, points, weights);
   while (true) {
-    if (!(all.excess.worst > 1)) {
+    if (!(all.excess.largest > 1)) {
       fit = std::move(all.fit);
       break;
     }
-    std::vector<std::size_t> candidates(spheres.size());
-    std::iota(candidates.begin(), candidates.end(), 0);
     auto [leaving, without_leaving] = member_that_leaves(
-        candidates, all.excess.worst_sphere,
+        every_member(spheres.size()), all.excess.worst,
         [&](std::size_t j) {
-          return all.fit ? residual_pull(surfaces[spheres[j]], all.fit->rms[cylinders.size() + j],
-                                         points)
+          return all.fit ? surface_pull(surfaces[spheres[j]], all.fit->rms[cylinders.size() + j],
+                                        points)
                          : std::numeric_limits<double>::quiet_NaN();
         },
         [&](std::size_t j) {
           std::vector<std::size_t> others = spheres;
           others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
           return spheres_on_line(settled, l, cylinders, others, options, points, weights);
-        },
-        [](const SpheresOnLine& without) {
-          return GuardExcess{without.excess.failing, without.excess.worst};
         });
     spheres.erase(spheres.begin() + static_cast<std::ptrdiff_t>(leaving));
     if (spheres.size() < fewest) break;
-    all = without_leaving
-              ? std::move(*without_leaving)
-              : spheres_on_line(settled, l, cylinders, spheres, options, points, weights);
+    all = std::move(without_leaving);
   }
   if (!fit) return false;
   std::vector<std::size_t> own_centre(spheres.size());  // a centre each
@@ -556,9 +537,7 @@ std::vector<CoaxialMember> sphere_members(const SettledSurfaces& settled,
 // their number (at least 1; infinite without a fit), and whose it is (an index into `set`).
 struct CentreOfSet {
   std::optional<ConcentricFit> fit;
-  double worst = std::numeric_limits<double>::infinity();
-  std::size_t worst_member = 0;
-  std::size_t failing = std::numeric_limits<std::size_t>::max();  // members above 1
+  GuardExcess excess = GuardExcess::without_fit();
 };
 CentreOfSet centre_of_set(const SettledSurfaces& settled, const std::vector<std::size_t>& set,
                           const RegularityOptions& options,
@@ -574,19 +553,13 @@ CentreOfSet centre_of_set(const SettledSurfaces& settled, const std::vector<std:
   if (!result.fit) return result;
   // A sphere gives up its centre: 3 degrees of freedom.
   const double bound = guard_bound(options.significance, set.size(), 3);
-  result.worst = 1;
-  result.failing = 0;
+  result.excess = {};
   for (std::size_t j = 0; j < set.size(); ++j) {
     const SettledSurfaces::Surface& sphere = settled.surfaces[set[j]];
     // A sphere's own fit has 4 parameters.
-    const double excess =
-        residual_excess(sphere.rms, result.fit->rms[j], points[sphere.cluster].size(), bound, 4,
-                        options.length_tolerance);
-    if (excess > 1) ++result.failing;
-    if (excess > result.worst) {
-      result.worst = excess;
-      result.worst_member = j;
-    }
+    result.excess.add(residual_excess(sphere.rms, result.fit->rms[j], points[sphere.cluster].size(),
+                                      bound, 4, options.length_tolerance),
+                      j);
   }
   return result;
 }
@@ -604,26 +577,20 @@ std::optional<ConcentricFit> one_centre(const SettledSurfaces& settled,
   CentreOfSet all = centre_of_set(settled, set, options, points, weights);
   while (true) {
     if (!all.fit) return std::nullopt;
-    if (!(all.worst > 1)) return std::move(all.fit);
+    if (!(all.excess.largest > 1)) return std::move(all.fit);
     if (set.size() == 2) return std::nullopt;  // one would stay
-    std::vector<std::size_t> candidates(set.size());
-    std::iota(candidates.begin(), candidates.end(), 0);
     auto [leaving, without_leaving] = member_that_leaves(
-        candidates, all.worst_member,
+        every_member(set.size()), all.excess.worst,
         [&](std::size_t j) {
-          return residual_pull(settled.surfaces[set[j]], all.fit->rms[j], points);
+          return surface_pull(settled.surfaces[set[j]], all.fit->rms[j], points);
         },
         [&](std::size_t j) {
           std::vector<std::size_t> others = set;
           others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
           return centre_of_set(settled, others, options, points, weights);
-        },
-        [](const CentreOfSet& without) {
-          return GuardExcess{without.failing, without.worst};
         });
     set.erase(set.begin() + static_cast<std::ptrdiff_t>(leaving));
-    all = without_leaving ? std::move(*without_leaving)
-                          : centre_of_set(settled, set, options, points, weights);
+    all = std::move(without_leaving);
   }
 }
 
@@ -661,8 +628,7 @@ struct SetsOnLine {
   std::vector<std::vector<std::size_t>> sets;
   std::vector<std::size_t> centre_of;
   std::optional<JointFit> fit;
-  LineExcess excess{std::numeric_limits<double>::infinity(), 0,
-                    std::numeric_limits<std::size_t>::max()};
+  GuardExcess excess = GuardExcess::without_fit();
 };
 SetsOnLine sets_on_line(const SettledSurfaces& settled, std::size_t l,
                         const std::vector<std::size_t>& cylinders,
@@ -690,7 +656,7 @@ SetsOnLine sets_on_line(const SettledSurfaces& settled, std::size_t l,
     if (shared == set_centre.end()) centres.push_back(settled.centres[surfaces[spheres[j]].centre]);
   }
   result.fit = fit_line(settled, l, cylinders, spheres, result.centre_of, centres, points, weights);
-  // On the line a sphere has 2 parameters of its own (as worst_member counts), and a set shares
+  // On the line a sphere has 2 parameters of its own (as fit_radii() counts), and a set shares
   // its place; only a sphere of a set may leave.
   result.excess = line_excess(
       settled, cylinders, spheres, result.fit ? &*result.fit : nullptr, 2, 1,
@@ -719,32 +685,24 @@ void share_centres_on_line(SettledSurfaces& settled, std::size_t l,
       sets_on_line(settled, l, cylinders, spheres, std::move(sets), options, points, weights);
   while (true) {
     if (all.sets.empty() || !all.fit) return;
-    if (!(all.excess.worst > 1)) break;
-    std::vector<std::size_t> candidates;  // the spheres of the sets, indices into `spheres`
+    if (!(all.excess.largest > 1)) break;
+    std::vector<std::size_t> candidates;  // the spheres of the sets, whose centres come first
     for (std::size_t j = 0; j < spheres.size(); ++j)
-      if (std::ranges::any_of(all.sets, [&](const std::vector<std::size_t>& set) {
-            return std::ranges::count(set, spheres[j]) > 0;
-          }))
-        candidates.push_back(j);
+      if (all.centre_of[j] < all.sets.size()) candidates.push_back(j);
     const auto without = [&](std::size_t j) {
       std::vector<std::vector<std::size_t>> fewer = all.sets;
       for (std::vector<std::size_t>& set : fewer) std::erase(set, spheres[j]);
       return fewer;
     };
     auto [leaving, without_leaving] = member_that_leaves(
-        candidates, all.excess.worst_sphere,
+        candidates, all.excess.worst,
         [&](std::size_t j) {
-          return residual_pull(surfaces[spheres[j]], all.fit->rms[cylinders.size() + j], points);
+          return surface_pull(surfaces[spheres[j]], all.fit->rms[cylinders.size() + j], points);
         },
         [&](std::size_t j) {
           return sets_on_line(settled, l, cylinders, spheres, without(j), options, points, weights);
-        },
-        [](const SetsOnLine& fewer) {
-          return GuardExcess{fewer.excess.failing, fewer.excess.worst};
         });
-    all = without_leaving ? std::move(*without_leaving)
-                          : sets_on_line(settled, l, cylinders, spheres, without(leaving), options,
-                                         points, weights);
+    all = std::move(without_leaving);
   }
   write_line(settled, l, cylinders, spheres, all.centre_of, *all.fit, primitives);
   for (const std::vector<std::size_t>& set : all.sets) {
@@ -899,9 +857,7 @@ RadiusProblem radius_problem(const SettledSurfaces& settled,
 struct RadiusFit {
   RadiusProblem problem;
   std::optional<JointFit> fit;
-  double worst = std::numeric_limits<double>::infinity();
-  std::size_t worst_member = 0;
-  std::size_t failing = std::numeric_limits<std::size_t>::max();  // members above 1
+  GuardExcess excess = GuardExcess::without_fit();
 
   // The index of the component's member j among fit->rms.
   std::size_t term(const SettledSurfaces& settled, const std::vector<std::size_t>& component,
@@ -930,21 +886,17 @@ RadiusFit fit_radii(const SettledSurfaces& settled, const std::vector<std::size_
                     [&](std::size_t k) { return class_size[class_of[k]] >= 2; }));
   // A member of a class gives up its radius: 1 degree of freedom.
   const double bound = guard_bound(options.significance, tested, 1);
-  result.worst = 1;
-  result.failing = 0;
+  result.excess = {};
   for (std::size_t j = 0; j < component.size(); ++j) {
     const SettledSurfaces::Surface& surface = settled.surfaces[component[j]];
     if (class_size[class_of[component[j]]] < 2) continue;
     // A sphere's own fit has 4 parameters (2 on a line), a cylinder's (on its direction) 3.
     const int parameters = !surface.sphere ? 3 : surface.line == kNoLine ? 4 : 2;
-    const double excess = residual_excess(
-        surface.rms, result.fit->rms[result.term(settled, component, j)],
-        points[surface.cluster].size(), bound, parameters, options.length_tolerance);
-    if (excess > 1) ++result.failing;
-    if (excess > result.worst) {
-      result.worst = excess;
-      result.worst_member = j;
-    }
+    result.excess.add(
+        residual_excess(surface.rms, result.fit->rms[result.term(settled, component, j)],
+                        points[surface.cluster].size(), bound, parameters,
+                        options.length_tolerance),
+        j);
   }
   return result;
 }
@@ -1028,7 +980,7 @@ void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& opt
     RadiusFit all =
         fit_radii(settled, component, class_of, class_size, options, points, weights, numbering);
     while (all.fit) {
-      if (!(all.worst > 1)) {
+      if (!(all.excess.largest > 1)) {
         write_equal_radii(settled, component, class_of, class_size, all.problem, *all.fit,
                           primitives, relations);
         break;
@@ -1037,10 +989,10 @@ void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& opt
       for (std::size_t j = 0; j < component.size(); ++j)
         if (class_size[class_of[component[j]]] >= 2) candidates.push_back(j);
       auto [leaving, without_leaving] = member_that_leaves(
-          candidates, all.worst_member,
+          candidates, all.excess.worst,
           [&](std::size_t j) {
-            return residual_pull(settled.surfaces[component[j]],
-                                 all.fit->rms[all.term(settled, component, j)], points);
+            return surface_pull(settled.surfaces[component[j]],
+                                all.fit->rms[all.term(settled, component, j)], points);
           },
           [&](std::size_t j) {
             const std::size_t k = component[j];
@@ -1051,14 +1003,9 @@ void equalize_radii(const SettledSurfaces& settled, const RegularityOptions& opt
             class_of[k] = left;
             ++class_size[left];
             return without;
-          },
-          [](const RadiusFit& without) {
-            return GuardExcess{without.failing, without.worst};
           });
       leave_class(component[leaving], class_of, class_size);
-      all = without_leaving ? std::move(*without_leaving)
-                            : fit_radii(settled, component, class_of, class_size, options, points,
-                                        weights, numbering);
+      all = std::move(without_leaving);
     }
   }
 }

@@ -73,12 +73,39 @@ double family_significance(double significance, std::size_t tests);
 /// times a χ² of `lost` degrees of freedom, is sent away as rarely as the significance promises.
 double guard_bound(double significance, std::size_t tests, std::size_t lost);
 
-/// How a joint fit explains its members against their own fits: how many fail the guard
-/// (residual_excess() above 1), and the largest excess (at least 1; infinite without a fit).
+/// How a joint fit explains its members against their own fits, from each one's
+/// residual_excess(): how many fail the guard (above 1), the largest excess (at least 1;
+/// infinite without a fit), and which member of those that may leave has the largest (`worst`).
 struct GuardExcess {
   std::size_t failing = 0;
   double largest = 1;
+  std::size_t worst = 0;
+  double worst_excess = -std::numeric_limits<double>::infinity();
+
+  /// Counts `member`'s excess.
+  void add(double excess, std::size_t member, bool may_leave = true) {
+    if (excess > 1) ++failing;
+    largest = std::max(largest, excess);
+    if (may_leave && excess > worst_excess) {
+      worst_excess = excess;
+      worst = member;
+    }
+  }
+  /// A joint fit that failed: every member fails.
+  static GuardExcess without_fit() {
+    GuardExcess excess;
+    excess.failing = std::numeric_limits<std::size_t>::max();
+    excess.largest = std::numeric_limits<double>::infinity();
+    return excess;
+  }
 };
+
+/// A member's pull on a joint fit (member_that_leaves()): its point count `count` times the rise
+/// of its residual sum, from its own fit's RMS `own_rms` to the joint fit's `joint_rms`.
+double residual_pull(double own_rms, double joint_rms, std::size_t count);
+
+/// 0, 1, ..., count − 1: every member of a joint fit, as member_that_leaves() takes them.
+std::vector<std::size_t> every_member(std::size_t count);
 
 /// How many members, besides the one of the largest excess, a guard refits a joint fit without, at
 /// most, to choose the one that leaves (member_that_leaves()).
@@ -94,27 +121,27 @@ inline constexpr std::size_t kLeavingSetSize = 16;
 /// the guard sent them back one by one until none was left (three exact concentric spheres and a
 /// noisy fourth: no relation at all).
 ///
-/// `without(j)` refits without member j; `score` reads how that fit explains the others. `worst`
-/// is taken out first. When others still fail, so are, in turn, the kLeavingTrials members that
-/// pull hardest among those of `candidates` (the members that may leave, increasing) that pull
-/// harder than `worst`. A member's pull, `pull(j)`, is its point count times its residual sum's
-/// rise: the square of the force n δ with which the unweighted least squares hold a member of
-/// stiffness n moved by δ, so a member that displaces the others pulls harder than any of them.
-/// One of those leaves instead of `worst` only when its absence leaves fewer members failing
-/// (of such, the fewest, then the smallest largest excess, then the first). Not the smallest
-/// largest excess alone: where several members fail on their own, taking out any other lowers
-/// the largest excess a little and fixes nothing (turbine's 564 surfaces of equal radii lost 368
-/// members instead of 43). Of more than kLeavingSetSize candidates, `worst` leaves: one member of
-/// n moves the shared parameters by about 1/n of its own offset, so the cascade is one of few
-/// members, while a large set's refits are costly and its failing members many (turbine's lost
-/// 104 instead of 43, in 20 s instead of 1.4). Returns the member that leaves and what `without`
-/// returned for it.
-template <class Pull, class Without, class Score>
+/// `without(j)` refits without member j and returns that fit with how it explains the others
+/// (its `excess`, a GuardExcess). `worst` is taken out first. When others still fail, so are, in
+/// turn, the kLeavingTrials members that pull hardest among those of `candidates` (the members that
+/// may leave, increasing) that pull harder than `worst`. A member's pull, `pull(j)`, is its point
+/// count times its residual sum's rise: the square of the force n δ with which the unweighted least
+/// squares hold a member of stiffness n moved by δ, so a member that displaces the others pulls
+/// harder than any of them. One of those leaves instead of `worst` only when its absence leaves
+/// fewer members failing (of such, the fewest, then the smallest largest excess, then the first).
+/// Not the smallest largest excess alone: where several members fail on their own, taking out any
+/// other lowers the largest excess a little and fixes nothing (turbine's 564 surfaces of equal
+/// radii lost 368 members instead of 43). Of more than kLeavingSetSize candidates, `worst` leaves:
+/// one member of n moves the shared parameters by about 1/n of its own offset, so the cascade is
+/// one of few members, while a large set's refits are costly and its failing members many
+/// (turbine's lost 104 instead of 43, in 20 s instead of 1.4). Returns the member that leaves and
+/// what `without` returned for it.
+template <class Pull, class Without>
 auto member_that_leaves(const std::vector<std::size_t>& candidates, std::size_t worst,
-                        const Pull& pull, const Without& without, const Score& score) {
+                        const Pull& pull, const Without& without) {
   using Refitted = std::invoke_result_t<Without, std::size_t>;
-  std::pair<std::size_t, std::optional<Refitted>> leaving{worst, without(worst)};
-  GuardExcess least = score(*leaving.second);
+  std::pair<std::size_t, Refitted> leaving{worst, without(worst)};
+  GuardExcess least = leaving.second.excess;
   if (least.failing == 0 || candidates.size() > kLeavingSetSize) return leaving;
   const double worst_pull = pull(worst);
   std::vector<std::pair<double, std::size_t>> harder;  // (pull, member), pulling harder than worst
@@ -127,7 +154,7 @@ auto member_that_leaves(const std::vector<std::size_t>& candidates, std::size_t 
             [](const auto& a, const auto& b) { return a.second < b.second; });
   for (const auto& [unused, j] : harder) {
     Refitted refitted = without(j);
-    const GuardExcess excess = score(refitted);
+    const GuardExcess& excess = refitted.excess;
     if (excess.failing < least.failing ||
         (excess.failing == least.failing && leaving.first != worst &&
          excess.largest < least.largest)) {

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstddef>
 #include <numbers>
+#include <numeric>
+#include <vector>
 
 #include "orthonormal_pair.hpp"
 
@@ -54,6 +56,17 @@ double residual_excess(double own_rms, double joint_rms, std::size_t count, doub
   const double rise = n * (joint_rms * joint_rms - own_rms * own_rms);
   return tolerated(rise / (bound * own_rms * own_rms * n / (n - parameters)), 1,
                    std::sqrt(std::max(rise / n, 0.0)), length_tolerance);
+}
+
+double residual_pull(double own_rms, double joint_rms, std::size_t count) {
+  const double n = static_cast<double>(count);
+  return n * n * (joint_rms * joint_rms - own_rms * own_rms);
+}
+
+std::vector<std::size_t> every_member(std::size_t count) {
+  std::vector<std::size_t> members(count);
+  std::iota(members.begin(), members.end(), 0);
+  return members;
 }
 
 Eigen::Matrix2d tilt_in_frame(const Eigen::Vector3d& direction, const Eigen::Matrix3d& covariance) {

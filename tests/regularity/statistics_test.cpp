@@ -162,19 +162,22 @@ struct Guard {
   std::vector<double> pull;
   std::vector<std::size_t> refitted;
 
+  // What the refit without a member holds: which member it left out, and how it explains the
+  // others.
+  struct Refitted {
+    std::size_t member;
+    GuardExcess excess;
+  };
+
   std::pair<std::size_t, std::size_t> leave(std::size_t worst) {
-    std::vector<std::size_t> candidates(left.size());
-    std::iota(candidates.begin(), candidates.end(), 0);
     refitted.clear();
-    auto [leaving, without] = member_that_leaves(
-        candidates, worst, [&](std::size_t j) { return pull[j]; },
+    const auto [leaving, without] = member_that_leaves(
+        detail::every_member(left.size()), worst, [&](std::size_t j) { return pull[j]; },
         [&](std::size_t j) {
           refitted.push_back(j);
-          return j;
-        },
-        [&](std::size_t j) { return left[j]; });
-    EXPECT_TRUE(without.has_value());
-    return {leaving, without.value_or(left.size())};
+          return Refitted{j, left[j]};
+        });
+    return {leaving, without.member};
   }
 };
 
